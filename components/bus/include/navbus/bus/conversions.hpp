@@ -1,0 +1,17 @@
+// IDL <-> core conversions. Units are converted here, once; the core works in SI.
+#pragma once
+
+#include <navbus_idl/Imu.h>
+#include <navbus_idl/Navigation.h>
+
+#include "navbus/core/strapdown.hpp"
+
+namespace navbus::bus {
+
+core::ImuIncrement toCore(const navbus::ImuIncrement& msg);
+navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id, std::uint64_t seq);
+
+/// Fills time, position, velocity and attitude fields of a solution from a navigation state.
+void fillSolution(const core::NavState& state, navbus::NavigationSolution& out);
+
+}  // namespace navbus::bus

@@ -1,0 +1,71 @@
+// A domain participant created from a named XML profile, with its topics, writers and readers.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+namespace navbus::bus {
+
+/// Thrown when a DDS entity cannot be created; the message names the entity and profile.
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Loads the QoS profiles once per process. Precedence: Fast DDS's standard environment
+/// variable FASTRTPS_DEFAULT_PROFILES_FILE (loaded by Fast DDS itself), else `explicit_file`,
+/// else the installed default. Throws DdsError if the chosen file cannot be loaded.
+/// Returns the file in force.
+std::string loadQosProfiles(const std::string& explicit_file);
+
+struct ParticipantOptions {
+  int domain_id{0};
+  std::string participant_profile;  ///< a <participant> profile name from the QoS file
+  std::string qos_file;             ///< empty: environment variable or installed default
+  std::string name;                 ///< participant name shown in discovery and health
+};
+
+class DdsContext {
+ public:
+  explicit DdsContext(const ParticipantOptions& options);
+  ~DdsContext();
+  DdsContext(const DdsContext&) = delete;
+  DdsContext& operator=(const DdsContext&) = delete;
+
+  /// Registers PubSubType (once) and returns the topic, created on first use.
+  template <class PubSubType>
+  eprosima::fastdds::dds::Topic* topic(const std::string& name) {
+    eprosima::fastdds::dds::TypeSupport type(new PubSubType());
+    return topicForType(name, type);
+  }
+
+  eprosima::fastdds::dds::DataWriter* createWriter(eprosima::fastdds::dds::Topic* topic,
+                                                   const std::string& profile);
+  eprosima::fastdds::dds::DataReader* createReader(eprosima::fastdds::dds::Topic* topic,
+                                                   const std::string& profile);
+
+  eprosima::fastdds::dds::DomainParticipant* participant() { return participant_; }
+  const std::string& name() const { return name_; }
+
+ private:
+  eprosima::fastdds::dds::Topic* topicForType(const std::string& name,
+                                              eprosima::fastdds::dds::TypeSupport type);
+
+  std::string name_;
+  eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
+  eprosima::fastdds::dds::Publisher* publisher_{nullptr};
+  eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+};
+
+}  // namespace navbus::bus

@@ -1,0 +1,50 @@
+// Per-input counters of a participant and their Health message.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <navbus_idl/Health.h>
+
+namespace navbus::bus {
+
+struct StreamCounters {
+  std::uint64_t received{0};
+  std::uint64_t accepted{0};
+  std::uint64_t sequence_gaps{0};
+  std::uint64_t deadline_misses{0};
+  std::map<navbus::RejectReason, std::uint64_t> rejected;
+
+  std::uint64_t rejectedTotal() const;
+};
+
+/// Counters of every input topic, in registration order.
+class HealthCounters {
+ public:
+  explicit HealthCounters(std::string participant) : participant_(std::move(participant)) {}
+
+  /// Returns the counters of a topic, creating them on first use.
+  StreamCounters& stream(const std::string& topic);
+  const StreamCounters* find(const std::string& topic) const;
+
+  void countPublished(std::uint64_t n = 1) { published_ += n; }
+  std::uint64_t published() const { return published_; }
+
+  /// Builds the next report (sequence incremented on each call).
+  navbus::Health report(navbus::ParticipantState state, std::uint64_t wall_time_ns);
+
+  /// One line per stream, for the end-of-run summary.
+  std::string summary() const;
+
+ private:
+  std::string participant_;
+  std::vector<std::pair<std::string, StreamCounters>> streams_;
+  std::uint64_t published_{0};
+  std::uint64_t seq_{0};
+};
+
+const char* rejectReasonName(navbus::RejectReason reason);
+
+}  // namespace navbus::bus

@@ -1,0 +1,157 @@
+// The participant skeleton shared by every navbus executable: entities created from QoS
+// profiles, one waitset loop (so handlers never run concurrently), timers, clean shutdown on
+// SIGINT/SIGTERM, and periodic health publication.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/core/status/LivelinessChangedStatus.hpp>
+#include <fastdds/dds/core/status/DeadlineMissedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <spdlog/spdlog.h>
+
+#include <navbus_idl/HealthPubSubTypes.h>
+
+#include "navbus/bus/dds_context.hpp"
+#include "navbus/bus/health.hpp"
+#include "navbus/bus/shutdown.hpp"
+
+namespace navbus::bus {
+
+/// A writer bound to its sample type; counts what it publishes in the participant's health.
+template <class Sample>
+class Writer {
+ public:
+  Writer() = default;
+  Writer(eprosima::fastdds::dds::DataWriter* writer, HealthCounters* health)
+      : writer_(writer), health_(health) {}
+  /// Returns false (and logs) if the sample could not be written.
+  bool write(const Sample& sample) {
+    if (!writer_->write(const_cast<Sample*>(&sample))) {
+      spdlog::error("write on '{}' failed", writer_->get_topic()->get_name());
+      return false;
+    }
+    health_->countPublished();
+    return true;
+  }
+  eprosima::fastdds::dds::DataWriter* raw() { return writer_; }
+  std::size_t matchedReaders() const;
+
+ private:
+  eprosima::fastdds::dds::DataWriter* writer_{nullptr};
+  HealthCounters* health_{nullptr};
+};
+
+struct ReaderCallbacks {
+  std::function<void(const eprosima::fastdds::dds::RequestedDeadlineMissedStatus&)> on_deadline;
+  std::function<void(const eprosima::fastdds::dds::LivelinessChangedStatus&)> on_liveliness;
+};
+
+class Participant {
+ public:
+  struct Options {
+    ParticipantOptions dds;
+    std::chrono::milliseconds health_period{1000};
+  };
+
+  Participant(const Options& options, ShutdownSignal& shutdown);
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  DdsContext& dds() { return dds_; }
+  HealthCounters& health() { return health_; }
+  void setState(navbus::ParticipantState state) { state_ = state; }
+  navbus::ParticipantState state() const { return state_; }
+
+  template <class PubSubType>
+  Writer<typename PubSubType::type> createWriter(const std::string& topic_name,
+                                                 const std::string& profile) {
+    auto* topic = dds_.topic<PubSubType>(topic_name);
+    return Writer<typename PubSubType::type>(dds_.createWriter(topic, profile), &health_);
+  }
+
+  /// Subscribes; `on_sample` gets every valid sample taken, in reception order. The skeleton
+  /// counts `received`; the handler counts accepted / rejected after validating.
+  template <class PubSubType>
+  void subscribe(const std::string& topic_name, const std::string& profile,
+                 std::function<void(const typename PubSubType::type&,
+                                    const eprosima::fastdds::dds::SampleInfo&)>
+                     on_sample,
+                 ReaderCallbacks callbacks = {}) {
+    using Sample = typename PubSubType::type;
+    auto* topic = dds_.topic<PubSubType>(topic_name);
+    auto* reader = dds_.createReader(topic, profile);
+    StreamCounters* counters = &health_.stream(topic_name);
+    auto take_all = [reader, counters, on_sample]() {
+      Sample sample;
+      eprosima::fastdds::dds::SampleInfo info;
+      while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+        if (info.valid_data) {
+          ++counters->received;
+          on_sample(sample, info);
+        }
+      }
+    };
+    addReader(reader, topic_name, std::move(take_all), std::move(callbacks));
+  }
+
+  /// Calls `fn` every `period` from the waitset loop (first call one period from now).
+  void addTimer(std::chrono::nanoseconds period, std::function<void()> fn);
+
+  /// Runs the waitset loop until shutdown is requested; publishes a last health report.
+  void run();
+  /// Asks the loop to end (from a handler).
+  void stop() { shutdown_.request(); }
+  bool stopping() const { return shutdown_.requested(); }
+
+  /// Publishes a health report now.
+  void publishHealth();
+
+ private:
+  struct ReaderEntry {
+    eprosima::fastdds::dds::DataReader* reader;
+    std::string topic;
+    std::function<void()> take_all;
+    ReaderCallbacks callbacks;
+  };
+  struct Timer {
+    std::chrono::nanoseconds period;
+    std::chrono::steady_clock::time_point next;
+    std::function<void()> fn;
+  };
+
+  void addReader(eprosima::fastdds::dds::DataReader* reader, const std::string& topic,
+                 std::function<void()> take_all, ReaderCallbacks callbacks);
+  void dispatch(ReaderEntry& entry);
+  void runDueTimers();
+
+  ShutdownSignal& shutdown_;
+  DdsContext dds_;
+  HealthCounters health_;
+  navbus::ParticipantState state_{navbus::STATE_STARTING};
+  eprosima::fastdds::dds::WaitSet waitset_;
+  std::vector<std::unique_ptr<ReaderEntry>> readers_;
+  std::vector<Timer> timers_;
+  Writer<navbus::Health> health_writer_;
+};
+
+template <class Sample>
+std::size_t Writer<Sample>::matchedReaders() const {
+  eprosima::fastdds::dds::PublicationMatchedStatus status;
+  writer_->get_publication_matched_status(status);
+  return static_cast<std::size_t>(status.current_count);
+}
+
+/// Nanoseconds of GPS time now (system clock, GPS-UTC leap seconds = 18 since 2017).
+std::uint64_t gpsTimeNowNs();
+/// Nanoseconds since the Unix epoch now.
+std::uint64_t wallTimeNowNs();
+
+}  // namespace navbus::bus

@@ -1,0 +1,40 @@
+// Topic names and QoS profile names: the only place they are spelled.
+// Profiles themselves live in qos/navbus_qos.xml.
+#pragma once
+
+namespace navbus::bus {
+
+namespace topic {
+inline constexpr const char* kImuIncrement = "navbus/imu/increment";
+inline constexpr const char* kImuRaw = "navbus/imu/raw";
+inline constexpr const char* kGnssObservations = "navbus/gnss/observations";
+inline constexpr const char* kGnssFix = "navbus/gnss/fix";
+inline constexpr const char* kStarTracker = "navbus/startracker/attitude";
+inline constexpr const char* kNavSolution = "navbus/nav/solution";
+inline constexpr const char* kFilterDiagnostics = "navbus/nav/diagnostics";
+inline constexpr const char* kFaultDecision = "navbus/fault/decision";
+inline constexpr const char* kFilterCommand = "navbus/filter/command";
+inline constexpr const char* kHealth = "navbus/health";
+}  // namespace topic
+
+namespace profile {
+// Participant profiles (transport / discovery choice).
+inline constexpr const char* kParticipantLoopback = "navbus_participant_udp_loopback";
+// Writer / reader profiles per topic class.
+inline constexpr const char* kSensorWriter = "navbus_sensor_writer";
+inline constexpr const char* kSensorReader = "navbus_sensor_reader";
+inline constexpr const char* kSensorWatchdogReader = "navbus_sensor_watchdog_reader";
+inline constexpr const char* kMeasurementWriter = "navbus_measurement_writer";
+inline constexpr const char* kMeasurementReader = "navbus_measurement_reader";
+inline constexpr const char* kMeasurementWatchdogReader = "navbus_measurement_watchdog_reader";
+inline constexpr const char* kSolutionWriter = "navbus_solution_writer";
+inline constexpr const char* kSolutionReader = "navbus_solution_reader";
+inline constexpr const char* kDecisionWriter = "navbus_decision_writer";
+inline constexpr const char* kDecisionReader = "navbus_decision_reader";
+inline constexpr const char* kDiagnosticsWriter = "navbus_diagnostics_writer";
+inline constexpr const char* kDiagnosticsReader = "navbus_diagnostics_reader";
+inline constexpr const char* kHealthWriter = "navbus_health_writer";
+inline constexpr const char* kHealthReader = "navbus_health_reader";
+}  // namespace profile
+
+}  // namespace navbus::bus

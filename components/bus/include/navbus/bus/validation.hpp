@@ -1,0 +1,66 @@
+// Input validation at the participant boundary: finite values, physical ranges, per-sensor
+// monotonic time, duplicates and sequence gaps. Every rejection names the field and value.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include <navbus_idl/Gnss.h>
+#include <navbus_idl/Imu.h>
+#include <navbus_idl/StarTracker.h>
+
+namespace navbus::bus {
+
+struct Rejection {
+  navbus::RejectReason reason;
+  std::string field;  ///< e.g. "delta_vel_b_mps[2]" or "satellites[3].sv_id"
+  double value;       ///< the offending value (NaN shown as nan)
+  std::string describe() const;
+};
+
+/// Physical limits; defaults cover aircraft, land vehicles and LEO spacecraft.
+struct ValidationLimits {
+  double max_specific_force_mps2{50.0 * 9.80665};  ///< accelerometer range
+  double max_angular_rate_radps{35.0};             ///< ~2000 deg/s, above any RLG dither peak
+  std::uint32_t max_interval_ns{1'000'000'000};    ///< longest IMU integration interval
+  double min_pseudorange_m{1.0e7};
+  double max_pseudorange_m{6.0e7};
+  double max_pseudorange_rate_mps{2.0e4};          ///< LEO receiver plus satellite motion
+  double min_sat_radius_m{2.0e7};                  ///< GNSS orbit radius bounds
+  double max_sat_radius_m{3.0e7};
+  double max_height_m{5.0e6};                      ///< receiver height bound (LEO included)
+  double min_height_m{-1.0e3};
+  double quaternion_norm_tolerance{1e-6};
+  double max_star_tracker_sigma_rad{0.1};
+};
+
+std::optional<Rejection> validate(const navbus::ImuIncrement& s, const ValidationLimits& l);
+std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const ValidationLimits& l);
+std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s, const ValidationLimits& l);
+std::optional<Rejection> validate(const navbus::GnssFix& s, const ValidationLimits& l);
+std::optional<Rejection> validate(const navbus::StarTrackerAttitude& s, const ValidationLimits& l);
+
+/// Tracks time and sequence per sensor id of one stream.
+class SequenceTracker {
+ public:
+  struct Outcome {
+    std::optional<Rejection> rejection;
+    std::uint64_t missing{0};  ///< samples skipped according to the sequence number
+    bool restarted{false};     ///< sequence went back while time went forward (writer restart)
+  };
+  /// Checks a sample and, if accepted, records it.
+  Outcome check(std::uint32_t sensor_id, std::uint64_t seq, std::uint64_t time_ns);
+  /// Forgets a sensor (e.g. after the stream was declared lost).
+  void reset(std::uint32_t sensor_id) { last_.erase(sensor_id); }
+
+ private:
+  struct Last {
+    std::uint64_t seq;
+    std::uint64_t time_ns;
+  };
+  std::map<std::uint32_t, Last> last_;
+};
+
+}  // namespace navbus::bus

@@ -1,0 +1,110 @@
+#include "navbus/bus/dds_context.hpp"
+
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+
+#ifndef NAVBUS_QOS_FILE_DEFAULT
+#error "NAVBUS_QOS_FILE_DEFAULT must be defined by the build"
+#endif
+
+namespace navbus::bus {
+
+namespace dds = eprosima::fastdds::dds;
+
+std::string loadQosProfiles(const std::string& explicit_file) {
+  static std::mutex mutex;
+  static std::string loaded;
+  std::lock_guard<std::mutex> lock(mutex);
+  const char* env = std::getenv("FASTRTPS_DEFAULT_PROFILES_FILE");
+  const std::string file =
+      (env != nullptr && *env != '\0') ? env
+                                       : (explicit_file.empty() ? NAVBUS_QOS_FILE_DEFAULT : explicit_file);
+  if (loaded == file) {
+    return file;
+  }
+  if (!std::ifstream(file).good()) {
+    throw DdsError("QoS file '" + file + "' cannot be read");
+  }
+  // Fast DDS loads the environment's file by itself when the factory starts; loading it again
+  // is harmless and reports a parse error here instead of silently falling back to defaults.
+  if (dds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(file) !=
+      ReturnCode_t::RETCODE_OK) {
+    throw DdsError("QoS file '" + file + "' could not be parsed as Fast DDS XML profiles");
+  }
+  loaded = file;
+  return file;
+}
+
+DdsContext::DdsContext(const ParticipantOptions& options) : name_(options.name) {
+  loadQosProfiles(options.qos_file);
+  auto* factory = dds::DomainParticipantFactory::get_instance();
+  dds::DomainParticipantQos qos;
+  if (factory->get_participant_qos_from_profile(options.participant_profile, qos) !=
+      ReturnCode_t::RETCODE_OK) {
+    throw DdsError("participant profile '" + options.participant_profile +
+                   "' is not defined in the QoS file");
+  }
+  qos.name(options.name);
+  participant_ = factory->create_participant(
+      static_cast<dds::DomainId_t>(options.domain_id), qos);
+  if (participant_ == nullptr) {
+    throw DdsError("cannot create participant '" + options.name + "' on domain " +
+                   std::to_string(options.domain_id) + " with profile '" +
+                   options.participant_profile + "'");
+  }
+  publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (publisher_ == nullptr || subscriber_ == nullptr) {
+    throw DdsError("cannot create publisher/subscriber of participant '" + options.name + "'");
+  }
+}
+
+DdsContext::~DdsContext() {
+  if (participant_ != nullptr) {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+}
+
+dds::Topic* DdsContext::topicForType(const std::string& name, dds::TypeSupport type) {
+  auto it = topics_.find(name);
+  if (it != topics_.end()) {
+    return it->second;
+  }
+  const std::string type_name = type.get_type_name();
+  if (participant_->find_type(type_name).empty()) {
+    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+      throw DdsError("cannot register type '" + type_name + "'");
+    }
+  }
+  dds::Topic* topic = participant_->create_topic(name, type_name, dds::TOPIC_QOS_DEFAULT);
+  if (topic == nullptr) {
+    throw DdsError("cannot create topic '" + name + "' of type '" + type_name + "'");
+  }
+  topics_.emplace(name, topic);
+  return topic;
+}
+
+dds::DataWriter* DdsContext::createWriter(dds::Topic* topic, const std::string& profile) {
+  dds::DataWriter* writer = publisher_->create_datawriter_with_profile(topic, profile);
+  if (writer == nullptr) {
+    throw DdsError("cannot create writer on '" + topic->get_name() + "' with profile '" +
+                   profile + "' (missing profile or inconsistent QoS)");
+  }
+  return writer;
+}
+
+dds::DataReader* DdsContext::createReader(dds::Topic* topic, const std::string& profile) {
+  dds::DataReader* reader = subscriber_->create_datareader_with_profile(topic, profile);
+  if (reader == nullptr) {
+    throw DdsError("cannot create reader on '" + topic->get_name() + "' with profile '" +
+                   profile + "' (missing profile or inconsistent QoS)");
+  }
+  return reader;
+}
+
+}  // namespace navbus::bus

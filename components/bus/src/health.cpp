@@ -1,0 +1,89 @@
+#include "navbus/bus/health.hpp"
+
+#include <sstream>
+
+namespace navbus::bus {
+
+std::uint64_t StreamCounters::rejectedTotal() const {
+  std::uint64_t n = 0;
+  for (const auto& [reason, count] : rejected) {
+    n += count;
+  }
+  return n;
+}
+
+StreamCounters& HealthCounters::stream(const std::string& topic) {
+  for (auto& [name, counters] : streams_) {
+    if (name == topic) {
+      return counters;
+    }
+  }
+  streams_.emplace_back(topic, StreamCounters{});
+  return streams_.back().second;
+}
+
+const StreamCounters* HealthCounters::find(const std::string& topic) const {
+  for (const auto& [name, counters] : streams_) {
+    if (name == topic) {
+      return &counters;
+    }
+  }
+  return nullptr;
+}
+
+navbus::Health HealthCounters::report(navbus::ParticipantState state, std::uint64_t wall_time_ns) {
+  navbus::Health h;
+  h.participant(participant_);
+  h.seq(++seq_);
+  h.wall_time_ns(wall_time_ns);
+  h.state(state);
+  h.samples_published(published_);
+  for (const auto& [name, c] : streams_) {
+    navbus::StreamHealth s;
+    s.topic(name);
+    s.received(c.received);
+    s.accepted(c.accepted);
+    s.sequence_gaps(c.sequence_gaps);
+    s.deadline_misses(c.deadline_misses);
+    for (const auto& [reason, count] : c.rejected) {
+      navbus::RejectCount rc;
+      rc.reason(reason);
+      rc.count(count);
+      s.rejected().push_back(rc);
+    }
+    h.inputs().push_back(s);
+  }
+  return h;
+}
+
+std::string HealthCounters::summary() const {
+  std::ostringstream out;
+  for (const auto& [name, c] : streams_) {
+    out << "  " << name << ": received " << c.received << ", accepted " << c.accepted
+        << ", rejected " << c.rejectedTotal();
+    for (const auto& [reason, count] : c.rejected) {
+      out << " [" << rejectReasonName(reason) << " " << count << "]";
+    }
+    out << ", sequence gaps " << c.sequence_gaps << ", deadline misses " << c.deadline_misses
+        << "\n";
+  }
+  out << "  published: " << published_ << " samples\n";
+  return out.str();
+}
+
+const char* rejectReasonName(navbus::RejectReason reason) {
+  switch (reason) {
+    case navbus::REJECT_NOT_FINITE: return "not_finite";
+    case navbus::REJECT_OUT_OF_RANGE: return "out_of_range";
+    case navbus::REJECT_TIME_NOT_MONOTONIC: return "time_not_monotonic";
+    case navbus::REJECT_DUPLICATE: return "duplicate";
+    case navbus::REJECT_UNKNOWN_SATELLITE: return "unknown_satellite";
+    case navbus::REJECT_BAD_INTERVAL: return "bad_interval";
+    case navbus::REJECT_BAD_QUATERNION: return "bad_quaternion";
+    case navbus::REJECT_LATE: return "late";
+    case navbus::REJECT_UNEXPECTED_SOURCE: return "unexpected_source";
+  }
+  return "unknown";
+}
+
+}  // namespace navbus::bus

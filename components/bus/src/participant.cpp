@@ -1,0 +1,120 @@
+#include "navbus/bus/participant.hpp"
+
+#include <algorithm>
+
+#include "navbus/bus/topics.hpp"
+
+namespace navbus::bus {
+
+namespace dds = eprosima::fastdds::dds;
+
+Participant::Participant(const Options& options, ShutdownSignal& shutdown)
+    : shutdown_(shutdown), dds_(options.dds), health_(options.dds.name) {
+  health_writer_ = createWriter<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthWriter);
+  waitset_.attach_condition(shutdown_.condition());
+  addTimer(options.health_period, [this] { publishHealth(); });
+}
+
+Participant::~Participant() {
+  waitset_.detach_condition(shutdown_.condition());
+  for (auto& entry : readers_) {
+    waitset_.detach_condition(entry->reader->get_statuscondition());
+  }
+}
+
+void Participant::addReader(dds::DataReader* reader, const std::string& topic,
+                            std::function<void()> take_all, ReaderCallbacks callbacks) {
+  auto entry = std::make_unique<ReaderEntry>(
+      ReaderEntry{reader, topic, std::move(take_all), std::move(callbacks)});
+  dds::StatusMask mask = dds::StatusMask::data_available();
+  mask << dds::StatusMask::requested_deadline_missed();
+  mask << dds::StatusMask::liveliness_changed();
+  reader->get_statuscondition().set_enabled_statuses(mask);
+  waitset_.attach_condition(reader->get_statuscondition());
+  readers_.push_back(std::move(entry));
+}
+
+void Participant::addTimer(std::chrono::nanoseconds period, std::function<void()> fn) {
+  timers_.push_back(Timer{period, std::chrono::steady_clock::now() + period, std::move(fn)});
+}
+
+void Participant::dispatch(ReaderEntry& entry) {
+  const dds::StatusMask changes = entry.reader->get_status_changes();
+  if (changes.is_active(dds::StatusMask::requested_deadline_missed())) {
+    dds::RequestedDeadlineMissedStatus status;
+    entry.reader->get_requested_deadline_missed_status(status);
+    health_.stream(entry.topic).deadline_misses +=
+        static_cast<std::uint64_t>(status.total_count_change);
+    if (entry.callbacks.on_deadline) {
+      entry.callbacks.on_deadline(status);
+    }
+  }
+  if (changes.is_active(dds::StatusMask::liveliness_changed())) {
+    dds::LivelinessChangedStatus status;
+    entry.reader->get_liveliness_changed_status(status);
+    if (entry.callbacks.on_liveliness) {
+      entry.callbacks.on_liveliness(status);
+    }
+  }
+  if (changes.is_active(dds::StatusMask::data_available())) {
+    entry.take_all();
+  }
+}
+
+void Participant::runDueTimers() {
+  const auto now = std::chrono::steady_clock::now();
+  for (auto& t : timers_) {
+    if (now >= t.next) {
+      t.fn();
+      // Skip missed periods instead of bursting to catch up.
+      while (t.next <= now) {
+        t.next += t.period;
+      }
+    }
+  }
+}
+
+void Participant::run() {
+  if (state_ == navbus::STATE_STARTING) {
+    state_ = navbus::STATE_RUNNING;
+  }
+  publishHealth();
+  dds::ConditionSeq active;
+  while (!shutdown_.requested()) {
+    auto next = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
+    for (const auto& t : timers_) {
+      next = std::min(next, t.next);
+    }
+    const auto wait = std::max(std::chrono::nanoseconds(0), next - std::chrono::steady_clock::now());
+    const auto wait_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
+    active.clear();
+    waitset_.wait(active, eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(wait_ns / 1'000'000'000),
+                                          static_cast<std::uint32_t>(wait_ns % 1'000'000'000)));
+    for (auto& entry : readers_) {
+      // Poll every reader: a condition can be triggered again while we handle another one.
+      dispatch(*entry);
+    }
+    runDueTimers();
+  }
+  state_ = navbus::STATE_STOPPING;
+  publishHealth();
+}
+
+void Participant::publishHealth() {
+  health_writer_.write(health_.report(state_, wallTimeNowNs()));
+}
+
+std::uint64_t wallTimeNowNs() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
+}
+
+std::uint64_t gpsTimeNowNs() {
+  // GPS epoch 1980-01-06 is 315964800 s after the Unix epoch; GPS is ahead of UTC by 18 s.
+  constexpr std::uint64_t kGpsEpochUnixNs = 315'964'800ULL * 1'000'000'000ULL;
+  constexpr std::uint64_t kLeapNs = 18ULL * 1'000'000'000ULL;
+  return wallTimeNowNs() - kGpsEpochUnixNs + kLeapNs;
+}
+
+}  // namespace navbus::bus

@@ -1,0 +1,191 @@
+#include "navbus/bus/validation.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "navbus/bus/health.hpp"
+
+namespace navbus::bus {
+
+namespace {
+
+std::string indexed(const char* name, std::size_t i) {
+  return std::string(name) + "[" + std::to_string(i) + "]";
+}
+
+template <std::size_t N>
+std::optional<Rejection> finiteArray(const std::array<double, N>& a, const std::string& name) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (!std::isfinite(a[i])) {
+      return Rejection{navbus::REJECT_NOT_FINITE, indexed(name.c_str(), i), a[i]};
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<Rejection> finite(double v, const std::string& name) {
+  if (!std::isfinite(v)) {
+    return Rejection{navbus::REJECT_NOT_FINITE, name, v};
+  }
+  return std::nullopt;
+}
+
+template <std::size_t N>
+double norm(const std::array<double, N>& a) {
+  double s = 0.0;
+  for (double v : a) {
+    s += v * v;
+  }
+  return std::sqrt(s);
+}
+
+std::optional<Rejection> range(double v, double lo, double hi, const std::string& name) {
+  if (v < lo || v > hi) {
+    return Rejection{navbus::REJECT_OUT_OF_RANGE, name, v};
+  }
+  return std::nullopt;
+}
+
+std::optional<Rejection> positive(double v, const std::string& name) {
+  if (!(v > 0.0)) {
+    return Rejection{navbus::REJECT_OUT_OF_RANGE, name, v};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string Rejection::describe() const {
+  std::ostringstream out;
+  out << rejectReasonName(reason) << ": " << field << " = " << value;
+  return out.str();
+}
+
+std::optional<Rejection> validate(const navbus::ImuIncrement& s, const ValidationLimits& l) {
+  if (auto r = finiteArray(s.delta_vel_b_mps(), "delta_vel_b_mps")) return r;
+  if (auto r = finiteArray(s.delta_angle_b_rad(), "delta_angle_b_rad")) return r;
+  if (s.interval_ns() == 0 || s.interval_ns() > l.max_interval_ns) {
+    return Rejection{navbus::REJECT_BAD_INTERVAL, "interval_ns", static_cast<double>(s.interval_ns())};
+  }
+  const double dt = 1e-9 * s.interval_ns();
+  if (auto r = range(norm(s.delta_vel_b_mps()) / dt, 0.0, l.max_specific_force_mps2,
+                     "|delta_vel_b_mps|/interval"))
+    return r;
+  if (auto r = range(norm(s.delta_angle_b_rad()) / dt, 0.0, l.max_angular_rate_radps,
+                     "|delta_angle_b_rad|/interval"))
+    return r;
+  return std::nullopt;
+}
+
+std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const ValidationLimits& l) {
+  if (s.samples().empty()) {
+    return Rejection{navbus::REJECT_OUT_OF_RANGE, "samples.size", 0.0};
+  }
+  if (s.sample_period_ns() == 0 || s.sample_period_ns() > l.max_interval_ns) {
+    return Rejection{navbus::REJECT_BAD_INTERVAL, "sample_period_ns",
+                     static_cast<double>(s.sample_period_ns())};
+  }
+  for (std::size_t i = 0; i < s.samples().size(); ++i) {
+    const auto& x = s.samples()[i];
+    const std::string prefix = indexed("samples", i) + ".";
+    if (auto r = finiteArray(x.angular_rate_b_radps(), prefix + "angular_rate_b_radps")) return r;
+    if (auto r = finiteArray(x.specific_force_b_mps2(), prefix + "specific_force_b_mps2")) return r;
+    if (auto r = range(norm(x.angular_rate_b_radps()), 0.0, l.max_angular_rate_radps,
+                       prefix + "|angular_rate_b_radps|"))
+      return r;
+    if (auto r = range(norm(x.specific_force_b_mps2()), 0.0, l.max_specific_force_mps2,
+                       prefix + "|specific_force_b_mps2|"))
+      return r;
+  }
+  return std::nullopt;
+}
+
+std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s, const ValidationLimits& l) {
+  for (std::size_t i = 0; i < s.satellites().size(); ++i) {
+    const auto& m = s.satellites()[i];
+    const std::string p = indexed("satellites", i) + ".";
+    if (m.sv_id() < 1 || m.sv_id() > 32) {
+      return Rejection{navbus::REJECT_UNKNOWN_SATELLITE, p + "sv_id", static_cast<double>(m.sv_id())};
+    }
+    if (auto r = finite(m.pseudorange_m(), p + "pseudorange_m")) return r;
+    if (auto r = finite(m.pseudorange_rate_mps(), p + "pseudorange_rate_mps")) return r;
+    if (auto r = finiteArray(m.sat_pos_ecef_m(), p + "sat_pos_ecef_m")) return r;
+    if (auto r = finiteArray(m.sat_vel_ecef_mps(), p + "sat_vel_ecef_mps")) return r;
+    if (auto r = finite(m.sat_clock_correction_m(), p + "sat_clock_correction_m")) return r;
+    if (auto r = finite(m.sat_clock_drift_mps(), p + "sat_clock_drift_mps")) return r;
+    if (auto r = finite(m.cn0_dbhz(), p + "cn0_dbhz")) return r;
+    if (auto r = finite(m.pseudorange_sigma_m(), p + "pseudorange_sigma_m")) return r;
+    if (auto r = finite(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps")) return r;
+    if (auto r = range(m.pseudorange_m(), l.min_pseudorange_m, l.max_pseudorange_m, p + "pseudorange_m"))
+      return r;
+    if (auto r = range(std::abs(m.pseudorange_rate_mps()), 0.0, l.max_pseudorange_rate_mps,
+                       p + "pseudorange_rate_mps"))
+      return r;
+    if (auto r = range(norm(m.sat_pos_ecef_m()), l.min_sat_radius_m, l.max_sat_radius_m,
+                       p + "|sat_pos_ecef_m|"))
+      return r;
+    if (auto r = range(m.cn0_dbhz(), 0.0, 70.0, p + "cn0_dbhz")) return r;
+    if (auto r = positive(m.pseudorange_sigma_m(), p + "pseudorange_sigma_m")) return r;
+    if (auto r = positive(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps")) return r;
+  }
+  return std::nullopt;
+}
+
+std::optional<Rejection> validate(const navbus::GnssFix& s, const ValidationLimits& l) {
+  if (auto r = finite(s.latitude_rad(), "latitude_rad")) return r;
+  if (auto r = finite(s.longitude_rad(), "longitude_rad")) return r;
+  if (auto r = finite(s.height_m(), "height_m")) return r;
+  if (auto r = finiteArray(s.pos_ecef_m(), "pos_ecef_m")) return r;
+  if (auto r = finiteArray(s.vel_ned_mps(), "vel_ned_mps")) return r;
+  if (auto r = finiteArray(s.pos_sigma_ned_m(), "pos_sigma_ned_m")) return r;
+  if (auto r = finiteArray(s.vel_sigma_ned_mps(), "vel_sigma_ned_mps")) return r;
+  if (auto r = range(s.latitude_rad(), -M_PI / 2, M_PI / 2, "latitude_rad")) return r;
+  if (auto r = range(s.longitude_rad(), -M_PI, M_PI, "longitude_rad")) return r;
+  if (auto r = range(s.height_m(), l.min_height_m, l.max_height_m, "height_m")) return r;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (auto r = positive(s.pos_sigma_ned_m()[i], indexed("pos_sigma_ned_m", i))) return r;
+    if (auto r = positive(s.vel_sigma_ned_mps()[i], indexed("vel_sigma_ned_mps", i))) return r;
+  }
+  return std::nullopt;
+}
+
+std::optional<Rejection> validate(const navbus::StarTrackerAttitude& s, const ValidationLimits& l) {
+  if (auto r = finiteArray(s.q_b_to_i(), "q_b_to_i")) return r;
+  if (auto r = finiteArray(s.sigma_b_rad(), "sigma_b_rad")) return r;
+  if (s.valid() && std::abs(norm(s.q_b_to_i()) - 1.0) > l.quaternion_norm_tolerance) {
+    return Rejection{navbus::REJECT_BAD_QUATERNION, "|q_b_to_i|", norm(s.q_b_to_i())};
+  }
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (auto r = positive(s.sigma_b_rad()[i], indexed("sigma_b_rad", i))) return r;
+    if (auto r = range(s.sigma_b_rad()[i], 0.0, l.max_star_tracker_sigma_rad, indexed("sigma_b_rad", i)))
+      return r;
+  }
+  return std::nullopt;
+}
+
+SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::uint64_t seq,
+                                                std::uint64_t time_ns) {
+  Outcome out;
+  auto it = last_.find(sensor_id);
+  if (it != last_.end()) {
+    const Last& last = it->second;
+    if (seq == last.seq && time_ns == last.time_ns) {
+      out.rejection = Rejection{navbus::REJECT_DUPLICATE, "seq", static_cast<double>(seq)};
+      return out;
+    }
+    if (time_ns <= last.time_ns) {
+      out.rejection = Rejection{navbus::REJECT_TIME_NOT_MONOTONIC, "time_gps_ns",
+                                static_cast<double>(time_ns)};
+      return out;
+    }
+    if (seq > last.seq + 1) {
+      out.missing = seq - last.seq - 1;
+    } else if (seq <= last.seq) {
+      out.restarted = true;
+    }
+  }
+  last_[sensor_id] = Last{seq, time_ns};
+  return out;
+}
+
+}  // namespace navbus::bus

@@ -1,0 +1,61 @@
+// WGS84 Earth model: constants, curvature, normal gravity, frame conversions.
+// Pure math, SI units, no I/O.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace navbus::core::earth {
+
+// WGS84 defining constants (NIMA TR8350.2).
+inline constexpr double kSemiMajorAxis_m = 6378137.0;
+inline constexpr double kFlattening = 1.0 / 298.257223563;
+inline constexpr double kRotationRate_radps = 7.292115e-5;
+inline constexpr double kGm_m3ps2 = 3.986004418e14;
+// Derived.
+inline constexpr double kSemiMinorAxis_m = kSemiMajorAxis_m * (1.0 - kFlattening);
+inline constexpr double kEccentricitySq = kFlattening * (2.0 - kFlattening);
+// Somigliana normal gravity on the ellipsoid (NIMA TR8350.2 eq. 4-1).
+inline constexpr double kGravityEquator_mps2 = 9.7803253359;
+inline constexpr double kGravityPole_mps2 = 9.8321849378;
+inline constexpr double kSpeedOfLight_mps = 299792458.0;
+
+/// Geodetic position on WGS84.
+struct Geodetic {
+  double latitude_rad{0.0};
+  double longitude_rad{0.0};
+  double height_m{0.0};
+};
+
+/// Radii of curvature at a latitude: meridian (north-south) and prime vertical (east-west).
+struct Radii {
+  double meridian_m;
+  double prime_vertical_m;
+};
+
+Radii radiiOfCurvature(double latitude_rad);
+
+/// Magnitude of normal gravity (gravitation plus centrifugal) at latitude and height,
+/// Somigliana on the ellipsoid with the second-order free-air correction (TR8350.2 eq. 4-3).
+double normalGravity(double latitude_rad, double height_m);
+
+/// Normal gravity vector in NED (the normal-gravity field is along the ellipsoid normal).
+Eigen::Vector3d gravityNed(double latitude_rad, double height_m);
+
+Eigen::Vector3d geodeticToEcef(const Geodetic& position);
+
+/// Exact-to-machine-precision inverse (iterated), valid from the centre of the Earth to orbit.
+Geodetic ecefToGeodetic(const Eigen::Vector3d& pos_ecef_m);
+
+/// Direction cosine matrix rotating NED vectors into ECEF at the given latitude and longitude.
+Eigen::Matrix3d C_n_e(double latitude_rad, double longitude_rad);
+
+/// Earth rate expressed in NED.
+Eigen::Vector3d omegaIeNed(double latitude_rad);
+
+/// Transport rate (rotation of NED w.r.t. ECEF) for a velocity w.r.t. Earth in NED.
+Eigen::Vector3d omegaEnNed(const Geodetic& position, const Eigen::Vector3d& vel_ned_mps);
+
+/// Rotation from ECI (coinciding with ECEF at GPS time 0) into ECEF at GPS time t.
+Eigen::Matrix3d C_i_e(double gps_time_s);
+
+}  // namespace navbus::core::earth

@@ -1,0 +1,55 @@
+// Strapdown inertial mechanization in the local NED frame on WGS84, driven by increments.
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "navbus/core/earth.hpp"
+
+namespace navbus::core {
+
+/// One navigation-rate IMU output in SI units (the core's view of an increment).
+struct ImuIncrement {
+  std::int64_t time_ns{0};                              ///< end of the interval, GPS time
+  double interval_s{0.0};                               ///< interval length
+  Eigen::Vector3d delta_vel_b_mps{Eigen::Vector3d::Zero()};   ///< specific-force integral, body
+  Eigen::Vector3d delta_angle_b_rad{Eigen::Vector3d::Zero()}; ///< inertial-rate integral, body
+};
+
+/// Position, velocity and attitude of the body.
+struct NavState {
+  std::int64_t time_ns{0};                              ///< GPS time of validity
+  earth::Geodetic position;                             ///< WGS84
+  Eigen::Vector3d vel_ned_mps{Eigen::Vector3d::Zero()}; ///< w.r.t. Earth, NED
+  Eigen::Quaterniond q_b_to_n{Eigen::Quaterniond::Identity()};  ///< body -> NED
+};
+
+/// Strapdown mechanization with two-sample coning and sculling corrections
+/// (Savage, Strapdown Analytics, ch. 7; increments from the previous interval are kept).
+/// The navigation-frame rotation, gravity and Coriolis terms are evaluated at the mid-interval
+/// state extrapolated from the previous step, which keeps the algorithm second-order accurate.
+class StrapdownNed {
+ public:
+  /// Starts from a known state; the first increment after this has no coning partner.
+  void initialize(const NavState& state);
+
+  /// Integrates one increment whose interval ends at inc.time_ns and starts at state time.
+  void propagate(const ImuIncrement& inc);
+
+  /// Restarts the integration at a new time without propagating across a gap
+  /// (the vehicle state cannot be known across missing inertial data).
+  void restartAt(std::int64_t time_ns);
+
+  const NavState& state() const { return state_; }
+  bool initialized() const { return initialized_; }
+
+ private:
+  NavState state_;
+  ImuIncrement previous_;
+  bool has_previous_{false};
+  bool initialized_{false};
+};
+
+}  // namespace navbus::core

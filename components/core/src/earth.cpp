@@ -1,0 +1,108 @@
+#include "navbus/core/earth.hpp"
+
+#include <cmath>
+
+namespace navbus::core::earth {
+
+Radii radiiOfCurvature(double latitude_rad) {
+  const double s = std::sin(latitude_rad);
+  const double w2 = 1.0 - kEccentricitySq * s * s;
+  const double w = std::sqrt(w2);
+  return {kSemiMajorAxis_m * (1.0 - kEccentricitySq) / (w2 * w), kSemiMajorAxis_m / w};
+}
+
+double normalGravity(double latitude_rad, double height_m) {
+  const double s2 = std::pow(std::sin(latitude_rad), 2);
+  // Somigliana closed formula, TR8350.2 eq. 4-1.
+  const double k = (kSemiMinorAxis_m * kGravityPole_mps2) /
+                       (kSemiMajorAxis_m * kGravityEquator_mps2) -
+                   1.0;
+  const double g0 =
+      kGravityEquator_mps2 * (1.0 + k * s2) / std::sqrt(1.0 - kEccentricitySq * s2);
+  // Second-order height correction, TR8350.2 eq. 4-3, with m = w^2 a^2 b / GM.
+  const double m = kRotationRate_radps * kRotationRate_radps * kSemiMajorAxis_m *
+                   kSemiMajorAxis_m * kSemiMinorAxis_m / kGm_m3ps2;
+  const double a = kSemiMajorAxis_m;
+  return g0 * (1.0 - 2.0 / a * (1.0 + kFlattening + m - 2.0 * kFlattening * s2) * height_m +
+               3.0 / (a * a) * height_m * height_m);
+}
+
+Eigen::Vector3d gravityNed(double latitude_rad, double height_m) {
+  return {0.0, 0.0, normalGravity(latitude_rad, height_m)};
+}
+
+Eigen::Vector3d geodeticToEcef(const Geodetic& p) {
+  const Radii r = radiiOfCurvature(p.latitude_rad);
+  const double cl = std::cos(p.latitude_rad);
+  const double sl = std::sin(p.latitude_rad);
+  const double n = r.prime_vertical_m;
+  return {(n + p.height_m) * cl * std::cos(p.longitude_rad),
+          (n + p.height_m) * cl * std::sin(p.longitude_rad),
+          (n * (1.0 - kEccentricitySq) + p.height_m) * sl};
+}
+
+Geodetic ecefToGeodetic(const Eigen::Vector3d& r) {
+  Geodetic g;
+  g.longitude_rad = std::atan2(r.y(), r.x());
+  const double p = std::hypot(r.x(), r.y());
+  // Fixed-point iteration on latitude; converges to 1e-15 rad in a few steps for |h| << a.
+  double lat = std::atan2(r.z(), p * (1.0 - kEccentricitySq));
+  double h = 0.0;
+  for (int i = 0; i < 10; ++i) {
+    const double n = radiiOfCurvature(lat).prime_vertical_m;
+    const double sl = std::sin(lat);
+    const double cl = std::cos(lat);
+    // Height from the larger of the two projections keeps precision near the poles.
+    h = (std::abs(cl) > 0.5) ? p / cl - n : r.z() / sl - n * (1.0 - kEccentricitySq);
+    const double lat_next = std::atan2(r.z(), p * (1.0 - kEccentricitySq * n / (n + h)));
+    if (std::abs(lat_next - lat) < 1e-15) {
+      lat = lat_next;
+      break;
+    }
+    lat = lat_next;
+  }
+  g.latitude_rad = lat;
+  const double n = radiiOfCurvature(lat).prime_vertical_m;
+  const double sl = std::sin(lat);
+  const double cl = std::cos(lat);
+  g.height_m = (std::abs(cl) > 0.5) ? p / cl - n : r.z() / sl - n * (1.0 - kEccentricitySq);
+  return g;
+}
+
+Eigen::Matrix3d C_n_e(double latitude_rad, double longitude_rad) {
+  const double sl = std::sin(latitude_rad);
+  const double cl = std::cos(latitude_rad);
+  const double so = std::sin(longitude_rad);
+  const double co = std::cos(longitude_rad);
+  Eigen::Matrix3d c;
+  // Columns are the N, E, D unit vectors expressed in ECEF.
+  c << -sl * co, -so, -cl * co,  //
+      -sl * so, co, -cl * so,    //
+      cl, 0.0, -sl;
+  return c;
+}
+
+Eigen::Vector3d omegaIeNed(double latitude_rad) {
+  return {kRotationRate_radps * std::cos(latitude_rad), 0.0,
+          -kRotationRate_radps * std::sin(latitude_rad)};
+}
+
+Eigen::Vector3d omegaEnNed(const Geodetic& p, const Eigen::Vector3d& v) {
+  const Radii r = radiiOfCurvature(p.latitude_rad);
+  const double rn = r.prime_vertical_m + p.height_m;
+  const double rm = r.meridian_m + p.height_m;
+  return {v.y() / rn, -v.x() / rm, -v.y() * std::tan(p.latitude_rad) / rn};
+}
+
+Eigen::Matrix3d C_i_e(double gps_time_s) {
+  const double a = kRotationRate_radps * gps_time_s;
+  const double c = std::cos(a);
+  const double s = std::sin(a);
+  Eigen::Matrix3d m;
+  m << c, s, 0.0,  //
+      -s, c, 0.0,  //
+      0.0, 0.0, 1.0;
+  return m;
+}
+
+}  // namespace navbus::core::earth
