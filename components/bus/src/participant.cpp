@@ -74,28 +74,41 @@ void Participant::runDueTimers() {
   }
 }
 
-void Participant::run() {
+void Participant::spinOnce(std::chrono::nanoseconds max_wait) {
   if (state_ == navbus::STATE_STARTING) {
     state_ = navbus::STATE_RUNNING;
+    publishHealth();
   }
-  publishHealth();
-  dds::ConditionSeq active;
+  auto next = std::chrono::steady_clock::now() + max_wait;
+  for (const auto& t : timers_) {
+    next = std::min(next, t.next);
+  }
+  const auto wait = std::max(std::chrono::nanoseconds(0),
+                             std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                 next - std::chrono::steady_clock::now()));
+  const auto wait_ns = wait.count();
+  active_.clear();
+  waitset_.wait(active_, eprosima::fastrtps::Duration_t(
+                             static_cast<std::int32_t>(wait_ns / 1'000'000'000),
+                             static_cast<std::uint32_t>(wait_ns % 1'000'000'000)));
+  for (auto& entry : readers_) {
+    // Poll every reader: a condition can be triggered again while we handle another one.
+    dispatch(*entry);
+  }
+  if (after_dispatch_) {
+    after_dispatch_();
+  }
+  runDueTimers();
+}
+
+void Participant::run() {
   while (!shutdown_.requested()) {
-    auto next = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
-    for (const auto& t : timers_) {
-      next = std::min(next, t.next);
-    }
-    const auto wait = std::max(std::chrono::nanoseconds(0), next - std::chrono::steady_clock::now());
-    const auto wait_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
-    active.clear();
-    waitset_.wait(active, eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(wait_ns / 1'000'000'000),
-                                          static_cast<std::uint32_t>(wait_ns % 1'000'000'000)));
-    for (auto& entry : readers_) {
-      // Poll every reader: a condition can be triggered again while we handle another one.
-      dispatch(*entry);
-    }
-    runDueTimers();
+    spinOnce(std::chrono::milliseconds(100));
   }
+  finish();
+}
+
+void Participant::finish() {
   state_ = navbus::STATE_STOPPING;
   publishHealth();
 }

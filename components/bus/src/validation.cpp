@@ -189,3 +189,29 @@ SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::ui
 }
 
 }  // namespace navbus::bus
+
+#include <spdlog/spdlog.h>
+
+namespace navbus::bus {
+
+void StreamGate::reject(const Rejection& r, std::uint32_t sensor_id) {
+  const std::uint64_t n = ++counters_.rejected[r.reason];
+  if (n == 1 || n % 1000 == 0) {
+    spdlog::warn("{}: rejected sample of sensor {} ({}; {} rejected for this reason so far)", topic_,
+                 sensor_id, r.describe(), n);
+  }
+}
+
+void StreamGate::unaccept() {
+  if (counters_.accepted > 0) --counters_.accepted;
+}
+
+void StreamGate::noteSequence(const SequenceTracker::Outcome& o) {
+  ++counters_.accepted;
+  counters_.sequence_gaps += o.missing;
+  if (o.restarted) {
+    spdlog::info("{}: sequence restarted (writer restart)", topic_);
+  }
+}
+
+}  // namespace navbus::bus

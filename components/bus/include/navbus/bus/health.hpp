@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
-#include <vector>
+#include <deque>
 
 #include <navbus_idl/Health.h>
 
@@ -25,7 +25,8 @@ class HealthCounters {
  public:
   explicit HealthCounters(std::string participant) : participant_(std::move(participant)) {}
 
-  /// Returns the counters of a topic, creating them on first use.
+  /// Returns the counters of a topic, creating them on first use. The reference stays valid
+  /// for the lifetime of this object.
   StreamCounters& stream(const std::string& topic);
   const StreamCounters* find(const std::string& topic) const;
 
@@ -40,7 +41,7 @@ class HealthCounters {
 
  private:
   std::string participant_;
-  std::vector<std::pair<std::string, StreamCounters>> streams_;
+  std::deque<std::pair<std::string, StreamCounters>> streams_;  // deque: references stay valid
   std::uint64_t published_{0};
   std::uint64_t seq_{0};
 };

@@ -102,11 +102,20 @@ class Participant {
     addReader(reader, topic_name, std::move(take_all), std::move(callbacks));
   }
 
+  /// Calls `fn` after every round of reader dispatch: all samples available in the round have
+  /// been handed over by then (the filter releases its ordered inputs here).
+  void setAfterDispatch(std::function<void()> fn) { after_dispatch_ = std::move(fn); }
+
   /// Calls `fn` every `period` from the waitset loop (first call one period from now).
   void addTimer(std::chrono::nanoseconds period, std::function<void()> fn);
 
   /// Runs the waitset loop until shutdown is requested; publishes a last health report.
   void run();
+  /// One loop iteration: waits at most `max_wait` (less if a timer is due), then handles
+  /// readers and due timers. For participants that drive their own loop (the simulator).
+  void spinOnce(std::chrono::nanoseconds max_wait);
+  /// Publishes the final (STOPPING) health report; run() does it by itself.
+  void finish();
   /// Asks the loop to end (from a handler).
   void stop() { shutdown_.request(); }
   bool stopping() const { return shutdown_.requested(); }
@@ -139,7 +148,9 @@ class Participant {
   eprosima::fastdds::dds::WaitSet waitset_;
   std::vector<std::unique_ptr<ReaderEntry>> readers_;
   std::vector<Timer> timers_;
+  std::function<void()> after_dispatch_;
   Writer<navbus::Health> health_writer_;
+  eprosima::fastdds::dds::ConditionSeq active_;
 };
 
 template <class Sample>

@@ -64,3 +64,48 @@ class SequenceTracker {
 };
 
 }  // namespace navbus::bus
+
+namespace navbus::bus {
+
+struct StreamCounters;
+
+/// The admission pipeline of one input topic: validate, check time/sequence per sensor, count
+/// (accepted, rejected by reason, sequence gaps) and log each kind of rejection the first time
+/// and every 1000th time after, with the field and value.
+class StreamGate {
+ public:
+  StreamGate(std::string topic, StreamCounters& counters, ValidationLimits limits = {})
+      : topic_(std::move(topic)), counters_(counters), limits_(limits) {}
+
+  template <class Sample>
+  bool admit(const Sample& sample, std::uint32_t sensor_id, std::uint64_t seq, std::uint64_t time_ns) {
+    if (auto r = validate(sample, limits_)) {
+      reject(*r, sensor_id);
+      return false;
+    }
+    const SequenceTracker::Outcome o = tracker_.check(sensor_id, seq, time_ns);
+    if (o.rejection) {
+      reject(*o.rejection, sensor_id);
+      return false;
+    }
+    noteSequence(o);
+    return true;
+  }
+
+  /// Counts a rejection decided after admission (e.g. late for the sequencer).
+  void reject(const Rejection& r, std::uint32_t sensor_id);
+  /// Undoes the accepted count of a sample rejected after admission.
+  void unaccept();
+  const std::string& topic() const { return topic_; }
+  SequenceTracker& tracker() { return tracker_; }
+
+ private:
+  void noteSequence(const SequenceTracker::Outcome& o);
+
+  std::string topic_;
+  StreamCounters& counters_;
+  ValidationLimits limits_;
+  SequenceTracker tracker_;
+};
+
+}  // namespace navbus::bus

@@ -1,0 +1,31 @@
+// navbus-filter configuration, converted to SI here.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include <yaml-cpp/yaml.h>
+
+#include "navbus/core/strapdown.hpp"
+
+namespace navbus::nav_filter {
+
+struct InputConfig {
+  std::uint32_t id{1};
+  std::int64_t period_ns{0};
+};
+
+struct FilterConfig {
+  std::uint32_t vehicle_id{1};
+  std::int64_t solution_period_ns{100'000'000};
+  core::NavState initial_state;  ///< time is taken from the first increment
+  InputConfig imu{1, 10'000'000};
+  std::optional<InputConfig> gnss_observations;
+  std::optional<InputConfig> gnss_fix;
+  std::optional<InputConfig> star_tracker;
+  std::int64_t sequencer_max_wait_ns{500'000'000};
+};
+
+FilterConfig parseFilterConfig(const YAML::Node& root);
+
+}  // namespace navbus::nav_filter

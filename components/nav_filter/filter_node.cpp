@@ -1,0 +1,266 @@
+#include "filter_node.hpp"
+
+#include <chrono>
+#include <sstream>
+
+#include "navbus/bus/conversions.hpp"
+#include "navbus/bus/topics.hpp"
+
+namespace navbus::nav_filter {
+
+namespace {
+
+std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const FilterConfig& c) {
+  std::vector<InputSequencer<FilterInput>::ExpectedStream> s;
+  s.push_back({{kRankImu, c.imu.id}, c.imu.period_ns});
+  if (c.gnss_observations) s.push_back({{kRankGnssObs, c.gnss_observations->id}, c.gnss_observations->period_ns});
+  if (c.gnss_fix) s.push_back({{kRankGnssFix, c.gnss_fix->id}, c.gnss_fix->period_ns});
+  if (c.star_tracker) s.push_back({{kRankStarTracker, c.star_tracker->id}, c.star_tracker->period_ns});
+  return s;
+}
+
+std::int64_t steadyNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+constexpr std::uint32_t kStreamLostFlags = navbus::FAULT_IMU_STREAM_LOST | navbus::FAULT_GNSS_STREAM_LOST |
+                                           navbus::FAULT_ST_STREAM_LOST | navbus::FAULT_RAW_IMU_LOST;
+
+}  // namespace
+
+FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
+    : participant_(p),
+      config_(config),
+      sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
+      imu_gate_(bus::topic::kImuIncrement, p.health().stream(bus::topic::kImuIncrement)),
+      gnss_obs_gate_(bus::topic::kGnssObservations, p.health().stream(bus::topic::kGnssObservations)),
+      gnss_fix_gate_(bus::topic::kGnssFix, p.health().stream(bus::topic::kGnssFix)),
+      star_gate_(bus::topic::kStarTracker, p.health().stream(bus::topic::kStarTracker)) {
+  using namespace bus;
+  solution_writer_ = p.createWriter<navbus::NavigationSolutionPubSubType>(topic::kNavSolution, profile::kSolutionWriter);
+  p.subscribe<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorReader,
+                                              [this](const auto& m, const auto&) { onImu(m); });
+  p.subscribe<navbus::GnssObservationEpochPubSubType>(
+      topic::kGnssObservations, profile::kMeasurementReader, [this](const auto& m, const auto&) {
+        onMeasurement(gnss_obs_gate_, m, m.receiver_id(), config_.gnss_observations, kRankGnssObs);
+      });
+  p.subscribe<navbus::GnssFixPubSubType>(topic::kGnssFix, profile::kMeasurementReader,
+                                         [this](const auto& m, const auto&) {
+                                           onMeasurement(gnss_fix_gate_, m, m.receiver_id(), config_.gnss_fix,
+                                                         kRankGnssFix);
+                                         });
+  p.subscribe<navbus::StarTrackerAttitudePubSubType>(
+      topic::kStarTracker, profile::kMeasurementReader, [this](const auto& m, const auto&) {
+        onMeasurement(star_gate_, m, m.tracker_id(), config_.star_tracker, kRankStarTracker);
+      });
+  p.subscribe<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader,
+                                               [this](const auto& d, const auto&) { onDecision(d); });
+  p.subscribe<navbus::FilterCommandPubSubType>(topic::kFilterCommand, profile::kDecisionReader,
+                                               [this](const auto& c, const auto&) { onCommand(c); });
+  // Bounded-wait release of inputs held for a silent stream, and the held solution while
+  // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
+  p.setAfterDispatch([this] { pump(); });
+  p.addTimer(std::chrono::milliseconds(20), [this] { pump(); });
+  p.addTimer(std::chrono::nanoseconds(config.solution_period_ns), [this] {
+    if (mode_ == navbus::MODE_INERTIAL_LOST) publishSolution();
+  });
+  reset();
+}
+
+void FilterNode::reset() {
+  mode_ = navbus::MODE_INITIALIZING;
+  fault_flags_ &= kStreamLostFlags;  // stream states are facts, not filter state
+  accel_bias_b_mps2_.setZero();
+  gyro_bias_b_radps_.setZero();
+  excluded_satellites_.clear();
+  strapdown_ = core::StrapdownNed();
+  updateState();
+}
+
+void FilterNode::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input) {
+  switch (sequencer_.push(id, time_ns, std::move(input))) {
+    case InputSequencer<FilterInput>::PushResult::kQueued:
+      break;
+    case InputSequencer<FilterInput>::PushResult::kLate:
+      gate.unaccept();
+      gate.reject({navbus::REJECT_LATE, "time_gps_ns", static_cast<double>(time_ns)}, id.sensor_id);
+      break;
+    case InputSequencer<FilterInput>::PushResult::kUnexpected:
+      gate.unaccept();
+      gate.reject({navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id.sensor_id)}, id.sensor_id);
+      break;
+  }
+}
+
+void FilterNode::onImu(const navbus::ImuIncrement& msg) {
+  if (!imu_gate_.admit(msg, msg.sensor_id(), msg.seq(), msg.time_gps_ns())) return;
+  queue(imu_gate_, {kRankImu, msg.sensor_id()}, static_cast<std::int64_t>(msg.time_gps_ns()), bus::toCore(msg));
+}
+
+template <class Sample>
+void FilterNode::onMeasurement(bus::StreamGate& gate, const Sample& msg, std::uint32_t id,
+                               const std::optional<InputConfig>& expected, StreamRank rank) {
+  if (!gate.admit(msg, id, msg.seq(), msg.time_gps_ns())) return;
+  if (!expected) {
+    gate.unaccept();
+    gate.reject({navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id)}, id);
+    return;
+  }
+  queue(gate, {rank, id}, static_cast<std::int64_t>(msg.time_gps_ns()), MeasurementEpoch{rank});
+}
+
+void FilterNode::pump() {
+  sequencer_.release(steadyNowNs(), [this](StreamId id, std::int64_t t, const FilterInput& in) {
+    process(id, t, in);
+  });
+}
+
+void FilterNode::process(StreamId, std::int64_t, const FilterInput& input) {
+  if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {
+    integrate(*inc);
+  }
+  // Measurement epochs: no fusion in mechanization-only mode (the fusion filters use them).
+}
+
+void FilterNode::integrate(const core::ImuIncrement& raw_inc) {
+  core::ImuIncrement inc = raw_inc;
+  inc.delta_vel_b_mps -= accel_bias_b_mps2_ * inc.interval_s;
+  inc.delta_angle_b_rad -= gyro_bias_b_radps_ * inc.interval_s;
+  const auto interval_ns = static_cast<std::int64_t>(std::llround(inc.interval_s * 1e9));
+  const std::int64_t start_ns = inc.time_ns - interval_ns;
+  if (!strapdown_.initialized()) {
+    core::NavState s = config_.initial_state;
+    s.time_ns = start_ns;
+    strapdown_.initialize(s);
+    next_output_ns_ = (start_ns / config_.solution_period_ns + 1) * config_.solution_period_ns;
+  } else if (start_ns - strapdown_.state().time_ns > interval_ns / 2) {
+    // Inertial data is missing between the state time and this interval: nothing can be
+    // propagated across the gap, so restart the integration and flag the solution.
+    strapdown_.restartAt(start_ns);
+    fault_flags_ |= navbus::FAULT_IMU_GAP;
+    ++imu_gaps_;
+    next_output_ns_ = (start_ns / config_.solution_period_ns + 1) * config_.solution_period_ns;
+  }
+  strapdown_.propagate(inc);
+  ++imu_used_;
+  if (mode_ == navbus::MODE_INITIALIZING || mode_ == navbus::MODE_INERTIAL_LOST) {
+    mode_ = navbus::MODE_INERTIAL_ONLY;
+    updateState();
+  }
+  if (strapdown_.state().time_ns >= next_output_ns_) {
+    publishSolution();
+    next_output_ns_ = (strapdown_.state().time_ns / config_.solution_period_ns + 1) * config_.solution_period_ns;
+  }
+}
+
+void FilterNode::publishSolution() {
+  if (!strapdown_.initialized()) return;
+  navbus::NavigationSolution sol;
+  sol.vehicle_id(config_.vehicle_id);
+  sol.seq(++solution_seq_);
+  bus::fillSolution(strapdown_.state(), sol);
+  // Mechanization alone estimates no covariance and no clock: the sigma fields stay 0 and
+  // covariance_valid says so. Biases are those compensated by command.
+  sol.covariance_valid(false);
+  for (std::size_t i = 0; i < 3; ++i) {
+    sol.accel_bias_b_mps2()[i] = accel_bias_b_mps2_[static_cast<int>(i)];
+    sol.gyro_bias_b_radps()[i] = gyro_bias_b_radps_[static_cast<int>(i)];
+  }
+  sol.mode(mode_);
+  sol.fusion(navbus::FUSION_NONE);
+  sol.active_fault_flags(fault_flags_);
+  sol.imu_samples_used(imu_used_);
+  solution_writer_.write(sol);
+}
+
+void FilterNode::updateState() {
+  participant_.setState((fault_flags_ & kStreamLostFlags) != 0 ? navbus::STATE_DEGRADED : navbus::STATE_RUNNING);
+}
+
+void FilterNode::onDecision(const navbus::FaultDecision& d) {
+  std::uint32_t flag = 0;
+  bool is_imu = false;
+  switch (d.source()) {
+    case navbus::SOURCE_IMU_STREAM:
+      if (d.sensor_id() != config_.imu.id) return;
+      flag = navbus::FAULT_IMU_STREAM_LOST;
+      is_imu = true;
+      break;
+    case navbus::SOURCE_IMU_RAW_STREAM: flag = navbus::FAULT_RAW_IMU_LOST; break;
+    case navbus::SOURCE_GNSS_OBS_STREAM:
+    case navbus::SOURCE_GNSS_FIX_STREAM: flag = navbus::FAULT_GNSS_STREAM_LOST; break;
+    case navbus::SOURCE_ST_STREAM: flag = navbus::FAULT_ST_STREAM_LOST; break;
+    default:
+      spdlog::warn("decision {} ({}) concerns a detector this filter mode does not use; ignored",
+                   d.decision_id(), d.detector());
+      return;
+  }
+  ++decisions_applied_;
+  if (d.action() == navbus::ACTION_STREAM_LOST) {
+    fault_flags_ |= flag;
+    if (is_imu) {
+      sequencer_.setActive({kRankImu, config_.imu.id}, false);
+      if (strapdown_.initialized()) mode_ = navbus::MODE_INERTIAL_LOST;
+    }
+    spdlog::warn("decision {}: {} stream {} lost; flags 0x{:x}", d.decision_id(), d.detector(), d.sensor_id(), fault_flags_);
+  } else if (d.action() == navbus::ACTION_STREAM_RESTORED) {
+    fault_flags_ &= ~flag;
+    spdlog::info("decision {}: stream {} restored; flags 0x{:x}", d.decision_id(), d.sensor_id(), fault_flags_);
+  }
+  updateState();
+  if (mode_ == navbus::MODE_INERTIAL_LOST) publishSolution();
+}
+
+void FilterNode::onCommand(const navbus::FilterCommand& c) {
+  if (c.vehicle_id() != config_.vehicle_id) return;
+  bool applied = true;
+  switch (c.kind()) {
+    case navbus::CMD_EXCLUDE_SATELLITE:
+      excluded_satellites_.insert(c.sv_id());
+      fault_flags_ |= navbus::FAULT_SATELLITE_EXCLUDED;
+      break;
+    case navbus::CMD_READMIT_SATELLITE:
+      excluded_satellites_.erase(c.sv_id());
+      if (excluded_satellites_.empty()) fault_flags_ &= ~navbus::FAULT_SATELLITE_EXCLUDED;
+      break;
+    case navbus::CMD_COMPENSATE_BIAS:
+      if (c.axis() > 2 || !std::isfinite(c.bias()) ||
+          (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)) {
+        applied = false;
+        break;
+      }
+      (c.sensor() == navbus::SOURCE_ACCELEROMETER ? accel_bias_b_mps2_ : gyro_bias_b_radps_)[c.axis()] += c.bias();
+      fault_flags_ |= navbus::FAULT_SENSOR_AXIS;
+      break;
+    case navbus::CMD_SELECT_FUSION:
+      applied = c.fusion() == navbus::FUSION_NONE;  // the only structure without fusion filters
+      break;
+    case navbus::CMD_SELECT_MODE:
+      applied = c.mode() == navbus::MODE_INERTIAL_ONLY;
+      break;
+    case navbus::CMD_RESET:
+      reset();
+      break;
+  }
+  if (applied) {
+    ++commands_applied_;
+    spdlog::info("command {} from '{}' applied", c.command_id(), c.issuer());
+  } else {
+    ++commands_refused_;
+    spdlog::warn("command {} from '{}' refused: kind {} not available in mechanization-only mode or bad field",
+                 c.command_id(), c.issuer(), static_cast<int>(c.kind()));
+  }
+}
+
+std::string FilterNode::summary() const {
+  std::ostringstream out;
+  out << "increments integrated " << imu_used_ << ", solutions published " << solution_seq_
+      << ", inertial gaps " << imu_gaps_ << ", decisions applied " << decisions_applied_
+      << ", commands applied " << commands_applied_ << " refused " << commands_refused_
+      << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending();
+  return out.str();
+}
+
+}  // namespace navbus::nav_filter

@@ -1,0 +1,139 @@
+// Deterministic merge of several time-stamped input streams (DESIGN.md, Determinism).
+//
+// Fast DDS 2.9 has no DESTINATION_ORDER BY_SOURCE_TIMESTAMP, and samples of different topics
+// arrive in any interleaving. The sequencer orders them by (time, stream rank, sensor id) and
+// releases a sample only when no expected stream can still deliver an earlier one. Each stream
+// declares its period: after a sample at t it promises nothing earlier than t + period, which
+// lets a 100 Hz IMU run ahead of a 1 Hz receiver without waiting a whole second. A stream that
+// holds the head back for longer than `max_wait` (wall time) is set aside until it delivers
+// again: the bounded wait that keeps a dead sensor from stalling navigation (counted in
+// timeouts()). A stream is also set aside when it is declared lost.
+// Pure logic: the caller supplies wall time.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace navbus::nav_filter {
+
+struct StreamId {
+  int rank{0};  ///< tie-break at equal times: lower rank first (IMU before measurements)
+  std::uint32_t sensor_id{0};
+  bool operator<(const StreamId& o) const { return std::tie(rank, sensor_id) < std::tie(o.rank, o.sensor_id); }
+  bool operator==(const StreamId& o) const { return rank == o.rank && sensor_id == o.sensor_id; }
+};
+
+template <class Payload>
+class InputSequencer {
+ public:
+  struct ExpectedStream {
+    StreamId id;
+    std::int64_t period_ns;  ///< promise: consecutive samples are at least this far apart
+  };
+  enum class PushResult { kQueued, kLate, kUnexpected };
+
+  InputSequencer(std::vector<ExpectedStream> expected, std::int64_t max_wait_ns)
+      : max_wait_ns_(max_wait_ns) {
+    for (const auto& e : expected) {
+      streams_.emplace(e.id, State{e.period_ns});
+    }
+  }
+
+  /// Queues a sample. kLate: its place in the order was already passed (released);
+  /// kUnexpected: the stream is not configured.
+  PushResult push(StreamId id, std::int64_t time_ns, Payload payload) {
+    auto it = streams_.find(id);
+    if (it == streams_.end()) {
+      return PushResult::kUnexpected;
+    }
+    const Key key{time_ns, id};
+    if (released_any_ && !(last_released_ < key)) {
+      return PushResult::kLate;
+    }
+    it->second.seen = true;
+    it->second.active = true;
+    it->second.last_time_ns = std::max(it->second.last_time_ns, time_ns);
+    queue_.emplace(key, std::move(payload));
+    return PushResult::kQueued;
+  }
+
+  /// A stream declared lost does not hold others back; it blocks again once it delivers.
+  void setActive(StreamId id, bool active) {
+    auto it = streams_.find(id);
+    if (it != streams_.end()) {
+      it->second.active = active;
+    }
+  }
+
+  /// Hands every releasable sample, in order, to consume(id, time_ns, payload).
+  void release(std::int64_t wall_now_ns,
+               const std::function<void(StreamId, std::int64_t, const Payload&)>& consume) {
+    while (!queue_.empty()) {
+      auto head = queue_.begin();
+      const std::vector<StreamId> blocking = blockingStreams(head->first);
+      if (!blocking.empty()) {
+        if (head_blocked_since_ns_ < 0 || !(blocked_key_ == head->first)) {
+          head_blocked_since_ns_ = wall_now_ns;
+          blocked_key_ = head->first;
+        }
+        if (wall_now_ns - head_blocked_since_ns_ < max_wait_ns_) {
+          return;
+        }
+        ++timeouts_;
+        for (const StreamId& id : blocking) {
+          streams_.at(id).active = false;
+        }
+      }
+      head_blocked_since_ns_ = -1;
+      last_released_ = head->first;
+      released_any_ = true;
+      consume(head->first.stream, head->first.time_ns, head->second);
+      queue_.erase(head);
+    }
+  }
+
+  std::size_t pending() const { return queue_.size(); }
+  std::uint64_t timeouts() const { return timeouts_; }
+
+ private:
+  struct Key {
+    std::int64_t time_ns;
+    StreamId stream;
+    bool operator<(const Key& o) const {
+      return std::tie(time_ns, stream) < std::tie(o.time_ns, o.stream);
+    }
+    bool operator==(const Key& o) const { return time_ns == o.time_ns && stream == o.stream; }
+  };
+  struct State {
+    std::int64_t period_ns;
+    bool seen{false};
+    bool active{true};
+    std::int64_t last_time_ns{0};
+  };
+
+  /// The expected, active streams that may still deliver a sample ordered before `key`.
+  std::vector<StreamId> blockingStreams(const Key& key) const {
+    std::vector<StreamId> out;
+    for (const auto& [id, s] : streams_) {
+      if (id == key.stream || !s.active) continue;
+      const Key earliest_next{s.last_time_ns + s.period_ns, id};
+      if (!s.seen || earliest_next < key) out.push_back(id);
+    }
+    return out;
+  }
+
+  std::map<StreamId, State> streams_;
+  std::multimap<Key, Payload> queue_;
+  std::int64_t max_wait_ns_;
+  Key last_released_{0, {}};
+  bool released_any_{false};
+  std::int64_t head_blocked_since_ns_{-1};
+  Key blocked_key_{0, {}};
+  std::uint64_t timeouts_{0};
+};
+
+}  // namespace navbus::nav_filter

@@ -1,0 +1,24 @@
+// navbus-filter: the integrated navigation filter participant.
+#include "filter_config.hpp"
+#include "filter_node.hpp"
+#include "navbus/bus/app.hpp"
+
+namespace nb = navbus;
+
+int main(int argc, char** argv) {
+  nb::bus::ShutdownSignal shutdown;
+  CLI::App app{"navbus-filter: strapdown navigation filter on the navbus DDS bus", "navbus-filter"};
+  nb::bus::CommonOptions common;
+  nb::bus::addCommonOptions(app, common, true);
+  app.footer("Exit codes: 0 stopped by SIGINT/SIGTERM, 1 runtime error, 2 configuration error, 3 DDS error.");
+  return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) {
+    const nb::nav_filter::FilterConfig config = nb::nav_filter::parseFilterConfig(yaml);
+    nb::bus::Participant participant(nb::bus::participantOptions(common, yaml, "navbus-filter"), shutdown);
+    nb::nav_filter::FilterNode node(participant, config);
+    spdlog::info("running: vehicle {}, solution every {} ms, IMU sensor {}", config.vehicle_id,
+                 config.solution_period_ns / 1'000'000, config.imu.id);
+    participant.run();
+    spdlog::info("summary: {}\n{}", node.summary(), participant.health().summary());
+    return static_cast<int>(nb::bus::kExitOk);
+  });
+}

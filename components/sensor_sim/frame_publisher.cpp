@@ -1,0 +1,146 @@
+#include "frame_publisher.hpp"
+
+#include <cmath>
+
+#include "navbus/bus/conversions.hpp"
+#include "navbus/bus/topics.hpp"
+#include "navbus/core/earth.hpp"
+
+namespace navbus::sensor_sim {
+
+namespace {
+template <class Array>
+void copy3(const Eigen::Vector3d& v, Array& a) {
+  a = {v.x(), v.y(), v.z()};
+}
+}  // namespace
+
+navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id, std::uint64_t seq) {
+  navbus::ImuRawBlock msg;
+  msg.sensor_id(sensor_id);
+  msg.seq(seq);
+  msg.first_sample_time_gps_ns(static_cast<std::uint64_t>(block.first_time_ns));
+  msg.sample_period_ns(static_cast<std::uint32_t>(std::llround(block.sample_period_s * 1e9)));
+  msg.samples().reserve(block.samples.size());
+  for (const auto& s : block.samples) {
+    navbus::ImuRawSample r;
+    copy3(s.angular_rate_b_radps, r.angular_rate_b_radps());
+    copy3(s.specific_force_b_mps2, r.specific_force_b_mps2());
+    msg.samples().push_back(r);
+  }
+  return msg;
+}
+
+navbus::GnssObservationEpoch toIdl(const sim::GnssEpoch& epoch, std::uint32_t receiver_id, std::uint64_t seq) {
+  navbus::GnssObservationEpoch msg;
+  msg.receiver_id(receiver_id);
+  msg.seq(seq);
+  msg.time_gps_ns(static_cast<std::uint64_t>(epoch.time_ns));
+  for (const auto& s : epoch.satellites) {
+    navbus::GnssSatelliteMeasurement m;
+    m.sv_id(static_cast<std::uint16_t>(s.sv_id));
+    m.pseudorange_m(s.pseudorange_m);
+    m.pseudorange_rate_mps(s.pseudorange_rate_mps);
+    copy3(s.sat_pos_ecef_m, m.sat_pos_ecef_m());
+    copy3(s.sat_vel_ecef_mps, m.sat_vel_ecef_mps());
+    m.sat_clock_correction_m(s.sat_clock_correction_m);
+    m.sat_clock_drift_mps(s.sat_clock_drift_mps);
+    m.cn0_dbhz(s.cn0_dbhz);
+    m.pseudorange_sigma_m(s.pseudorange_sigma_m);
+    m.pseudorange_rate_sigma_mps(s.pseudorange_rate_sigma_mps);
+    m.valid(true);
+    msg.satellites().push_back(m);
+  }
+  return msg;
+}
+
+navbus::GnssFix toIdl(const sim::GnssFixSample& fix, std::uint32_t receiver_id, std::uint64_t seq) {
+  navbus::GnssFix msg;
+  msg.receiver_id(receiver_id);
+  msg.seq(seq);
+  msg.time_gps_ns(static_cast<std::uint64_t>(fix.time_ns));
+  msg.latitude_rad(fix.position.latitude_rad);
+  msg.longitude_rad(fix.position.longitude_rad);
+  msg.height_m(fix.position.height_m);
+  copy3(core::earth::geodeticToEcef(fix.position), msg.pos_ecef_m());
+  copy3(fix.vel_ned_mps, msg.vel_ned_mps());
+  copy3(fix.pos_sigma_ned_m, msg.pos_sigma_ned_m());
+  copy3(fix.vel_sigma_ned_mps, msg.vel_sigma_ned_mps());
+  msg.num_satellites_used(static_cast<std::uint16_t>(fix.num_satellites));
+  msg.valid(fix.num_satellites >= 4);
+  return msg;
+}
+
+navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_t tracker_id, std::uint64_t seq) {
+  navbus::StarTrackerAttitude msg;
+  msg.tracker_id(tracker_id);
+  msg.seq(seq);
+  msg.time_gps_ns(static_cast<std::uint64_t>(st.time_ns));
+  msg.q_b_to_i() = {st.q_b_to_i.w(), st.q_b_to_i.x(), st.q_b_to_i.y(), st.q_b_to_i.z()};
+  copy3(st.sigma_b_rad, msg.sigma_b_rad());
+  msg.valid(true);
+  return msg;
+}
+
+FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& config)
+    : participant_(participant), config_(config) {
+  using namespace bus;
+  imu_ = participant.createWriter<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorWriter);
+  if (config.publish_raw) {
+    raw_ = participant.createWriter<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, profile::kSensorWriter);
+  }
+  if (config.publish_gnss) {
+    gnss_ = participant.createWriter<navbus::GnssObservationEpochPubSubType>(topic::kGnssObservations,
+                                                                            profile::kMeasurementWriter);
+    fix_ = participant.createWriter<navbus::GnssFixPubSubType>(topic::kGnssFix, profile::kMeasurementWriter);
+  }
+  if (config.publish_star_tracker) {
+    star_ = participant.createWriter<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker,
+                                                                           profile::kMeasurementWriter);
+  }
+}
+
+template <class Sample>
+bool FramePublisher::writeReliably(bus::Writer<Sample>& writer, const Sample& sample) {
+  while (!writer.write(sample)) {
+    // max_blocking_time elapsed with the history full: a reliable reader is behind.
+    ++counts_.write_retries;
+    if (participant_.stopping()) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool FramePublisher::publish(const sim::SensorFrame& f) {
+  // Order within a frame: the increment first, then the measurements valid at its end time.
+  const std::uint64_t k = counts_.imu + 1;
+  if (!writeReliably(imu_, bus::toIdl(f.increment, config_.imu_sensor_id, k))) return false;
+  ++counts_.imu;
+  if (config_.publish_raw) {
+    if (!writeReliably(raw_, toIdl(f.raw, config_.imu_sensor_id, counts_.raw + 1))) return false;
+    ++counts_.raw;
+  }
+  if (config_.publish_gnss && f.has_gnss) {
+    if (!writeReliably(gnss_, toIdl(f.gnss, config_.gnss_receiver_id, counts_.gnss_epochs + 1))) return false;
+    ++counts_.gnss_epochs;
+    if (!writeReliably(fix_, toIdl(f.fix, config_.gnss_receiver_id, counts_.gnss_fixes + 1))) return false;
+    ++counts_.gnss_fixes;
+  }
+  if (config_.publish_star_tracker && f.has_star_tracker) {
+    if (!writeReliably(star_, toIdl(f.star_tracker, config_.star_tracker_id, counts_.star_tracker + 1))) return false;
+    ++counts_.star_tracker;
+  }
+  return true;
+}
+
+void FramePublisher::flush() {
+  const eprosima::fastrtps::Duration_t timeout(5, 0);
+  for (auto* w : {imu_.raw(), raw_.raw(), gnss_.raw(), fix_.raw(), star_.raw()}) {
+    if (w != nullptr) {
+      w->wait_for_acknowledgments(timeout);
+    }
+  }
+}
+
+}  // namespace navbus::sensor_sim

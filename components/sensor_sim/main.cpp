@@ -1,0 +1,88 @@
+// navbus-sensor-sim: publishes IMU increments, raw IMU blocks, GNSS observations and fixes, and
+// star-tracker attitudes of a simulated vehicle, in real time or as fast as the readers allow.
+#include <chrono>
+#include <thread>
+
+#include "frame_publisher.hpp"
+#include "navbus/bus/app.hpp"
+#include "navbus/sim/stationary_source.hpp"
+#include "sim_config.hpp"
+
+namespace nb = navbus;
+
+int main(int argc, char** argv) {
+  nb::bus::ShutdownSignal shutdown;
+  CLI::App app{"navbus-sensor-sim: simulated IMU, GNSS and star-tracker streams on the navbus DDS bus",
+               "navbus-sensor-sim"};
+  nb::bus::CommonOptions common;
+  double duration_override = -1.0;
+  std::string pacing_override;
+  nb::bus::addCommonOptions(app, common, false);
+  app.add_option("--duration", duration_override, "seconds of data to publish (0: until stopped)")
+      ->check(CLI::Range(0.0, 1e7));
+  app.add_option("--pacing", pacing_override, "realtime or fast (flow-controlled, nothing lost)")
+      ->check(CLI::IsMember({"realtime", "fast"}));
+  app.footer("Exit codes: 0 done, 1 runtime error, 2 configuration error, 3 DDS error.");
+
+  return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) {
+    nb::sensor_sim::SimConfig config = nb::sensor_sim::parseSimConfig(yaml);
+    if (duration_override >= 0.0) config.duration_s = duration_override;
+    if (!pacing_override.empty()) {
+      config.pacing = pacing_override == "fast" ? nb::sensor_sim::Pacing::kFast
+                                                : nb::sensor_sim::Pacing::kRealTime;
+    }
+    nb::bus::Participant participant(
+        nb::bus::participantOptions(common, yaml, "navbus-sensor-sim"), shutdown);
+    nb::sensor_sim::FramePublisher publisher(participant, config);
+
+    using Clock = std::chrono::steady_clock;
+    if (config.pacing == nb::sensor_sim::Pacing::kFast) {
+      // Flow control starts with the readers: wait for them so that nothing is published into
+      // the void before the filter has joined.
+      const auto until = Clock::now() + std::chrono::duration<double>(config.wait_for_readers_s);
+      while (!participant.stopping() &&
+             publisher.imuReaders() < static_cast<std::size_t>(config.min_readers) && Clock::now() < until) {
+        participant.spinOnce(std::chrono::milliseconds(50));
+      }
+      if (publisher.imuReaders() < static_cast<std::size_t>(config.min_readers)) {
+        spdlog::warn("only {} of {} IMU readers matched after {} s; publishing anyway",
+                     publisher.imuReaders(), config.min_readers, config.wait_for_readers_s);
+      }
+    }
+    if (config.start_now) {
+      // Real GPS time, on a whole IMU period, so that a restarted simulator continues forward.
+      const auto now = static_cast<std::int64_t>(nb::bus::gpsTimeNowNs());
+      config.source.start_time_ns = now - now % config.source.imu_period_ns;
+    }
+    nb::sim::StationarySource source(config.source);
+    const std::int64_t period_ns = config.source.imu_period_ns;
+    const std::int64_t total = config.duration_s > 0.0
+                                   ? static_cast<std::int64_t>(std::llround(config.duration_s * 1e9 / static_cast<double>(period_ns)))
+                                   : -1;
+    spdlog::info("publishing {} s of data, {} pacing, IMU {} Hz, start GPS {} ns",
+                 config.duration_s > 0 ? std::to_string(config.duration_s) : std::string("unbounded"),
+                 config.pacing == nb::sensor_sim::Pacing::kFast ? "fast" : "real-time",
+                 1e9 / static_cast<double>(period_ns), config.source.start_time_ns);
+    const auto wall_start = Clock::now();
+    while (!participant.stopping() && (total < 0 || source.index() < total)) {
+      const nb::sim::SensorFrame frame = source.next();
+      if (!publisher.publish(frame)) break;
+      if (config.pacing == nb::sensor_sim::Pacing::kRealTime) {
+        const auto due = wall_start + std::chrono::nanoseconds(source.index() * period_ns);
+        while (!participant.stopping() && Clock::now() < due) {
+          participant.spinOnce(std::chrono::duration_cast<std::chrono::nanoseconds>(due - Clock::now()));
+        }
+      } else {
+        participant.spinOnce(std::chrono::nanoseconds(0));
+      }
+    }
+    publisher.flush();
+    participant.finish();
+    const auto& n = publisher.counts();
+    spdlog::info("summary: published {} IMU increments, {} raw blocks, {} GNSS epochs, {} GNSS fixes, "
+                 "{} star-tracker attitudes ({} s of data), {} write retries",
+                 n.imu, n.raw, n.gnss_epochs, n.gnss_fixes, n.star_tracker,
+                 static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9, n.write_retries);
+    return static_cast<int>(nb::bus::kExitOk);
+  });
+}

@@ -1,0 +1,74 @@
+// Simulated sensor outputs in SI units (no DDS types; the sensor_sim participant converts).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "navbus/core/earth.hpp"
+#include "navbus/core/strapdown.hpp"
+
+namespace navbus::sim {
+
+struct RawImuSample {
+  Eigen::Vector3d angular_rate_b_radps{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d specific_force_b_mps2{Eigen::Vector3d::Zero()};
+};
+
+/// Raw samples of one navigation interval, the i-th at first_time_ns + round(i * period).
+struct RawImuBlock {
+  std::int64_t first_time_ns{0};
+  double sample_period_s{0.0};
+  std::vector<RawImuSample> samples;
+};
+
+struct SatelliteMeasurement {
+  int sv_id{0};
+  double pseudorange_m{0.0};
+  double pseudorange_rate_mps{0.0};
+  Eigen::Vector3d sat_pos_ecef_m{Eigen::Vector3d::Zero()};  ///< at transmission, ECEF at reception
+  Eigen::Vector3d sat_vel_ecef_mps{Eigen::Vector3d::Zero()};
+  double sat_clock_correction_m{0.0};
+  double sat_clock_drift_mps{0.0};
+  double cn0_dbhz{0.0};
+  double pseudorange_sigma_m{0.0};
+  double pseudorange_rate_sigma_mps{0.0};
+  double elevation_rad{0.0};
+};
+
+struct GnssEpoch {
+  std::int64_t time_ns{0};  ///< reception time
+  std::vector<SatelliteMeasurement> satellites;
+};
+
+struct GnssFixSample {
+  std::int64_t time_ns{0};
+  core::earth::Geodetic position;
+  Eigen::Vector3d vel_ned_mps{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d pos_sigma_ned_m{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d vel_sigma_ned_mps{Eigen::Vector3d::Zero()};
+  int num_satellites{0};
+};
+
+struct StarTrackerSample {
+  std::int64_t time_ns{0};
+  Eigen::Quaterniond q_b_to_i{Eigen::Quaterniond::Identity()};
+  Eigen::Vector3d sigma_b_rad{Eigen::Vector3d::Zero()};
+};
+
+/// Everything the source produces for one navigation interval ending at `time_ns`.
+struct SensorFrame {
+  std::int64_t time_ns{0};
+  core::ImuIncrement increment;
+  RawImuBlock raw;
+  bool has_gnss{false};
+  GnssEpoch gnss;
+  GnssFixSample fix;
+  bool has_star_tracker{false};
+  StarTrackerSample star_tracker;
+  core::NavState truth;
+};
+
+}  // namespace navbus::sim

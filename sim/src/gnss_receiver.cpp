@@ -1,0 +1,97 @@
+#include "navbus/sim/gnss_receiver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "navbus/core/earth.hpp"
+
+namespace navbus::sim {
+
+namespace earth = core::earth;
+
+GnssReceiverModel::GnssReceiverModel(const GnssReceiverConfig& config,
+                                     const CircularConstellation& constellation)
+    : config_(config), constellation_(constellation) {}
+
+GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
+                                     const Eigen::Vector3d& rx_pos, const Eigen::Vector3d& rx_vel,
+                                     std::mt19937_64& rng) const {
+  std::normal_distribution<double> unit(0.0, 1.0);
+  const double t = 1e-9 * static_cast<double>(t_ns);
+  const double since_start_s = 1e-9 * static_cast<double>(t_ns - t0_ns);
+  const earth::Geodetic rx_geo = earth::ecefToGeodetic(rx_pos);
+  const Eigen::Matrix3d C_e_n = earth::C_n_e(rx_geo.latitude_rad, rx_geo.longitude_rad).transpose();
+  const double clock_bias = config_.clock_bias_m + config_.clock_drift_mps * since_start_s;
+
+  GnssEpoch epoch;
+  epoch.time_ns = t_ns;
+  for (int sv = 1; sv <= constellation_.size(); ++sv) {
+    // Light-time iteration: the signal left the satellite tau seconds before reception.
+    double tau = 0.07;
+    SatelliteState s;
+    Eigen::Vector3d pos_rot;
+    Eigen::Vector3d vel_rot;
+    for (int it = 0; it < 4; ++it) {
+      s = constellation_.state(sv, t - tau);
+      // Sagnac: express the transmit-time position in the ECEF frame of reception time.
+      const double a = earth::kRotationRate_radps * tau;
+      const Eigen::Matrix3d rot = Eigen::AngleAxisd(-a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      pos_rot = rot * s.pos_ecef_m;
+      vel_rot = rot * s.vel_ecef_mps;
+      tau = (pos_rot - rx_pos).norm() / earth::kSpeedOfLight_mps;
+    }
+    const Eigen::Vector3d los = (pos_rot - rx_pos).normalized();
+    const Eigen::Vector3d los_n = C_e_n * los;
+    const double elevation = std::asin(-los_n.z());
+    if (elevation < config_.elevation_mask_rad) {
+      continue;
+    }
+    SatelliteMeasurement m;
+    m.sv_id = sv;
+    m.elevation_rad = elevation;
+    m.sat_pos_ecef_m = pos_rot;
+    m.sat_vel_ecef_mps = vel_rot;
+    m.pseudorange_m = (pos_rot - rx_pos).norm() + clock_bias +
+                      config_.pseudorange_sigma_m * unit(rng);
+    m.pseudorange_rate_mps = los.dot(vel_rot - rx_vel) + config_.clock_drift_mps +
+                             config_.pseudorange_rate_sigma_mps * unit(rng);
+    m.pseudorange_sigma_m = config_.pseudorange_sigma_m;
+    m.pseudorange_rate_sigma_mps = config_.pseudorange_rate_sigma_mps;
+    // C/N0 rising with elevation, 35..50 dB-Hz: a common empirical shape.
+    m.cn0_dbhz = 35.0 + 15.0 * std::sin(elevation);
+    epoch.satellites.push_back(m);
+  }
+  std::sort(epoch.satellites.begin(), epoch.satellites.end(),
+            [](const auto& a, const auto& b) { return a.elevation_rad > b.elevation_rad; });
+  if (static_cast<int>(epoch.satellites.size()) > config_.max_satellites) {
+    epoch.satellites.resize(static_cast<std::size_t>(config_.max_satellites));
+  }
+  std::sort(epoch.satellites.begin(), epoch.satellites.end(),
+            [](const auto& a, const auto& b) { return a.sv_id < b.sv_id; });
+  return epoch;
+}
+
+GnssFixSample GnssReceiverModel::fix(std::int64_t t_ns, const earth::Geodetic& truth_pos,
+                                     const Eigen::Vector3d& truth_vel_ned, int num_satellites,
+                                     std::mt19937_64& rng) const {
+  std::normal_distribution<double> unit(0.0, 1.0);
+  GnssFixSample f;
+  f.time_ns = t_ns;
+  const earth::Radii r = earth::radiiOfCurvature(truth_pos.latitude_rad);
+  const Eigen::Vector3d dpos_ned(config_.fix_pos_sigma_m * unit(rng), config_.fix_pos_sigma_m * unit(rng),
+                                 config_.fix_pos_sigma_m * unit(rng));
+  f.position = truth_pos;
+  f.position.latitude_rad += dpos_ned.x() / (r.meridian_m + truth_pos.height_m);
+  f.position.longitude_rad +=
+      dpos_ned.y() / ((r.prime_vertical_m + truth_pos.height_m) * std::cos(truth_pos.latitude_rad));
+  f.position.height_m -= dpos_ned.z();
+  for (int i = 0; i < 3; ++i) {
+    f.vel_ned_mps[i] = truth_vel_ned[i] + config_.fix_vel_sigma_mps * unit(rng);
+  }
+  f.pos_sigma_ned_m.setConstant(config_.fix_pos_sigma_m);
+  f.vel_sigma_ned_mps.setConstant(config_.fix_vel_sigma_mps);
+  f.num_satellites = num_satellites;
+  return f;
+}
+
+}  // namespace navbus::sim
