@@ -204,10 +204,12 @@ void FilterNode::onDecision(const navbus::FaultDecision& d) {
       sequencer_.setActive({kRankImu, config_.imu.id}, false);
       if (strapdown_.initialized()) mode_ = navbus::MODE_INERTIAL_LOST;
     }
-    spdlog::warn("decision {}: {} stream {} lost; flags 0x{:x}", d.decision_id(), d.detector(), d.sensor_id(), fault_flags_);
+    spdlog::warn("decision {} ({}): stream source {} id {} lost; flags 0x{:x}", d.decision_id(), d.detector(),
+                 static_cast<int>(d.source()), d.sensor_id(), fault_flags_);
   } else if (d.action() == navbus::ACTION_STREAM_RESTORED) {
     fault_flags_ &= ~flag;
-    spdlog::info("decision {}: stream {} restored; flags 0x{:x}", d.decision_id(), d.sensor_id(), fault_flags_);
+    spdlog::info("decision {} ({}): stream source {} id {} restored; flags 0x{:x}", d.decision_id(), d.detector(),
+                 static_cast<int>(d.source()), d.sensor_id(), fault_flags_);
   }
   updateState();
   if (mode_ == navbus::MODE_INERTIAL_LOST) publishSolution();

@@ -134,6 +134,16 @@ bool FramePublisher::publish(const sim::SensorFrame& f) {
   return true;
 }
 
+bool FramePublisher::readersMatched() const {
+  const auto& m = config_.min_readers;
+  auto enough = [](const auto& writer, int wanted) {
+    return writer.matchedReaders() >= static_cast<std::size_t>(wanted);
+  };
+  return enough(imu_, m.imu) && (!config_.publish_raw || enough(raw_, m.raw_imu)) &&
+         (!config_.publish_gnss || (enough(gnss_, m.gnss) && enough(fix_, m.gnss))) &&
+         (!config_.publish_star_tracker || enough(star_, m.star_tracker));
+}
+
 void FramePublisher::flush() {
   const eprosima::fastrtps::Duration_t timeout(5, 0);
   for (auto* w : {imu_.raw(), raw_.raw(), gnss_.raw(), fix_.raw(), star_.raw()}) {

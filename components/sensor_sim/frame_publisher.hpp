@@ -29,6 +29,8 @@ class FramePublisher {
   bool publish(const sim::SensorFrame& frame);
   /// Readers matched on the IMU increment topic.
   std::size_t imuReaders() const { return imu_.matchedReaders(); }
+  /// True when every enabled topic has at least its configured number of matched readers.
+  bool readersMatched() const;
   /// Waits (bounded) until every written sample is acknowledged by the reliable readers.
   void flush();
 

@@ -36,18 +36,15 @@ int main(int argc, char** argv) {
     nb::sensor_sim::FramePublisher publisher(participant, config);
 
     using Clock = std::chrono::steady_clock;
-    if (config.pacing == nb::sensor_sim::Pacing::kFast) {
-      // Flow control starts with the readers: wait for them so that nothing is published into
-      // the void before the filter has joined.
-      const auto until = Clock::now() + std::chrono::duration<double>(config.wait_for_readers_s);
-      while (!participant.stopping() &&
-             publisher.imuReaders() < static_cast<std::size_t>(config.min_readers) && Clock::now() < until) {
-        participant.spinOnce(std::chrono::milliseconds(50));
-      }
-      if (publisher.imuReaders() < static_cast<std::size_t>(config.min_readers)) {
-        spdlog::warn("only {} of {} IMU readers matched after {} s; publishing anyway",
-                     publisher.imuReaders(), config.min_readers, config.wait_for_readers_s);
-      }
+    // Reliable delivery starts with matching: wait (bounded) for the readers so that nothing
+    // is published before the filter and the fault manager have joined.
+    const auto until = Clock::now() + std::chrono::duration<double>(config.wait_for_readers_s);
+    while (!participant.stopping() && !publisher.readersMatched() && Clock::now() < until) {
+      participant.spinOnce(std::chrono::milliseconds(20));
+    }
+    if (!publisher.readersMatched()) {
+      spdlog::warn("readers not all matched after {} s ({} on the IMU topic, {} wanted); publishing anyway",
+                   config.wait_for_readers_s, publisher.imuReaders(), config.min_readers.imu);
     }
     if (config.start_now) {
       // Real GPS time, on a whole IMU period, so that a restarted simulator continues forward.

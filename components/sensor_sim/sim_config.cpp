@@ -71,7 +71,15 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   }
   c.wait_for_readers_s = bus::checkRange(
       bus::get<double>(timing, "timing", "wait_for_readers_s", 10.0), 0, 3600, "timing.wait_for_readers_s");
-  c.min_readers = static_cast<int>(bus::checkRange(bus::get<int>(timing, "timing", "min_readers", 1), 0, 64, "timing.min_readers"));
+  const YAML::Node wait = timing["min_readers"];
+  auto readers = [&](const char* key, int fallback) {
+    return static_cast<int>(bus::checkRange(bus::get<int>(wait, "timing.min_readers", key, fallback), 0, 64,
+                                            std::string("timing.min_readers.") + key));
+  };
+  c.min_readers.imu = readers("imu", 1);
+  c.min_readers.raw_imu = readers("raw_imu", 0);
+  c.min_readers.gnss = readers("gnss", 1);
+  c.min_readers.star_tracker = readers("star_tracker", 1);
   const double imu_hz = bus::checkRange(bus::get<double>(timing, "timing", "imu_rate_hz", 100.0), 1, 2000, "timing.imu_rate_hz");
   const double period_ns = 1e9 / imu_hz;
   if (std::abs(period_ns - std::round(period_ns)) > 1e-6) {

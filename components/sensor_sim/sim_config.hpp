@@ -18,8 +18,11 @@ struct SimConfig {
   bool start_now{true};          ///< start at the current GPS time (real time), else start_gps_ns
   double duration_s{0.0};        ///< 0: until stopped
   Pacing pacing{Pacing::kRealTime};
-  double wait_for_readers_s{10.0};
-  int min_readers{1};            ///< fast mode: readers of the IMU topic to wait for
+  double wait_for_readers_s{10.0};  ///< wait this long for readers before publishing
+  /// Readers to wait for before publishing, per topic.
+  struct MinReaders {
+    int imu{1}, raw_imu{0}, gnss{1}, star_tracker{1};
+  } min_readers;
   std::uint32_t imu_sensor_id{1};
   std::uint32_t gnss_receiver_id{1};
   std::uint32_t star_tracker_id{1};

@@ -80,7 +80,7 @@ class Participant {
   /// Subscribes; `on_sample` gets every valid sample taken, in reception order. The skeleton
   /// counts `received`; the handler counts accepted / rejected after validating.
   template <class PubSubType>
-  void subscribe(const std::string& topic_name, const std::string& profile,
+  eprosima::fastdds::dds::DataReader* subscribe(const std::string& topic_name, const std::string& profile,
                  std::function<void(const typename PubSubType::type&,
                                     const eprosima::fastdds::dds::SampleInfo&)>
                      on_sample,
@@ -100,6 +100,7 @@ class Participant {
       }
     };
     addReader(reader, topic_name, std::move(take_all), std::move(callbacks));
+    return reader;
   }
 
   /// Calls `fn` after every round of reader dispatch: all samples available in the round have
@@ -155,6 +156,7 @@ class Participant {
 
 template <class Sample>
 std::size_t Writer<Sample>::matchedReaders() const {
+  if (writer_ == nullptr) return 0;
   eprosima::fastdds::dds::PublicationMatchedStatus status;
   writer_->get_publication_matched_status(status);
   return static_cast<std::size_t>(status.current_count);

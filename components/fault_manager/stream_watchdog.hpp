@@ -1,0 +1,52 @@
+// Stream watchdog state machine: one state per (stream, sensor id). DDS supplies the timing
+// (a requested deadline missed, a writer's liveliness lost); this class decides when a stream
+// is lost and when it is back, once per transition. Pure logic, unit-tested.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <tuple>
+#include <vector>
+
+namespace navbus::fault_manager {
+
+/// Which stream (mirrors navbus::FaultSource for the watchdog sources).
+enum class StreamKind { kImu, kImuRaw, kGnssObservations, kGnssFix, kStarTracker };
+
+struct StreamKey {
+  StreamKind kind;
+  std::uint32_t sensor_id;
+  bool operator<(const StreamKey& o) const { return std::tie(kind, sensor_id) < std::tie(o.kind, o.sensor_id); }
+};
+
+struct WatchdogEvent {
+  StreamKey key;
+  bool lost;                       ///< true: stream lost; false: stream restored
+  std::uint64_t last_time_gps_ns;  ///< sensor time of the latest sample seen (lost) or the new one (restored)
+  double silence_s;                ///< wall time without data when the transition was decided
+};
+
+class StreamWatchdog {
+ public:
+  /// A sample arrived; returns a 'restored' event if the stream was lost.
+  std::optional<WatchdogEvent> onSample(const StreamKey& key, std::uint64_t time_gps_ns,
+                                        std::int64_t wall_now_ns);
+  /// DDS reported a missed deadline for this stream's instance; returns a 'lost' event once.
+  std::optional<WatchdogEvent> onDeadlineMissed(const StreamKey& key, std::int64_t wall_now_ns);
+  /// Every writer of a topic lost liveliness: all its streams that are alive are lost.
+  std::vector<WatchdogEvent> onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
+
+  bool isLost(const StreamKey& key) const;
+
+ private:
+  struct State {
+    bool lost{false};
+    std::uint64_t last_time_gps_ns{0};
+    std::int64_t last_arrival_wall_ns{0};
+  };
+  std::optional<WatchdogEvent> markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns);
+  std::map<StreamKey, State> states_;
+};
+
+}  // namespace navbus::fault_manager
