@@ -49,8 +49,9 @@ DdsContext::DdsContext(const ParticipantOptions& options) : name_(options.name) 
                    "' is not defined in the QoS file");
   }
   qos.name(options.name);
-  participant_ = factory->create_participant(
-      static_cast<dds::DomainId_t>(options.domain_id), qos);
+  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(options.domain_id), qos,
+                                             options.listener,
+                                             options.listener ? dds::StatusMask::none() : dds::StatusMask::all());
   if (participant_ == nullptr) {
     throw DdsError("cannot create participant '" + options.name + "' on domain " +
                    std::to_string(options.domain_id) + " with profile '" +

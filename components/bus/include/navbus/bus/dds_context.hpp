@@ -7,6 +7,7 @@
 #include <string>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -33,6 +34,8 @@ struct ParticipantOptions {
   std::string participant_profile;  ///< a <participant> profile name from the QoS file
   std::string qos_file;             ///< empty: environment variable or installed default
   std::string name;                 ///< participant name shown in discovery and health
+  /// Optional listener installed at creation, so that no discovery event is missed.
+  eprosima::fastdds::dds::DomainParticipantListener* listener{nullptr};
 };
 
 class DdsContext {

@@ -1,0 +1,119 @@
+// Text and CSV renderings of navbus messages, driven by visitFields().
+#pragma once
+
+#include <array>
+#include <cstdio>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <fastrtps/utils/fixed_size_string.hpp>
+
+#include "message_fields.hpp"
+
+namespace navbus::tool {
+
+/// Shortest text that reads back to the same double (17 significant digits).
+std::string formatNumber(double v);
+std::string csvQuote(const std::string& s);
+
+/// Collects the cells (or the column names) of one message.
+class CellCollector {
+ public:
+  explicit CellCollector(std::string prefix = "") : prefix_(std::move(prefix)) {}
+
+  template <class T>
+  void operator()(const std::string& name, const T& value) {
+    if constexpr (std::is_enum_v<T>) {
+      add(name, enumName(value));
+    } else if constexpr (std::is_same_v<T, bool>) {
+      add(name, value ? "1" : "0");
+    } else if constexpr (std::is_floating_point_v<T>) {
+      add(name, formatNumber(value));
+    } else if constexpr (std::is_integral_v<T>) {
+      add(name, std::to_string(value));
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      add(name, csvQuote(value));
+    } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+      std::string joined;
+      for (std::size_t i = 0; i < value.size(); ++i) joined += (i ? ";" : "") + formatNumber(value[i]);
+      add(name, joined);
+    } else {  // std::array<double, N>
+      for (std::size_t i = 0; i < value.size(); ++i) add(name + "[" + std::to_string(i) + "]", formatNumber(value[i]));
+    }
+  }
+  /// Bounded IDL strings (string<N>) are fixed_string<N> in the generated C++.
+  template <std::size_t N>
+  void operator()(const std::string& name, const eprosima::fastrtps::fixed_string<N>& value) {
+    add(name, csvQuote(value.to_string()));
+  }
+  void text(const std::string& name, const std::string& s) { add(name, csvQuote(s)); }
+
+  template <class S>
+  void rows(const std::string& name, const std::vector<S>& seq) {
+    rows_at_ = cells_.size();
+    CellCollector names(prefix_ + name + ".");
+    visitFields(S{}, names);
+    row_names_ = names.names_;
+    for (const auto& element : seq) {
+      CellCollector sub;
+      visitFields(element, sub);
+      row_cells_.push_back(sub.cells_);
+    }
+  }
+
+  /// Column names, with the row fields in place of the sequence.
+  std::vector<std::string> header() const;
+  /// One row per element of the sequence (one row, its cells empty, if there is none).
+  std::vector<std::vector<std::string>> rowsOut() const;
+
+ private:
+  void add(const std::string& name, const std::string& cell) {
+    names_.push_back(prefix_ + name);
+    cells_.push_back(cell);
+  }
+  std::string prefix_;
+  std::vector<std::string> names_;
+  std::vector<std::string> cells_;
+  std::size_t rows_at_{static_cast<std::size_t>(-1)};
+  std::vector<std::string> row_names_;
+  std::vector<std::vector<std::string>> row_cells_;
+};
+
+std::string joinCsv(const std::vector<std::string>& cells);
+
+template <class T>
+std::string csvHeader() {
+  CellCollector c;
+  visitFields(T{}, c);
+  return joinCsv(c.header());
+}
+
+template <class T>
+std::vector<std::string> csvRows(const T& msg) {
+  CellCollector c;
+  visitFields(msg, c);
+  std::vector<std::string> out;
+  for (const auto& r : c.rowsOut()) out.push_back(joinCsv(r));
+  return out;
+}
+
+/// "name: value" lines, sequences of structs indexed.
+template <class T>
+std::string textOf(const T& msg) {
+  CellCollector c;
+  visitFields(msg, c);
+  const auto names = c.header();
+  std::string out;
+  const auto rows = c.rowsOut();
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (r > 0 && names[i].find('.') == std::string::npos) continue;  // row-independent fields once
+      out += names[i] + (rows.size() > 1 && names[i].find('.') != std::string::npos ? "#" + std::to_string(r) : "") +
+             ": " + rows[r][i] + "\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace navbus::tool

@@ -1,0 +1,210 @@
+// navbus: the user's tool for the bus: `topics`, `echo`, `record`.
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+
+#include "navbus/bus/app.hpp"
+#include "navbus/bus/config.hpp"
+#include "topic_registry.hpp"
+
+namespace nb = navbus;
+namespace fdds = eprosima::fastdds::dds;
+
+namespace {
+
+/// Collects discovered writers and readers by GUID.
+class DiscoveryListener : public fdds::DomainParticipantListener {
+ public:
+  struct Endpoints {
+    std::string type;
+    std::set<std::string> writers, readers;
+  };
+  void on_publisher_discovery(fdds::DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    update(info.info.topicName().to_string(), info.info.typeName().to_string(), guid(info.info.guid()), true,
+           info.status == eprosima::fastrtps::rtps::WriterDiscoveryInfo::REMOVED_WRITER);
+  }
+  void on_subscriber_discovery(fdds::DomainParticipant*, eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+    update(info.info.topicName().to_string(), info.info.typeName().to_string(), guid(info.info.guid()), false,
+           info.status == eprosima::fastrtps::rtps::ReaderDiscoveryInfo::REMOVED_READER);
+  }
+  std::map<std::string, Endpoints> snapshot() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return topics_;
+  }
+
+ private:
+  static std::string guid(const eprosima::fastrtps::rtps::GUID_t& g) {
+    std::ostringstream out;
+    out << g;
+    return out.str();
+  }
+  void update(const std::string& topic, const std::string& type, const std::string& id, bool writer, bool removed) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto& e = topics_[topic];
+    e.type = type;
+    auto& set = writer ? e.writers : e.readers;
+    if (removed) set.erase(id); else set.insert(id);
+  }
+  std::mutex mutex_;
+  std::map<std::string, Endpoints> topics_;
+};
+
+/// Prints samples as text blocks or CSV lines.
+class EchoSink : public nb::tool::SampleSink {
+ public:
+  EchoSink(bool csv, const std::string& header, std::uint64_t limit) : csv_(csv), limit_(limit) {
+    if (csv_) std::cout << header << "\n";
+  }
+  void onSample(const std::string& topic, const std::function<std::string()>& text,
+                const std::function<std::vector<std::string>()>& rows) override {
+    if (limit_ > 0 && count_ >= limit_) return;  // one dispatch round may hold more samples
+    ++count_;
+    if (csv_) {
+      for (const auto& r : rows()) std::cout << r << "\n";
+    } else {
+      std::cout << "--- " << topic << " #" << count_ << "\n" << text();
+    }
+    std::cout.flush();
+  }
+  std::uint64_t count() const { return count_; }
+
+ private:
+  bool csv_;
+  std::uint64_t limit_;
+  std::uint64_t count_{0};
+};
+
+/// Writes one CSV file per topic.
+class RecordSink : public nb::tool::SampleSink {
+ public:
+  void open(const nb::tool::TopicEntry& e, const std::filesystem::path& dir) {
+    std::string file = e.name;
+    for (char& c : file) if (c == '/') c = '_';
+    auto& f = files_[e.name];
+    f.stream = std::make_unique<std::ofstream>(dir / (file + ".csv"));
+    if (!*f.stream) throw std::runtime_error("cannot write " + (dir / (file + ".csv")).string());
+    *f.stream << e.csv_header << "\n";
+  }
+  void onSample(const std::string& topic, const std::function<std::string()>&,
+                const std::function<std::vector<std::string>()>& rows) override {
+    auto& f = files_.at(topic);
+    ++f.samples;
+    for (const auto& r : rows()) *f.stream << r << "\n";
+  }
+  void flush() {
+    for (auto& [name, f] : files_) f.stream->flush();
+  }
+  std::uint64_t samples(const std::string& topic) const { return files_.at(topic).samples; }
+
+ private:
+  struct File {
+    std::unique_ptr<std::ofstream> stream;
+    std::uint64_t samples{0};
+  };
+  std::map<std::string, File> files_;
+};
+
+const nb::tool::TopicEntry& requireTopic(const std::string& name) {
+  const auto* e = nb::tool::findTopic(name);
+  if (e == nullptr) {
+    std::string known;
+    for (const auto& t : nb::tool::topicRegistry()) known += " " + t.name;
+    throw nb::bus::ConfigError("unknown topic '" + name + "'; navbus topics are:" + known);
+  }
+  return *e;
+}
+
+/// Runs the participant until `done()` or `duration_s` (0: until SIGINT/SIGTERM).
+void runFor(nb::bus::Participant& p, double duration_s, const std::function<bool()>& done) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
+  while (!p.stopping() && !done() && (duration_s <= 0.0 || std::chrono::steady_clock::now() < end)) {
+    p.spinOnce(std::chrono::milliseconds(50));
+  }
+  p.finish();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  nb::bus::ShutdownSignal shutdown;
+  CLI::App app{"navbus: inspect and record the navbus DDS bus", "navbus"};
+  nb::bus::CommonOptions common;
+  nb::bus::addCommonOptions(app, common, false);
+  app.require_subcommand(1);
+  app.footer("Exit codes: 0 ok, 1 fewer samples than --count, 2 usage or configuration error, 3 DDS error.");
+
+  double wait_s = 2.0;
+  auto* topics_cmd = app.add_subcommand("topics", "list the topics seen on the bus with their writers and readers");
+  topics_cmd->add_option("--wait", wait_s, "seconds of discovery before printing")->check(CLI::Range(0.1, 600.0));
+
+  std::string echo_topic;
+  bool echo_csv = false;
+  std::uint64_t count = 0;
+  double duration_s = 0.0;
+  auto* echo_cmd = app.add_subcommand("echo", "print the samples of one topic");
+  echo_cmd->add_option("topic", echo_topic, "topic name, e.g. navbus/nav/solution")->required();
+  echo_cmd->add_flag("--csv", echo_csv, "CSV instead of text");
+  echo_cmd->add_option("-n,--count", count, "stop after this many samples (exit 1 if not reached)");
+  echo_cmd->add_option("--duration", duration_s, "stop after this many seconds (0: until SIGINT)");
+
+  std::vector<std::string> record_topics;
+  std::string out_dir;
+  auto* record_cmd = app.add_subcommand("record", "record topics into CSV files, one per topic");
+  record_cmd->add_option("topics", record_topics, "topic names")->required();
+  record_cmd->add_option("-o,--out", out_dir, "output directory (created)")->required();
+  record_cmd->add_option("-n,--count", count, "stop when every topic has this many samples (exit 1 if not reached)");
+  record_cmd->add_option("--duration", duration_s, "stop after this many seconds (0: until SIGINT)");
+
+  return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) -> int {
+    auto options = nb::bus::participantOptions(common, yaml, "navbus");
+    if (*topics_cmd) {
+      DiscoveryListener listener;
+      options.dds.listener = &listener;
+      nb::bus::Participant p(options, shutdown);
+      runFor(p, wait_s, [] { return false; });
+      std::printf("%-30s %-36s %8s %8s\n", "TOPIC", "TYPE", "WRITERS", "READERS");
+      for (const auto& [topic, e] : listener.snapshot()) {
+        std::printf("%-30s %-36s %8zu %8zu\n", topic.c_str(), e.type.c_str(), e.writers.size(), e.readers.size());
+      }
+      return nb::bus::kExitOk;
+    }
+    if (*echo_cmd) {
+      const auto& entry = requireTopic(echo_topic);
+      nb::bus::Participant p(options, shutdown);
+      EchoSink sink(echo_csv, entry.csv_header, count);
+      entry.subscribe(p, sink);
+      runFor(p, duration_s, [&] { return count > 0 && sink.count() >= count; });
+      return (count > 0 && sink.count() < count) ? nb::bus::kExitRuntimeError : nb::bus::kExitOk;
+    }
+    // record
+    std::filesystem::create_directories(out_dir);
+    nb::bus::Participant p(options, shutdown);
+    RecordSink sink;
+    std::vector<const nb::tool::TopicEntry*> entries;
+    for (const auto& t : record_topics) {
+      entries.push_back(&requireTopic(t));
+      sink.open(*entries.back(), out_dir);
+      entries.back()->subscribe(p, sink);
+    }
+    auto all_counted = [&] {
+      if (count == 0) return false;
+      for (const auto* e : entries) if (sink.samples(e->name) < count) return false;
+      return true;
+    };
+    runFor(p, duration_s, all_counted);
+    sink.flush();
+    bool reached = true;
+    for (const auto* e : entries) {
+      spdlog::info("recorded {} samples of {}", sink.samples(e->name), e->name);
+      reached = reached && sink.samples(e->name) >= count;
+    }
+    return reached ? nb::bus::kExitOk : nb::bus::kExitRuntimeError;
+  });
+}
