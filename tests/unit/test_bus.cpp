@@ -1,0 +1,211 @@
+// Boundary validation, counters, configuration errors and the participant skeleton.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/bus/dds_context.hpp"
+#include "navbus/bus/health.hpp"
+#include "navbus/bus/participant.hpp"
+#include "navbus/bus/topics.hpp"
+#include "navbus/bus/validation.hpp"
+
+using navbus::bus::SequenceTracker;
+using navbus::bus::validate;
+using navbus::bus::ValidationLimits;
+
+namespace {
+navbus::ImuIncrement goodImu() {
+  navbus::ImuIncrement m;
+  m.sensor_id(1);
+  m.seq(1);
+  m.time_gps_ns(1'000'000'000);
+  m.interval_ns(10'000'000);
+  m.delta_vel_b_mps({0.0, 0.0, -0.098});
+  m.delta_angle_b_rad({5e-7, 0.0, -5e-7});
+  return m;
+}
+navbus::GnssObservationEpoch goodEpoch() {
+  navbus::GnssObservationEpoch e;
+  navbus::GnssSatelliteMeasurement s;
+  s.sv_id(5);
+  s.pseudorange_m(2.2e7);
+  s.pseudorange_rate_mps(300.0);
+  s.sat_pos_ecef_m({1.5e7, 1.5e7, 1.2e7});
+  s.cn0_dbhz(45.0);
+  s.pseudorange_sigma_m(3.0);
+  s.pseudorange_rate_sigma_mps(0.05);
+  s.valid(true);
+  e.satellites().push_back(s);
+  return e;
+}
+}  // namespace
+
+TEST(Validation, AcceptsAPhysicalImuIncrement) { EXPECT_FALSE(validate(goodImu(), ValidationLimits{})); }
+
+TEST(Validation, RejectsNonFiniteImuFieldsNamingTheField) {
+  auto m = goodImu();
+  m.delta_vel_b_mps()[2] = std::numeric_limits<double>::quiet_NaN();
+  const auto r = validate(m, ValidationLimits{});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->reason, navbus::REJECT_NOT_FINITE);
+  EXPECT_EQ(r->field, "delta_vel_b_mps[2]");
+  m = goodImu();
+  m.delta_angle_b_rad()[0] = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(validate(m, ValidationLimits{})->field, "delta_angle_b_rad[0]");
+}
+
+TEST(Validation, RejectsOutOfRangeAndBadIntervals) {
+  auto m = goodImu();
+  m.delta_vel_b_mps()[0] = 100.0;  // 10000 m/s^2 over 10 ms
+  EXPECT_EQ(validate(m, ValidationLimits{})->reason, navbus::REJECT_OUT_OF_RANGE);
+  m = goodImu();
+  m.delta_angle_b_rad()[1] = 1.0;  // 100 rad/s
+  EXPECT_EQ(validate(m, ValidationLimits{})->reason, navbus::REJECT_OUT_OF_RANGE);
+  m = goodImu();
+  m.interval_ns(0);
+  const auto r = validate(m, ValidationLimits{});
+  EXPECT_EQ(r->reason, navbus::REJECT_BAD_INTERVAL);
+  EXPECT_EQ(r->value, 0.0);
+}
+
+TEST(Validation, GnssEpochRules) {
+  EXPECT_FALSE(validate(goodEpoch(), ValidationLimits{}));
+  auto e = goodEpoch();
+  e.satellites()[0].sv_id(40);
+  auto r = validate(e, ValidationLimits{});
+  EXPECT_EQ(r->reason, navbus::REJECT_UNKNOWN_SATELLITE);
+  EXPECT_EQ(r->field, "satellites[0].sv_id");
+  EXPECT_EQ(r->value, 40.0);
+  e = goodEpoch();
+  e.satellites()[0].pseudorange_m(1.0e3);
+  EXPECT_EQ(validate(e, ValidationLimits{})->reason, navbus::REJECT_OUT_OF_RANGE);
+  e = goodEpoch();
+  e.satellites()[0].sat_pos_ecef_m()[1] = std::nan("");
+  EXPECT_EQ(validate(e, ValidationLimits{})->field, "satellites[0].sat_pos_ecef_m[1]");
+}
+
+TEST(Validation, StarTrackerQuaternionMustBeUnit) {
+  navbus::StarTrackerAttitude s;
+  s.q_b_to_i({1.0, 0.0, 0.0, 0.0});
+  s.sigma_b_rad({1e-6, 1e-6, 1e-5});
+  s.valid(true);
+  EXPECT_FALSE(validate(s, ValidationLimits{}));
+  s.q_b_to_i({1.0, 0.01, 0.0, 0.0});
+  EXPECT_EQ(validate(s, ValidationLimits{})->reason, navbus::REJECT_BAD_QUATERNION);
+  s.valid(false);  // an invalid sample's quaternion is not used, so not judged
+  EXPECT_FALSE(validate(s, ValidationLimits{}));
+}
+
+TEST(Validation, GnssFixRanges) {
+  navbus::GnssFix f;
+  f.latitude_rad(0.5);
+  f.longitude_rad(2.0);
+  f.height_m(100.0);
+  f.pos_sigma_ned_m({1, 1, 2});
+  f.vel_sigma_ned_mps({0.1, 0.1, 0.2});
+  EXPECT_FALSE(validate(f, ValidationLimits{}));
+  f.latitude_rad(2.0);
+  EXPECT_EQ(validate(f, ValidationLimits{})->field, "latitude_rad");
+  f.latitude_rad(0.5);
+  f.pos_sigma_ned_m()[1] = 0.0;
+  EXPECT_EQ(validate(f, ValidationLimits{})->field, "pos_sigma_ned_m[1]");
+}
+
+TEST(SequenceTracker, DuplicatesOrderAndGaps) {
+  SequenceTracker t;
+  EXPECT_FALSE(t.check(1, 1, 100).rejection);
+  auto o = t.check(1, 1, 100);
+  ASSERT_TRUE(o.rejection);
+  EXPECT_EQ(o.rejection->reason, navbus::REJECT_DUPLICATE);
+  o = t.check(1, 2, 90);
+  EXPECT_EQ(o.rejection->reason, navbus::REJECT_TIME_NOT_MONOTONIC);
+  o = t.check(1, 5, 130);
+  EXPECT_FALSE(o.rejection);
+  EXPECT_EQ(o.missing, 3u);
+  o = t.check(1, 1, 200);  // writer restarted: sequence back, time forward
+  EXPECT_FALSE(o.rejection);
+  EXPECT_TRUE(o.restarted);
+  EXPECT_FALSE(t.check(2, 1, 50).rejection);  // sensors are independent
+}
+
+TEST(HealthCounters, ReportCarriesEveryStreamAndReason) {
+  navbus::bus::HealthCounters h("p");
+  auto& s = h.stream("a");
+  s.received = 10;
+  s.accepted = 7;
+  navbus::bus::StreamGate gate("a", s);
+  gate.reject({navbus::REJECT_DUPLICATE, "seq", 3}, 1);
+  gate.reject({navbus::REJECT_DUPLICATE, "seq", 4}, 1);
+  gate.reject({navbus::REJECT_NOT_FINITE, "x", std::nan("")}, 1);
+  h.stream("b");
+  const navbus::Health r = h.report(navbus::STATE_RUNNING, 5);
+  ASSERT_EQ(r.inputs().size(), 2u);
+  EXPECT_EQ(r.inputs()[0].topic().to_string(), "a");
+  ASSERT_EQ(r.inputs()[0].rejected().size(), 2u);
+  std::uint64_t dup = 0;
+  for (const auto& rc : r.inputs()[0].rejected()) {
+    if (rc.reason() == navbus::REJECT_DUPLICATE) dup = rc.count();
+  }
+  EXPECT_EQ(dup, 2u);
+  EXPECT_EQ(r.seq(), 1u);
+}
+
+TEST(Config, ErrorsNameTheKeyAndValue) {
+  const YAML::Node n = YAML::Load("timing: {imu_rate_hz: fast}");
+  try {
+    navbus::bus::get<double>(n["timing"], "timing", "imu_rate_hz", 1.0);
+    FAIL() << "no exception";
+  } catch (const navbus::bus::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("timing.imu_rate_hz"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("fast"), std::string::npos);
+  }
+  EXPECT_THROW(navbus::bus::checkRange(500.0, 0, 232, "domain_id"), navbus::bus::ConfigError);
+  EXPECT_THROW(navbus::bus::loadYamlFile("/nonexistent/x.yaml"), navbus::bus::ConfigError);
+}
+
+TEST(Skeleton, UnknownParticipantProfileIsAClearError) {
+  navbus::bus::ParticipantOptions o;
+  o.domain_id = 200;
+  o.participant_profile = "no_such_profile";
+  o.name = "unit";
+  try {
+    navbus::bus::DdsContext ctx(o);
+    FAIL() << "no exception";
+  } catch (const navbus::bus::DdsError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_profile"), std::string::npos);
+  }
+}
+
+TEST(Skeleton, UnknownWriterProfileIsAClearErrorAndKnownOnesWork) {
+  navbus::bus::ShutdownSignal shutdown;
+  navbus::bus::Participant::Options o;
+  o.dds.domain_id = 201;
+  o.dds.participant_profile = navbus::bus::profile::kParticipantLoopback;
+  o.dds.name = "unit";
+  navbus::bus::Participant p(o, shutdown);
+  try {
+    p.createWriter<navbus::HealthPubSubType>("navbus/unit", "no_such_writer_profile");
+    FAIL() << "no exception";
+  } catch (const navbus::bus::DdsError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_writer_profile"), std::string::npos);
+  }
+  // A writer and a reader in one participant exchange a sample through the waitset loop.
+  auto writer = p.createWriter<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthWriter);
+  int received = 0;
+  p.subscribe<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthReader,
+                                        [&](const navbus::Health& h, const auto&) {
+                                          received += h.participant().to_string() == "x" ? 1 : 0;
+                                        });
+  navbus::Health h;
+  h.participant("x");
+  ASSERT_TRUE(writer.write(h));
+  for (int i = 0; i < 100 && received == 0; ++i) p.spinOnce(std::chrono::milliseconds(20));
+  EXPECT_EQ(received, 1);
+  EXPECT_EQ(p.health().find("navbus/unit")->received, 1u);
+  // Shutdown requested from inside ends run().
+  p.stop();
+  p.run();
+  EXPECT_EQ(p.state(), navbus::STATE_STOPPING);
+}
