@@ -1,0 +1,140 @@
+// Helpers for multi-process tests: child processes, temporary files, a test subscriber.
+#pragma once
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "navbus/bus/participant.hpp"
+#include "navbus/bus/topics.hpp"
+
+namespace navbus::test {
+
+/// A navbus executable run as a child process, its output in a log file. Killed if still
+/// running when destroyed.
+class ChildProcess {
+ public:
+  ChildProcess(const std::string& exe, const std::vector<std::string>& args, const std::string& log) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      // The test process blocks SIGINT/SIGTERM (ShutdownSignal); the child must not inherit it.
+      sigset_t none;
+      sigemptyset(&none);
+      sigprocmask(SIG_SETMASK, &none, nullptr);
+      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      std::vector<char*> argv;
+      argv.push_back(const_cast<char*>(exe.c_str()));
+      for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      execv(exe.c_str(), argv.data());
+      _exit(127);
+    }
+  }
+  ~ChildProcess() {
+    if (running()) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  void signal(int sig) { kill(pid_, sig); }
+  bool running() {
+    if (exited_) return false;
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      exited_ = true;
+      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      return false;
+    }
+    return true;
+  }
+  /// Waits for the exit; returns the exit code (128 + signal if killed), nullopt on timeout.
+  std::optional<int> wait(std::chrono::milliseconds timeout) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (running()) {
+      if (std::chrono::steady_clock::now() > end) return std::nullopt;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return exit_code_;
+  }
+
+ private:
+  pid_t pid_{-1};
+  bool exited_{false};
+  int exit_code_{-1};
+};
+
+/// A per-test scratch directory under the build tree.
+inline std::filesystem::path scratchDir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("navbus-test-" + name + "-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+inline std::string writeFile(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+inline std::string readFile(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// The test's own participant on the bus.
+inline bus::Participant::Options testParticipant(int domain, const std::string& name) {
+  bus::Participant::Options o;
+  o.dds.domain_id = domain;
+  o.dds.participant_profile = bus::profile::kParticipantLoopback;
+  o.dds.name = name;
+  o.health_period = std::chrono::milliseconds(1000);
+  return o;
+}
+
+/// Spins the participant until pred() holds or the timeout passes; returns pred().
+inline bool spinUntil(bus::Participant& p, std::chrono::milliseconds timeout, const std::function<bool()>& pred) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (!pred() && std::chrono::steady_clock::now() < end) p.spinOnce(std::chrono::milliseconds(10));
+  return pred();
+}
+
+/// Removes shared-memory files the Fast DDS SHM transport may have left (our test profiles use
+/// UDP on loopback, so normally there are none).
+inline void cleanSharedMemory() {
+  for (const auto& e : std::filesystem::directory_iterator("/dev/shm")) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind("fastrtps_", 0) == 0 || n.rfind("sem.fastrtps_", 0) == 0 || n.rfind("fast_datasharing", 0) == 0) {
+      std::error_code ec;
+      std::filesystem::remove(e.path(), ec);
+    }
+  }
+}
+
+inline std::string filterConfig(int domain, std::uint32_t imu_id = 1, bool measurements = true) {
+  std::string c = "domain_id: " + std::to_string(domain) +
+                  "\nvehicle_id: 1\nsolution_rate_hz: 10\nsequencer_max_wait_s: 0.5\n"
+                  "initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
+                  "inputs:\n  imu: {id: " + std::to_string(imu_id) + ", period_s: 0.01}\n";
+  if (measurements) {
+    c += "  gnss_observations: {id: 1, period_s: 1.0}\n  gnss_fix: {id: 1, period_s: 1.0}\n"
+         "  star_tracker: {id: 1, period_s: 0.2}\n";
+  }
+  return c;
+}
+
+}  // namespace navbus::test

@@ -1,0 +1,137 @@
+// A publisher sends NaN, infinite, out-of-order, duplicate, out-of-range and otherwise invalid
+// samples among good ones: each is rejected and counted by reason in the filter's health, and
+// the solution stays finite.
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include <gtest/gtest.h>
+#include <navbus_idl/HealthPubSubTypes.h>
+#include <navbus_idl/NavigationPubSubTypes.h>
+
+#include "frame_publisher.hpp"
+#include "harness.hpp"
+#include "navbus/bus/conversions.hpp"
+#include "navbus/bus/health.hpp"
+#include "navbus/sim/stationary_source.hpp"
+
+using namespace navbus;
+using namespace std::chrono_literals;
+
+namespace {
+constexpr int kDomain = 74;
+using Counts = std::map<std::string, std::map<RejectReason, std::uint64_t>>;
+}  // namespace
+
+TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
+  test::cleanSharedMemory();
+  const auto dir = test::scratchDir("bad-input");
+  const std::string cfg = test::writeFile(dir / "filter.yaml", test::filterConfig(kDomain));
+  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
+
+  bus::ShutdownSignal shutdown;
+  bus::Participant me(test::testParticipant(kDomain, "bad-input-test"), shutdown);
+  std::vector<NavigationSolution> solutions;
+  me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution, bus::profile::kSolutionReader,
+      [&](const NavigationSolution& s, const auto&) { solutions.push_back(s); });
+  Health filter_health;
+  me.subscribe<HealthPubSubType>(bus::topic::kHealth, bus::profile::kHealthReader, [&](const Health& h, const auto&) {
+    if (h.participant().to_string() == "navbus-filter") filter_health = h;
+  });
+  auto imu = me.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement, bus::profile::kSensorWriter);
+  auto obs = me.createWriter<GnssObservationEpochPubSubType>(bus::topic::kGnssObservations, bus::profile::kMeasurementWriter);
+  auto fix = me.createWriter<GnssFixPubSubType>(bus::topic::kGnssFix, bus::profile::kMeasurementWriter);
+  auto star = me.createWriter<StarTrackerAttitudePubSubType>(bus::topic::kStarTracker, bus::profile::kMeasurementWriter);
+  ASSERT_TRUE(test::spinUntil(me, 20s, [&] {
+    return imu.matchedReaders() && obs.matchedReaders() && fix.matchedReaders() && star.matchedReaders();
+  }));
+
+  sim::StationarySourceConfig src_cfg;
+  src_cfg.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
+  src_cfg.start_time_ns = 1'400'000'000'000'000'000;
+  sim::StationarySource src(src_cfg);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  std::uint64_t seq = 0, n_obs = 0, n_fix = 0, n_star = 0;
+  ImuIncrement last;
+  for (int k = 0; k < 300; ++k) {
+    const sim::SensorFrame f = src.next();
+    const ImuIncrement good = bus::toIdl(f.increment, 1, ++seq);
+    ImuIncrement bad = good;  // bad samples carry the seq of the good one that follows them
+    switch (k) {
+      case 20: bad.delta_vel_b_mps()[1] = nan; imu.write(bad); break;
+      case 40: bad.delta_angle_b_rad()[2] = inf; imu.write(bad); break;
+      case 60: bad.delta_vel_b_mps()[0] = 50.0; imu.write(bad); break;           // 5000 m/s^2
+      case 80: bad.interval_ns(0); imu.write(bad); break;
+      case 100: bad.time_gps_ns(last.time_gps_ns() - 5'000'000); imu.write(bad); break;  // out of order
+      case 120: imu.write(last); break;                                          // duplicate
+      case 140: bad.sensor_id(9); imu.write(bad); break;                          // not configured
+      default: break;
+    }
+    imu.write(good);
+    last = good;
+    if (f.has_gnss) {
+      obs.write(sensor_sim::toIdl(f.gnss, 1, ++n_obs));
+      fix.write(sensor_sim::toIdl(f.fix, 1, ++n_fix));
+      if (n_obs == 1) {
+        auto e = sensor_sim::toIdl(f.gnss, 1, n_obs + 1);
+        e.satellites().at(0).sv_id(40);
+        obs.write(e);
+        auto x = sensor_sim::toIdl(f.fix, 1, n_fix + 1);
+        x.latitude_rad(nan);
+        fix.write(x);
+      }
+    }
+    if (f.has_star_tracker) {
+      star.write(sensor_sim::toIdl(f.star_tracker, 1, ++n_star));
+      if (n_star == 2) {
+        auto s = sensor_sim::toIdl(f.star_tracker, 1, n_star + 1);
+        s.q_b_to_i()[1] += 0.01;
+        star.write(s);
+      }
+    }
+    me.spinOnce(1ms);
+  }
+
+  auto counts = [&] {
+    Counts c;
+    for (const auto& in : filter_health.inputs()) {
+      for (const auto& r : in.rejected()) c[in.topic().to_string()][r.reason()] = r.count();
+    }
+    return c;
+  };
+  auto stream = [&](const std::string& topic) -> const StreamHealth* {
+    for (const auto& in : filter_health.inputs()) if (in.topic().to_string() == topic) return &in;
+    return nullptr;
+  };
+  const Counts expected = {
+      {bus::topic::kImuIncrement,
+       {{REJECT_NOT_FINITE, 2}, {REJECT_OUT_OF_RANGE, 1}, {REJECT_BAD_INTERVAL, 1}, {REJECT_TIME_NOT_MONOTONIC, 1},
+        {REJECT_DUPLICATE, 1}, {REJECT_UNEXPECTED_SOURCE, 1}}},
+      {bus::topic::kGnssObservations, {{REJECT_UNKNOWN_SATELLITE, 1}}},
+      {bus::topic::kGnssFix, {{REJECT_NOT_FINITE, 1}}},
+      {bus::topic::kStarTracker, {{REJECT_BAD_QUATERNION, 1}}},
+  };
+  ASSERT_TRUE(test::spinUntil(me, 20s, [&] {
+    const auto* s = stream(bus::topic::kImuIncrement);
+    return s != nullptr && s->received() == 307 && counts() == expected && solutions.size() >= 30;
+  })) << test::readFile(dir / "filter.log");
+  const auto* s = stream(bus::topic::kImuIncrement);
+  EXPECT_EQ(s->accepted(), 300u);
+  EXPECT_EQ(s->sequence_gaps(), 0u);
+  for (const auto& [topic, reasons] : counts()) {
+    for (const auto& [reason, n] : reasons) std::printf("rejected on %s: %s x%llu\n", topic.c_str(),
+                                                        bus::rejectReasonName(reason), static_cast<unsigned long long>(n));
+  }
+  EXPECT_EQ(solutions.size(), 30u);
+  for (const auto& sol : solutions) {
+    EXPECT_TRUE(std::isfinite(sol.latitude_rad()) && std::isfinite(sol.longitude_rad()) &&
+                std::isfinite(sol.height_m()) && std::isfinite(sol.roll_rad()) && std::isfinite(sol.yaw_rad()));
+    for (double v : sol.vel_ned_mps()) EXPECT_TRUE(std::isfinite(v));
+    EXPECT_LT(std::abs(sol.height_m() - 100.0), 1.0);
+  }
+  filter.signal(SIGTERM);
+  EXPECT_EQ(filter.wait(10s), 0);
+  std::filesystem::remove_all(dir);
+  test::cleanSharedMemory();
+}
