@@ -13,28 +13,39 @@ namespace navbus::fault_manager {
 
 namespace {
 std::int64_t steadyNowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
 navbus::FaultSource toSource(StreamKind k) {
   switch (k) {
-    case StreamKind::kImu: return navbus::SOURCE_IMU_STREAM;
-    case StreamKind::kImuRaw: return navbus::SOURCE_IMU_RAW_STREAM;
-    case StreamKind::kGnssObservations: return navbus::SOURCE_GNSS_OBS_STREAM;
-    case StreamKind::kGnssFix: return navbus::SOURCE_GNSS_FIX_STREAM;
-    case StreamKind::kStarTracker: return navbus::SOURCE_ST_STREAM;
+    case StreamKind::kImu:
+      return navbus::SOURCE_IMU_STREAM;
+    case StreamKind::kImuRaw:
+      return navbus::SOURCE_IMU_RAW_STREAM;
+    case StreamKind::kGnssObservations:
+      return navbus::SOURCE_GNSS_OBS_STREAM;
+    case StreamKind::kGnssFix:
+      return navbus::SOURCE_GNSS_FIX_STREAM;
+    case StreamKind::kStarTracker:
+      return navbus::SOURCE_ST_STREAM;
   }
   return navbus::SOURCE_IMU_STREAM;
 }
 
 const char* kindName(StreamKind k) {
   switch (k) {
-    case StreamKind::kImu: return "imu";
-    case StreamKind::kImuRaw: return "imu-raw";
-    case StreamKind::kGnssObservations: return "gnss-observations";
-    case StreamKind::kGnssFix: return "gnss-fix";
-    case StreamKind::kStarTracker: return "star-tracker";
+    case StreamKind::kImu:
+      return "imu";
+    case StreamKind::kImuRaw:
+      return "imu-raw";
+    case StreamKind::kGnssObservations:
+      return "gnss-observations";
+    case StreamKind::kGnssFix:
+      return "gnss-fix";
+    case StreamKind::kStarTracker:
+      return "star-tracker";
   }
   return "?";
 }
@@ -42,13 +53,15 @@ const char* kindName(StreamKind k) {
 
 FaultManagerNode::FaultManagerNode(bus::Participant& p) : participant_(p) {
   using namespace bus;
-  decision_writer_ = p.createWriter<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionWriter);
+  decision_writer_ = p.createWriter<navbus::FaultDecisionPubSubType>(topic::kFaultDecision,
+                                                                     profile::kDecisionWriter);
   watch<navbus::ImuIncrementPubSubType>(
       topic::kImuIncrement, profile::kSensorWatchdogReader, StreamKind::kImu,
       [](const auto& m) { return m.sensor_id(); }, [](const auto& m) { return m.time_gps_ns(); });
   watch<navbus::ImuRawBlockPubSubType>(
       topic::kImuRaw, profile::kSensorWatchdogReader, StreamKind::kImuRaw,
-      [](const auto& m) { return m.sensor_id(); }, [](const auto& m) { return m.first_sample_time_gps_ns(); });
+      [](const auto& m) { return m.sensor_id(); },
+      [](const auto& m) { return m.first_sample_time_gps_ns(); });
   watch<navbus::GnssObservationEpochPubSubType>(
       topic::kGnssObservations, profile::kMeasurementWatchdogReader, StreamKind::kGnssObservations,
       [](const auto& m) { return m.receiver_id(); }, [](const auto& m) { return m.time_gps_ns(); });
@@ -61,22 +74,25 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p) : participant_(p) {
 }
 
 template <class PubSubType, class IdFn, class TimeFn>
-void FaultManagerNode::watch(const std::string& topic, const std::string& profile, StreamKind kind, IdFn id,
-                             TimeFn time) {
+void FaultManagerNode::watch(const std::string& topic, const std::string& profile, StreamKind kind,
+                             IdFn id, TimeFn time) {
   bus::ReaderCallbacks callbacks;
-  callbacks.on_deadline = [this, kind](const eprosima::fastdds::dds::RequestedDeadlineMissedStatus& st) {
+  callbacks.on_deadline = [this,
+                           kind](const eprosima::fastdds::dds::RequestedDeadlineMissedStatus& st) {
     auto it = instances_.find({kind, st.last_instance_handle});
     if (it == instances_.end()) return;
     if (auto e = watchdog_.onDeadlineMissed({kind, it->second}, steadyNowNs())) publish(*e);
   };
-  callbacks.on_liveliness = [this, kind](const eprosima::fastdds::dds::LivelinessChangedStatus& st) {
+  callbacks.on_liveliness = [this,
+                             kind](const eprosima::fastdds::dds::LivelinessChangedStatus& st) {
     if (st.alive_count == 0 && st.alive_count_change < 0) {
       for (const auto& e : watchdog_.onWritersGone(kind, steadyNowNs())) publish(e);
     }
   };
   auto* reader = participant_.subscribe<PubSubType>(
       topic, profile,
-      [this, topic, kind, id, time](const typename PubSubType::type& m, const eprosima::fastdds::dds::SampleInfo& info) {
+      [this, topic, kind, id, time](const typename PubSubType::type& m,
+                                    const eprosima::fastdds::dds::SampleInfo& info) {
         instances_[{kind, info.instance_handle}] = id(m);
         ++participant_.health().stream(topic).accepted;  // observed, not validated: a monitor
         if (auto e = watchdog_.onSample({kind, id(m)}, time(m), steadyNowNs())) publish(*e);
@@ -84,7 +100,8 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
       callbacks);
   // The decisions quote the reader's own requested deadline (from the QoS profile) as threshold.
   const auto period = reader->get_qos().deadline().period;
-  deadline_s_[kind] = static_cast<double>(period.seconds) + 1e-9 * static_cast<double>(period.nanosec);
+  deadline_s_[kind] =
+      static_cast<double>(period.seconds) + 1e-9 * static_cast<double>(period.nanosec);
 }
 
 void FaultManagerNode::publish(const WatchdogEvent& e) {
@@ -101,13 +118,14 @@ void FaultManagerNode::publish(const WatchdogEvent& e) {
   d.detector("watchdog");
   decision_writer_.write(d);
   (e.lost ? lost_decisions_ : restored_decisions_)++;
-  spdlog::warn("decision {}: {} stream {} {} (silent {:.3f} s)", d.decision_id(), kindName(e.key.kind),
-               e.key.sensor_id, e.lost ? "LOST" : "RESTORED", e.silence_s);
+  spdlog::warn("decision {}: {} stream {} {} (silent {:.3f} s)", d.decision_id(),
+               kindName(e.key.kind), e.key.sensor_id, e.lost ? "LOST" : "RESTORED", e.silence_s);
 }
 
 std::string FaultManagerNode::summary() const {
   std::ostringstream out;
-  out << "decisions published: " << lost_decisions_ << " stream lost, " << restored_decisions_ << " restored";
+  out << "decisions published: " << lost_decisions_ << " stream lost, " << restored_decisions_
+      << " restored";
   return out.str();
 }
 

@@ -21,7 +21,8 @@ class FaultManagerNode {
 
  private:
   template <class PubSubType, class IdFn, class TimeFn>
-  void watch(const std::string& topic, const std::string& profile, StreamKind kind, IdFn id, TimeFn time);
+  void watch(const std::string& topic, const std::string& profile, StreamKind kind, IdFn id,
+             TimeFn time);
   void publish(const WatchdogEvent& e);
 
   bus::Participant& participant_;
@@ -29,7 +30,8 @@ class FaultManagerNode {
   bus::Writer<navbus::FaultDecision> decision_writer_;
   std::map<StreamKind, double> deadline_s_;
   /// DDS instance handle -> sensor id, per stream kind (deadline statuses name the instance).
-  std::map<std::pair<StreamKind, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t> instances_;
+  std::map<std::pair<StreamKind, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>
+      instances_;
   std::uint32_t next_decision_id_{1};
   std::uint64_t lost_decisions_{0};
   std::uint64_t restored_decisions_{0};

@@ -2,13 +2,15 @@
 
 namespace navbus::fault_manager {
 
-std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key, std::uint64_t time_gps_ns,
+std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
+                                                      std::uint64_t time_gps_ns,
                                                       std::int64_t wall_now_ns) {
   auto [it, inserted] = states_.try_emplace(key);
   State& s = it->second;
   std::optional<WatchdogEvent> event;
   if (!inserted && s.lost) {
-    event = WatchdogEvent{key, false, time_gps_ns, 1e-9 * static_cast<double>(wall_now_ns - s.last_arrival_wall_ns)};
+    event = WatchdogEvent{key, false, time_gps_ns,
+                          1e-9 * static_cast<double>(wall_now_ns - s.last_arrival_wall_ns)};
   }
   s.lost = false;
   s.last_time_gps_ns = time_gps_ns;
@@ -16,20 +18,24 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key, std:
   return event;
 }
 
-std::optional<WatchdogEvent> StreamWatchdog::markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns) {
+std::optional<WatchdogEvent> StreamWatchdog::markLost(const StreamKey& key, State& s,
+                                                      std::int64_t wall_now_ns) {
   if (s.lost) return std::nullopt;
   s.lost = true;
-  return WatchdogEvent{key, true, s.last_time_gps_ns, 1e-9 * static_cast<double>(wall_now_ns - s.last_arrival_wall_ns)};
+  return WatchdogEvent{key, true, s.last_time_gps_ns,
+                       1e-9 * static_cast<double>(wall_now_ns - s.last_arrival_wall_ns)};
 }
 
-std::optional<WatchdogEvent> StreamWatchdog::onDeadlineMissed(const StreamKey& key, std::int64_t wall_now_ns) {
+std::optional<WatchdogEvent> StreamWatchdog::onDeadlineMissed(const StreamKey& key,
+                                                              std::int64_t wall_now_ns) {
   auto it = states_.find(key);
   // A stream never seen cannot be lost: the deadline only counts for instances that exist.
   if (it == states_.end()) return std::nullopt;
   return markLost(key, it->second, wall_now_ns);
 }
 
-std::vector<WatchdogEvent> StreamWatchdog::onWritersGone(StreamKind kind, std::int64_t wall_now_ns) {
+std::vector<WatchdogEvent> StreamWatchdog::onWritersGone(StreamKind kind,
+                                                         std::int64_t wall_now_ns) {
   std::vector<WatchdogEvent> out;
   for (auto& [key, s] : states_) {
     if (key.kind != kind) continue;

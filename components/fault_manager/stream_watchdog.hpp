@@ -17,14 +17,17 @@ enum class StreamKind { kImu, kImuRaw, kGnssObservations, kGnssFix, kStarTracker
 struct StreamKey {
   StreamKind kind;
   std::uint32_t sensor_id;
-  bool operator<(const StreamKey& o) const { return std::tie(kind, sensor_id) < std::tie(o.kind, o.sensor_id); }
+  bool operator<(const StreamKey& o) const {
+    return std::tie(kind, sensor_id) < std::tie(o.kind, o.sensor_id);
+  }
 };
 
 struct WatchdogEvent {
   StreamKey key;
-  bool lost;                       ///< true: stream lost; false: stream restored
-  std::uint64_t last_time_gps_ns;  ///< sensor time of the latest sample seen (lost) or the new one (restored)
-  double silence_s;                ///< wall time without data when the transition was decided
+  bool lost;  ///< true: stream lost; false: stream restored
+  std::uint64_t
+      last_time_gps_ns;  ///< sensor time of the latest sample seen (lost) or the new one (restored)
+  double silence_s;      ///< wall time without data when the transition was decided
 };
 
 class StreamWatchdog {

@@ -13,9 +13,11 @@ namespace {
 std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const FilterConfig& c) {
   std::vector<InputSequencer<FilterInput>::ExpectedStream> s;
   s.push_back({{kRankImu, c.imu.id}, c.imu.period_ns});
-  if (c.gnss_observations) s.push_back({{kRankGnssObs, c.gnss_observations->id}, c.gnss_observations->period_ns});
+  if (c.gnss_observations)
+    s.push_back({{kRankGnssObs, c.gnss_observations->id}, c.gnss_observations->period_ns});
   if (c.gnss_fix) s.push_back({{kRankGnssFix, c.gnss_fix->id}, c.gnss_fix->period_ns});
-  if (c.star_tracker) s.push_back({{kRankStarTracker, c.star_tracker->id}, c.star_tracker->period_ns});
+  if (c.star_tracker)
+    s.push_back({{kRankStarTracker, c.star_tracker->id}, c.star_tracker->period_ns});
   return s;
 }
 
@@ -25,8 +27,9 @@ std::int64_t steadyNowNs() {
       .count();
 }
 
-constexpr std::uint32_t kStreamLostFlags = navbus::FAULT_IMU_STREAM_LOST | navbus::FAULT_GNSS_STREAM_LOST |
-                                           navbus::FAULT_ST_STREAM_LOST | navbus::FAULT_RAW_IMU_LOST;
+constexpr std::uint32_t kStreamLostFlags =
+    navbus::FAULT_IMU_STREAM_LOST | navbus::FAULT_GNSS_STREAM_LOST | navbus::FAULT_ST_STREAM_LOST |
+    navbus::FAULT_RAW_IMU_LOST;
 
 }  // namespace
 
@@ -35,30 +38,33 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
       config_(config),
       sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
       imu_gate_(bus::topic::kImuIncrement, p.health().stream(bus::topic::kImuIncrement)),
-      gnss_obs_gate_(bus::topic::kGnssObservations, p.health().stream(bus::topic::kGnssObservations)),
+      gnss_obs_gate_(bus::topic::kGnssObservations,
+                     p.health().stream(bus::topic::kGnssObservations)),
       gnss_fix_gate_(bus::topic::kGnssFix, p.health().stream(bus::topic::kGnssFix)),
       star_gate_(bus::topic::kStarTracker, p.health().stream(bus::topic::kStarTracker)) {
   using namespace bus;
-  solution_writer_ = p.createWriter<navbus::NavigationSolutionPubSubType>(topic::kNavSolution, profile::kSolutionWriter);
+  solution_writer_ = p.createWriter<navbus::NavigationSolutionPubSubType>(topic::kNavSolution,
+                                                                          profile::kSolutionWriter);
   p.subscribe<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorReader,
                                               [this](const auto& m, const auto&) { onImu(m); });
   p.subscribe<navbus::GnssObservationEpochPubSubType>(
       topic::kGnssObservations, profile::kMeasurementReader, [this](const auto& m, const auto&) {
         onMeasurement(gnss_obs_gate_, m, m.receiver_id(), config_.gnss_observations, kRankGnssObs);
       });
-  p.subscribe<navbus::GnssFixPubSubType>(topic::kGnssFix, profile::kMeasurementReader,
-                                         [this](const auto& m, const auto&) {
-                                           onMeasurement(gnss_fix_gate_, m, m.receiver_id(), config_.gnss_fix,
-                                                         kRankGnssFix);
-                                         });
+  p.subscribe<navbus::GnssFixPubSubType>(
+      topic::kGnssFix, profile::kMeasurementReader, [this](const auto& m, const auto&) {
+        onMeasurement(gnss_fix_gate_, m, m.receiver_id(), config_.gnss_fix, kRankGnssFix);
+      });
   p.subscribe<navbus::StarTrackerAttitudePubSubType>(
       topic::kStarTracker, profile::kMeasurementReader, [this](const auto& m, const auto&) {
         onMeasurement(star_gate_, m, m.tracker_id(), config_.star_tracker, kRankStarTracker);
       });
-  p.subscribe<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader,
-                                               [this](const auto& d, const auto&) { onDecision(d); });
-  p.subscribe<navbus::FilterCommandPubSubType>(topic::kFilterCommand, profile::kDecisionReader,
-                                               [this](const auto& c, const auto&) { onCommand(c); });
+  p.subscribe<navbus::FaultDecisionPubSubType>(
+      topic::kFaultDecision, profile::kDecisionReader,
+      [this](const auto& d, const auto&) { onDecision(d); });
+  p.subscribe<navbus::FilterCommandPubSubType>(
+      topic::kFilterCommand, profile::kDecisionReader,
+      [this](const auto& c, const auto&) { onCommand(c); });
   // Bounded-wait release of inputs held for a silent stream, and the held solution while
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });
@@ -79,7 +85,8 @@ void FilterNode::reset() {
   updateState();
 }
 
-void FilterNode::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input) {
+void FilterNode::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
+                       FilterInput input) {
   switch (sequencer_.push(id, time_ns, std::move(input))) {
     case InputSequencer<FilterInput>::PushResult::kQueued:
       break;
@@ -89,14 +96,17 @@ void FilterNode::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
       break;
     case InputSequencer<FilterInput>::PushResult::kUnexpected:
       gate.unaccept();
-      gate.reject({navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id.sensor_id)}, id.sensor_id);
+      gate.reject(
+          {navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id.sensor_id)},
+          id.sensor_id);
       break;
   }
 }
 
 void FilterNode::onImu(const navbus::ImuIncrement& msg) {
   if (!imu_gate_.admit(msg, msg.sensor_id(), msg.seq(), msg.time_gps_ns())) return;
-  queue(imu_gate_, {kRankImu, msg.sensor_id()}, static_cast<std::int64_t>(msg.time_gps_ns()), bus::toCore(msg));
+  queue(imu_gate_, {kRankImu, msg.sensor_id()}, static_cast<std::int64_t>(msg.time_gps_ns()),
+        bus::toCore(msg));
 }
 
 template <class Sample>
@@ -151,7 +161,8 @@ void FilterNode::integrate(const core::ImuIncrement& raw_inc) {
   }
   if (strapdown_.state().time_ns >= next_output_ns_) {
     publishSolution();
-    next_output_ns_ = (strapdown_.state().time_ns / config_.solution_period_ns + 1) * config_.solution_period_ns;
+    next_output_ns_ =
+        (strapdown_.state().time_ns / config_.solution_period_ns + 1) * config_.solution_period_ns;
   }
 }
 
@@ -176,7 +187,8 @@ void FilterNode::publishSolution() {
 }
 
 void FilterNode::updateState() {
-  participant_.setState((fault_flags_ & kStreamLostFlags) != 0 ? navbus::STATE_DEGRADED : navbus::STATE_RUNNING);
+  participant_.setState((fault_flags_ & kStreamLostFlags) != 0 ? navbus::STATE_DEGRADED
+                                                               : navbus::STATE_RUNNING);
 }
 
 void FilterNode::onDecision(const navbus::FaultDecision& d) {
@@ -188,10 +200,16 @@ void FilterNode::onDecision(const navbus::FaultDecision& d) {
       flag = navbus::FAULT_IMU_STREAM_LOST;
       is_imu = true;
       break;
-    case navbus::SOURCE_IMU_RAW_STREAM: flag = navbus::FAULT_RAW_IMU_LOST; break;
+    case navbus::SOURCE_IMU_RAW_STREAM:
+      flag = navbus::FAULT_RAW_IMU_LOST;
+      break;
     case navbus::SOURCE_GNSS_OBS_STREAM:
-    case navbus::SOURCE_GNSS_FIX_STREAM: flag = navbus::FAULT_GNSS_STREAM_LOST; break;
-    case navbus::SOURCE_ST_STREAM: flag = navbus::FAULT_ST_STREAM_LOST; break;
+    case navbus::SOURCE_GNSS_FIX_STREAM:
+      flag = navbus::FAULT_GNSS_STREAM_LOST;
+      break;
+    case navbus::SOURCE_ST_STREAM:
+      flag = navbus::FAULT_ST_STREAM_LOST;
+      break;
     default:
       spdlog::warn("decision {} ({}) concerns a detector this filter mode does not use; ignored",
                    d.decision_id(), d.detector());
@@ -204,12 +222,12 @@ void FilterNode::onDecision(const navbus::FaultDecision& d) {
       sequencer_.setActive({kRankImu, config_.imu.id}, false);
       if (strapdown_.initialized()) mode_ = navbus::MODE_INERTIAL_LOST;
     }
-    spdlog::warn("decision {} ({}): stream source {} id {} lost; flags 0x{:x}", d.decision_id(), d.detector(),
-                 static_cast<int>(d.source()), d.sensor_id(), fault_flags_);
+    spdlog::warn("decision {} ({}): stream source {} id {} lost; flags 0x{:x}", d.decision_id(),
+                 d.detector(), static_cast<int>(d.source()), d.sensor_id(), fault_flags_);
   } else if (d.action() == navbus::ACTION_STREAM_RESTORED) {
     fault_flags_ &= ~flag;
-    spdlog::info("decision {} ({}): stream source {} id {} restored; flags 0x{:x}", d.decision_id(), d.detector(),
-                 static_cast<int>(d.source()), d.sensor_id(), fault_flags_);
+    spdlog::info("decision {} ({}): stream source {} id {} restored; flags 0x{:x}", d.decision_id(),
+                 d.detector(), static_cast<int>(d.source()), d.sensor_id(), fault_flags_);
   }
   updateState();
   if (mode_ == navbus::MODE_INERTIAL_LOST) publishSolution();
@@ -233,7 +251,8 @@ void FilterNode::onCommand(const navbus::FilterCommand& c) {
         applied = false;
         break;
       }
-      (c.sensor() == navbus::SOURCE_ACCELEROMETER ? accel_bias_b_mps2_ : gyro_bias_b_radps_)[c.axis()] += c.bias();
+      (c.sensor() == navbus::SOURCE_ACCELEROMETER ? accel_bias_b_mps2_
+                                                  : gyro_bias_b_radps_)[c.axis()] += c.bias();
       fault_flags_ |= navbus::FAULT_SENSOR_AXIS;
       break;
     case navbus::CMD_SELECT_FUSION:
@@ -251,8 +270,10 @@ void FilterNode::onCommand(const navbus::FilterCommand& c) {
     spdlog::info("command {} from '{}' applied", c.command_id(), c.issuer());
   } else {
     ++commands_refused_;
-    spdlog::warn("command {} from '{}' refused: kind {} not available in mechanization-only mode or bad field",
-                 c.command_id(), c.issuer(), static_cast<int>(c.kind()));
+    spdlog::warn(
+        "command {} from '{}' refused: kind {} not available in mechanization-only mode or bad "
+        "field",
+        c.command_id(), c.issuer(), static_cast<int>(c.kind()));
   }
 }
 

@@ -23,7 +23,9 @@ namespace navbus::nav_filter {
 struct StreamId {
   int rank{0};  ///< tie-break at equal times: lower rank first (IMU before measurements)
   std::uint32_t sensor_id{0};
-  bool operator<(const StreamId& o) const { return std::tie(rank, sensor_id) < std::tie(o.rank, o.sensor_id); }
+  bool operator<(const StreamId& o) const {
+    return std::tie(rank, sensor_id) < std::tie(o.rank, o.sensor_id);
+  }
   bool operator==(const StreamId& o) const { return rank == o.rank && sensor_id == o.sensor_id; }
 };
 

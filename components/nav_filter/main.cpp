@@ -10,10 +10,13 @@ int main(int argc, char** argv) {
   CLI::App app{"navbus-filter: strapdown navigation filter on the navbus DDS bus", "navbus-filter"};
   nb::bus::CommonOptions common;
   nb::bus::addCommonOptions(app, common, true);
-  app.footer("Exit codes: 0 stopped by SIGINT/SIGTERM, 1 runtime error, 2 configuration error, 3 DDS error.");
+  app.footer(
+      "Exit codes: 0 stopped by SIGINT/SIGTERM, 1 runtime error, 2 configuration error, 3 DDS "
+      "error.");
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) {
     const nb::nav_filter::FilterConfig config = nb::nav_filter::parseFilterConfig(yaml);
-    nb::bus::Participant participant(nb::bus::participantOptions(common, yaml, "navbus-filter"), shutdown);
+    nb::bus::Participant participant(nb::bus::participantOptions(common, yaml, "navbus-filter"),
+                                     shutdown);
     nb::nav_filter::FilterNode node(participant, config);
     spdlog::info("running: vehicle {}, solution every {} ms, IMU sensor {}", config.vehicle_id,
                  config.solution_period_ns / 1'000'000, config.imu.id);

@@ -15,7 +15,8 @@ void copy3(const Eigen::Vector3d& v, Array& a) {
 }
 }  // namespace
 
-navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id, std::uint64_t seq) {
+navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id,
+                          std::uint64_t seq) {
   navbus::ImuRawBlock msg;
   msg.sensor_id(sensor_id);
   msg.seq(seq);
@@ -31,7 +32,8 @@ navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id
   return msg;
 }
 
-navbus::GnssObservationEpoch toIdl(const sim::GnssEpoch& epoch, std::uint32_t receiver_id, std::uint64_t seq) {
+navbus::GnssObservationEpoch toIdl(const sim::GnssEpoch& epoch, std::uint32_t receiver_id,
+                                   std::uint64_t seq) {
   navbus::GnssObservationEpoch msg;
   msg.receiver_id(receiver_id);
   msg.seq(seq);
@@ -71,7 +73,8 @@ navbus::GnssFix toIdl(const sim::GnssFixSample& fix, std::uint32_t receiver_id, 
   return msg;
 }
 
-navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_t tracker_id, std::uint64_t seq) {
+navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_t tracker_id,
+                                  std::uint64_t seq) {
   navbus::StarTrackerAttitude msg;
   msg.tracker_id(tracker_id);
   msg.seq(seq);
@@ -85,18 +88,21 @@ navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_
 FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& config)
     : participant_(participant), config_(config) {
   using namespace bus;
-  imu_ = participant.createWriter<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorWriter);
+  imu_ = participant.createWriter<navbus::ImuIncrementPubSubType>(topic::kImuIncrement,
+                                                                  profile::kSensorWriter);
   if (config.publish_raw) {
-    raw_ = participant.createWriter<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, profile::kSensorWriter);
+    raw_ = participant.createWriter<navbus::ImuRawBlockPubSubType>(topic::kImuRaw,
+                                                                   profile::kSensorWriter);
   }
   if (config.publish_gnss) {
-    gnss_ = participant.createWriter<navbus::GnssObservationEpochPubSubType>(topic::kGnssObservations,
-                                                                            profile::kMeasurementWriter);
-    fix_ = participant.createWriter<navbus::GnssFixPubSubType>(topic::kGnssFix, profile::kMeasurementWriter);
+    gnss_ = participant.createWriter<navbus::GnssObservationEpochPubSubType>(
+        topic::kGnssObservations, profile::kMeasurementWriter);
+    fix_ = participant.createWriter<navbus::GnssFixPubSubType>(topic::kGnssFix,
+                                                               profile::kMeasurementWriter);
   }
   if (config.publish_star_tracker) {
-    star_ = participant.createWriter<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker,
-                                                                           profile::kMeasurementWriter);
+    star_ = participant.createWriter<navbus::StarTrackerAttitudePubSubType>(
+        topic::kStarTracker, profile::kMeasurementWriter);
   }
 }
 
@@ -122,13 +128,17 @@ bool FramePublisher::publish(const sim::SensorFrame& f) {
     ++counts_.raw;
   }
   if (config_.publish_gnss && f.has_gnss) {
-    if (!writeReliably(gnss_, toIdl(f.gnss, config_.gnss_receiver_id, counts_.gnss_epochs + 1))) return false;
+    if (!writeReliably(gnss_, toIdl(f.gnss, config_.gnss_receiver_id, counts_.gnss_epochs + 1)))
+      return false;
     ++counts_.gnss_epochs;
-    if (!writeReliably(fix_, toIdl(f.fix, config_.gnss_receiver_id, counts_.gnss_fixes + 1))) return false;
+    if (!writeReliably(fix_, toIdl(f.fix, config_.gnss_receiver_id, counts_.gnss_fixes + 1)))
+      return false;
     ++counts_.gnss_fixes;
   }
   if (config_.publish_star_tracker && f.has_star_tracker) {
-    if (!writeReliably(star_, toIdl(f.star_tracker, config_.star_tracker_id, counts_.star_tracker + 1))) return false;
+    if (!writeReliably(star_,
+                       toIdl(f.star_tracker, config_.star_tracker_id, counts_.star_tracker + 1)))
+      return false;
     ++counts_.star_tracker;
   }
   return true;

@@ -16,10 +16,13 @@
 
 namespace navbus::sensor_sim {
 
-navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id, std::uint64_t seq);
-navbus::GnssObservationEpoch toIdl(const sim::GnssEpoch& epoch, std::uint32_t receiver_id, std::uint64_t seq);
+navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id,
+                          std::uint64_t seq);
+navbus::GnssObservationEpoch toIdl(const sim::GnssEpoch& epoch, std::uint32_t receiver_id,
+                                   std::uint64_t seq);
 navbus::GnssFix toIdl(const sim::GnssFixSample& fix, std::uint32_t receiver_id, std::uint64_t seq);
-navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_t tracker_id, std::uint64_t seq);
+navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_t tracker_id,
+                                  std::uint64_t seq);
 
 class FramePublisher {
  public:

@@ -12,8 +12,9 @@ namespace nb = navbus;
 
 int main(int argc, char** argv) {
   nb::bus::ShutdownSignal shutdown;
-  CLI::App app{"navbus-sensor-sim: simulated IMU, GNSS and star-tracker streams on the navbus DDS bus",
-               "navbus-sensor-sim"};
+  CLI::App app{
+      "navbus-sensor-sim: simulated IMU, GNSS and star-tracker streams on the navbus DDS bus",
+      "navbus-sensor-sim"};
   nb::bus::CommonOptions common;
   double duration_override = -1.0;
   std::string pacing_override;
@@ -31,8 +32,8 @@ int main(int argc, char** argv) {
       config.pacing = pacing_override == "fast" ? nb::sensor_sim::Pacing::kFast
                                                 : nb::sensor_sim::Pacing::kRealTime;
     }
-    nb::bus::Participant participant(
-        nb::bus::participantOptions(common, yaml, "navbus-sensor-sim"), shutdown);
+    nb::bus::Participant participant(nb::bus::participantOptions(common, yaml, "navbus-sensor-sim"),
+                                     shutdown);
     nb::sensor_sim::FramePublisher publisher(participant, config);
 
     using Clock = std::chrono::steady_clock;
@@ -43,8 +44,9 @@ int main(int argc, char** argv) {
       participant.spinOnce(std::chrono::milliseconds(20));
     }
     if (!publisher.readersMatched()) {
-      spdlog::warn("readers not all matched after {} s ({} on the IMU topic, {} wanted); publishing anyway",
-                   config.wait_for_readers_s, publisher.imuReaders(), config.min_readers.imu);
+      spdlog::warn(
+          "readers not all matched after {} s ({} on the IMU topic, {} wanted); publishing anyway",
+          config.wait_for_readers_s, publisher.imuReaders(), config.min_readers.imu);
     }
     if (config.start_now) {
       // Real GPS time, on a whole IMU period, so that a restarted simulator continues forward.
@@ -54,12 +56,14 @@ int main(int argc, char** argv) {
     nb::sim::StationarySource source(config.source);
     const std::int64_t period_ns = config.source.imu_period_ns;
     const std::int64_t total = config.duration_s > 0.0
-                                   ? static_cast<std::int64_t>(std::llround(config.duration_s * 1e9 / static_cast<double>(period_ns)))
+                                   ? static_cast<std::int64_t>(std::llround(
+                                         config.duration_s * 1e9 / static_cast<double>(period_ns)))
                                    : -1;
-    spdlog::info("publishing {} s of data, {} pacing, IMU {} Hz, start GPS {} ns",
-                 config.duration_s > 0 ? std::to_string(config.duration_s) : std::string("unbounded"),
-                 config.pacing == nb::sensor_sim::Pacing::kFast ? "fast" : "real-time",
-                 1e9 / static_cast<double>(period_ns), config.source.start_time_ns);
+    spdlog::info(
+        "publishing {} s of data, {} pacing, IMU {} Hz, start GPS {} ns",
+        config.duration_s > 0 ? std::to_string(config.duration_s) : std::string("unbounded"),
+        config.pacing == nb::sensor_sim::Pacing::kFast ? "fast" : "real-time",
+        1e9 / static_cast<double>(period_ns), config.source.start_time_ns);
     const auto wall_start = Clock::now();
     while (!participant.stopping() && (total < 0 || source.index() < total)) {
       const nb::sim::SensorFrame frame = source.next();
@@ -67,7 +71,8 @@ int main(int argc, char** argv) {
       if (config.pacing == nb::sensor_sim::Pacing::kRealTime) {
         const auto due = wall_start + std::chrono::nanoseconds(source.index() * period_ns);
         while (!participant.stopping() && Clock::now() < due) {
-          participant.spinOnce(std::chrono::duration_cast<std::chrono::nanoseconds>(due - Clock::now()));
+          participant.spinOnce(
+              std::chrono::duration_cast<std::chrono::nanoseconds>(due - Clock::now()));
         }
       } else {
         participant.spinOnce(std::chrono::nanoseconds(0));
@@ -76,10 +81,11 @@ int main(int argc, char** argv) {
     publisher.flush();
     participant.finish();
     const auto& n = publisher.counts();
-    spdlog::info("summary: published {} IMU increments, {} raw blocks, {} GNSS epochs, {} GNSS fixes, "
-                 "{} star-tracker attitudes ({} s of data), {} write retries",
-                 n.imu, n.raw, n.gnss_epochs, n.gnss_fixes, n.star_tracker,
-                 static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9, n.write_retries);
+    spdlog::info(
+        "summary: published {} IMU increments, {} raw blocks, {} GNSS epochs, {} GNSS fixes, "
+        "{} star-tracker attitudes ({} s of data), {} write retries",
+        n.imu, n.raw, n.gnss_epochs, n.gnss_fixes, n.star_tracker,
+        static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9, n.write_retries);
     return static_cast<int>(nb::bus::kExitOk);
   });
 }

@@ -15,8 +15,8 @@ enum class Pacing { kRealTime, kFast };
 
 struct SimConfig {
   sim::StationarySourceConfig source;
-  bool start_now{true};          ///< start at the current GPS time (real time), else start_gps_ns
-  double duration_s{0.0};        ///< 0: until stopped
+  bool start_now{true};    ///< start at the current GPS time (real time), else start_gps_ns
+  double duration_s{0.0};  ///< 0: until stopped
   Pacing pacing{Pacing::kRealTime};
   double wait_for_readers_s{10.0};  ///< wait this long for readers before publishing
   /// Readers to wait for before publishing, per topic.

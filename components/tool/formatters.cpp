@@ -30,7 +30,9 @@ std::vector<std::vector<std::string>> CellCollector::rowsOut() const {
   if (rows_at_ == static_cast<std::size_t>(-1)) return {cells_};
   std::vector<std::vector<std::string>> out;
   const std::vector<std::vector<std::string>> elements =
-      row_cells_.empty() ? std::vector<std::vector<std::string>>{std::vector<std::string>(row_names_.size())} : row_cells_;
+      row_cells_.empty()
+          ? std::vector<std::vector<std::string>>{std::vector<std::string>(row_names_.size())}
+          : row_cells_;
   for (const auto& e : elements) {
     std::vector<std::string> row(cells_.begin(), cells_.begin() + static_cast<long>(rows_at_));
     row.insert(row.end(), e.begin(), e.end());

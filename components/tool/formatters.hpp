@@ -36,10 +36,12 @@ class CellCollector {
       add(name, csvQuote(value));
     } else if constexpr (std::is_same_v<T, std::vector<double>>) {
       std::string joined;
-      for (std::size_t i = 0; i < value.size(); ++i) joined += (i ? ";" : "") + formatNumber(value[i]);
+      for (std::size_t i = 0; i < value.size(); ++i)
+        joined += (i ? ";" : "") + formatNumber(value[i]);
       add(name, joined);
     } else {  // std::array<double, N>
-      for (std::size_t i = 0; i < value.size(); ++i) add(name + "[" + std::to_string(i) + "]", formatNumber(value[i]));
+      for (std::size_t i = 0; i < value.size(); ++i)
+        add(name + "[" + std::to_string(i) + "]", formatNumber(value[i]));
     }
   }
   /// Bounded IDL strings (string<N>) are fixed_string<N> in the generated C++.
@@ -108,8 +110,11 @@ std::string textOf(const T& msg) {
   const auto rows = c.rowsOut();
   for (std::size_t r = 0; r < rows.size(); ++r) {
     for (std::size_t i = 0; i < names.size(); ++i) {
-      if (r > 0 && names[i].find('.') == std::string::npos) continue;  // row-independent fields once
-      out += names[i] + (rows.size() > 1 && names[i].find('.') != std::string::npos ? "#" + std::to_string(r) : "") +
+      if (r > 0 && names[i].find('.') == std::string::npos)
+        continue;  // row-independent fields once
+      out += names[i] +
+             (rows.size() > 1 && names[i].find('.') != std::string::npos ? "#" + std::to_string(r)
+                                                                         : "") +
              ": " + rows[r][i] + "\n";
     }
   }

@@ -26,12 +26,16 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
     std::string type;
     std::set<std::string> writers, readers;
   };
-  void on_publisher_discovery(fdds::DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
-    update(info.info.topicName().to_string(), info.info.typeName().to_string(), guid(info.info.guid()), true,
+  void on_publisher_discovery(fdds::DomainParticipant*,
+                              eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    update(info.info.topicName().to_string(), info.info.typeName().to_string(),
+           guid(info.info.guid()), true,
            info.status == eprosima::fastrtps::rtps::WriterDiscoveryInfo::REMOVED_WRITER);
   }
-  void on_subscriber_discovery(fdds::DomainParticipant*, eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
-    update(info.info.topicName().to_string(), info.info.typeName().to_string(), guid(info.info.guid()), false,
+  void on_subscriber_discovery(fdds::DomainParticipant*,
+                               eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+    update(info.info.topicName().to_string(), info.info.typeName().to_string(),
+           guid(info.info.guid()), false,
            info.status == eprosima::fastrtps::rtps::ReaderDiscoveryInfo::REMOVED_READER);
   }
   std::map<std::string, Endpoints> snapshot() {
@@ -45,12 +49,16 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
     out << g;
     return out.str();
   }
-  void update(const std::string& topic, const std::string& type, const std::string& id, bool writer, bool removed) {
+  void update(const std::string& topic, const std::string& type, const std::string& id, bool writer,
+              bool removed) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto& e = topics_[topic];
     e.type = type;
     auto& set = writer ? e.writers : e.readers;
-    if (removed) set.erase(id); else set.insert(id);
+    if (removed)
+      set.erase(id);
+    else
+      set.insert(id);
   }
   std::mutex mutex_;
   std::map<std::string, Endpoints> topics_;
@@ -86,7 +94,8 @@ class RecordSink : public nb::tool::SampleSink {
  public:
   void open(const nb::tool::TopicEntry& e, const std::filesystem::path& dir) {
     std::string file = e.name;
-    for (char& c : file) if (c == '/') c = '_';
+    for (char& c : file)
+      if (c == '/') c = '_';
     auto& f = files_[e.name];
     f.stream = std::make_unique<std::ofstream>(dir / (file + ".csv"));
     if (!*f.stream) throw std::runtime_error("cannot write " + (dir / (file + ".csv")).string());
@@ -124,7 +133,8 @@ const nb::tool::TopicEntry& requireTopic(const std::string& name) {
 /// Runs the participant until `done()` or `duration_s` (0: until SIGINT/SIGTERM).
 void runFor(nb::bus::Participant& p, double duration_s, const std::function<bool()>& done) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
-  while (!p.stopping() && !done() && (duration_s <= 0.0 || std::chrono::steady_clock::now() < end)) {
+  while (!p.stopping() && !done() &&
+         (duration_s <= 0.0 || std::chrono::steady_clock::now() < end)) {
     p.spinOnce(std::chrono::milliseconds(50));
   }
   p.finish();
@@ -138,11 +148,15 @@ int main(int argc, char** argv) {
   nb::bus::CommonOptions common;
   nb::bus::addCommonOptions(app, common, false);
   app.require_subcommand(1);
-  app.footer("Exit codes: 0 ok, 1 fewer samples than --count, 2 usage or configuration error, 3 DDS error.");
+  app.footer(
+      "Exit codes: 0 ok, 1 fewer samples than --count, 2 usage or configuration error, 3 DDS "
+      "error.");
 
   double wait_s = 2.0;
-  auto* topics_cmd = app.add_subcommand("topics", "list the topics seen on the bus with their writers and readers");
-  topics_cmd->add_option("--wait", wait_s, "seconds of discovery before printing")->check(CLI::Range(0.1, 600.0));
+  auto* topics_cmd = app.add_subcommand(
+      "topics", "list the topics seen on the bus with their writers and readers");
+  topics_cmd->add_option("--wait", wait_s, "seconds of discovery before printing")
+      ->check(CLI::Range(0.1, 600.0));
 
   std::string echo_topic;
   bool echo_csv = false;
@@ -159,8 +173,10 @@ int main(int argc, char** argv) {
   auto* record_cmd = app.add_subcommand("record", "record topics into CSV files, one per topic");
   record_cmd->add_option("topics", record_topics, "topic names")->required();
   record_cmd->add_option("-o,--out", out_dir, "output directory (created)")->required();
-  record_cmd->add_option("-n,--count", count, "stop when every topic has this many samples (exit 1 if not reached)");
-  record_cmd->add_option("--duration", duration_s, "stop after this many seconds (0: until SIGINT)");
+  record_cmd->add_option("-n,--count", count,
+                         "stop when every topic has this many samples (exit 1 if not reached)");
+  record_cmd->add_option("--duration", duration_s,
+                         "stop after this many seconds (0: until SIGINT)");
 
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) -> int {
     auto options = nb::bus::participantOptions(common, yaml, "navbus");
@@ -171,7 +187,8 @@ int main(int argc, char** argv) {
       runFor(p, wait_s, [] { return false; });
       std::printf("%-30s %-36s %8s %8s\n", "TOPIC", "TYPE", "WRITERS", "READERS");
       for (const auto& [topic, e] : listener.snapshot()) {
-        std::printf("%-30s %-36s %8zu %8zu\n", topic.c_str(), e.type.c_str(), e.writers.size(), e.readers.size());
+        std::printf("%-30s %-36s %8zu %8zu\n", topic.c_str(), e.type.c_str(), e.writers.size(),
+                    e.readers.size());
       }
       return nb::bus::kExitOk;
     }
@@ -195,7 +212,8 @@ int main(int argc, char** argv) {
     }
     auto all_counted = [&] {
       if (count == 0) return false;
-      for (const auto* e : entries) if (sink.samples(e->name) < count) return false;
+      for (const auto* e : entries)
+        if (sink.samples(e->name) < count) return false;
       return true;
     };
     runFor(p, duration_s, all_counted);

@@ -4,81 +4,126 @@ namespace navbus::tool {
 
 const char* enumName(navbus::FilterMode v) {
   switch (v) {
-    case navbus::MODE_INITIALIZING: return "INITIALIZING";
-    case navbus::MODE_INERTIAL_ONLY: return "INERTIAL_ONLY";
-    case navbus::MODE_TIGHTLY_COUPLED: return "TIGHTLY_COUPLED";
-    case navbus::MODE_LOOSELY_COUPLED: return "LOOSELY_COUPLED";
-    case navbus::MODE_MDF_F1_ZUPT: return "MDF_F1_ZUPT";
-    case navbus::MODE_MDF_F2_GNSS: return "MDF_F2_GNSS";
-    case navbus::MODE_MDF_F3_RECOVERY: return "MDF_F3_RECOVERY";
-    case navbus::MODE_MDF_F4_CIF: return "MDF_F4_CIF";
-    case navbus::MODE_INERTIAL_LOST: return "INERTIAL_LOST";
+    case navbus::MODE_INITIALIZING:
+      return "INITIALIZING";
+    case navbus::MODE_INERTIAL_ONLY:
+      return "INERTIAL_ONLY";
+    case navbus::MODE_TIGHTLY_COUPLED:
+      return "TIGHTLY_COUPLED";
+    case navbus::MODE_LOOSELY_COUPLED:
+      return "LOOSELY_COUPLED";
+    case navbus::MODE_MDF_F1_ZUPT:
+      return "MDF_F1_ZUPT";
+    case navbus::MODE_MDF_F2_GNSS:
+      return "MDF_F2_GNSS";
+    case navbus::MODE_MDF_F3_RECOVERY:
+      return "MDF_F3_RECOVERY";
+    case navbus::MODE_MDF_F4_CIF:
+      return "MDF_F4_CIF";
+    case navbus::MODE_INERTIAL_LOST:
+      return "INERTIAL_LOST";
   }
   return "UNKNOWN";
 }
 const char* enumName(navbus::FusionStructure v) {
   switch (v) {
-    case navbus::FUSION_NONE: return "NONE";
-    case navbus::FUSION_CENTRALIZED: return "CENTRALIZED";
-    case navbus::FUSION_FEDERATED: return "FEDERATED";
-    case navbus::FUSION_ADAPTIVE: return "ADAPTIVE";
+    case navbus::FUSION_NONE:
+      return "NONE";
+    case navbus::FUSION_CENTRALIZED:
+      return "CENTRALIZED";
+    case navbus::FUSION_FEDERATED:
+      return "FEDERATED";
+    case navbus::FUSION_ADAPTIVE:
+      return "ADAPTIVE";
   }
   return "UNKNOWN";
 }
 const char* enumName(navbus::FaultSource v) {
   switch (v) {
-    case navbus::SOURCE_IMU_STREAM: return "IMU_STREAM";
-    case navbus::SOURCE_IMU_RAW_STREAM: return "IMU_RAW_STREAM";
-    case navbus::SOURCE_GNSS_OBS_STREAM: return "GNSS_OBS_STREAM";
-    case navbus::SOURCE_GNSS_FIX_STREAM: return "GNSS_FIX_STREAM";
-    case navbus::SOURCE_ST_STREAM: return "ST_STREAM";
-    case navbus::SOURCE_ACCELEROMETER: return "ACCELEROMETER";
-    case navbus::SOURCE_GYRO: return "GYRO";
-    case navbus::SOURCE_SATELLITE: return "SATELLITE";
-    case navbus::SOURCE_STAR_TRACKER: return "STAR_TRACKER";
+    case navbus::SOURCE_IMU_STREAM:
+      return "IMU_STREAM";
+    case navbus::SOURCE_IMU_RAW_STREAM:
+      return "IMU_RAW_STREAM";
+    case navbus::SOURCE_GNSS_OBS_STREAM:
+      return "GNSS_OBS_STREAM";
+    case navbus::SOURCE_GNSS_FIX_STREAM:
+      return "GNSS_FIX_STREAM";
+    case navbus::SOURCE_ST_STREAM:
+      return "ST_STREAM";
+    case navbus::SOURCE_ACCELEROMETER:
+      return "ACCELEROMETER";
+    case navbus::SOURCE_GYRO:
+      return "GYRO";
+    case navbus::SOURCE_SATELLITE:
+      return "SATELLITE";
+    case navbus::SOURCE_STAR_TRACKER:
+      return "STAR_TRACKER";
   }
   return "UNKNOWN";
 }
 const char* enumName(navbus::FaultAction v) {
   switch (v) {
-    case navbus::ACTION_NONE: return "NONE";
-    case navbus::ACTION_STREAM_LOST: return "STREAM_LOST";
-    case navbus::ACTION_STREAM_RESTORED: return "STREAM_RESTORED";
-    case navbus::ACTION_EXCLUDE: return "EXCLUDE";
-    case navbus::ACTION_READMIT: return "READMIT";
-    case navbus::ACTION_COMPENSATE: return "COMPENSATE";
+    case navbus::ACTION_NONE:
+      return "NONE";
+    case navbus::ACTION_STREAM_LOST:
+      return "STREAM_LOST";
+    case navbus::ACTION_STREAM_RESTORED:
+      return "STREAM_RESTORED";
+    case navbus::ACTION_EXCLUDE:
+      return "EXCLUDE";
+    case navbus::ACTION_READMIT:
+      return "READMIT";
+    case navbus::ACTION_COMPENSATE:
+      return "COMPENSATE";
   }
   return "UNKNOWN";
 }
 const char* enumName(navbus::CommandKind v) {
   switch (v) {
-    case navbus::CMD_EXCLUDE_SATELLITE: return "EXCLUDE_SATELLITE";
-    case navbus::CMD_READMIT_SATELLITE: return "READMIT_SATELLITE";
-    case navbus::CMD_COMPENSATE_BIAS: return "COMPENSATE_BIAS";
-    case navbus::CMD_SELECT_FUSION: return "SELECT_FUSION";
-    case navbus::CMD_SELECT_MODE: return "SELECT_MODE";
-    case navbus::CMD_RESET: return "RESET";
+    case navbus::CMD_EXCLUDE_SATELLITE:
+      return "EXCLUDE_SATELLITE";
+    case navbus::CMD_READMIT_SATELLITE:
+      return "READMIT_SATELLITE";
+    case navbus::CMD_COMPENSATE_BIAS:
+      return "COMPENSATE_BIAS";
+    case navbus::CMD_SELECT_FUSION:
+      return "SELECT_FUSION";
+    case navbus::CMD_SELECT_MODE:
+      return "SELECT_MODE";
+    case navbus::CMD_RESET:
+      return "RESET";
   }
   return "UNKNOWN";
 }
 const char* enumName(navbus::ParticipantState v) {
   switch (v) {
-    case navbus::STATE_STARTING: return "STARTING";
-    case navbus::STATE_RUNNING: return "RUNNING";
-    case navbus::STATE_DEGRADED: return "DEGRADED";
-    case navbus::STATE_STOPPING: return "STOPPING";
+    case navbus::STATE_STARTING:
+      return "STARTING";
+    case navbus::STATE_RUNNING:
+      return "RUNNING";
+    case navbus::STATE_DEGRADED:
+      return "DEGRADED";
+    case navbus::STATE_STOPPING:
+      return "STOPPING";
   }
   return "UNKNOWN";
 }
 const char* enumName(navbus::MeasurementKind v) {
   switch (v) {
-    case navbus::MEAS_PSEUDORANGE: return "PSEUDORANGE";
-    case navbus::MEAS_PSEUDORANGE_RATE: return "PSEUDORANGE_RATE";
-    case navbus::MEAS_POSITION: return "POSITION";
-    case navbus::MEAS_VELOCITY: return "VELOCITY";
-    case navbus::MEAS_ATTITUDE: return "ATTITUDE";
-    case navbus::MEAS_ZERO_VELOCITY: return "ZERO_VELOCITY";
-    case navbus::MEAS_NONHOLONOMIC: return "NONHOLONOMIC";
+    case navbus::MEAS_PSEUDORANGE:
+      return "PSEUDORANGE";
+    case navbus::MEAS_PSEUDORANGE_RATE:
+      return "PSEUDORANGE_RATE";
+    case navbus::MEAS_POSITION:
+      return "POSITION";
+    case navbus::MEAS_VELOCITY:
+      return "VELOCITY";
+    case navbus::MEAS_ATTITUDE:
+      return "ATTITUDE";
+    case navbus::MEAS_ZERO_VELOCITY:
+      return "ZERO_VELOCITY";
+    case navbus::MEAS_NONHOLONOMIC:
+      return "NONHOLONOMIC";
   }
   return "UNKNOWN";
 }

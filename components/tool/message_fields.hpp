@@ -26,88 +26,178 @@ const char* enumName(navbus::FaultAction v);
 const char* enumName(navbus::CommandKind v);
 const char* enumName(navbus::ParticipantState v);
 const char* enumName(navbus::MeasurementKind v);
-inline const char* enumName(navbus::RejectReason v) { return bus::rejectReasonName(v); }
+inline const char* enumName(navbus::RejectReason v) {
+  return bus::rejectReasonName(v);
+}
 
-template <class V> void visitFields(const navbus::ImuIncrement& m, V& v) {
-  v("sensor_id", m.sensor_id()); v("seq", m.seq()); v("time_gps_ns", m.time_gps_ns());
-  v("interval_ns", m.interval_ns()); v("delta_vel_b_mps", m.delta_vel_b_mps());
-  v("delta_angle_b_rad", m.delta_angle_b_rad()); v("status_flags", m.status_flags());
+template <class V>
+void visitFields(const navbus::ImuIncrement& m, V& v) {
+  v("sensor_id", m.sensor_id());
+  v("seq", m.seq());
+  v("time_gps_ns", m.time_gps_ns());
+  v("interval_ns", m.interval_ns());
+  v("delta_vel_b_mps", m.delta_vel_b_mps());
+  v("delta_angle_b_rad", m.delta_angle_b_rad());
+  v("status_flags", m.status_flags());
 }
-template <class V> void visitFields(const navbus::ImuRawSample& m, V& v) {
-  v("angular_rate_b_radps", m.angular_rate_b_radps()); v("specific_force_b_mps2", m.specific_force_b_mps2());
+template <class V>
+void visitFields(const navbus::ImuRawSample& m, V& v) {
+  v("angular_rate_b_radps", m.angular_rate_b_radps());
+  v("specific_force_b_mps2", m.specific_force_b_mps2());
 }
-template <class V> void visitFields(const navbus::ImuRawBlock& m, V& v) {
-  v("sensor_id", m.sensor_id()); v("seq", m.seq()); v("first_sample_time_gps_ns", m.first_sample_time_gps_ns());
-  v("sample_period_ns", m.sample_period_ns()); v.rows("samples", m.samples());
+template <class V>
+void visitFields(const navbus::ImuRawBlock& m, V& v) {
+  v("sensor_id", m.sensor_id());
+  v("seq", m.seq());
+  v("first_sample_time_gps_ns", m.first_sample_time_gps_ns());
+  v("sample_period_ns", m.sample_period_ns());
+  v.rows("samples", m.samples());
 }
-template <class V> void visitFields(const navbus::GnssSatelliteMeasurement& m, V& v) {
-  v("sv_id", m.sv_id()); v("pseudorange_m", m.pseudorange_m()); v("pseudorange_rate_mps", m.pseudorange_rate_mps());
-  v("sat_pos_ecef_m", m.sat_pos_ecef_m()); v("sat_vel_ecef_mps", m.sat_vel_ecef_mps());
-  v("sat_clock_correction_m", m.sat_clock_correction_m()); v("sat_clock_drift_mps", m.sat_clock_drift_mps());
-  v("cn0_dbhz", m.cn0_dbhz()); v("pseudorange_sigma_m", m.pseudorange_sigma_m());
-  v("pseudorange_rate_sigma_mps", m.pseudorange_rate_sigma_mps()); v("valid", m.valid());
-}
-template <class V> void visitFields(const navbus::GnssObservationEpoch& m, V& v) {
-  v("receiver_id", m.receiver_id()); v("seq", m.seq()); v("time_gps_ns", m.time_gps_ns());
-  v.rows("satellites", m.satellites());
-}
-template <class V> void visitFields(const navbus::GnssFix& m, V& v) {
-  v("receiver_id", m.receiver_id()); v("seq", m.seq()); v("time_gps_ns", m.time_gps_ns());
-  v("latitude_rad", m.latitude_rad()); v("longitude_rad", m.longitude_rad()); v("height_m", m.height_m());
-  v("pos_ecef_m", m.pos_ecef_m()); v("vel_ned_mps", m.vel_ned_mps()); v("pos_sigma_ned_m", m.pos_sigma_ned_m());
-  v("vel_sigma_ned_mps", m.vel_sigma_ned_mps()); v("num_satellites_used", m.num_satellites_used());
+template <class V>
+void visitFields(const navbus::GnssSatelliteMeasurement& m, V& v) {
+  v("sv_id", m.sv_id());
+  v("pseudorange_m", m.pseudorange_m());
+  v("pseudorange_rate_mps", m.pseudorange_rate_mps());
+  v("sat_pos_ecef_m", m.sat_pos_ecef_m());
+  v("sat_vel_ecef_mps", m.sat_vel_ecef_mps());
+  v("sat_clock_correction_m", m.sat_clock_correction_m());
+  v("sat_clock_drift_mps", m.sat_clock_drift_mps());
+  v("cn0_dbhz", m.cn0_dbhz());
+  v("pseudorange_sigma_m", m.pseudorange_sigma_m());
+  v("pseudorange_rate_sigma_mps", m.pseudorange_rate_sigma_mps());
   v("valid", m.valid());
 }
-template <class V> void visitFields(const navbus::StarTrackerAttitude& m, V& v) {
-  v("tracker_id", m.tracker_id()); v("seq", m.seq()); v("time_gps_ns", m.time_gps_ns());
-  v("q_b_to_i", m.q_b_to_i()); v("sigma_b_rad", m.sigma_b_rad()); v("valid", m.valid());
+template <class V>
+void visitFields(const navbus::GnssObservationEpoch& m, V& v) {
+  v("receiver_id", m.receiver_id());
+  v("seq", m.seq());
+  v("time_gps_ns", m.time_gps_ns());
+  v.rows("satellites", m.satellites());
 }
-template <class V> void visitFields(const navbus::NavigationSolution& m, V& v) {
-  v("vehicle_id", m.vehicle_id()); v("seq", m.seq()); v("time_gps_ns", m.time_gps_ns());
-  v("latitude_rad", m.latitude_rad()); v("longitude_rad", m.longitude_rad()); v("height_m", m.height_m());
-  v("pos_ecef_m", m.pos_ecef_m()); v("vel_ned_mps", m.vel_ned_mps()); v("q_b_to_n", m.q_b_to_n());
-  v("roll_rad", m.roll_rad()); v("pitch_rad", m.pitch_rad()); v("yaw_rad", m.yaw_rad());
-  v("pos_sigma_ned_m", m.pos_sigma_ned_m()); v("vel_sigma_ned_mps", m.vel_sigma_ned_mps());
-  v("att_sigma_ned_rad", m.att_sigma_ned_rad()); v("clock_bias_m", m.clock_bias_m());
-  v("clock_drift_mps", m.clock_drift_mps()); v("clock_bias_sigma_m", m.clock_bias_sigma_m());
-  v("clock_drift_sigma_mps", m.clock_drift_sigma_mps()); v("accel_bias_b_mps2", m.accel_bias_b_mps2());
-  v("gyro_bias_b_radps", m.gyro_bias_b_radps()); v("accel_bias_sigma_b_mps2", m.accel_bias_sigma_b_mps2());
-  v("gyro_bias_sigma_b_radps", m.gyro_bias_sigma_b_radps()); v("mode", m.mode()); v("fusion", m.fusion());
-  v("covariance_valid", m.covariance_valid()); v("active_fault_flags", m.active_fault_flags());
+template <class V>
+void visitFields(const navbus::GnssFix& m, V& v) {
+  v("receiver_id", m.receiver_id());
+  v("seq", m.seq());
+  v("time_gps_ns", m.time_gps_ns());
+  v("latitude_rad", m.latitude_rad());
+  v("longitude_rad", m.longitude_rad());
+  v("height_m", m.height_m());
+  v("pos_ecef_m", m.pos_ecef_m());
+  v("vel_ned_mps", m.vel_ned_mps());
+  v("pos_sigma_ned_m", m.pos_sigma_ned_m());
+  v("vel_sigma_ned_mps", m.vel_sigma_ned_mps());
+  v("num_satellites_used", m.num_satellites_used());
+  v("valid", m.valid());
+}
+template <class V>
+void visitFields(const navbus::StarTrackerAttitude& m, V& v) {
+  v("tracker_id", m.tracker_id());
+  v("seq", m.seq());
+  v("time_gps_ns", m.time_gps_ns());
+  v("q_b_to_i", m.q_b_to_i());
+  v("sigma_b_rad", m.sigma_b_rad());
+  v("valid", m.valid());
+}
+template <class V>
+void visitFields(const navbus::NavigationSolution& m, V& v) {
+  v("vehicle_id", m.vehicle_id());
+  v("seq", m.seq());
+  v("time_gps_ns", m.time_gps_ns());
+  v("latitude_rad", m.latitude_rad());
+  v("longitude_rad", m.longitude_rad());
+  v("height_m", m.height_m());
+  v("pos_ecef_m", m.pos_ecef_m());
+  v("vel_ned_mps", m.vel_ned_mps());
+  v("q_b_to_n", m.q_b_to_n());
+  v("roll_rad", m.roll_rad());
+  v("pitch_rad", m.pitch_rad());
+  v("yaw_rad", m.yaw_rad());
+  v("pos_sigma_ned_m", m.pos_sigma_ned_m());
+  v("vel_sigma_ned_mps", m.vel_sigma_ned_mps());
+  v("att_sigma_ned_rad", m.att_sigma_ned_rad());
+  v("clock_bias_m", m.clock_bias_m());
+  v("clock_drift_mps", m.clock_drift_mps());
+  v("clock_bias_sigma_m", m.clock_bias_sigma_m());
+  v("clock_drift_sigma_mps", m.clock_drift_sigma_mps());
+  v("accel_bias_b_mps2", m.accel_bias_b_mps2());
+  v("gyro_bias_b_radps", m.gyro_bias_b_radps());
+  v("accel_bias_sigma_b_mps2", m.accel_bias_sigma_b_mps2());
+  v("gyro_bias_sigma_b_radps", m.gyro_bias_sigma_b_radps());
+  v("mode", m.mode());
+  v("fusion", m.fusion());
+  v("covariance_valid", m.covariance_valid());
+  v("active_fault_flags", m.active_fault_flags());
   v("imu_samples_used", m.imu_samples_used());
 }
-template <class V> void visitFields(const navbus::FilterDiagnostics& m, V& v) {
-  v("vehicle_id", m.vehicle_id()); v("seq", m.seq()); v("time_gps_ns", m.time_gps_ns()); v("n", m.n()); v("m", m.m());
+template <class V>
+void visitFields(const navbus::FilterDiagnostics& m, V& v) {
+  v("vehicle_id", m.vehicle_id());
+  v("seq", m.seq());
+  v("time_gps_ns", m.time_gps_ns());
+  v("n", m.n());
+  v("m", m.m());
   std::ostringstream layout;
-  for (const auto& b : m.state_layout()) layout << b.name() << ":" << b.index() << "+" << b.dof() << "[" << b.unit() << "] ";
+  for (const auto& b : m.state_layout())
+    layout << b.name() << ":" << b.index() << "+" << b.dof() << "[" << b.unit() << "] ";
   v.text("state_layout", layout.str());
   std::ostringstream rows;
-  for (const auto& r : m.rows()) rows << enumName(r.kind()) << ":" << r.sv_id() << ":" << r.axis() << " ";
+  for (const auto& r : m.rows())
+    rows << enumName(r.kind()) << ":" << r.sv_id() << ":" << r.axis() << " ";
   v.text("rows", rows.str());
-  v("innovation", m.innovation()); v("innovation_cov", m.innovation_cov()); v("h", m.h()); v("k", m.k());
-  v("phi", m.phi()); v("test_ratio", m.test_ratio());
+  v("innovation", m.innovation());
+  v("innovation_cov", m.innovation_cov());
+  v("h", m.h());
+  v("k", m.k());
+  v("phi", m.phi());
+  v("test_ratio", m.test_ratio());
 }
-template <class V> void visitFields(const navbus::FaultDecision& m, V& v) {
-  v("decision_id", m.decision_id()); v("time_gps_ns", m.time_gps_ns()); v("source", m.source());
-  v("sensor_id", m.sensor_id()); v("sv_id", m.sv_id()); v("axis", m.axis()); v("test_statistic", m.test_statistic());
-  v("threshold", m.threshold()); v("magnitude", m.magnitude()); v("onset_time_gps_ns", m.onset_time_gps_ns());
-  v("action", m.action()); v("detector", m.detector());
+template <class V>
+void visitFields(const navbus::FaultDecision& m, V& v) {
+  v("decision_id", m.decision_id());
+  v("time_gps_ns", m.time_gps_ns());
+  v("source", m.source());
+  v("sensor_id", m.sensor_id());
+  v("sv_id", m.sv_id());
+  v("axis", m.axis());
+  v("test_statistic", m.test_statistic());
+  v("threshold", m.threshold());
+  v("magnitude", m.magnitude());
+  v("onset_time_gps_ns", m.onset_time_gps_ns());
+  v("action", m.action());
+  v("detector", m.detector());
 }
-template <class V> void visitFields(const navbus::FilterCommand& m, V& v) {
-  v("command_id", m.command_id()); v("vehicle_id", m.vehicle_id()); v("kind", m.kind()); v("sv_id", m.sv_id());
-  v("sensor", m.sensor()); v("axis", m.axis()); v("bias", m.bias()); v("fusion", m.fusion()); v("mode", m.mode());
+template <class V>
+void visitFields(const navbus::FilterCommand& m, V& v) {
+  v("command_id", m.command_id());
+  v("vehicle_id", m.vehicle_id());
+  v("kind", m.kind());
+  v("sv_id", m.sv_id());
+  v("sensor", m.sensor());
+  v("axis", m.axis());
+  v("bias", m.bias());
+  v("fusion", m.fusion());
+  v("mode", m.mode());
   v("issuer", m.issuer());
 }
-template <class V> void visitFields(const navbus::StreamHealth& m, V& v) {
-  v("topic", m.topic()); v("received", m.received()); v("accepted", m.accepted());
-  v("sequence_gaps", m.sequence_gaps()); v("deadline_misses", m.deadline_misses());
+template <class V>
+void visitFields(const navbus::StreamHealth& m, V& v) {
+  v("topic", m.topic());
+  v("received", m.received());
+  v("accepted", m.accepted());
+  v("sequence_gaps", m.sequence_gaps());
+  v("deadline_misses", m.deadline_misses());
   std::ostringstream rejected;
   for (const auto& r : m.rejected()) rejected << enumName(r.reason()) << "=" << r.count() << " ";
   v.text("rejected", rejected.str());
 }
-template <class V> void visitFields(const navbus::Health& m, V& v) {
-  v("participant", m.participant()); v("seq", m.seq()); v("wall_time_ns", m.wall_time_ns()); v("state", m.state());
-  v("samples_published", m.samples_published()); v.rows("inputs", m.inputs());
+template <class V>
+void visitFields(const navbus::Health& m, V& v) {
+  v("participant", m.participant());
+  v("seq", m.seq());
+  v("wall_time_ns", m.wall_time_ns());
+  v("state", m.state());
+  v("samples_published", m.samples_published());
+  v.rows("inputs", m.inputs());
 }
 
 }  // namespace navbus::tool

@@ -19,9 +19,11 @@ TopicEntry entry(const char* topic, const char* profile) {
   PubSubType type;
   return TopicEntry{topic, type.getName(), profile, csvHeader<T>(),
                     [topic, profile](bus::Participant& p, SampleSink& sink) {
-                      p.subscribe<PubSubType>(topic, profile, [topic, &sink](const T& m, const auto&) {
-                        sink.onSample(topic, [&m] { return textOf(m); }, [&m] { return csvRows(m); });
-                      });
+                      p.subscribe<PubSubType>(
+                          topic, profile, [topic, &sink](const T& m, const auto&) {
+                            sink.onSample(
+                                topic, [&m] { return textOf(m); }, [&m] { return csvRows(m); });
+                          });
                     }};
 }
 }  // namespace
@@ -31,11 +33,14 @@ const std::vector<TopicEntry>& topicRegistry() {
   static const std::vector<TopicEntry> registry = {
       entry<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorReader),
       entry<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, profile::kSensorReader),
-      entry<navbus::GnssObservationEpochPubSubType>(topic::kGnssObservations, profile::kMeasurementReader),
+      entry<navbus::GnssObservationEpochPubSubType>(topic::kGnssObservations,
+                                                    profile::kMeasurementReader),
       entry<navbus::GnssFixPubSubType>(topic::kGnssFix, profile::kMeasurementReader),
-      entry<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker, profile::kMeasurementReader),
+      entry<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker,
+                                                   profile::kMeasurementReader),
       entry<navbus::NavigationSolutionPubSubType>(topic::kNavSolution, profile::kSolutionReader),
-      entry<navbus::FilterDiagnosticsPubSubType>(topic::kFilterDiagnostics, profile::kDiagnosticsReader),
+      entry<navbus::FilterDiagnosticsPubSubType>(topic::kFilterDiagnostics,
+                                                 profile::kDiagnosticsReader),
       entry<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader),
       entry<navbus::FilterCommandPubSubType>(topic::kFilterCommand, profile::kDecisionReader),
       entry<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthReader),

@@ -19,7 +19,8 @@ SatelliteState CircularConstellation::state(int sv_id, double t) const {
   const int slot = index % config_.satellites_per_plane;
   const double raan = 2.0 * M_PI * plane / config_.planes;
   // Slots evenly spaced in a plane, phased by plane so that planes do not line up.
-  const double u0 = 2.0 * M_PI * slot / config_.satellites_per_plane + M_PI * plane / (2.0 * config_.planes);
+  const double u0 =
+      2.0 * M_PI * slot / config_.satellites_per_plane + M_PI * plane / (2.0 * config_.planes);
   const double u = u0 + mean_motion_radps_ * t;
   const double r = config_.radius_m;
   const Eigen::Vector3d pos_orbit(r * std::cos(u), r * std::sin(u), 0.0);

@@ -35,7 +35,8 @@ GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
       s = constellation_.state(sv, t - tau);
       // Sagnac: express the transmit-time position in the ECEF frame of reception time.
       const double a = earth::kRotationRate_radps * tau;
-      const Eigen::Matrix3d rot = Eigen::AngleAxisd(-a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      const Eigen::Matrix3d rot =
+          Eigen::AngleAxisd(-a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
       pos_rot = rot * s.pos_ecef_m;
       vel_rot = rot * s.vel_ecef_mps;
       tau = (pos_rot - rx_pos).norm() / earth::kSpeedOfLight_mps;
@@ -51,8 +52,8 @@ GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
     m.elevation_rad = elevation;
     m.sat_pos_ecef_m = pos_rot;
     m.sat_vel_ecef_mps = vel_rot;
-    m.pseudorange_m = (pos_rot - rx_pos).norm() + clock_bias +
-                      config_.pseudorange_sigma_m * unit(rng);
+    m.pseudorange_m =
+        (pos_rot - rx_pos).norm() + clock_bias + config_.pseudorange_sigma_m * unit(rng);
     m.pseudorange_rate_mps = los.dot(vel_rot - rx_vel) + config_.clock_drift_mps +
                              config_.pseudorange_rate_sigma_mps * unit(rng);
     m.pseudorange_sigma_m = config_.pseudorange_sigma_m;
@@ -78,7 +79,8 @@ GnssFixSample GnssReceiverModel::fix(std::int64_t t_ns, const earth::Geodetic& t
   GnssFixSample f;
   f.time_ns = t_ns;
   const earth::Radii r = earth::radiiOfCurvature(truth_pos.latitude_rad);
-  const Eigen::Vector3d dpos_ned(config_.fix_pos_sigma_m * unit(rng), config_.fix_pos_sigma_m * unit(rng),
+  const Eigen::Vector3d dpos_ned(config_.fix_pos_sigma_m * unit(rng),
+                                 config_.fix_pos_sigma_m * unit(rng),
                                  config_.fix_pos_sigma_m * unit(rng));
   f.position = truth_pos;
   f.position.latitude_rad += dpos_ned.x() / (r.meridian_m + truth_pos.height_m);

@@ -62,7 +62,8 @@ SensorFrame StationarySource::next() {
 
   if (config_.gnss_every_n_increments > 0 && index_ % config_.gnss_every_n_increments == 0) {
     f.has_gnss = true;
-    f.gnss = receiver_.observe(t_end, config_.start_time_ns, pos_ecef_m_, Eigen::Vector3d::Zero(), rng_);
+    f.gnss =
+        receiver_.observe(t_end, config_.start_time_ns, pos_ecef_m_, Eigen::Vector3d::Zero(), rng_);
     f.fix = receiver_.fix(t_end, truth_.position, truth_.vel_ned_mps,
                           static_cast<int>(f.gnss.satellites.size()), rng_);
   }

@@ -25,7 +25,8 @@ namespace navbus::test {
 /// running when destroyed.
 class ChildProcess {
  public:
-  ChildProcess(const std::string& exe, const std::vector<std::string>& args, const std::string& log) {
+  ChildProcess(const std::string& exe, const std::vector<std::string>& args,
+               const std::string& log) {
     pid_ = fork();
     if (pid_ == 0) {
       // The test process blocks SIGINT/SIGTERM (ShutdownSignal); the child must not inherit it.
@@ -81,7 +82,8 @@ class ChildProcess {
 
 /// A per-test scratch directory under the build tree.
 inline std::filesystem::path scratchDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("navbus-test-" + name + "-" + std::to_string(getpid()));
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("navbus-test-" + name + "-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   return dir;
 }
@@ -107,9 +109,11 @@ inline bus::Participant::Options testParticipant(int domain, const std::string& 
 }
 
 /// Spins the participant until pred() holds or the timeout passes; returns pred().
-inline bool spinUntil(bus::Participant& p, std::chrono::milliseconds timeout, const std::function<bool()>& pred) {
+inline bool spinUntil(bus::Participant& p, std::chrono::milliseconds timeout,
+                      const std::function<bool()>& pred) {
   const auto end = std::chrono::steady_clock::now() + timeout;
-  while (!pred() && std::chrono::steady_clock::now() < end) p.spinOnce(std::chrono::milliseconds(10));
+  while (!pred() && std::chrono::steady_clock::now() < end)
+    p.spinOnce(std::chrono::milliseconds(10));
   return pred();
 }
 
@@ -118,7 +122,8 @@ inline bool spinUntil(bus::Participant& p, std::chrono::milliseconds timeout, co
 inline void cleanSharedMemory() {
   for (const auto& e : std::filesystem::directory_iterator("/dev/shm")) {
     const std::string n = e.path().filename().string();
-    if (n.rfind("fastrtps_", 0) == 0 || n.rfind("sem.fastrtps_", 0) == 0 || n.rfind("fast_datasharing", 0) == 0) {
+    if (n.rfind("fastrtps_", 0) == 0 || n.rfind("sem.fastrtps_", 0) == 0 ||
+        n.rfind("fast_datasharing", 0) == 0) {
       std::error_code ec;
       std::filesystem::remove(e.path(), ec);
     }
@@ -129,7 +134,8 @@ inline std::string filterConfig(int domain, std::uint32_t imu_id = 1, bool measu
   std::string c = "domain_id: " + std::to_string(domain) +
                   "\nvehicle_id: 1\nsolution_rate_hz: 10\nsequencer_max_wait_s: 0.5\n"
                   "initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
-                  "inputs:\n  imu: {id: " + std::to_string(imu_id) + ", period_s: 0.01}\n";
+                  "inputs:\n  imu: {id: " +
+                  std::to_string(imu_id) + ", period_s: 0.01}\n";
   if (measurements) {
     c += "  gnss_observations: {id: 1, period_s: 1.0}\n  gnss_fix: {id: 1, period_s: 1.0}\n"
          "  star_tracker: {id: 1, period_s: 0.2}\n";

@@ -32,18 +32,26 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(kDomain, "bad-input-test"), shutdown);
   std::vector<NavigationSolution> solutions;
-  me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution, bus::profile::kSolutionReader,
+  me.subscribe<NavigationSolutionPubSubType>(
+      bus::topic::kNavSolution, bus::profile::kSolutionReader,
       [&](const NavigationSolution& s, const auto&) { solutions.push_back(s); });
   Health filter_health;
-  me.subscribe<HealthPubSubType>(bus::topic::kHealth, bus::profile::kHealthReader, [&](const Health& h, const auto&) {
-    if (h.participant().to_string() == "navbus-filter") filter_health = h;
-  });
-  auto imu = me.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement, bus::profile::kSensorWriter);
-  auto obs = me.createWriter<GnssObservationEpochPubSubType>(bus::topic::kGnssObservations, bus::profile::kMeasurementWriter);
-  auto fix = me.createWriter<GnssFixPubSubType>(bus::topic::kGnssFix, bus::profile::kMeasurementWriter);
-  auto star = me.createWriter<StarTrackerAttitudePubSubType>(bus::topic::kStarTracker, bus::profile::kMeasurementWriter);
+  me.subscribe<HealthPubSubType>(bus::topic::kHealth, bus::profile::kHealthReader,
+                                 [&](const Health& h, const auto&) {
+                                   if (h.participant().to_string() == "navbus-filter")
+                                     filter_health = h;
+                                 });
+  auto imu = me.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement,
+                                                     bus::profile::kSensorWriter);
+  auto obs = me.createWriter<GnssObservationEpochPubSubType>(bus::topic::kGnssObservations,
+                                                             bus::profile::kMeasurementWriter);
+  auto fix =
+      me.createWriter<GnssFixPubSubType>(bus::topic::kGnssFix, bus::profile::kMeasurementWriter);
+  auto star = me.createWriter<StarTrackerAttitudePubSubType>(bus::topic::kStarTracker,
+                                                             bus::profile::kMeasurementWriter);
   ASSERT_TRUE(test::spinUntil(me, 20s, [&] {
-    return imu.matchedReaders() && obs.matchedReaders() && fix.matchedReaders() && star.matchedReaders();
+    return imu.matchedReaders() && obs.matchedReaders() && fix.matchedReaders() &&
+           star.matchedReaders();
   }));
 
   sim::StationarySourceConfig src_cfg;
@@ -59,14 +67,35 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
     const ImuIncrement good = bus::toIdl(f.increment, 1, ++seq);
     ImuIncrement bad = good;  // bad samples carry the seq of the good one that follows them
     switch (k) {
-      case 20: bad.delta_vel_b_mps()[1] = nan; imu.write(bad); break;
-      case 40: bad.delta_angle_b_rad()[2] = inf; imu.write(bad); break;
-      case 60: bad.delta_vel_b_mps()[0] = 50.0; imu.write(bad); break;           // 5000 m/s^2
-      case 80: bad.interval_ns(0); imu.write(bad); break;
-      case 100: bad.time_gps_ns(last.time_gps_ns() - 5'000'000); imu.write(bad); break;  // out of order
-      case 120: imu.write(last); break;                                          // duplicate
-      case 140: bad.sensor_id(9); imu.write(bad); break;                          // not configured
-      default: break;
+      case 20:
+        bad.delta_vel_b_mps()[1] = nan;
+        imu.write(bad);
+        break;
+      case 40:
+        bad.delta_angle_b_rad()[2] = inf;
+        imu.write(bad);
+        break;
+      case 60:
+        bad.delta_vel_b_mps()[0] = 50.0;
+        imu.write(bad);
+        break;  // 5000 m/s^2
+      case 80:
+        bad.interval_ns(0);
+        imu.write(bad);
+        break;
+      case 100:
+        bad.time_gps_ns(last.time_gps_ns() - 5'000'000);
+        imu.write(bad);
+        break;  // out of order
+      case 120:
+        imu.write(last);
+        break;  // duplicate
+      case 140:
+        bad.sensor_id(9);
+        imu.write(bad);
+        break;  // not configured
+      default:
+        break;
     }
     imu.write(good);
     last = good;
@@ -101,13 +130,18 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
     return c;
   };
   auto stream = [&](const std::string& topic) -> const StreamHealth* {
-    for (const auto& in : filter_health.inputs()) if (in.topic().to_string() == topic) return &in;
+    for (const auto& in : filter_health.inputs())
+      if (in.topic().to_string() == topic) return &in;
     return nullptr;
   };
   const Counts expected = {
       {bus::topic::kImuIncrement,
-       {{REJECT_NOT_FINITE, 2}, {REJECT_OUT_OF_RANGE, 1}, {REJECT_BAD_INTERVAL, 1}, {REJECT_TIME_NOT_MONOTONIC, 1},
-        {REJECT_DUPLICATE, 1}, {REJECT_UNEXPECTED_SOURCE, 1}}},
+       {{REJECT_NOT_FINITE, 2},
+        {REJECT_OUT_OF_RANGE, 1},
+        {REJECT_BAD_INTERVAL, 1},
+        {REJECT_TIME_NOT_MONOTONIC, 1},
+        {REJECT_DUPLICATE, 1},
+        {REJECT_UNEXPECTED_SOURCE, 1}}},
       {bus::topic::kGnssObservations, {{REJECT_UNKNOWN_SATELLITE, 1}}},
       {bus::topic::kGnssFix, {{REJECT_NOT_FINITE, 1}}},
       {bus::topic::kStarTracker, {{REJECT_BAD_QUATERNION, 1}}},
@@ -120,13 +154,15 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
   EXPECT_EQ(s->accepted(), 300u);
   EXPECT_EQ(s->sequence_gaps(), 0u);
   for (const auto& [topic, reasons] : counts()) {
-    for (const auto& [reason, n] : reasons) std::printf("rejected on %s: %s x%llu\n", topic.c_str(),
-                                                        bus::rejectReasonName(reason), static_cast<unsigned long long>(n));
+    for (const auto& [reason, n] : reasons)
+      std::printf("rejected on %s: %s x%llu\n", topic.c_str(), bus::rejectReasonName(reason),
+                  static_cast<unsigned long long>(n));
   }
   EXPECT_EQ(solutions.size(), 30u);
   for (const auto& sol : solutions) {
     EXPECT_TRUE(std::isfinite(sol.latitude_rad()) && std::isfinite(sol.longitude_rad()) &&
-                std::isfinite(sol.height_m()) && std::isfinite(sol.roll_rad()) && std::isfinite(sol.yaw_rad()));
+                std::isfinite(sol.height_m()) && std::isfinite(sol.roll_rad()) &&
+                std::isfinite(sol.yaw_rad()));
     for (double v : sol.vel_ned_mps()) EXPECT_TRUE(std::isfinite(v));
     EXPECT_LT(std::abs(sol.height_m() - 100.0), 1.0);
   }

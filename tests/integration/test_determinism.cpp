@@ -15,7 +15,7 @@ using namespace std::chrono_literals;
 namespace {
 
 constexpr std::int64_t kStartNs = 1'400'000'000'000'000'000;  // an arbitrary whole-second GPS time
-constexpr int kFrames = 500;                                    // 5 s at 100 Hz
+constexpr int kFrames = 500;                                  // 5 s at 100 Hz
 
 std::vector<sim::SensorFrame> makeFrames() {
   sim::StationarySourceConfig cfg;
@@ -33,7 +33,8 @@ std::vector<sim::SensorFrame> makeFrames() {
 
 enum class Delivery { kInTimeOrderSteady, kMeasurementsAheadImuInBursts };
 
-std::vector<std::string> runFilter(int domain, Delivery delivery, const std::vector<sim::SensorFrame>& frames) {
+std::vector<std::string> runFilter(int domain, Delivery delivery,
+                                   const std::vector<sim::SensorFrame>& frames) {
   const auto dir = test::scratchDir("determinism-" + std::to_string(domain));
   const std::string cfg = test::writeFile(dir / "filter.yaml", test::filterConfig(domain));
   test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
@@ -41,14 +42,22 @@ std::vector<std::string> runFilter(int domain, Delivery delivery, const std::vec
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(domain, "determinism-test"), shutdown);
   std::vector<std::string> solutions;
-  me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution, bus::profile::kSolutionReader,
-      [&](const NavigationSolution& s, const auto&) { solutions.push_back(tool::csvRows(s).at(0)); });
-  auto imu = me.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement, bus::profile::kSensorWriter);
-  auto obs = me.createWriter<GnssObservationEpochPubSubType>(bus::topic::kGnssObservations, bus::profile::kMeasurementWriter);
-  auto fix = me.createWriter<GnssFixPubSubType>(bus::topic::kGnssFix, bus::profile::kMeasurementWriter);
-  auto star = me.createWriter<StarTrackerAttitudePubSubType>(bus::topic::kStarTracker, bus::profile::kMeasurementWriter);
+  me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution,
+                                             bus::profile::kSolutionReader,
+                                             [&](const NavigationSolution& s, const auto&) {
+                                               solutions.push_back(tool::csvRows(s).at(0));
+                                             });
+  auto imu = me.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement,
+                                                     bus::profile::kSensorWriter);
+  auto obs = me.createWriter<GnssObservationEpochPubSubType>(bus::topic::kGnssObservations,
+                                                             bus::profile::kMeasurementWriter);
+  auto fix =
+      me.createWriter<GnssFixPubSubType>(bus::topic::kGnssFix, bus::profile::kMeasurementWriter);
+  auto star = me.createWriter<StarTrackerAttitudePubSubType>(bus::topic::kStarTracker,
+                                                             bus::profile::kMeasurementWriter);
   EXPECT_TRUE(test::spinUntil(me, 20s, [&] {
-    return imu.matchedReaders() && obs.matchedReaders() && fix.matchedReaders() && star.matchedReaders();
+    return imu.matchedReaders() && obs.matchedReaders() && fix.matchedReaders() &&
+           star.matchedReaders();
   }));
 
   std::uint64_t n_imu = 0, n_obs = 0, n_fix = 0, n_star = 0;
@@ -70,13 +79,15 @@ std::vector<std::string> runFilter(int domain, Delivery delivery, const std::vec
     // Measurements up to 1.5 s ahead of the increments; increments in bursts of 37 with pauses.
     std::size_t next_measurement = 0;
     for (std::size_t k = 0; k < frames.size(); ++k) {
-      while (next_measurement < frames.size() && next_measurement < k + 150) write_measurements(frames[next_measurement++]);
+      while (next_measurement < frames.size() && next_measurement < k + 150)
+        write_measurements(frames[next_measurement++]);
       imu.write(bus::toIdl(frames[k].increment, 1, ++n_imu));
       if (k % 37 == 36) me.spinOnce(30ms);
     }
   }
   // 5 s of data at 10 Hz: 50 solutions; wait for them, then a little longer for any extra.
-  EXPECT_TRUE(test::spinUntil(me, 30s, [&] { return solutions.size() >= 50; })) << test::readFile(dir / "filter.log");
+  EXPECT_TRUE(test::spinUntil(me, 30s, [&] { return solutions.size() >= 50; }))
+      << test::readFile(dir / "filter.log");
   test::spinUntil(me, 700ms, [] { return false; });
   filter.signal(SIGTERM);
   EXPECT_EQ(filter.wait(10s), 0);

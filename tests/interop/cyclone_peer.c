@@ -10,12 +10,12 @@
 #include "Navigation.h"
 #include "dds/dds.h"
 
-#define CHECK(x, what)                                                   \
-  do {                                                                   \
-    if ((x) < 0) {                                                       \
+#define CHECK(x, what)                                                           \
+  do {                                                                           \
+    if ((x) < 0) {                                                               \
       fprintf(stderr, "cyclone_peer: %s failed: %s\n", what, dds_strretcode(x)); \
-      return 1;                                                          \
-    }                                                                    \
+      return 1;                                                                  \
+    }                                                                            \
   } while (0)
 
 static const double kDeg = M_PI / 180.0;
@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   dds_qset_reliability(wqos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_history(wqos, DDS_HISTORY_KEEP_ALL, 0);
   dds_qset_liveliness(wqos, DDS_LIVELINESS_AUTOMATIC, DDS_SECS(1));
-  dds_entity_t imu_topic = dds_create_topic(participant, &navbus_ImuIncrement_desc, "navbus/imu/increment", NULL, NULL);
+  dds_entity_t imu_topic =
+      dds_create_topic(participant, &navbus_ImuIncrement_desc, "navbus/imu/increment", NULL, NULL);
   CHECK(imu_topic, "create imu topic");
   dds_entity_t writer = dds_create_writer(participant, imu_topic, wqos, NULL);
   CHECK(writer, "create writer");
@@ -54,8 +55,8 @@ int main(int argc, char** argv) {
   dds_qset_reliability(rqos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_durability(rqos, DDS_DURABILITY_TRANSIENT_LOCAL);
   dds_qset_history(rqos, DDS_HISTORY_KEEP_ALL, 0);
-  dds_entity_t sol_topic =
-      dds_create_topic(participant, &navbus_NavigationSolution_desc, "navbus/nav/solution", NULL, NULL);
+  dds_entity_t sol_topic = dds_create_topic(participant, &navbus_NavigationSolution_desc,
+                                            "navbus/nav/solution", NULL, NULL);
   CHECK(sol_topic, "create solution topic");
   dds_entity_t reader = dds_create_reader(participant, sol_topic, rqos, NULL);
   CHECK(reader, "create reader");
@@ -104,15 +105,17 @@ int main(int argc, char** argv) {
       ++solutions;
       last_time = buf[j].time_gps_ns;
       const double dlat_m = (buf[j].latitude_rad - lat) * 6.36e6;
-      if (!isfinite(buf[j].latitude_rad) || fabs(dlat_m) > 1.0 || fabs(buf[j].height_m - 100.0) > 1.0 ||
-          buf[j].mode != navbus_MODE_INERTIAL_ONLY) {
+      if (!isfinite(buf[j].latitude_rad) || fabs(dlat_m) > 1.0 ||
+          fabs(buf[j].height_m - 100.0) > 1.0 || buf[j].mode != navbus_MODE_INERTIAL_ONLY) {
         ++bad;
       }
     }
     dds_sleepfor(DDS_MSECS(50));
   }
-  printf("cyclone_peer: wrote %d increments, read %d solutions from navbus-filter (%d out of bounds), last at GPS %llu ns\n",
-         n, solutions, bad, (unsigned long long)last_time);
+  printf(
+      "cyclone_peer: wrote %d increments, read %d solutions from navbus-filter (%d out of bounds), "
+      "last at GPS %llu ns\n",
+      n, solutions, bad, (unsigned long long)last_time);
   dds_delete(participant);
   dds_delete_qos(wqos);
   dds_delete_qos(rqos);

@@ -42,7 +42,9 @@ navbus::GnssObservationEpoch goodEpoch() {
 }
 }  // namespace
 
-TEST(Validation, AcceptsAPhysicalImuIncrement) { EXPECT_FALSE(validate(goodImu(), ValidationLimits{})); }
+TEST(Validation, AcceptsAPhysicalImuIncrement) {
+  EXPECT_FALSE(validate(goodImu(), ValidationLimits{}));
+}
 
 TEST(Validation, RejectsNonFiniteImuFieldsNamingTheField) {
   auto m = goodImu();
@@ -192,7 +194,8 @@ TEST(Skeleton, UnknownWriterProfileIsAClearErrorAndKnownOnesWork) {
     EXPECT_NE(std::string(e.what()).find("no_such_writer_profile"), std::string::npos);
   }
   // A writer and a reader in one participant exchange a sample through the waitset loop.
-  auto writer = p.createWriter<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthWriter);
+  auto writer =
+      p.createWriter<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthWriter);
   int received = 0;
   p.subscribe<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthReader,
                                         [&](const navbus::Health& h, const auto&) {

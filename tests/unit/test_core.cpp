@@ -45,12 +45,14 @@ TEST(Earth, NedFrameIsOrthonormalAndDownPointsInward) {
 }
 
 TEST(Rotation, QuaternionFromRotationVectorMatchesAngleAxis) {
-  for (const Eigen::Vector3d& phi : {Eigen::Vector3d(0.3, -0.2, 1.1), Eigen::Vector3d(1e-9, 2e-9, -1e-9),
-                                     Eigen::Vector3d(0.0, 0.0, 0.0)}) {
+  for (const Eigen::Vector3d& phi :
+       {Eigen::Vector3d(0.3, -0.2, 1.1), Eigen::Vector3d(1e-9, 2e-9, -1e-9),
+        Eigen::Vector3d(0.0, 0.0, 0.0)}) {
     const Eigen::Quaterniond q = quaternionFromRotationVector(phi);
     const double angle = phi.norm();
-    const Eigen::Matrix3d expected =
-        angle > 0 ? Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d expected = angle > 0
+                                         ? Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix()
+                                         : Eigen::Matrix3d::Identity();
     EXPECT_TRUE(q.toRotationMatrix().isApprox(expected, 1e-14));
     EXPECT_NEAR(q.norm(), 1.0, 1e-15);
   }
@@ -89,7 +91,8 @@ std::pair<double, double> stationaryDrift(double seconds, double yaw_deg) {
   const auto& p = ins.state().position;
   const earth::Radii radii = earth::radiiOfCurvature(p.latitude_rad);
   const double dn = (p.latitude_rad - cfg.position.latitude_rad) * radii.meridian_m;
-  const double de = (p.longitude_rad - cfg.position.longitude_rad) * radii.prime_vertical_m * std::cos(p.latitude_rad);
+  const double de = (p.longitude_rad - cfg.position.longitude_rad) * radii.prime_vertical_m *
+                    std::cos(p.latitude_rad);
   return {std::hypot(dn, de), std::abs(p.height_m - cfg.position.height_m)};
 }
 }  // namespace

@@ -118,7 +118,8 @@ TEST(Formatters, CsvHasOneRowPerSatelliteAndRoundTripsDoubles) {
     e.satellites().push_back(m);
   }
   const std::string header = navbus::tool::csvHeader<navbus::GnssObservationEpoch>();
-  EXPECT_EQ(header.rfind("receiver_id,seq,time_gps_ns,satellites.sv_id,satellites.pseudorange_m", 0), 0u);
+  EXPECT_EQ(
+      header.rfind("receiver_id,seq,time_gps_ns,satellites.sv_id,satellites.pseudorange_m", 0), 0u);
   const auto rows = navbus::tool::csvRows(e);
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1].rfind("3,0,42,9,20000000.125", 0), 0u);

@@ -38,7 +38,8 @@ TEST(GnssReceiver, PseudorangesAreRangePlusClockAndRespectTheMask) {
   for (const auto& s : f.gnss.satellites) {
     EXPECT_GE(s.elevation_rad, cfg.gnss.elevation_mask_rad);
     const double range = (s.sat_pos_ecef_m - rx).norm();
-    EXPECT_NEAR(s.pseudorange_m - range, cfg.gnss.clock_bias_m + cfg.gnss.clock_drift_mps * 0.01, 0.01);
+    EXPECT_NEAR(s.pseudorange_m - range, cfg.gnss.clock_bias_m + cfg.gnss.clock_drift_mps * 0.01,
+                0.01);
   }
 }
 

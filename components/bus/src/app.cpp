@@ -16,8 +16,9 @@ void addCommonOptions(CLI::App& app, CommonOptions& o, bool config_required) {
       ->check(CLI::Range(0, 232));
   app.add_option("--qos", o.qos_file,
                  "Fast DDS QoS XML file (FASTRTPS_DEFAULT_PROFILES_FILE takes precedence)");
-  app.add_option("--profile", o.participant_profile,
-                 "participant profile name in the QoS file (default: navbus_participant_udp_loopback)");
+  app.add_option(
+      "--profile", o.participant_profile,
+      "participant profile name in the QoS file (default: navbus_participant_udp_loopback)");
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
 }
@@ -33,8 +34,8 @@ Participant::Options participantOptions(const CommonOptions& o, const YAML::Node
       !o.participant_profile.empty()
           ? o.participant_profile
           : get<std::string>(cfg, "", "participant_profile", profile::kParticipantLoopback);
-  const double health_s = checkRange(get<double>(cfg, "", "health_period_s", 1.0), 0.05, 60.0,
-                                     "health_period_s");
+  const double health_s =
+      checkRange(get<double>(cfg, "", "health_period_s", 1.0), 0.05, 60.0, "health_period_s");
   p.health_period = std::chrono::milliseconds(static_cast<long>(health_s * 1000.0));
   return p;
 }
@@ -51,8 +52,8 @@ int runMain(CLI::App& app, int argc, char** argv, CommonOptions& options,
   spdlog::set_level(spdlog::level::from_str(options.log_level));
   spdlog::set_pattern("[%H:%M:%S.%e] [%n] [%l] %v");
   try {
-    const YAML::Node config =
-        options.config_file.empty() ? YAML::Node(YAML::NodeType::Map) : loadYamlFile(options.config_file);
+    const YAML::Node config = options.config_file.empty() ? YAML::Node(YAML::NodeType::Map)
+                                                          : loadYamlFile(options.config_file);
     return body(config);
   } catch (const ConfigError& e) {
     spdlog::error("{}", e.what());

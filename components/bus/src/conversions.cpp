@@ -15,7 +15,8 @@ core::ImuIncrement toCore(const navbus::ImuIncrement& msg) {
   return inc;
 }
 
-navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id, std::uint64_t seq) {
+navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id,
+                           std::uint64_t seq) {
   navbus::ImuIncrement msg;
   msg.sensor_id(sensor_id);
   msg.seq(seq);

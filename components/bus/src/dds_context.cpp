@@ -20,9 +20,9 @@ std::string loadQosProfiles(const std::string& explicit_file) {
   static std::string loaded;
   std::lock_guard<std::mutex> lock(mutex);
   const char* env = std::getenv("FASTRTPS_DEFAULT_PROFILES_FILE");
-  const std::string file =
-      (env != nullptr && *env != '\0') ? env
-                                       : (explicit_file.empty() ? NAVBUS_QOS_FILE_DEFAULT : explicit_file);
+  const std::string file = (env != nullptr && *env != '\0')
+                               ? env
+                               : (explicit_file.empty() ? NAVBUS_QOS_FILE_DEFAULT : explicit_file);
   if (loaded == file) {
     return file;
   }
@@ -49,9 +49,9 @@ DdsContext::DdsContext(const ParticipantOptions& options) : name_(options.name) 
                    "' is not defined in the QoS file");
   }
   qos.name(options.name);
-  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(options.domain_id), qos,
-                                             options.listener,
-                                             options.listener ? dds::StatusMask::none() : dds::StatusMask::all());
+  participant_ = factory->create_participant(
+      static_cast<dds::DomainId_t>(options.domain_id), qos, options.listener,
+      options.listener ? dds::StatusMask::none() : dds::StatusMask::all());
   if (participant_ == nullptr) {
     throw DdsError("cannot create participant '" + options.name + "' on domain " +
                    std::to_string(options.domain_id) + " with profile '" +
@@ -93,8 +93,8 @@ dds::Topic* DdsContext::topicForType(const std::string& name, dds::TypeSupport t
 dds::DataWriter* DdsContext::createWriter(dds::Topic* topic, const std::string& profile) {
   dds::DataWriter* writer = publisher_->create_datawriter_with_profile(topic, profile);
   if (writer == nullptr) {
-    throw DdsError("cannot create writer on '" + topic->get_name() + "' with profile '" +
-                   profile + "' (missing profile or inconsistent QoS)");
+    throw DdsError("cannot create writer on '" + topic->get_name() + "' with profile '" + profile +
+                   "' (missing profile or inconsistent QoS)");
   }
   return writer;
 }
@@ -102,8 +102,8 @@ dds::DataWriter* DdsContext::createWriter(dds::Topic* topic, const std::string& 
 dds::DataReader* DdsContext::createReader(dds::Topic* topic, const std::string& profile) {
   dds::DataReader* reader = subscriber_->create_datareader_with_profile(topic, profile);
   if (reader == nullptr) {
-    throw DdsError("cannot create reader on '" + topic->get_name() + "' with profile '" +
-                   profile + "' (missing profile or inconsistent QoS)");
+    throw DdsError("cannot create reader on '" + topic->get_name() + "' with profile '" + profile +
+                   "' (missing profile or inconsistent QoS)");
   }
   return reader;
 }

@@ -73,15 +73,24 @@ std::string HealthCounters::summary() const {
 
 const char* rejectReasonName(navbus::RejectReason reason) {
   switch (reason) {
-    case navbus::REJECT_NOT_FINITE: return "not_finite";
-    case navbus::REJECT_OUT_OF_RANGE: return "out_of_range";
-    case navbus::REJECT_TIME_NOT_MONOTONIC: return "time_not_monotonic";
-    case navbus::REJECT_DUPLICATE: return "duplicate";
-    case navbus::REJECT_UNKNOWN_SATELLITE: return "unknown_satellite";
-    case navbus::REJECT_BAD_INTERVAL: return "bad_interval";
-    case navbus::REJECT_BAD_QUATERNION: return "bad_quaternion";
-    case navbus::REJECT_LATE: return "late";
-    case navbus::REJECT_UNEXPECTED_SOURCE: return "unexpected_source";
+    case navbus::REJECT_NOT_FINITE:
+      return "not_finite";
+    case navbus::REJECT_OUT_OF_RANGE:
+      return "out_of_range";
+    case navbus::REJECT_TIME_NOT_MONOTONIC:
+      return "time_not_monotonic";
+    case navbus::REJECT_DUPLICATE:
+      return "duplicate";
+    case navbus::REJECT_UNKNOWN_SATELLITE:
+      return "unknown_satellite";
+    case navbus::REJECT_BAD_INTERVAL:
+      return "bad_interval";
+    case navbus::REJECT_BAD_QUATERNION:
+      return "bad_quaternion";
+    case navbus::REJECT_LATE:
+      return "late";
+    case navbus::REJECT_UNEXPECTED_SOURCE:
+      return "unexpected_source";
   }
   return "unknown";
 }

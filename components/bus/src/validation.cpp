@@ -65,7 +65,8 @@ std::optional<Rejection> validate(const navbus::ImuIncrement& s, const Validatio
   if (auto r = finiteArray(s.delta_vel_b_mps(), "delta_vel_b_mps")) return r;
   if (auto r = finiteArray(s.delta_angle_b_rad(), "delta_angle_b_rad")) return r;
   if (s.interval_ns() == 0 || s.interval_ns() > l.max_interval_ns) {
-    return Rejection{navbus::REJECT_BAD_INTERVAL, "interval_ns", static_cast<double>(s.interval_ns())};
+    return Rejection{navbus::REJECT_BAD_INTERVAL, "interval_ns",
+                     static_cast<double>(s.interval_ns())};
   }
   const double dt = 1e-9 * s.interval_ns();
   if (auto r = range(norm(s.delta_vel_b_mps()) / dt, 0.0, l.max_specific_force_mps2,
@@ -100,12 +101,14 @@ std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const Validation
   return std::nullopt;
 }
 
-std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s, const ValidationLimits& l) {
+std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s,
+                                  const ValidationLimits& l) {
   for (std::size_t i = 0; i < s.satellites().size(); ++i) {
     const auto& m = s.satellites()[i];
     const std::string p = indexed("satellites", i) + ".";
     if (m.sv_id() < 1 || m.sv_id() > 32) {
-      return Rejection{navbus::REJECT_UNKNOWN_SATELLITE, p + "sv_id", static_cast<double>(m.sv_id())};
+      return Rejection{navbus::REJECT_UNKNOWN_SATELLITE, p + "sv_id",
+                       static_cast<double>(m.sv_id())};
     }
     if (auto r = finite(m.pseudorange_m(), p + "pseudorange_m")) return r;
     if (auto r = finite(m.pseudorange_rate_mps(), p + "pseudorange_rate_mps")) return r;
@@ -116,7 +119,8 @@ std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s, const V
     if (auto r = finite(m.cn0_dbhz(), p + "cn0_dbhz")) return r;
     if (auto r = finite(m.pseudorange_sigma_m(), p + "pseudorange_sigma_m")) return r;
     if (auto r = finite(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps")) return r;
-    if (auto r = range(m.pseudorange_m(), l.min_pseudorange_m, l.max_pseudorange_m, p + "pseudorange_m"))
+    if (auto r =
+            range(m.pseudorange_m(), l.min_pseudorange_m, l.max_pseudorange_m, p + "pseudorange_m"))
       return r;
     if (auto r = range(std::abs(m.pseudorange_rate_mps()), 0.0, l.max_pseudorange_rate_mps,
                        p + "pseudorange_rate_mps"))
@@ -126,7 +130,8 @@ std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s, const V
       return r;
     if (auto r = range(m.cn0_dbhz(), 0.0, 70.0, p + "cn0_dbhz")) return r;
     if (auto r = positive(m.pseudorange_sigma_m(), p + "pseudorange_sigma_m")) return r;
-    if (auto r = positive(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps")) return r;
+    if (auto r = positive(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps"))
+      return r;
   }
   return std::nullopt;
 }
@@ -157,7 +162,8 @@ std::optional<Rejection> validate(const navbus::StarTrackerAttitude& s, const Va
   }
   for (std::size_t i = 0; i < 3; ++i) {
     if (auto r = positive(s.sigma_b_rad()[i], indexed("sigma_b_rad", i))) return r;
-    if (auto r = range(s.sigma_b_rad()[i], 0.0, l.max_star_tracker_sigma_rad, indexed("sigma_b_rad", i)))
+    if (auto r =
+            range(s.sigma_b_rad()[i], 0.0, l.max_star_tracker_sigma_rad, indexed("sigma_b_rad", i)))
       return r;
   }
   return std::nullopt;
@@ -174,8 +180,8 @@ SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::ui
       return out;
     }
     if (time_ns <= last.time_ns) {
-      out.rejection = Rejection{navbus::REJECT_TIME_NOT_MONOTONIC, "time_gps_ns",
-                                static_cast<double>(time_ns)};
+      out.rejection =
+          Rejection{navbus::REJECT_TIME_NOT_MONOTONIC, "time_gps_ns", static_cast<double>(time_ns)};
       return out;
     }
     if (seq > last.seq + 1) {
@@ -197,8 +203,8 @@ namespace navbus::bus {
 void StreamGate::reject(const Rejection& r, std::uint32_t sensor_id) {
   const std::uint64_t n = ++counters_.rejected[r.reason];
   if (n == 1 || n % 1000 == 0) {
-    spdlog::warn("{}: rejected sample of sensor {} ({}; {} rejected for this reason so far)", topic_,
-                 sensor_id, r.describe(), n);
+    spdlog::warn("{}: rejected sample of sensor {} ({}; {} rejected for this reason so far)",
+                 topic_, sensor_id, r.describe(), n);
   }
 }
 

@@ -14,14 +14,12 @@ Radii radiiOfCurvature(double latitude_rad) {
 double normalGravity(double latitude_rad, double height_m) {
   const double s2 = std::pow(std::sin(latitude_rad), 2);
   // Somigliana closed formula, TR8350.2 eq. 4-1.
-  const double k = (kSemiMinorAxis_m * kGravityPole_mps2) /
-                       (kSemiMajorAxis_m * kGravityEquator_mps2) -
-                   1.0;
-  const double g0 =
-      kGravityEquator_mps2 * (1.0 + k * s2) / std::sqrt(1.0 - kEccentricitySq * s2);
+  const double k =
+      (kSemiMinorAxis_m * kGravityPole_mps2) / (kSemiMajorAxis_m * kGravityEquator_mps2) - 1.0;
+  const double g0 = kGravityEquator_mps2 * (1.0 + k * s2) / std::sqrt(1.0 - kEccentricitySq * s2);
   // Second-order height correction, TR8350.2 eq. 4-3, with m = w^2 a^2 b / GM.
-  const double m = kRotationRate_radps * kRotationRate_radps * kSemiMajorAxis_m *
-                   kSemiMajorAxis_m * kSemiMinorAxis_m / kGm_m3ps2;
+  const double m = kRotationRate_radps * kRotationRate_radps * kSemiMajorAxis_m * kSemiMajorAxis_m *
+                   kSemiMinorAxis_m / kGm_m3ps2;
   const double a = kSemiMajorAxis_m;
   return g0 * (1.0 - 2.0 / a * (1.0 + kFlattening + m - 2.0 * kFlattening * s2) * height_m +
                3.0 / (a * a) * height_m * height_m);

@@ -22,8 +22,10 @@ void StrapdownNed::propagate(const ImuIncrement& inc) {
   const double dt = inc.interval_s;
   const Eigen::Vector3d& dth = inc.delta_angle_b_rad;
   const Eigen::Vector3d& dv = inc.delta_vel_b_mps;
-  const Eigen::Vector3d dth_prev = has_previous_ ? previous_.delta_angle_b_rad : Eigen::Vector3d::Zero();
-  const Eigen::Vector3d dv_prev = has_previous_ ? previous_.delta_vel_b_mps : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d dth_prev =
+      has_previous_ ? previous_.delta_angle_b_rad : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d dv_prev =
+      has_previous_ ? previous_.delta_vel_b_mps : Eigen::Vector3d::Zero();
 
   const earth::Geodetic pos0 = state_.position;
   const Eigen::Vector3d vel0 = state_.vel_ned_mps;
@@ -42,17 +44,19 @@ void StrapdownNed::propagate(const ImuIncrement& inc) {
     const Eigen::Vector3d w_ie = earth::omegaIeNed(pos_mid.latitude_rad);
     const Eigen::Vector3d w_en = earth::omegaEnNed(pos_mid, vel_mid);
     const Eigen::Vector3d zeta = (w_ie + w_en) * dt;  // NED rotation over the interval
-    const Eigen::Vector3d dv_sf_n = (Eigen::Matrix3d::Identity() - 0.5 * skew(zeta)) * C_b_n0 * dv_sf_b;
+    const Eigen::Vector3d dv_sf_n =
+        (Eigen::Matrix3d::Identity() - 0.5 * skew(zeta)) * C_b_n0 * dv_sf_b;
     const Eigen::Vector3d g_n = earth::gravityNed(pos_mid.latitude_rad, pos_mid.height_m);
     const Eigen::Vector3d dv_cor_n = (g_n - (2.0 * w_ie + w_en).cross(vel_mid)) * dt;
     vel1 = vel0 + dv_sf_n + dv_cor_n;
     vel_mid = 0.5 * (vel0 + vel1);
     // Position at mid-interval for the next pass (half step with the mid velocity).
     const earth::Radii r = earth::radiiOfCurvature(pos0.latitude_rad);
-    pos_mid.latitude_rad = pos0.latitude_rad + 0.5 * dt * vel_mid.x() / (r.meridian_m + pos0.height_m);
-    pos_mid.longitude_rad =
-        pos0.longitude_rad + 0.5 * dt * vel_mid.y() /
-                                 ((r.prime_vertical_m + pos0.height_m) * std::cos(pos0.latitude_rad));
+    pos_mid.latitude_rad =
+        pos0.latitude_rad + 0.5 * dt * vel_mid.x() / (r.meridian_m + pos0.height_m);
+    pos_mid.longitude_rad = pos0.longitude_rad + 0.5 * dt * vel_mid.y() /
+                                                     ((r.prime_vertical_m + pos0.height_m) *
+                                                      std::cos(pos0.latitude_rad));
     pos_mid.height_m = pos0.height_m - 0.5 * dt * vel_mid.z();
   }
 
@@ -63,8 +67,8 @@ void StrapdownNed::propagate(const ImuIncrement& inc) {
   const double h_mid = 0.5 * (pos0.height_m + pos1.height_m);
   pos1.latitude_rad = pos0.latitude_rad + dt * vel_mid.x() / (r_mid.meridian_m + h_mid);
   const double lat_mid = 0.5 * (pos0.latitude_rad + pos1.latitude_rad);
-  pos1.longitude_rad =
-      pos0.longitude_rad + dt * vel_mid.y() / ((r_mid.prime_vertical_m + h_mid) * std::cos(lat_mid));
+  pos1.longitude_rad = pos0.longitude_rad +
+                       dt * vel_mid.y() / ((r_mid.prime_vertical_m + h_mid) * std::cos(lat_mid));
   pos1.longitude_rad = std::remainder(pos1.longitude_rad, 2.0 * M_PI);
 
   // Attitude: body rotation with the coning correction, NED rotation at mid-interval.
@@ -74,9 +78,9 @@ void StrapdownNed::propagate(const ImuIncrement& inc) {
   pos_att.height_m = h_mid;
   const Eigen::Vector3d zeta =
       (earth::omegaIeNed(lat_mid) + earth::omegaEnNed(pos_att, vel_mid)) * dt;
-  state_.q_b_to_n = (quaternionFromRotationVector(-zeta) * state_.q_b_to_n *
-                     quaternionFromRotationVector(phi_b))
-                        .normalized();
+  state_.q_b_to_n =
+      (quaternionFromRotationVector(-zeta) * state_.q_b_to_n * quaternionFromRotationVector(phi_b))
+          .normalized();
   state_.vel_ned_mps = vel1;
   state_.position = pos1;
   state_.time_ns = inc.time_ns;

@@ -11,12 +11,12 @@ namespace navbus::sim {
 
 struct GnssReceiverConfig {
   double elevation_mask_rad{5.0 * M_PI / 180.0};
-  int max_satellites{32};            ///< keep at most this many (highest elevation first)
-  double clock_bias_m{3000.0};       ///< c * receiver clock bias at t = 0 (seed 000 eq. 3)
-  double clock_drift_mps{1.0};       ///< c * receiver clock drift, constant here
-  double pseudorange_sigma_m{3.0};   ///< white noise, 1 sigma
+  int max_satellites{32};           ///< keep at most this many (highest elevation first)
+  double clock_bias_m{3000.0};      ///< c * receiver clock bias at t = 0 (seed 000 eq. 3)
+  double clock_drift_mps{1.0};      ///< c * receiver clock drift, constant here
+  double pseudorange_sigma_m{3.0};  ///< white noise, 1 sigma
   double pseudorange_rate_sigma_mps{0.05};
-  double fix_pos_sigma_m{2.5};       ///< receiver fix error model (white), 1 sigma per axis
+  double fix_pos_sigma_m{2.5};  ///< receiver fix error model (white), 1 sigma per axis
   double fix_vel_sigma_mps{0.1};
 };
 

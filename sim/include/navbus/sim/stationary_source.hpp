@@ -22,7 +22,7 @@ struct ImuErrorConfig {
 struct StationarySourceConfig {
   core::earth::Geodetic position;
   Eigen::Vector3d roll_pitch_yaw_rad{Eigen::Vector3d::Zero()};
-  std::int64_t start_time_ns{0};    ///< GPS time of the start of the first interval
+  std::int64_t start_time_ns{0};  ///< GPS time of the start of the first interval
   std::int64_t imu_period_ns{10'000'000};
   int raw_samples_per_increment{24};
   int gnss_every_n_increments{100};

@@ -4,8 +4,8 @@
 #include <functional>
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <yaml-cpp/yaml.h>
+#include <CLI/CLI.hpp>
 
 #include "navbus/bus/participant.hpp"
 
@@ -14,9 +14,9 @@ namespace navbus::bus {
 /// Exit codes of every navbus executable.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitRuntimeError = 1,   ///< failure while running (e.g. a test expectation in a tool)
-  kExitConfigError = 2,    ///< bad command line or configuration
-  kExitDdsError = 3,       ///< a DDS entity could not be created (profile, QoS, transport)
+  kExitRuntimeError = 1,  ///< failure while running (e.g. a test expectation in a tool)
+  kExitConfigError = 2,   ///< bad command line or configuration
+  kExitDdsError = 3,      ///< a DDS entity could not be created (profile, QoS, transport)
 };
 
 struct CommonOptions {

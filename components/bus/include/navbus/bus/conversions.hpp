@@ -9,7 +9,8 @@
 namespace navbus::bus {
 
 core::ImuIncrement toCore(const navbus::ImuIncrement& msg);
-navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id, std::uint64_t seq);
+navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id,
+                           std::uint64_t seq);
 
 /// Fills time, position, velocity and attitude fields of a solution from a navigation state.
 void fillSolution(const core::NavState& state, navbus::NavigationSolution& out);

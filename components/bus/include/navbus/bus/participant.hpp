@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include <fastdds/dds/core/condition/WaitSet.hpp>
-#include <fastdds/dds/core/status/LivelinessChangedStatus.hpp>
-#include <fastdds/dds/core/status/DeadlineMissedStatus.hpp>
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <spdlog/spdlog.h>
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/core/status/DeadlineMissedStatus.hpp>
+#include <fastdds/dds/core/status/LivelinessChangedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include <navbus_idl/HealthPubSubTypes.h>
 
@@ -80,11 +80,12 @@ class Participant {
   /// Subscribes; `on_sample` gets every valid sample taken, in reception order. The skeleton
   /// counts `received`; the handler counts accepted / rejected after validating.
   template <class PubSubType>
-  eprosima::fastdds::dds::DataReader* subscribe(const std::string& topic_name, const std::string& profile,
-                 std::function<void(const typename PubSubType::type&,
-                                    const eprosima::fastdds::dds::SampleInfo&)>
-                     on_sample,
-                 ReaderCallbacks callbacks = {}) {
+  eprosima::fastdds::dds::DataReader* subscribe(
+      const std::string& topic_name, const std::string& profile,
+      std::function<void(const typename PubSubType::type&,
+                         const eprosima::fastdds::dds::SampleInfo&)>
+          on_sample,
+      ReaderCallbacks callbacks = {}) {
     using Sample = typename PubSubType::type;
     auto* topic = dds_.topic<PubSubType>(topic_name);
     auto* reader = dds_.createReader(topic, profile);

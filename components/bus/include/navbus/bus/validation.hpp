@@ -27,10 +27,10 @@ struct ValidationLimits {
   std::uint32_t max_interval_ns{1'000'000'000};    ///< longest IMU integration interval
   double min_pseudorange_m{1.0e7};
   double max_pseudorange_m{6.0e7};
-  double max_pseudorange_rate_mps{2.0e4};          ///< LEO receiver plus satellite motion
-  double min_sat_radius_m{2.0e7};                  ///< GNSS orbit radius bounds
+  double max_pseudorange_rate_mps{2.0e4};  ///< LEO receiver plus satellite motion
+  double min_sat_radius_m{2.0e7};          ///< GNSS orbit radius bounds
   double max_sat_radius_m{3.0e7};
-  double max_height_m{5.0e6};                      ///< receiver height bound (LEO included)
+  double max_height_m{5.0e6};  ///< receiver height bound (LEO included)
   double min_height_m{-1.0e3};
   double quaternion_norm_tolerance{1e-6};
   double max_star_tracker_sigma_rad{0.1};
@@ -78,7 +78,8 @@ class StreamGate {
       : topic_(std::move(topic)), counters_(counters), limits_(limits) {}
 
   template <class Sample>
-  bool admit(const Sample& sample, std::uint32_t sensor_id, std::uint64_t seq, std::uint64_t time_ns) {
+  bool admit(const Sample& sample, std::uint32_t sensor_id, std::uint64_t seq,
+             std::uint64_t time_ns) {
     if (auto r = validate(sample, limits_)) {
       reject(*r, sensor_id);
       return false;

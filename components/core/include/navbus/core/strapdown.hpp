@@ -12,17 +12,17 @@ namespace navbus::core {
 
 /// One navigation-rate IMU output in SI units (the core's view of an increment).
 struct ImuIncrement {
-  std::int64_t time_ns{0};                              ///< end of the interval, GPS time
-  double interval_s{0.0};                               ///< interval length
-  Eigen::Vector3d delta_vel_b_mps{Eigen::Vector3d::Zero()};   ///< specific-force integral, body
-  Eigen::Vector3d delta_angle_b_rad{Eigen::Vector3d::Zero()}; ///< inertial-rate integral, body
+  std::int64_t time_ns{0};                                     ///< end of the interval, GPS time
+  double interval_s{0.0};                                      ///< interval length
+  Eigen::Vector3d delta_vel_b_mps{Eigen::Vector3d::Zero()};    ///< specific-force integral, body
+  Eigen::Vector3d delta_angle_b_rad{Eigen::Vector3d::Zero()};  ///< inertial-rate integral, body
 };
 
 /// Position, velocity and attitude of the body.
 struct NavState {
-  std::int64_t time_ns{0};                              ///< GPS time of validity
-  earth::Geodetic position;                             ///< WGS84
-  Eigen::Vector3d vel_ned_mps{Eigen::Vector3d::Zero()}; ///< w.r.t. Earth, NED
+  std::int64_t time_ns{0};                                      ///< GPS time of validity
+  earth::Geodetic position;                                     ///< WGS84
+  Eigen::Vector3d vel_ned_mps{Eigen::Vector3d::Zero()};         ///< w.r.t. Earth, NED
   Eigen::Quaterniond q_b_to_n{Eigen::Quaterniond::Identity()};  ///< body -> NED
 };
 

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages navbus needs, only those missing. Run as root.
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config git
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools   # Fast DDS 2.9, Fast-CDR, code generator, CLI
+  libeigen3-dev libfftw3-dev                               # math
+  libyaml-cpp-dev libcli11-dev libspdlog-dev               # configuration, command line, logging
+  libgtest-dev libbenchmark-dev                            # tests and benchmarks
+  cyclonedds-dev cyclonedds-tools                          # second DDS vendor for the interop test
+  iproute2                                                 # network namespaces for the topology test
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}"

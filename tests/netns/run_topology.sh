@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# The docker-compose topology without Docker: one Linux network namespace per participant
+# (sensor-sim, filter, fault-manager, and an observer running `navbus record`), each with one
+# veth into a bridge that lives in its own "switch" namespace, so nothing touches the host's
+# interfaces. Participants use the navbus_participant_udp_lan profile (UDP, multicast
+# discovery, no shared memory): discovery and data must cross the bridge.
+# Exits 77 (skipped) where network namespaces cannot be created.
+set -euo pipefail
+bin=$1
+id=$$
+probe="nbprobe$id"
+if ! ip netns add "$probe" 2>/dev/null; then
+  echo "SKIP: network namespaces are not permitted here (ip netns add failed)"
+  exit 77
+fi
+ip netns del "$probe"
+
+hosts=(sim filter fm obs)
+sw="nbsw$id"
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  sleep 0.5
+  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
+  for h in "${hosts[@]}"; do ip netns del "nb$h$id" 2>/dev/null || true; done
+  ip netns del "$sw" 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+ip netns add "$sw"
+ip netns exec "$sw" ip link add br0 type bridge mcast_snooping 0
+ip netns exec "$sw" ip link set br0 up
+n=1
+for h in "${hosts[@]}"; do
+  ns="nb$h$id"
+  ip netns add "$ns"
+  ip link add "v$h$id" type veth peer name "s$h$id"
+  ip link set "v$h$id" netns "$ns"
+  ip link set "s$h$id" netns "$sw"
+  ip netns exec "$sw" ip link set "s$h$id" master br0 up
+  ip netns exec "$ns" ip link set "v$h$id" name eth0
+  ip netns exec "$ns" ip addr add "10.254.77.$n/24" dev eth0
+  ip netns exec "$ns" ip link set eth0 up
+  ip netns exec "$ns" ip link set lo up
+  # Multicast (SPDP discovery) leaves through eth0; the bridge is the whole network.
+  ip netns exec "$ns" ip route add 224.0.0.0/4 dev eth0
+  n=$((n + 1))
+done
+echo "namespaces: ${hosts[*]} on bridge br0 (10.254.77.0/24)"
+
+domain=76
+common=(--domain $domain --profile navbus_participant_udp_lan)
+cat > "$work/filter.yaml" <<YAML
+initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}
+inputs:
+  imu: {id: 1, period_s: 0.01}
+  gnss_observations: {id: 1, period_s: 1.0}
+  gnss_fix: {id: 1, period_s: 1.0}
+  star_tracker: {id: 1, period_s: 0.2}
+YAML
+cat > "$work/sim.yaml" <<YAML
+timing: {start: now, duration_s: 6, pacing: realtime, wait_for_readers_s: 30,
+         min_readers: {imu: 2, raw_imu: 1, gnss: 2, star_tracker: 2}}
+YAML
+
+ip netns exec "nbfilter$id" "$bin/navbus-filter" -c "$work/filter.yaml" "${common[@]}" > "$work/filter.log" 2>&1 &
+pids+=($!)
+ip netns exec "nbfm$id" "$bin/navbus-fault-manager" "${common[@]}" > "$work/fm.log" 2>&1 &
+pids+=($!)
+ip netns exec "nbobs$id" "$bin/navbus" "${common[@]}" record navbus/nav/solution navbus/fault/decision \
+  -o "$work/rec" --duration 25 > "$work/rec.log" 2>&1 &
+rec_pid=$!
+pids+=($rec_pid)
+sleep 1
+ip netns exec "nbsim$id" "$bin/navbus-sensor-sim" -c "$work/sim.yaml" "${common[@]}" > "$work/sim.log" 2>&1
+# The simulator has ended: give the watchdog time to decide, then stop the observer.
+sleep 3
+kill -TERM $rec_pid
+wait $rec_pid || true
+
+solutions=$(($(wc -l < "$work/rec/navbus_nav_solution.csv") - 1))
+lost=$(grep -c "IMU_STREAM,.*STREAM_LOST" "$work/rec/navbus_fault_decision.csv" || true)
+echo "observer namespace recorded $solutions solutions and $lost IMU stream-lost decisions"
+cat "$work/sim.log"
+status=0
+# 6 s of data at 10 Hz, published by the filter in another namespace.
+if [ "$solutions" -lt 55 ]; then echo "FAIL: expected at least 55 solutions across namespaces"; status=1; fi
+if [ "$lost" -lt 1 ]; then echo "FAIL: no IMU stream-lost decision crossed the namespaces"; status=1; fi
+if [ $status -ne 0 ]; then cat "$work/filter.log" "$work/fm.log" "$work/rec.log"; fi
+exit $status
