@@ -8,8 +8,6 @@
 namespace navbus::nav_filter {
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
-
 std::int64_t seconds(double s) {
   return std::llround(s * 1e9);
 }
@@ -42,31 +40,9 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   const YAML::Node init = root["initial_state"];
   if (!init) throw bus::ConfigError("configuration initial_state is missing");
   auto& s = c.initial_state;
-  s.position.latitude_rad =
-      bus::checkRange(bus::require<double>(init, "initial_state", "latitude_deg"), -90, 90,
-                      "initial_state.latitude_deg") *
-      kDeg;
-  s.position.longitude_rad =
-      bus::checkRange(bus::require<double>(init, "initial_state", "longitude_deg"), -180, 180,
-                      "initial_state.longitude_deg") *
-      kDeg;
-  s.position.height_m = bus::checkRange(bus::require<double>(init, "initial_state", "height_m"),
-                                        -500, 5e6, "initial_state.height_m");
-  const auto vel =
-      bus::get<std::vector<double>>(init, "initial_state", "vel_ned_mps", {0.0, 0.0, 0.0});
-  if (vel.size() != 3)
-    throw bus::ConfigError("configuration initial_state.vel_ned_mps must have 3 elements");
-  s.vel_ned_mps = Eigen::Vector3d(vel[0], vel[1], vel[2]);
-  const Eigen::Vector3d rpy(
-      bus::checkRange(bus::get<double>(init, "initial_state", "roll_deg", 0.0), -180, 180,
-                      "initial_state.roll_deg") *
-          kDeg,
-      bus::checkRange(bus::get<double>(init, "initial_state", "pitch_deg", 0.0), -90, 90,
-                      "initial_state.pitch_deg") *
-          kDeg,
-      bus::checkRange(bus::get<double>(init, "initial_state", "yaw_deg", 0.0), -180, 360,
-                      "initial_state.yaw_deg") *
-          kDeg);
+  s.position = bus::getGeodeticDeg(init, "initial_state", nullptr);
+  s.vel_ned_mps = bus::getVector3(init, "initial_state", "vel_ned_mps", 1.0);
+  const Eigen::Vector3d rpy = bus::getRollPitchYawDeg(init, "initial_state");
   s.q_b_to_n = Eigen::Quaterniond(core::dcmFromEuler(rpy));
 
   const YAML::Node inputs = root["inputs"];

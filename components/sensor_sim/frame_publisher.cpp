@@ -8,12 +8,7 @@
 
 namespace navbus::sensor_sim {
 
-namespace {
-template <class Array>
-void copy3(const Eigen::Vector3d& v, Array& a) {
-  a = {v.x(), v.y(), v.z()};
-}
-}  // namespace
+using bus::toArray;
 
 navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id,
                           std::uint64_t seq) {
@@ -25,8 +20,8 @@ navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id
   msg.samples().reserve(block.samples.size());
   for (const auto& s : block.samples) {
     navbus::ImuRawSample r;
-    copy3(s.angular_rate_b_radps, r.angular_rate_b_radps());
-    copy3(s.specific_force_b_mps2, r.specific_force_b_mps2());
+    r.angular_rate_b_radps(toArray(s.angular_rate_b_radps));
+    r.specific_force_b_mps2(toArray(s.specific_force_b_mps2));
     msg.samples().push_back(r);
   }
   return msg;
@@ -43,8 +38,8 @@ navbus::GnssObservationEpoch toIdl(const sim::GnssEpoch& epoch, std::uint32_t re
     m.sv_id(static_cast<std::uint16_t>(s.sv_id));
     m.pseudorange_m(s.pseudorange_m);
     m.pseudorange_rate_mps(s.pseudorange_rate_mps);
-    copy3(s.sat_pos_ecef_m, m.sat_pos_ecef_m());
-    copy3(s.sat_vel_ecef_mps, m.sat_vel_ecef_mps());
+    m.sat_pos_ecef_m(toArray(s.sat_pos_ecef_m));
+    m.sat_vel_ecef_mps(toArray(s.sat_vel_ecef_mps));
     m.sat_clock_correction_m(s.sat_clock_correction_m);
     m.sat_clock_drift_mps(s.sat_clock_drift_mps);
     m.cn0_dbhz(s.cn0_dbhz);
@@ -64,10 +59,10 @@ navbus::GnssFix toIdl(const sim::GnssFixSample& fix, std::uint32_t receiver_id, 
   msg.latitude_rad(fix.position.latitude_rad);
   msg.longitude_rad(fix.position.longitude_rad);
   msg.height_m(fix.position.height_m);
-  copy3(core::earth::geodeticToEcef(fix.position), msg.pos_ecef_m());
-  copy3(fix.vel_ned_mps, msg.vel_ned_mps());
-  copy3(fix.pos_sigma_ned_m, msg.pos_sigma_ned_m());
-  copy3(fix.vel_sigma_ned_mps, msg.vel_sigma_ned_mps());
+  msg.pos_ecef_m(toArray(core::earth::geodeticToEcef(fix.position)));
+  msg.vel_ned_mps(toArray(fix.vel_ned_mps));
+  msg.pos_sigma_ned_m(toArray(fix.pos_sigma_ned_m));
+  msg.vel_sigma_ned_mps(toArray(fix.vel_sigma_ned_mps));
   msg.num_satellites_used(static_cast<std::uint16_t>(fix.num_satellites));
   msg.valid(fix.num_satellites >= 4);
   return msg;
@@ -80,7 +75,7 @@ navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_
   msg.seq(seq);
   msg.time_gps_ns(static_cast<std::uint64_t>(st.time_ns));
   msg.q_b_to_i() = {st.q_b_to_i.w(), st.q_b_to_i.x(), st.q_b_to_i.y(), st.q_b_to_i.z()};
-  copy3(st.sigma_b_rad, msg.sigma_b_rad());
+  msg.sigma_b_rad(toArray(st.sigma_b_rad));
   msg.valid(true);
   return msg;
 }

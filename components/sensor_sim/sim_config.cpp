@@ -11,16 +11,6 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr double kMicroG = 9.80665e-6;  // m/s^2
 constexpr double kDegPerHour = kDeg / 3600.0;
 
-Eigen::Vector3d vector3(const YAML::Node& node, const std::string& where, const std::string& key,
-                        double scale) {
-  const auto v = bus::get<std::vector<double>>(node, where, key, {0.0, 0.0, 0.0});
-  if (v.size() != 3) {
-    throw bus::ConfigError("configuration " + where + "." + key + " must have 3 elements, has " +
-                           std::to_string(v.size()));
-  }
-  return Eigen::Vector3d(v[0], v[1], v[2]) * scale;
-}
-
 /// Integer number of `fast` periods in one `slow` period, or a ConfigError.
 int ratio(double fast_hz, double slow_hz, const std::string& name) {
   const double r = fast_hz / slow_hz;
@@ -36,25 +26,9 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   SimConfig c;
   auto& s = c.source;
   const YAML::Node veh = root["vehicle"];
-  s.position.latitude_rad = bus::checkRange(bus::get<double>(veh, "vehicle", "latitude_deg", 36.5),
-                                            -90, 90, "vehicle.latitude_deg") *
-                            kDeg;
-  s.position.longitude_rad =
-      bus::checkRange(bus::get<double>(veh, "vehicle", "longitude_deg", 127.5), -180, 180,
-                      "vehicle.longitude_deg") *
-      kDeg;
-  s.position.height_m = bus::checkRange(bus::get<double>(veh, "vehicle", "height_m", 100.0), -500,
-                                        1e5, "vehicle.height_m");
-  s.roll_pitch_yaw_rad =
-      Eigen::Vector3d(bus::checkRange(bus::get<double>(veh, "vehicle", "roll_deg", 0.0), -180, 180,
-                                      "vehicle.roll_deg") *
-                          kDeg,
-                      bus::checkRange(bus::get<double>(veh, "vehicle", "pitch_deg", 0.0), -89, 89,
-                                      "vehicle.pitch_deg") *
-                          kDeg,
-                      bus::checkRange(bus::get<double>(veh, "vehicle", "yaw_deg", 0.0), -180, 360,
-                                      "vehicle.yaw_deg") *
-                          kDeg);
+  const core::earth::Geodetic default_site{36.5 * kDeg, 127.5 * kDeg, 100.0};  // seed 000
+  s.position = bus::getGeodeticDeg(veh, "vehicle", &default_site);
+  s.roll_pitch_yaw_rad = bus::getRollPitchYawDeg(veh, "vehicle");
 
   const YAML::Node timing = root["timing"];
   const std::string start = bus::get<std::string>(timing, "timing", "start", "now");
@@ -119,8 +93,8 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   s.star_tracker_every_n_increments = ratio(imu_hz, st_hz, "timing.star_tracker_rate_hz");
 
   const YAML::Node imu = root["imu"];
-  s.imu.accel_bias_b_mps2 = vector3(imu, "imu", "accel_bias_ug", kMicroG);
-  s.imu.gyro_bias_b_radps = vector3(imu, "imu", "gyro_bias_deg_per_h", kDegPerHour);
+  s.imu.accel_bias_b_mps2 = bus::getVector3(imu, "imu", "accel_bias_ug", kMicroG);
+  s.imu.gyro_bias_b_radps = bus::getVector3(imu, "imu", "gyro_bias_deg_per_h", kDegPerHour);
   // ug/sqrt(Hz) -> (m/s^2)/sqrt(Hz); deg/sqrt(h) -> rad/sqrt(s) = (rad/s)/sqrt(Hz).
   s.imu.accel_noise_density_mps2_per_sqrthz =
       bus::checkRange(bus::get<double>(imu, "imu", "accel_noise_ug_per_sqrthz", 0.0), 0, 1e5,

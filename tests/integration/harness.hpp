@@ -16,6 +16,10 @@
 #include <thread>
 #include <vector>
 
+#include <navbus_idl/GnssPubSubTypes.h>
+#include <navbus_idl/ImuPubSubTypes.h>
+#include <navbus_idl/StarTrackerPubSubTypes.h>
+
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/topics.hpp"
 
@@ -129,6 +133,27 @@ inline void cleanSharedMemory() {
     }
   }
 }
+
+/// The test's writers for every sensor stream navbus-filter reads, with the simulator's profiles.
+struct SensorInputWriters {
+  explicit SensorInputWriters(bus::Participant& p)
+      : imu(p.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement,
+                                                   bus::profile::kSensorWriter)),
+        obs(p.createWriter<GnssObservationEpochPubSubType>(bus::topic::kGnssObservations,
+                                                           bus::profile::kMeasurementWriter)),
+        fix(p.createWriter<GnssFixPubSubType>(bus::topic::kGnssFix,
+                                              bus::profile::kMeasurementWriter)),
+        star(p.createWriter<StarTrackerAttitudePubSubType>(bus::topic::kStarTracker,
+                                                           bus::profile::kMeasurementWriter)) {}
+  bool matched() const {
+    return imu.matchedReaders() && obs.matchedReaders() && fix.matchedReaders() &&
+           star.matchedReaders();
+  }
+  bus::Writer<ImuIncrement> imu;
+  bus::Writer<GnssObservationEpoch> obs;
+  bus::Writer<GnssFix> fix;
+  bus::Writer<StarTrackerAttitude> star;
+};
 
 inline std::string filterConfig(int domain, std::uint32_t imu_id = 1, bool measurements = true) {
   std::string c = "domain_id: " + std::to_string(domain) +

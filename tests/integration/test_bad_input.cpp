@@ -41,18 +41,8 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
                                    if (h.participant().to_string() == "navbus-filter")
                                      filter_health = h;
                                  });
-  auto imu = me.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement,
-                                                     bus::profile::kSensorWriter);
-  auto obs = me.createWriter<GnssObservationEpochPubSubType>(bus::topic::kGnssObservations,
-                                                             bus::profile::kMeasurementWriter);
-  auto fix =
-      me.createWriter<GnssFixPubSubType>(bus::topic::kGnssFix, bus::profile::kMeasurementWriter);
-  auto star = me.createWriter<StarTrackerAttitudePubSubType>(bus::topic::kStarTracker,
-                                                             bus::profile::kMeasurementWriter);
-  ASSERT_TRUE(test::spinUntil(me, 20s, [&] {
-    return imu.matchedReaders() && obs.matchedReaders() && fix.matchedReaders() &&
-           star.matchedReaders();
-  }));
+  test::SensorInputWriters w(me);
+  ASSERT_TRUE(test::spinUntil(me, 20s, [&] { return w.matched(); }));
 
   sim::StationarySourceConfig src_cfg;
   src_cfg.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
@@ -69,54 +59,54 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
     switch (k) {
       case 20:
         bad.delta_vel_b_mps()[1] = nan;
-        imu.write(bad);
+        w.imu.write(bad);
         break;
       case 40:
         bad.delta_angle_b_rad()[2] = inf;
-        imu.write(bad);
+        w.imu.write(bad);
         break;
       case 60:
         bad.delta_vel_b_mps()[0] = 50.0;
-        imu.write(bad);
+        w.imu.write(bad);
         break;  // 5000 m/s^2
       case 80:
         bad.interval_ns(0);
-        imu.write(bad);
+        w.imu.write(bad);
         break;
       case 100:
         bad.time_gps_ns(last.time_gps_ns() - 5'000'000);
-        imu.write(bad);
+        w.imu.write(bad);
         break;  // out of order
       case 120:
-        imu.write(last);
+        w.imu.write(last);
         break;  // duplicate
       case 140:
         bad.sensor_id(9);
-        imu.write(bad);
+        w.imu.write(bad);
         break;  // not configured
       default:
         break;
     }
-    imu.write(good);
+    w.imu.write(good);
     last = good;
     if (f.has_gnss) {
-      obs.write(sensor_sim::toIdl(f.gnss, 1, ++n_obs));
-      fix.write(sensor_sim::toIdl(f.fix, 1, ++n_fix));
+      w.obs.write(sensor_sim::toIdl(f.gnss, 1, ++n_obs));
+      w.fix.write(sensor_sim::toIdl(f.fix, 1, ++n_fix));
       if (n_obs == 1) {
         auto e = sensor_sim::toIdl(f.gnss, 1, n_obs + 1);
         e.satellites().at(0).sv_id(40);
-        obs.write(e);
+        w.obs.write(e);
         auto x = sensor_sim::toIdl(f.fix, 1, n_fix + 1);
         x.latitude_rad(nan);
-        fix.write(x);
+        w.fix.write(x);
       }
     }
     if (f.has_star_tracker) {
-      star.write(sensor_sim::toIdl(f.star_tracker, 1, ++n_star));
+      w.star.write(sensor_sim::toIdl(f.star_tracker, 1, ++n_star));
       if (n_star == 2) {
         auto s = sensor_sim::toIdl(f.star_tracker, 1, n_star + 1);
         s.q_b_to_i()[1] += 0.01;
-        star.write(s);
+        w.star.write(s);
       }
     }
     me.spinOnce(1ms);

@@ -47,31 +47,21 @@ std::vector<std::string> runFilter(int domain, Delivery delivery,
                                              [&](const NavigationSolution& s, const auto&) {
                                                solutions.push_back(tool::csvRows(s).at(0));
                                              });
-  auto imu = me.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement,
-                                                     bus::profile::kSensorWriter);
-  auto obs = me.createWriter<GnssObservationEpochPubSubType>(bus::topic::kGnssObservations,
-                                                             bus::profile::kMeasurementWriter);
-  auto fix =
-      me.createWriter<GnssFixPubSubType>(bus::topic::kGnssFix, bus::profile::kMeasurementWriter);
-  auto star = me.createWriter<StarTrackerAttitudePubSubType>(bus::topic::kStarTracker,
-                                                             bus::profile::kMeasurementWriter);
-  EXPECT_TRUE(test::spinUntil(me, 20s, [&] {
-    return imu.matchedReaders() && obs.matchedReaders() && fix.matchedReaders() &&
-           star.matchedReaders();
-  }));
+  test::SensorInputWriters w(me);
+  EXPECT_TRUE(test::spinUntil(me, 20s, [&] { return w.matched(); }));
 
   std::uint64_t n_imu = 0, n_obs = 0, n_fix = 0, n_star = 0;
   auto write_measurements = [&](const sim::SensorFrame& f) {
     if (f.has_gnss) {
-      obs.write(sensor_sim::toIdl(f.gnss, 1, ++n_obs));
-      fix.write(sensor_sim::toIdl(f.fix, 1, ++n_fix));
+      w.obs.write(sensor_sim::toIdl(f.gnss, 1, ++n_obs));
+      w.fix.write(sensor_sim::toIdl(f.fix, 1, ++n_fix));
     }
-    if (f.has_star_tracker) star.write(sensor_sim::toIdl(f.star_tracker, 1, ++n_star));
+    if (f.has_star_tracker) w.star.write(sensor_sim::toIdl(f.star_tracker, 1, ++n_star));
   };
   if (delivery == Delivery::kInTimeOrderSteady) {
     // One frame every 2 ms, each sample in time order.
     for (const auto& f : frames) {
-      imu.write(bus::toIdl(f.increment, 1, ++n_imu));
+      w.imu.write(bus::toIdl(f.increment, 1, ++n_imu));
       write_measurements(f);
       me.spinOnce(2ms);
     }
@@ -81,7 +71,7 @@ std::vector<std::string> runFilter(int domain, Delivery delivery,
     for (std::size_t k = 0; k < frames.size(); ++k) {
       while (next_measurement < frames.size() && next_measurement < k + 150)
         write_measurements(frames[next_measurement++]);
-      imu.write(bus::toIdl(frames[k].increment, 1, ++n_imu));
+      w.imu.write(bus::toIdl(frames[k].increment, 1, ++n_imu));
       if (k % 37 == 36) me.spinOnce(30ms);
     }
   }

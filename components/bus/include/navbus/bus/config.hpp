@@ -5,6 +5,9 @@
 #include <string>
 
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Core>
+
+#include "navbus/core/earth.hpp"
 
 namespace navbus::bus {
 
@@ -42,5 +45,17 @@ T require(const YAML::Node& node, const std::string& where, const std::string& k
 
 /// Throws ConfigError unless lo <= value <= hi.
 double checkRange(double value, double lo, double hi, const std::string& name);
+
+/// `where.key` as a 3-element list times `scale` (unit conversion); `fallback` when absent.
+Eigen::Vector3d getVector3(const YAML::Node& node, const std::string& where, const std::string& key,
+                           double scale, const Eigen::Vector3d& fallback = Eigen::Vector3d::Zero());
+
+/// latitude_deg, longitude_deg and height_m of `node`, converted to radians; `fallback` for
+/// absent keys, or all required when `fallback` is null.
+core::earth::Geodetic getGeodeticDeg(const YAML::Node& node, const std::string& where,
+                                     const core::earth::Geodetic* fallback);
+
+/// roll_deg, pitch_deg and yaw_deg of `node` (0 when absent), converted to radians.
+Eigen::Vector3d getRollPitchYawDeg(const YAML::Node& node, const std::string& where);
 
 }  // namespace navbus::bus

@@ -1,12 +1,21 @@
 // IDL <-> core conversions. Units are converted here, once; the core works in SI.
 #pragma once
 
+#include <array>
+
 #include <navbus_idl/Imu.h>
 #include <navbus_idl/Navigation.h>
 
 #include "navbus/core/strapdown.hpp"
 
 namespace navbus::bus {
+
+inline std::array<double, 3> toArray(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+inline Eigen::Vector3d toVector(const std::array<double, 3>& a) {
+  return {a[0], a[1], a[2]};
+}
 
 core::ImuIncrement toCore(const navbus::ImuIncrement& msg);
 navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id,
