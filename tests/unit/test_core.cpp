@@ -103,6 +103,10 @@ TEST(Strapdown, ErrorFreeStationaryIncrementsKeepTheVehicleInPlace) {
   // then the position stays within centimetres for any heading.
   for (double yaw : {0.0, 45.0, 170.0}) {
     const auto [horizontal_m, vertical_m] = stationaryDrift(600.0, yaw);
+    std::printf(
+        "stationary error-free increments, 600 s, yaw %.0f deg: horizontal %.2e m, vertical %.2e "
+        "m\n",
+        yaw, horizontal_m, vertical_m);
     EXPECT_LT(horizontal_m, 0.01) << "yaw " << yaw;
     EXPECT_LT(vertical_m, 0.01) << "yaw " << yaw;
   }
