@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 namespace navbus::core::earth {
 
 Radii radiiOfCurvature(double latitude_rad) {
@@ -27,6 +29,21 @@ double normalGravity(double latitude_rad, double height_m) {
 
 Eigen::Vector3d gravityNed(double latitude_rad, double height_m) {
   return {0.0, 0.0, normalGravity(latitude_rad, height_m)};
+}
+
+Eigen::Vector3d pointMassGravitationEcef(const Eigen::Vector3d& r) {
+  const double n = r.norm();
+  return -kGm_m3ps2 / (n * n * n) * r;
+}
+
+Eigen::Vector3d gravityNed(GravityModel model, const Geodetic& position) {
+  if (model == GravityModel::kWgs84Normal) {
+    return gravityNed(position.latitude_rad, position.height_m);
+  }
+  const Eigen::Vector3d r = geodeticToEcef(position);
+  const Eigen::Vector3d w(0.0, 0.0, kRotationRate_radps);
+  const Eigen::Vector3d g_e = pointMassGravitationEcef(r) - w.cross(w.cross(r));
+  return C_n_e(position.latitude_rad, position.longitude_rad).transpose() * g_e;
 }
 
 Eigen::Vector3d geodeticToEcef(const Geodetic& p) {

@@ -46,7 +46,7 @@ void StrapdownNed::propagate(const ImuIncrement& inc) {
     const Eigen::Vector3d zeta = (w_ie + w_en) * dt;  // NED rotation over the interval
     const Eigen::Vector3d dv_sf_n =
         (Eigen::Matrix3d::Identity() - 0.5 * skew(zeta)) * C_b_n0 * dv_sf_b;
-    const Eigen::Vector3d g_n = earth::gravityNed(pos_mid.latitude_rad, pos_mid.height_m);
+    const Eigen::Vector3d g_n = earth::gravityNed(gravity_, pos_mid);
     const Eigen::Vector3d dv_cor_n = (g_n - (2.0 * w_ie + w_en).cross(vel_mid)) * dt;
     vel1 = vel0 + dv_sf_n + dv_cor_n;
     vel_mid = 0.5 * (vel0 + vel1);

@@ -41,6 +41,19 @@ double normalGravity(double latitude_rad, double height_m);
 /// Normal gravity vector in NED (the normal-gravity field is along the ellipsoid normal).
 Eigen::Vector3d gravityNed(double latitude_rad, double height_m);
 
+/// Which gravity field a mechanization or a simulation uses. Truth and navigation must agree:
+/// seed 001 models a spherical Earth (point-mass gravitation), the others WGS84 normal gravity.
+enum class GravityModel {
+  kWgs84Normal,  ///< Somigliana with the second-order height correction (surface and aircraft)
+  kPointMass     ///< GM / r^2 towards the centre, plus the centrifugal term (orbits, seed 001)
+};
+
+/// Gravity (gravitation plus centrifugal) in NED at a position, for the chosen model.
+Eigen::Vector3d gravityNed(GravityModel model, const Geodetic& position);
+
+/// Point-mass gravitation (no centrifugal term) in ECEF at an ECEF position.
+Eigen::Vector3d pointMassGravitationEcef(const Eigen::Vector3d& pos_ecef_m);
+
 Eigen::Vector3d geodeticToEcef(const Geodetic& position);
 
 /// Exact-to-machine-precision inverse (iterated), valid from the centre of the Earth to orbit.

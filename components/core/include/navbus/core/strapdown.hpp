@@ -32,6 +32,9 @@ struct NavState {
 /// state extrapolated from the previous step, which keeps the algorithm second-order accurate.
 class StrapdownNed {
  public:
+  explicit StrapdownNed(earth::GravityModel gravity = earth::GravityModel::kWgs84Normal)
+      : gravity_(gravity) {}
+
   /// Starts from a known state; the first increment after this has no coning partner.
   void initialize(const NavState& state);
 
@@ -46,6 +49,7 @@ class StrapdownNed {
   bool initialized() const { return initialized_; }
 
  private:
+  earth::GravityModel gravity_;
   NavState state_;
   ImuIncrement previous_;
   bool has_previous_{false};
