@@ -64,7 +64,7 @@ navbus::GnssFix toIdl(const sim::GnssFixSample& fix, std::uint32_t receiver_id, 
   msg.pos_sigma_ned_m(toArray(fix.pos_sigma_ned_m));
   msg.vel_sigma_ned_mps(toArray(fix.vel_sigma_ned_mps));
   msg.num_satellites_used(static_cast<std::uint16_t>(fix.num_satellites));
-  msg.valid(fix.num_satellites >= 4);
+  msg.valid(fix.valid);
   return msg;
 }
 

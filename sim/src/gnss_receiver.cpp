@@ -4,18 +4,19 @@
 #include <cmath>
 
 #include "navbus/core/earth.hpp"
+#include "navbus/core/gnss_fix.hpp"
 
 namespace navbus::sim {
 
 namespace earth = core::earth;
 
 GnssReceiverModel::GnssReceiverModel(const GnssReceiverConfig& config,
-                                     const CircularConstellation& constellation)
+                                     const Constellation& constellation)
     : config_(config), constellation_(constellation) {}
 
 GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
                                      const Eigen::Vector3d& rx_pos, const Eigen::Vector3d& rx_vel,
-                                     std::mt19937_64& rng) const {
+                                     std::mt19937_64& rng) {
   std::normal_distribution<double> unit(0.0, 1.0);
   const double t = 1e-9 * static_cast<double>(t_ns);
   const double since_start_s = 1e-9 * static_cast<double>(t_ns - t0_ns);
@@ -25,7 +26,10 @@ GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
 
   GnssEpoch epoch;
   epoch.time_ns = t_ns;
-  for (int sv = 1; sv <= constellation_.size(); ++sv) {
+  for (const auto& elements : constellation_.almanac()) {
+    const int sv = elements.sv_id;
+    if (!tracked_.empty() && std::find(tracked_.begin(), tracked_.end(), sv) == tracked_.end())
+      continue;
     // Light-time iteration: the signal left the satellite tau seconds before reception.
     double tau = 0.07;
     SatelliteState s;
@@ -67,17 +71,50 @@ GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
   if (static_cast<int>(epoch.satellites.size()) > config_.max_satellites) {
     epoch.satellites.resize(static_cast<std::size_t>(config_.max_satellites));
   }
+  if (config_.fixed_satellites > 0 && tracked_.empty()) {
+    // Keep the N best-placed satellites of the first epoch for the whole run (seed 000 uses 4).
+    for (std::size_t i = 0;
+         i < epoch.satellites.size() && static_cast<int>(i) < config_.fixed_satellites; ++i) {
+      tracked_.push_back(epoch.satellites[i].sv_id);
+    }
+    epoch.satellites.resize(tracked_.size());
+  }
   std::sort(epoch.satellites.begin(), epoch.satellites.end(),
             [](const auto& a, const auto& b) { return a.sv_id < b.sv_id; });
   return epoch;
 }
 
-GnssFixSample GnssReceiverModel::fix(std::int64_t t_ns, const earth::Geodetic& truth_pos,
-                                     const Eigen::Vector3d& truth_vel_ned, int num_satellites,
+GnssFixSample GnssReceiverModel::fix(const GnssEpoch& epoch, const earth::Geodetic& truth_pos,
+                                     const Eigen::Vector3d& truth_vel_ned,
                                      std::mt19937_64& rng) const {
-  std::normal_distribution<double> unit(0.0, 1.0);
   GnssFixSample f;
-  f.time_ns = t_ns;
+  f.time_ns = epoch.time_ns;
+  f.num_satellites = static_cast<int>(epoch.satellites.size());
+  if (config_.fix_least_squares) {
+    std::vector<core::RangeObservation> obs;
+    for (const auto& s : epoch.satellites) {
+      obs.push_back({s.sat_pos_ecef_m, s.sat_vel_ecef_mps,
+                     s.pseudorange_m + s.sat_clock_correction_m,
+                     s.pseudorange_rate_mps + s.sat_clock_drift_mps});
+    }
+    const core::LeastSquaresFix ls = core::leastSquaresFix(obs);
+    f.valid = ls.valid;
+    if (!ls.valid) return f;
+    f.position = earth::ecefToGeodetic(ls.pos_ecef_m);
+    const Eigen::Matrix3d C_e_n =
+        earth::C_n_e(f.position.latitude_rad, f.position.longitude_rad).transpose();
+    f.vel_ned_mps = C_e_n * ls.vel_ecef_mps;
+    // Reported 1-sigma: DOP times the receiver's own measurement sigma.
+    f.pos_sigma_ned_m =
+        Eigen::Vector3d(ls.hdop / std::sqrt(2.0), ls.hdop / std::sqrt(2.0), ls.vdop) *
+        config_.pseudorange_sigma_m;
+    f.vel_sigma_ned_mps =
+        Eigen::Vector3d(ls.hdop / std::sqrt(2.0), ls.hdop / std::sqrt(2.0), ls.vdop) *
+        config_.pseudorange_rate_sigma_mps;
+    f.pdop = ls.pdop;
+    return f;
+  }
+  std::normal_distribution<double> unit(0.0, 1.0);
   const earth::Radii r = earth::radiiOfCurvature(truth_pos.latitude_rad);
   const Eigen::Vector3d dpos_ned(config_.fix_pos_sigma_m * unit(rng),
                                  config_.fix_pos_sigma_m * unit(rng),
@@ -92,7 +129,7 @@ GnssFixSample GnssReceiverModel::fix(std::int64_t t_ns, const earth::Geodetic& t
   }
   f.pos_sigma_ned_m.setConstant(config_.fix_pos_sigma_m);
   f.vel_sigma_ned_mps.setConstant(config_.fix_vel_sigma_mps);
-  f.num_satellites = num_satellites;
+  f.valid = f.num_satellites >= 4;
   return f;
 }
 

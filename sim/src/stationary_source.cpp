@@ -64,8 +64,7 @@ SensorFrame StationarySource::next() {
     f.has_gnss = true;
     f.gnss =
         receiver_.observe(t_end, config_.start_time_ns, pos_ecef_m_, Eigen::Vector3d::Zero(), rng_);
-    f.fix = receiver_.fix(t_end, truth_.position, truth_.vel_ned_mps,
-                          static_cast<int>(f.gnss.satellites.size()), rng_);
+    f.fix = receiver_.fix(f.gnss, truth_.position, truth_.vel_ned_mps, rng_);
   }
   if (config_.star_tracker_every_n_increments > 0 &&
       index_ % config_.star_tracker_every_n_increments == 0) {

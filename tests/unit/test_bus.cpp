@@ -102,6 +102,9 @@ TEST(Validation, StarTrackerQuaternionMustBeUnit) {
 
 TEST(Validation, GnssFixRanges) {
   navbus::GnssFix f;
+  f.valid(false);
+  EXPECT_FALSE(validate(f, ValidationLimits{}));  // invalid fixes: finiteness only
+  f.valid(true);
   f.latitude_rad(0.5);
   f.longitude_rad(2.0);
   f.height_m(100.0);

@@ -10,7 +10,7 @@
 namespace earth = navbus::core::earth;
 
 TEST(Constellation, CircularOrbitsFollowKeplersLaw) {
-  navbus::sim::CircularConstellation c({});
+  navbus::sim::Constellation c(navbus::sim::ConstellationConfig{});
   const double period = 2 * M_PI * std::sqrt(std::pow(26'559'700.0, 3) / earth::kGm_m3ps2);
   EXPECT_NEAR(period, 43082.0, 5.0);  // half a sidereal day
   // In ECI the satellite returns after one period; in ECEF it is rotated by the Earth.

@@ -144,6 +144,7 @@ std::optional<Rejection> validate(const navbus::GnssFix& s, const ValidationLimi
   if (auto r = finiteArray(s.vel_ned_mps(), "vel_ned_mps")) return r;
   if (auto r = finiteArray(s.pos_sigma_ned_m(), "pos_sigma_ned_m")) return r;
   if (auto r = finiteArray(s.vel_sigma_ned_mps(), "vel_sigma_ned_mps")) return r;
+  if (!s.valid()) return std::nullopt;  // a fix marked invalid is not used, so not judged further
   if (auto r = range(s.latitude_rad(), -M_PI / 2, M_PI / 2, "latitude_rad")) return r;
   if (auto r = range(s.longitude_rad(), -M_PI, M_PI, "longitude_rad")) return r;
   if (auto r = range(s.height_m(), l.min_height_m, l.max_height_m, "height_m")) return r;

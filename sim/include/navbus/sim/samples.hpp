@@ -50,6 +50,8 @@ struct GnssFixSample {
   Eigen::Vector3d pos_sigma_ned_m{Eigen::Vector3d::Zero()};
   Eigen::Vector3d vel_sigma_ned_mps{Eigen::Vector3d::Zero()};
   int num_satellites{0};
+  bool valid{false};
+  double pdop{0.0};  ///< 0 when the fix does not come from the pseudoranges
 };
 
 struct StarTrackerSample {

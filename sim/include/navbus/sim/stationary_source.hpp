@@ -47,7 +47,7 @@ class StationarySource {
 
  private:
   StationarySourceConfig config_;
-  CircularConstellation constellation_;
+  Constellation constellation_;
   GnssReceiverModel receiver_;
   std::mt19937_64 rng_;
   RawImuSample ideal_;
