@@ -12,7 +12,7 @@
 
 #include "navbus/bus/participant.hpp"
 #include "navbus/sim/samples.hpp"
-#include "sim_config.hpp"
+#include "scenario_config.hpp"
 
 namespace navbus::sensor_sim {
 

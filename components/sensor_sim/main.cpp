@@ -3,10 +3,12 @@
 #include <chrono>
 #include <thread>
 
+#include "file_writer.hpp"
 #include "frame_publisher.hpp"
 #include "navbus/bus/app.hpp"
-#include "navbus/sim/stationary_source.hpp"
-#include "sim_config.hpp"
+#include "navbus/bus/config.hpp"
+#include "navbus/sim/scenario_source.hpp"
+#include "scenario_config.hpp"
 
 namespace nb = navbus;
 
@@ -18,7 +20,16 @@ int main(int argc, char** argv) {
   nb::bus::CommonOptions common;
   double duration_override = -1.0;
   std::string pacing_override;
+  std::string files_dir;
+  std::uint64_t seed_override = 0;
+  bool seed_given = false;
   nb::bus::addCommonOptions(app, common, false);
+  app.add_option("--scenario", common.config_file,
+                 "scenario file (same as --config), e.g. scenarios/seed000_aircraft.yaml");
+  app.add_option("--files", files_dir,
+                 "write the streams as CSV files into this directory instead of publishing");
+  app.add_option("--seed", seed_override, "Monte Carlo seed (overrides the scenario's)")
+      ->each([&](const std::string&) { seed_given = true; });
   app.add_option("--duration", duration_override, "seconds of data to publish (0: until stopped)")
       ->check(CLI::Range(0.0, 1e7));
   app.add_option("--pacing", pacing_override, "realtime or fast (flow-controlled, nothing lost)")
@@ -32,6 +43,44 @@ int main(int argc, char** argv) {
       config.pacing = pacing_override == "fast" ? nb::sensor_sim::Pacing::kFast
                                                 : nb::sensor_sim::Pacing::kRealTime;
     }
+    if (seed_given) config.scenario.seed = seed_override;
+    auto startNow = [&] {
+      // Real GPS time, on a whole IMU period, so that a restarted simulator continues forward.
+      const auto now = static_cast<std::int64_t>(nb::bus::gpsTimeNowNs());
+      config.scenario.start_time_ns = now - now % config.scenario.imu_period_ns;
+    };
+    const std::int64_t period_ns = config.scenario.imu_period_ns;
+    double duration_s = config.duration_s;
+    if (duration_s <= 0.0 && !files_dir.empty()) {
+      double segments_s = 0.0;
+      for (const auto& seg : config.scenario.segments) segments_s += seg.duration_s;
+      if (segments_s <= 0.0) {
+        throw nb::bus::ConfigError(
+            "--files needs a finite run: set timing.duration_s or --duration");
+      }
+      duration_s = segments_s;
+    }
+    const std::int64_t total =
+        duration_s > 0.0 ? static_cast<std::int64_t>(
+                               std::llround(duration_s * 1e9 / static_cast<double>(period_ns)))
+                         : -1;
+    if (!files_dir.empty()) {
+      // Offline: no DDS participant at all.
+      if (config.start_now) startNow();
+      nb::sim::ScenarioSource source(config.scenario);
+      nb::sensor_sim::FileWriter files(files_dir, config.scenario);
+      while (!shutdown.requested() && source.index() < total) files.write(source.next());
+      const auto& n = files.counts();
+      spdlog::info(
+          "summary: scenario '{}' seed {}: wrote {} IMU increments, {} raw blocks, {} GNSS epochs, "
+          "{} fixes, "
+          "{} star-tracker attitudes ({} s) to {}",
+          config.scenario.name, config.scenario.seed, n.imu, n.raw, n.gnss_epochs, n.gnss_fixes,
+          n.star_tracker, static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9,
+          files_dir);
+      return static_cast<int>(nb::bus::kExitOk);
+    }
+
     nb::bus::Participant participant(nb::bus::participantOptions(common, yaml, "navbus-sensor-sim"),
                                      shutdown);
     nb::sensor_sim::FramePublisher publisher(participant, config);
@@ -48,22 +97,12 @@ int main(int argc, char** argv) {
           "readers not all matched after {} s ({} on the IMU topic, {} wanted); publishing anyway",
           config.wait_for_readers_s, publisher.imuReaders(), config.min_readers.imu);
     }
-    if (config.start_now) {
-      // Real GPS time, on a whole IMU period, so that a restarted simulator continues forward.
-      const auto now = static_cast<std::int64_t>(nb::bus::gpsTimeNowNs());
-      config.source.start_time_ns = now - now % config.source.imu_period_ns;
-    }
-    nb::sim::StationarySource source(config.source);
-    const std::int64_t period_ns = config.source.imu_period_ns;
-    const std::int64_t total = config.duration_s > 0.0
-                                   ? static_cast<std::int64_t>(std::llround(
-                                         config.duration_s * 1e9 / static_cast<double>(period_ns)))
-                                   : -1;
-    spdlog::info(
-        "publishing {} s of data, {} pacing, IMU {} Hz, start GPS {} ns",
-        config.duration_s > 0 ? std::to_string(config.duration_s) : std::string("unbounded"),
-        config.pacing == nb::sensor_sim::Pacing::kFast ? "fast" : "real-time",
-        1e9 / static_cast<double>(period_ns), config.source.start_time_ns);
+    if (config.start_now) startNow();  // after the wait: the data starts now
+    nb::sim::ScenarioSource source(config.scenario);
+    spdlog::info("publishing {} s of data, {} pacing, IMU {} Hz, start GPS {} ns",
+                 duration_s > 0 ? std::to_string(duration_s) : std::string("unbounded"),
+                 config.pacing == nb::sensor_sim::Pacing::kFast ? "fast" : "real-time",
+                 1e9 / static_cast<double>(period_ns), config.scenario.start_time_ns);
     const auto wall_start = Clock::now();
     while (!participant.stopping() && (total < 0 || source.index() < total)) {
       const nb::sim::SensorFrame frame = source.next();

@@ -13,7 +13,7 @@
 #include "harness.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
-#include "navbus/sim/stationary_source.hpp"
+#include "navbus/sim/scenario_source.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -44,10 +44,10 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
   test::SensorInputWriters w(me);
   ASSERT_TRUE(test::spinUntil(me, 20s, [&] { return w.matched(); }));
 
-  sim::StationarySourceConfig src_cfg;
-  src_cfg.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
+  sim::ScenarioConfig src_cfg;
+  src_cfg.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
   src_cfg.start_time_ns = 1'400'000'000'000'000'000;
-  sim::StationarySource src(src_cfg);
+  sim::ScenarioSource src(src_cfg);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   std::uint64_t seq = 0, n_obs = 0, n_fix = 0, n_star = 0;

@@ -7,7 +7,7 @@
 #include "frame_publisher.hpp"
 #include "harness.hpp"
 #include "navbus/bus/conversions.hpp"
-#include "navbus/sim/stationary_source.hpp"
+#include "navbus/sim/scenario_source.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -18,14 +18,14 @@ constexpr std::int64_t kStartNs = 1'400'000'000'000'000'000;  // an arbitrary wh
 constexpr int kFrames = 500;                                  // 5 s at 100 Hz
 
 std::vector<sim::SensorFrame> makeFrames() {
-  sim::StationarySourceConfig cfg;
-  cfg.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
+  sim::ScenarioConfig cfg;
+  cfg.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
   cfg.start_time_ns = kStartNs;
-  cfg.imu.accel_noise_density_mps2_per_sqrthz = 50e-6 * 9.80665;
-  cfg.imu.gyro_noise_density_radps_per_sqrthz = 0.01 * M_PI / 180 / 60;
-  cfg.imu.accel_bias_b_mps2 = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
+  cfg.imu.accel.random_walk = 50e-6 * 9.80665;
+  cfg.imu.gyro.random_walk = 0.01 * M_PI / 180 / 60;
+  cfg.imu.accel.bias = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
   cfg.seed = 11;
-  sim::StationarySource src(cfg);
+  sim::ScenarioSource src(cfg);
   std::vector<sim::SensorFrame> frames;
   for (int k = 0; k < kFrames; ++k) frames.push_back(src.next());
   return frames;

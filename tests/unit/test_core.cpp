@@ -6,7 +6,7 @@
 #include "navbus/core/earth.hpp"
 #include "navbus/core/rotation.hpp"
 #include "navbus/core/strapdown.hpp"
-#include "navbus/sim/stationary_source.hpp"
+#include "navbus/sim/scenario_source.hpp"
 
 namespace earth = navbus::core::earth;
 using navbus::core::dcmFromEuler;
@@ -73,27 +73,27 @@ namespace {
 /// Runs the mechanization on error-free stationary increments and returns the horizontal and
 /// vertical position errors after `seconds`.
 std::pair<double, double> stationaryDrift(double seconds, double yaw_deg) {
-  navbus::sim::StationarySourceConfig cfg;
-  cfg.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
-  cfg.roll_pitch_yaw_rad = Eigen::Vector3d(0.02, -0.01, yaw_deg * M_PI / 180);
+  navbus::sim::ScenarioConfig cfg;
+  cfg.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
+  cfg.vehicle.roll_pitch_yaw_rad = Eigen::Vector3d(0.02, -0.01, yaw_deg * M_PI / 180);
   cfg.gnss_every_n_increments = 0;
   cfg.star_tracker_every_n_increments = 0;
   cfg.raw_samples_per_increment = 1;
-  navbus::sim::StationarySource source(cfg);
+  navbus::sim::ScenarioSource source(cfg);
   navbus::core::StrapdownNed ins;
   navbus::core::NavState s0;
   s0.time_ns = cfg.start_time_ns;
-  s0.position = cfg.position;
-  s0.q_b_to_n = Eigen::Quaterniond(dcmFromEuler(cfg.roll_pitch_yaw_rad));
+  s0.position = cfg.vehicle.position;
+  s0.q_b_to_n = Eigen::Quaterniond(dcmFromEuler(cfg.vehicle.roll_pitch_yaw_rad));
   ins.initialize(s0);
   const auto steps = static_cast<long>(seconds * 100);
   for (long k = 0; k < steps; ++k) ins.propagate(source.next().increment);
   const auto& p = ins.state().position;
   const earth::Radii radii = earth::radiiOfCurvature(p.latitude_rad);
-  const double dn = (p.latitude_rad - cfg.position.latitude_rad) * radii.meridian_m;
-  const double de = (p.longitude_rad - cfg.position.longitude_rad) * radii.prime_vertical_m *
-                    std::cos(p.latitude_rad);
-  return {std::hypot(dn, de), std::abs(p.height_m - cfg.position.height_m)};
+  const double dn = (p.latitude_rad - cfg.vehicle.position.latitude_rad) * radii.meridian_m;
+  const double de = (p.longitude_rad - cfg.vehicle.position.longitude_rad) *
+                    radii.prime_vertical_m * std::cos(p.latitude_rad);
+  return {std::hypot(dn, de), std::abs(p.height_m - cfg.vehicle.position.height_m)};
 }
 }  // namespace
 
@@ -115,20 +115,20 @@ TEST(Strapdown, ErrorFreeStationaryIncrementsKeepTheVehicleInPlace) {
 TEST(Strapdown, UnmodelledAccelerometerBiasProducesTheSchulerDrift) {
   // A 100 ug north bias, no compensation: the classic first-order error after t seconds is
   // 0.5 * b * t^2 while t is much shorter than the Schuler period (84 min); check at 60 s.
-  navbus::sim::StationarySourceConfig cfg;
-  cfg.position = {0.5, 2.0, 0.0};
+  navbus::sim::ScenarioConfig cfg;
+  cfg.vehicle.position = {0.5, 2.0, 0.0};
   cfg.gnss_every_n_increments = 0;
   cfg.star_tracker_every_n_increments = 0;
   cfg.raw_samples_per_increment = 1;
-  cfg.imu.accel_bias_b_mps2 = Eigen::Vector3d(100e-6 * 9.80665, 0, 0);
-  navbus::sim::StationarySource source(cfg);
+  cfg.imu.accel.bias = Eigen::Vector3d(100e-6 * 9.80665, 0, 0);
+  navbus::sim::ScenarioSource source(cfg);
   navbus::core::StrapdownNed ins;
   navbus::core::NavState s0;
-  s0.position = cfg.position;
+  s0.position = cfg.vehicle.position;
   ins.initialize(s0);
   for (int k = 0; k < 6000; ++k) ins.propagate(source.next().increment);
-  const double dn = (ins.state().position.latitude_rad - cfg.position.latitude_rad) *
-                    earth::radiiOfCurvature(cfg.position.latitude_rad).meridian_m;
+  const double dn = (ins.state().position.latitude_rad - cfg.vehicle.position.latitude_rad) *
+                    earth::radiiOfCurvature(cfg.vehicle.position.latitude_rad).meridian_m;
   const double expected = 0.5 * 100e-6 * 9.80665 * 60.0 * 60.0;
   EXPECT_NEAR(dn, expected, 0.02 * expected);
 }

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "navbus/core/earth.hpp"
-#include "navbus/sim/stationary_source.hpp"
+#include "navbus/sim/scenario_source.hpp"
 
 namespace earth = navbus::core::earth;
 
@@ -23,18 +23,18 @@ TEST(Constellation, CircularOrbitsFollowKeplersLaw) {
 }
 
 TEST(GnssReceiver, PseudorangesAreRangePlusClockAndRespectTheMask) {
-  navbus::sim::StationarySourceConfig cfg;
-  cfg.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
+  navbus::sim::ScenarioConfig cfg;
+  cfg.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
   cfg.gnss.pseudorange_sigma_m = 1e-3;
   cfg.gnss.pseudorange_rate_sigma_mps = 1e-4;
   cfg.gnss.elevation_mask_rad = 10.0 * M_PI / 180;
   cfg.gnss.max_satellites = 32;
   cfg.gnss_every_n_increments = 1;
-  navbus::sim::StationarySource src(cfg);
+  navbus::sim::ScenarioSource src(cfg);
   const auto f = src.next();
   ASSERT_TRUE(f.has_gnss);
   ASSERT_GE(f.gnss.satellites.size(), 4u);
-  const Eigen::Vector3d rx = earth::geodeticToEcef(cfg.position);
+  const Eigen::Vector3d rx = earth::geodeticToEcef(cfg.vehicle.position);
   for (const auto& s : f.gnss.satellites) {
     EXPECT_GE(s.elevation_rad, cfg.gnss.elevation_mask_rad);
     const double range = (s.sat_pos_ecef_m - rx).norm();
@@ -43,17 +43,17 @@ TEST(GnssReceiver, PseudorangesAreRangePlusClockAndRespectTheMask) {
   }
 }
 
-TEST(StationarySource, RawSamplesSumToTheIncrement) {
-  navbus::sim::StationarySourceConfig cfg;
-  cfg.imu.accel_noise_density_mps2_per_sqrthz = 1e-4;
-  cfg.imu.gyro_noise_density_radps_per_sqrthz = 1e-5;
-  navbus::sim::StationarySource src(cfg);
+TEST(ScenarioSource, RawSamplesSumToTheIncrement) {
+  navbus::sim::ScenarioConfig cfg;
+  cfg.imu.accel.random_walk = 1e-4;
+  cfg.imu.gyro.random_walk = 1e-5;
+  navbus::sim::ScenarioSource src(cfg);
   const auto f = src.next();
   Eigen::Vector3d dv = Eigen::Vector3d::Zero();
   for (const auto& s : f.raw.samples) dv += s.specific_force_b_mps2 * f.raw.sample_period_s;
   EXPECT_TRUE(dv.isApprox(f.increment.delta_vel_b_mps, 1e-12));
   EXPECT_EQ(f.raw.samples.size(), 24u);
   // Same seed, same data.
-  navbus::sim::StationarySource again(cfg);
+  navbus::sim::ScenarioSource again(cfg);
   EXPECT_EQ(again.next().increment.delta_vel_b_mps, f.increment.delta_vel_b_mps);
 }

@@ -71,6 +71,8 @@ struct SensorFrame {
   bool has_star_tracker{false};
   StarTrackerSample star_tracker;
   core::NavState truth;
+  Eigen::Vector3d truth_accel_bias_b_mps2{Eigen::Vector3d::Zero()};  ///< model + injected faults
+  Eigen::Vector3d truth_gyro_bias_b_radps{Eigen::Vector3d::Zero()};
 };
 
 }  // namespace navbus::sim

@@ -1,5 +1,5 @@
-// navbus-sensor-sim configuration: YAML in the units written in its comments, converted to SI
-// here, once.
+// navbus-sensor-sim scenario files: YAML in the units of the papers' tables (written in the key
+// names and comments), converted to SI here, once. See scenarios/*.yaml and the README.
 #pragma once
 
 #include <cstdint>
@@ -7,16 +7,16 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "navbus/sim/stationary_source.hpp"
+#include "navbus/sim/scenario_source.hpp"
 
 namespace navbus::sensor_sim {
 
 enum class Pacing { kRealTime, kFast };
 
 struct SimConfig {
-  sim::StationarySourceConfig source;
-  bool start_now{true};    ///< start at the current GPS time (real time), else start_gps_ns
-  double duration_s{0.0};  ///< 0: until stopped
+  sim::ScenarioConfig scenario;
+  bool start_now{true};    ///< start at the current GPS time (real time), else the configured time
+  double duration_s{0.0};  ///< 0: until stopped (bus) or the end of the segments (files)
   Pacing pacing{Pacing::kRealTime};
   double wait_for_readers_s{10.0};  ///< wait this long for readers before publishing
   /// Readers to wait for before publishing, per topic.

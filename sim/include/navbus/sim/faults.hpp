@@ -1,0 +1,64 @@
+// Fault injection scheduled by the scenario (seeds 000, 001, 003, 004). Times are seconds since
+// the scenario start; sizes are SI. Each query answers what is active at a time.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace navbus::sim {
+
+enum class FaultKind {
+  kImuBiasStep,        ///< seed 000 table 2: a step on one accelerometer or gyro axis
+  kPseudorangeRamp,    ///< seed 000 table 3: slope [m/s] from start, saturating at `saturation`
+  kGnssPositionPulse,  ///< seed 001: a position error [m, NED] on the fixes while active
+  kSensorStuck,        ///< seed 003: an axis output frozen at its value at the start
+  kGnssOutage,         ///< seed 004: no GNSS epochs or fixes while active
+  kStarTrackerOutage,  ///< no star-tracker solution while active
+  kStarTrackerBias     ///< a star-tracker attitude bias [rad, body] while active
+};
+
+enum class SensorKind { kAccelerometer, kGyro };
+
+struct Fault {
+  FaultKind kind{FaultKind::kImuBiasStep};
+  double start_s{0.0};
+  double end_s{1e300};  ///< active while start <= t < end
+  SensorKind sensor{SensorKind::kAccelerometer};
+  int axis{0};  ///< 0..2
+  int sv_id{0};
+  double magnitude{0.0};                            ///< bias step [m/s^2 | rad/s]
+  double slope{0.0};                                ///< pseudorange ramp [m/s]
+  double saturation{0.0};                           ///< pseudorange ramp limit [m]
+  Eigen::Vector3d vector{Eigen::Vector3d::Zero()};  ///< position pulse [m, NED] or ST bias [rad]
+};
+
+class FaultSchedule {
+ public:
+  FaultSchedule() = default;
+  explicit FaultSchedule(std::vector<Fault> faults) : faults_(std::move(faults)) {}
+
+  /// Additional accelerometer and gyro biases [m/s^2, rad/s] at t.
+  Eigen::Vector3d accelBias(double t) const { return imuBias(t, SensorKind::kAccelerometer); }
+  Eigen::Vector3d gyroBias(double t) const { return imuBias(t, SensorKind::kGyro); }
+  /// Axes frozen at t: the start time of the stuck fault per axis, or nothing.
+  std::optional<double> stuckSince(SensorKind sensor, int axis, double t) const;
+  double pseudorangeError(int sv_id, double t) const;
+  Eigen::Vector3d positionPulse(double t) const;
+  bool gnssOut(double t) const { return any(FaultKind::kGnssOutage, t); }
+  bool starTrackerOut(double t) const { return any(FaultKind::kStarTrackerOutage, t); }
+  Eigen::Vector3d starTrackerBias(double t) const;
+  const std::vector<Fault>& faults() const { return faults_; }
+
+ private:
+  Eigen::Vector3d imuBias(double t, SensorKind sensor) const;
+  bool any(FaultKind kind, double t) const;
+  static bool active(const Fault& f, double t) { return t >= f.start_s && t < f.end_s; }
+  std::vector<Fault> faults_;
+};
+
+const char* faultKindName(FaultKind kind);
+
+}  // namespace navbus::sim

@@ -1,0 +1,77 @@
+#include "navbus/sim/faults.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace navbus::sim {
+
+Eigen::Vector3d FaultSchedule::imuBias(double t, SensorKind sensor) const {
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const auto& f : faults_) {
+    if (f.kind == FaultKind::kImuBiasStep && f.sensor == sensor && active(f, t))
+      b[f.axis] += f.magnitude;
+  }
+  return b;
+}
+
+std::optional<double> FaultSchedule::stuckSince(SensorKind sensor, int axis, double t) const {
+  for (const auto& f : faults_) {
+    if (f.kind == FaultKind::kSensorStuck && f.sensor == sensor && f.axis == axis && active(f, t))
+      return f.start_s;
+  }
+  return std::nullopt;
+}
+
+double FaultSchedule::pseudorangeError(int sv_id, double t) const {
+  double e = 0.0;
+  for (const auto& f : faults_) {
+    if (f.kind != FaultKind::kPseudorangeRamp || f.sv_id != sv_id || !active(f, t)) continue;
+    const double ramp = f.slope * (t - f.start_s);
+    // Saturation keeps the sign of the slope (seed 000: 12.5 m/s saturating at 125 m after 10 s).
+    e += f.saturation > 0.0 ? std::copysign(std::min(std::abs(ramp), f.saturation), ramp) : ramp;
+  }
+  return e;
+}
+
+Eigen::Vector3d FaultSchedule::positionPulse(double t) const {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (const auto& f : faults_) {
+    if (f.kind == FaultKind::kGnssPositionPulse && active(f, t)) p += f.vector;
+  }
+  return p;
+}
+
+Eigen::Vector3d FaultSchedule::starTrackerBias(double t) const {
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const auto& f : faults_) {
+    if (f.kind == FaultKind::kStarTrackerBias && active(f, t)) b += f.vector;
+  }
+  return b;
+}
+
+bool FaultSchedule::any(FaultKind kind, double t) const {
+  return std::any_of(faults_.begin(), faults_.end(),
+                     [&](const Fault& f) { return f.kind == kind && active(f, t); });
+}
+
+const char* faultKindName(FaultKind kind) {
+  switch (kind) {
+    case FaultKind::kImuBiasStep:
+      return "imu_bias_step";
+    case FaultKind::kPseudorangeRamp:
+      return "pseudorange_ramp";
+    case FaultKind::kGnssPositionPulse:
+      return "gnss_position_pulse";
+    case FaultKind::kSensorStuck:
+      return "sensor_stuck";
+    case FaultKind::kGnssOutage:
+      return "gnss_outage";
+    case FaultKind::kStarTrackerOutage:
+      return "star_tracker_outage";
+    case FaultKind::kStarTrackerBias:
+      return "star_tracker_bias";
+  }
+  return "unknown";
+}
+
+}  // namespace navbus::sim
