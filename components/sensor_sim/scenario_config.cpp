@@ -26,6 +26,10 @@ int ratio(double fast_hz, double slow_hz, const std::string& name) {
   return static_cast<int>(std::lround(r));
 }
 
+/// node[key], or an undefined node when `node` itself is absent (yaml-cpp throws on indexing
+/// an absent node).
+YAML::Node child(const YAML::Node& node, const char* key) { return node ? node[key] : YAML::Node(); }
+
 int axisIndex(const YAML::Node& n, const std::string& where) {
   const std::string a = get<std::string>(n, where, "axis", "x");
   if (a == "x") return 0;
@@ -44,7 +48,7 @@ sim::SensorKind sensorKind(const YAML::Node& n, const std::string& where) {
 
 std::vector<sim::Segment> parseSegments(const YAML::Node& list) {
   std::vector<sim::Segment> out;
-  if (!list) return out;
+  if (!list || list.IsNull()) return out;
   if (!list.IsSequence()) throw ConfigError("configuration vehicle.segments must be a list");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node n = list[i];
@@ -134,7 +138,8 @@ void parseTriad(const YAML::Node& imu, const std::string& prefix, double bias_un
 
 sim::FaultSchedule parseFaults(const YAML::Node& list) {
   std::vector<sim::Fault> out;
-  if (!list) return sim::FaultSchedule{};
+  if (!list || list.IsNull()) return sim::FaultSchedule{};
+  if (!list.IsSequence()) throw ConfigError("configuration faults must be a list");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node n = list[i];
     const std::string where = "faults[" + std::to_string(i) + "]";
@@ -223,7 +228,7 @@ SimConfig parseSimConfig(const YAML::Node& root) {
     s.vehicle.heading_rad =
         get<double>(veh, "vehicle", "heading_deg", s.vehicle.roll_pitch_yaw_rad.z() / kDeg) * kDeg;
     s.vehicle.flight_path_rad = get<double>(veh, "vehicle", "flight_path_deg", 0.0) * kDeg;
-    s.segments = parseSegments(veh["segments"]);
+    s.segments = parseSegments(child(veh, "segments"));
   }
   const std::string gravity =
       get<std::string>(root, "", "gravity", s.orbit ? "point_mass" : "wgs84");
@@ -258,7 +263,7 @@ SimConfig parseSimConfig(const YAML::Node& root) {
     throw ConfigError("configuration timing.pacing = '" + pacing + "' is not realtime or fast");
   c.wait_for_readers_s = checkRange(get<double>(timing, "timing", "wait_for_readers_s", 10.0), 0,
                                     3600, "timing.wait_for_readers_s");
-  const YAML::Node wait = timing["min_readers"];
+  const YAML::Node wait = child(timing, "min_readers");
   auto readers = [&](const char* key, int fallback) {
     return static_cast<int>(checkRange(get<int>(wait, "timing.min_readers", key, fallback), 0, 64,
                                        std::string("timing.min_readers.") + key));

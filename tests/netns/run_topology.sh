@@ -74,7 +74,7 @@ ip netns exec "nbobs$id" "$bin/navbus" "${common[@]}" record navbus/nav/solution
 rec_pid=$!
 pids+=($rec_pid)
 sleep 1
-ip netns exec "nbsim$id" "$bin/navbus-sensor-sim" -c "$work/sim.yaml" "${common[@]}" > "$work/sim.log" 2>&1
+ip netns exec "nbsim$id" "$bin/navbus-sensor-sim" -c "$work/sim.yaml" "${common[@]}" > "$work/sim.log" 2>&1 || { cat "$work/sim.log"; exit 1; }
 # The simulator has ended: give the watchdog time to decide, then stop the observer.
 sleep 3
 kill -TERM $rec_pid
