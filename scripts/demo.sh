@@ -23,7 +23,7 @@ pids+=($!)
 rec=$!
 pids+=($rec)
 echo "demo: filter, fault manager and recorder started on domain $domain; simulator publishing 20 s of data"
-"$bin/navbus-sensor-sim" -c config/sensor_sim.yaml -d "$domain" 2>&1 | tee "$out/sensor_sim.log" | grep -E "summary|warn|error" || true
+"$bin/navbus-sensor-sim" -c sim/scenarios/default.yaml -d "$domain" 2>&1 | tee "$out/sensor_sim.log" | grep -E "summary|warn|error" || true
 sleep 3   # the watchdogs see the streams stop
 kill -TERM "${pids[@]}"
 wait "${pids[@]}" 2>/dev/null || true

@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
       spdlog::info(
           "summary: scenario '{}' seed {}: wrote {} IMU increments, {} raw blocks, {} GNSS epochs, "
           "{} fixes, "
-          "{} star-tracker attitudes ({} s) to {}",
+          "{} star-tracker attitudes ({:.3f} s) to {}",
           config.scenario.name, config.scenario.seed, n.imu, n.raw, n.gnss_epochs, n.gnss_fixes,
           n.star_tracker, static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9,
           files_dir);
@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
     const auto& n = publisher.counts();
     spdlog::info(
         "summary: published {} IMU increments, {} raw blocks, {} GNSS epochs, {} GNSS fixes, "
-        "{} star-tracker attitudes ({} s of data), {} write retries",
+        "{} star-tracker attitudes ({:.3f} s of data), {} write retries",
         n.imu, n.raw, n.gnss_epochs, n.gnss_fixes, n.star_tracker,
         static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9, n.write_retries);
     return static_cast<int>(nb::bus::kExitOk);

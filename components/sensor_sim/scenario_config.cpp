@@ -28,7 +28,9 @@ int ratio(double fast_hz, double slow_hz, const std::string& name) {
 
 /// node[key], or an undefined node when `node` itself is absent (yaml-cpp throws on indexing
 /// an absent node).
-YAML::Node child(const YAML::Node& node, const char* key) { return node ? node[key] : YAML::Node(); }
+YAML::Node child(const YAML::Node& node, const char* key) {
+  return node ? node[key] : YAML::Node();
+}
 
 int axisIndex(const YAML::Node& n, const std::string& where) {
   const std::string a = get<std::string>(n, where, "axis", "x");
@@ -357,6 +359,12 @@ SimConfig parseSimConfig(const YAML::Node& root) {
       checkRange(get<int>(gnss, "gnss", "fixed_satellites", 0), 0, 32, "gnss.fixed_satellites"));
   s.gnss.clock_bias_m = get<double>(gnss, "gnss", "clock_bias_m", 3000.0);
   s.gnss.clock_drift_mps = get<double>(gnss, "gnss", "clock_drift_mps", 1.0);
+  s.gnss.clock_bias_noise_m_per_sqrts =
+      checkRange(get<double>(gnss, "gnss", "clock_bias_noise_m_per_sqrts", 0.0), 0, 1e3,
+                 "gnss.clock_bias_noise_m_per_sqrts");
+  s.gnss.clock_drift_noise_mps_per_sqrts =
+      checkRange(get<double>(gnss, "gnss", "clock_drift_noise_mps_per_sqrts", 0.0), 0, 1e2,
+                 "gnss.clock_drift_noise_mps_per_sqrts");
   s.gnss.pseudorange_sigma_m = checkRange(get<double>(gnss, "gnss", "pseudorange_sigma_m", 3.0),
                                           1e-3, 1e3, "gnss.pseudorange_sigma_m");
   s.gnss.pseudorange_rate_sigma_mps =

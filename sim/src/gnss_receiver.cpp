@@ -12,7 +12,10 @@ namespace earth = core::earth;
 
 GnssReceiverModel::GnssReceiverModel(const GnssReceiverConfig& config,
                                      const Constellation& constellation)
-    : config_(config), constellation_(constellation) {}
+    : config_(config),
+      constellation_(constellation),
+      clock_bias_m_(config.clock_bias_m),
+      clock_drift_mps_(config.clock_drift_mps) {}
 
 GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
                                      const Eigen::Vector3d& rx_pos, const Eigen::Vector3d& rx_vel,
@@ -22,7 +25,16 @@ GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
   const double since_start_s = 1e-9 * static_cast<double>(t_ns - t0_ns);
   const earth::Geodetic rx_geo = earth::ecefToGeodetic(rx_pos);
   const Eigen::Matrix3d C_e_n = earth::C_n_e(rx_geo.latitude_rad, rx_geo.longitude_rad).transpose();
-  const double clock_bias = config_.clock_bias_m + config_.clock_drift_mps * since_start_s;
+  // Clock random walk (seed 000 eq. 3) integrated exactly from the previous epoch.
+  const double dt = since_start_s - clock_time_s_;
+  if (dt > 0.0) {
+    const double w2 = config_.clock_drift_noise_mps_per_sqrts * std::sqrt(dt) * unit(rng);
+    const double w1 = config_.clock_bias_noise_m_per_sqrts * std::sqrt(dt) * unit(rng);
+    clock_bias_m_ += clock_drift_mps_ * dt + w1;
+    clock_drift_mps_ += w2;
+    clock_time_s_ = since_start_s;
+  }
+  const double clock_bias = clock_bias_m_;
 
   GnssEpoch epoch;
   epoch.time_ns = t_ns;
@@ -58,7 +70,7 @@ GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
     m.sat_vel_ecef_mps = vel_rot;
     m.pseudorange_m =
         (pos_rot - rx_pos).norm() + clock_bias + config_.pseudorange_sigma_m * unit(rng);
-    m.pseudorange_rate_mps = los.dot(vel_rot - rx_vel) + config_.clock_drift_mps +
+    m.pseudorange_rate_mps = los.dot(vel_rot - rx_vel) + clock_drift_mps_ +
                              config_.pseudorange_rate_sigma_mps * unit(rng);
     m.pseudorange_sigma_m = config_.pseudorange_sigma_m;
     m.pseudorange_rate_sigma_mps = config_.pseudorange_rate_sigma_mps;

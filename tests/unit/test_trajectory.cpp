@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include "navbus/bus/config.hpp"
 #include "navbus/core/rotation.hpp"
 #include "navbus/core/strapdown.hpp"
 #include "navbus/sim/trajectory.hpp"
+#include "scenario_config.hpp"
 
 namespace earth = navbus::core::earth;
 using navbus::sim::Segment;
@@ -44,24 +46,20 @@ Errors integrate(navbus::sim::Trajectory& truth, earth::GravityModel gravity, do
   return {dp.norm(), (s.vel_ned_mps - t.vel_ned_mps).norm(), std::abs(da.angle())};
 }
 
-/// Seed 000: stationary 0-500 s, accelerating 501-510 s, level flight north at 200 m/s to 2000 s.
-std::vector<Segment> seed000Segments() {
-  Segment still{500.0};
-  Segment wait{1.0};
-  Segment accelerate{10.0, 20.0};
-  Segment cruise{1489.0};
-  return {still, wait, accelerate, cruise};
+navbus::sim::ScenarioConfig scenario(const std::string& file) {
+  return navbus::sensor_sim::parseSimConfig(
+             navbus::bus::loadYamlFile(std::string(NAVBUS_SCENARIO_DIR) + "/" + file))
+      .scenario;
 }
 }  // namespace
 
 TEST(Trajectory, AircraftPerfectIncrementsReproduceTheTruthOver2000s) {
-  // Given the seed-000 aircraft trajectory at 36.5 N 127.5 E,
-  navbus::sim::VehicleStart start;
-  start.position = {36.5 * kDeg, 127.5 * kDeg, 1000.0};
-  navbus::sim::VehicleTrajectory truth(start, seed000Segments(), earth::GravityModel::kWgs84Normal);
+  // Given the seed-000 aircraft trajectory of the scenario file,
+  const auto c = scenario("seed000_aircraft.yaml");
+  navbus::sim::VehicleTrajectory truth(c.vehicle, c.segments, c.gravity);
   // when its perfect 100 Hz increments are integrated for 2000 s,
   const Errors e = integrate(truth, earth::GravityModel::kWgs84Normal, 100.0, 2000.0);
-  std::printf("aircraft 2000 s: position error %.4f m, velocity %.2e m/s, attitude %.2e rad\n",
+  std::printf("aircraft 2000 s: position error %.2e m, velocity %.2e m/s, attitude %.2e rad\n",
               e.position_m, e.velocity_mps, e.attitude_rad);
   // then the position error stays below 0.1 m (the target).
   EXPECT_LT(e.position_m, 0.1);
@@ -96,15 +94,16 @@ TEST(Trajectory, ManoeuvresKeepIncrementsConsistent) {
   segs = {climb, level, roll_in, turn, roll_out, wiggle, unwiggle, speed_up};
   navbus::sim::VehicleTrajectory truth(start, segs, earth::GravityModel::kWgs84Normal);
   const Errors e = integrate(truth, earth::GravityModel::kWgs84Normal, 100.0, truth.duration());
-  std::printf("manoeuvres %.0f s: position error %.4f m, velocity %.2e m/s, attitude %.2e rad\n",
+  std::printf("manoeuvres %.0f s: position error %.2e m, velocity %.2e m/s, attitude %.2e rad\n",
               truth.duration(), e.position_m, e.velocity_mps, e.attitude_rad);
   EXPECT_LT(e.position_m, 0.05);
   EXPECT_LT(e.attitude_rad, 1e-6);
 }
 
 TEST(Trajectory, OrbitPeriodFollowsKeplerAndOneOrbitIsReproduced) {
-  navbus::sim::OrbitStart o;
-  o.start_gps_s = 1.4e9;
+  const auto c = scenario("seed001_leo.yaml");
+  navbus::sim::OrbitStart o = c.orbit_start;
+  o.start_gps_s = 1e-9 * static_cast<double>(c.start_time_ns);
   navbus::sim::CircularOrbitTrajectory truth(o);
   const double r = earth::kSemiMajorAxis_m + o.altitude_m;
   EXPECT_NEAR(truth.periodSeconds(), 2 * M_PI * std::sqrt(r * r * r / earth::kGm_m3ps2), 1e-9);
@@ -117,8 +116,8 @@ TEST(Trajectory, OrbitPeriodFollowsKeplerAndOneOrbitIsReproduced) {
   EXPECT_NEAR(truth.velocityEci().norm(), std::sqrt(earth::kGm_m3ps2 / r), 1e-6);
   // One orbit of perfect 200 Hz increments through the NED mechanization with the same
   // (point-mass) gravity.
-  const Errors e = integrate(truth, earth::GravityModel::kPointMass, 200.0, truth.periodSeconds());
-  std::printf("one orbit (%.0f s): position error %.4f m, velocity %.2e m/s, attitude %.2e rad\n",
+  const Errors e = integrate(truth, c.gravity, 200.0, truth.periodSeconds());
+  std::printf("one orbit (%.0f s): position error %.2e m, velocity %.2e m/s, attitude %.2e rad\n",
               truth.periodSeconds(), e.position_m, e.velocity_mps, e.attitude_rad);
   EXPECT_LT(e.position_m, 1.0);
   const auto ri = truth.positionEci();

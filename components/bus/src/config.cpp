@@ -1,20 +1,46 @@
 #include "navbus/bus/config.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 namespace navbus::bus {
 
-YAML::Node loadYamlFile(const std::string& path) {
+namespace {
+/// Copies `over` onto `base`: maps merge key by key, anything else replaces.
+YAML::Node merge(YAML::Node base, const YAML::Node& over) {
+  if (!base.IsMap() || !over.IsMap()) return YAML::Clone(over);
+  for (const auto& kv : over) {
+    const std::string key = kv.first.as<std::string>();
+    base[key] = base[key] ? merge(YAML::Clone(base[key]), kv.second) : YAML::Clone(kv.second);
+  }
+  return base;
+}
+
+YAML::Node loadWithExtends(const std::filesystem::path& path, int depth) {
+  if (depth > 8)
+    throw ConfigError("configuration file '" + path.string() + "': 'extends' nested too deeply");
   if (!std::ifstream(path).good()) {
-    throw ConfigError("configuration file '" + path + "' cannot be read");
+    throw ConfigError("configuration file '" + path.string() + "' cannot be read");
   }
+  YAML::Node node;
   try {
-    return YAML::LoadFile(path);
+    node = YAML::LoadFile(path.string());
   } catch (const YAML::Exception& e) {
-    throw ConfigError("configuration file '" + path + "': " + e.what());
+    throw ConfigError("configuration file '" + path.string() + "': " + e.what());
   }
+  if (!node.IsMap() || !node["extends"]) return node;
+  // `extends: base.yaml` (relative to this file): this file's keys override the base's.
+  const std::filesystem::path base_path = path.parent_path() / node["extends"].as<std::string>();
+  YAML::Node base = loadWithExtends(base_path, depth + 1);
+  node.remove("extends");
+  return merge(base, node);
+}
+}  // namespace
+
+YAML::Node loadYamlFile(const std::string& path) {
+  return loadWithExtends(path, 0);
 }
 
 double checkRange(double value, double lo, double hi, const std::string& name) {

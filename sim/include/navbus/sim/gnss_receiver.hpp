@@ -15,7 +15,10 @@ struct GnssReceiverConfig {
   int max_satellites{32};       ///< keep at most this many (highest elevation first)
   int fixed_satellites{0};      ///< >0: track only the N highest at the first epoch (seed 000: 4)
   double clock_bias_m{3000.0};  ///< c * receiver clock bias at t = 0 (seed 000 eq. 3)
-  double clock_drift_mps{1.0};  ///< c * receiver clock drift, constant here
+  double clock_drift_mps{1.0};  ///< c * receiver clock drift at t = 0
+  /// Seed 000 eq. 3: x_b' = x_f + w1, x_f' = w2, with white w1, w2 of these densities.
+  double clock_bias_noise_m_per_sqrts{0.0};
+  double clock_drift_noise_mps_per_sqrts{0.0};
   double pseudorange_sigma_m{3.0};  ///< white noise, 1 sigma
   double pseudorange_rate_sigma_mps{0.05};
   bool fix_least_squares{true};  ///< fixes from the pseudoranges (else the white-noise model)
@@ -40,7 +43,11 @@ class GnssReceiverModel {
  private:
   GnssReceiverConfig config_;
   const Constellation& constellation_;
-  std::vector<int> tracked_;  ///< fixed_satellites > 0: the satellites chosen at the first epoch
+  std::vector<int> tracked_;
+  double clock_bias_m_;  ///< receiver clock state (seed 000 eq. 3)
+  double clock_drift_mps_;
+  double clock_time_s_{0.0};  ///< time since the start at which the clock state holds  ///<
+                              ///< fixed_satellites > 0: the satellites chosen at the first epoch
 };
 
 }  // namespace navbus::sim

@@ -16,7 +16,9 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Loads a YAML file; throws ConfigError naming the file on failure.
+/// Loads a YAML file; throws ConfigError naming the file on failure. A top-level
+/// `extends: other.yaml` (relative path) loads that file first; this file's keys override its
+/// keys (maps merge recursively, lists and scalars replace).
 YAML::Node loadYamlFile(const std::string& path);
 
 /// Reads `key` of `node` as T; returns `fallback` when the key is absent; throws ConfigError

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Each paper's scenario through navbus-sensor-sim, to files and over the bus (a `navbus record`
+# observer), for a few seconds of data; the row and sample counts must match the rates.
+# Domains 80-83.
+set -euo pipefail
+bin=$1 scenarios=$2
+work=$(mktemp -d)
+trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$work"' EXIT
+seconds=3
+status=0
+domain=80
+check() {  # name expected actual
+  if [ "$2" -eq "$3" ]; then echo "  ok   $1: $3"; else echo "  FAIL $1: expected $2, got $3"; status=1; fi
+}
+rows() { echo $(($(wc -l < "$1") - 1)); }
+for scenario in seed000_aircraft:100:1:0 seed001_leo:200:10:5 seed003_laser_ins:100:0:0 seed004_land_vehicle:50:1:0; do
+  IFS=: read -r name imu_hz gnss_hz st_hz <<< "$scenario"
+  file="$scenarios/$name.yaml"
+  echo "$name ($imu_hz Hz IMU, $gnss_hz Hz GNSS, $st_hz Hz star tracker), $seconds s"
+  # To files.
+  "$bin/navbus-sensor-sim" --scenario "$file" --files "$work/$name" --duration $seconds > "$work/$name.files.log" 2>&1 \
+    || { cat "$work/$name.files.log"; exit 1; }
+  check "imu.csv rows" $((imu_hz * seconds)) "$(rows "$work/$name/imu.csv")"
+  check "truth.csv rows" $((imu_hz * seconds)) "$(rows "$work/$name/truth.csv")"
+  check "gnss_fix.csv rows" $((gnss_hz * seconds)) "$(rows "$work/$name/gnss_fix.csv")"
+  check "star_tracker.csv rows" $((st_hz * seconds)) "$(rows "$work/$name/star_tracker.csv")"
+  # Over the bus, fast pacing, recorded by a separate participant.
+  topics=(navbus/imu/increment navbus/imu/raw)
+  [ "$gnss_hz" -gt 0 ] && topics+=(navbus/gnss/observations navbus/gnss/fix)
+  [ "$st_hz" -gt 0 ] && topics+=(navbus/startracker/attitude)
+  "$bin/navbus" -d $domain record "${topics[@]}" -o "$work/$name.bus" > "$work/$name.rec.log" 2>&1 &
+  rec=$!
+  "$bin/navbus-sensor-sim" --scenario "$file" -d $domain --duration $seconds --pacing fast > "$work/$name.bus.log" 2>&1 \
+    || { cat "$work/$name.bus.log"; exit 1; }
+  kill -TERM $rec
+  wait $rec || true
+  check "bus imu increments" $((imu_hz * seconds)) "$(rows "$work/$name.bus/navbus_imu_increment.csv")"
+  if [ "$gnss_hz" -gt 0 ]; then check "bus gnss fixes" $((gnss_hz * seconds)) "$(rows "$work/$name.bus/navbus_gnss_fix.csv")"; fi
+  if [ "$st_hz" -gt 0 ]; then check "bus star-tracker attitudes" $((st_hz * seconds)) "$(rows "$work/$name.bus/navbus_startracker_attitude.csv")"; fi
+  domain=$((domain + 1))
+done
+exit $status

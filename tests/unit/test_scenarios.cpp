@@ -1,0 +1,220 @@
+// The papers' scenario files: they load, the same seed gives the same data, and each injected
+// fault appears at its scheduled time with its scheduled size (compared in lockstep with the
+// fault-free run of the same seed, so the difference is the fault alone).
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/core/spectrum.hpp"
+#include "scenario_config.hpp"
+
+namespace fs = std::filesystem;
+using navbus::sim::ScenarioConfig;
+using navbus::sim::ScenarioSource;
+using navbus::sim::SensorFrame;
+
+namespace {
+ScenarioConfig load(const std::string& name) {
+  return navbus::sensor_sim::parseSimConfig(
+             navbus::bus::loadYamlFile(std::string(NAVBUS_SCENARIO_DIR) + "/" + name))
+      .scenario;
+}
+double seconds(const ScenarioConfig& c, std::int64_t t_ns) {
+  return 1e-9 * static_cast<double>(t_ns - c.start_time_ns);
+}
+}  // namespace
+
+TEST(Scenarios, EveryScenarioFileLoads) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(NAVBUS_SCENARIO_DIR)) {
+    if (e.path().extension() != ".yaml") continue;
+    EXPECT_NO_THROW(
+        navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(e.path().string())))
+        << e.path();
+    ++n;
+  }
+  EXPECT_GE(n, 8);
+}
+
+TEST(Scenarios, SameSeedSameBitsOtherSeedOtherData) {
+  auto c = load("seed004_land_vehicle.yaml");
+  ScenarioSource a(c), b(c);
+  c.seed = 2;
+  ScenarioSource other(c);
+  bool differs = false;
+  for (int k = 0; k < 3000; ++k) {
+    const SensorFrame fa = a.next(), fb = b.next(), fo = other.next();
+    ASSERT_EQ(fa.increment.delta_vel_b_mps, fb.increment.delta_vel_b_mps);
+    ASSERT_EQ(fa.increment.delta_angle_b_rad, fb.increment.delta_angle_b_rad);
+    ASSERT_EQ(fa.has_gnss, fb.has_gnss);
+    if (fa.has_gnss) {
+      ASSERT_EQ(fa.fix.position.latitude_rad, fb.fix.position.latitude_rad);
+    }
+    differs = differs || fa.increment.delta_vel_b_mps != fo.increment.delta_vel_b_mps;
+  }
+  EXPECT_TRUE(differs);
+}
+
+TEST(Scenarios, Seed000AccelerometerStepAt502s) {
+  const auto base = load("seed000_aircraft.yaml");
+  const auto faulty = load("seed000_accel_step.yaml");
+  ScenarioSource a(base), b(faulty);
+  double max_before = 0, min_after = 1e9, max_after = 0;
+  for (int k = 0; k < 50500; ++k) {  // to 505 s
+    const SensorFrame fa = a.next(), fb = b.next();
+    const double t = seconds(base, fa.time_ns);
+    const Eigen::Vector3d d =
+        (fb.increment.delta_vel_b_mps - fa.increment.delta_vel_b_mps) / fa.increment.interval_s;
+    EXPECT_LT(std::abs(d.y()) + std::abs(d.z()), 1e-9);
+    if (t <= 502.0) max_before = std::max(max_before, std::abs(d.x()));
+    if (t > 502.0 + 1e-6) {
+      min_after = std::min(min_after, d.x());
+      max_after = std::max(max_after, d.x());
+    }
+  }
+  std::printf(
+      "seed 000 accel step: before 502 s %.2e m/s^2, after %.6f..%.6f m/s^2 (10 mg = %.6f)\n",
+      max_before, min_after, max_after, 10e-3 * 9.80665);
+  EXPECT_LT(max_before, 1e-9);
+  EXPECT_NEAR(min_after, 10e-3 * 9.80665, 1e-9);
+  EXPECT_NEAR(max_after, 10e-3 * 9.80665, 1e-9);
+}
+
+TEST(Scenarios, Seed000PseudorangeRampFrom650sSaturatingAt250m) {
+  const auto base = load("seed000_aircraft.yaml");
+  const auto faulty = load("seed000_pseudorange_ramp.yaml");
+  ScenarioSource a(base), b(faulty);
+  int checked = 0;
+  for (int k = 0; k < 66500; ++k) {  // to 665 s
+    const SensorFrame fa = a.next(), fb = b.next();
+    if (!fa.has_gnss) continue;
+    const double t = seconds(base, fa.time_ns);
+    ASSERT_EQ(fa.gnss.satellites.size(), fb.gnss.satellites.size());
+    for (std::size_t i = 0; i < fa.gnss.satellites.size(); ++i) {
+      const double d = fb.gnss.satellites[i].pseudorange_m - fa.gnss.satellites[i].pseudorange_m;
+      const double expected =
+          fa.gnss.satellites[i].sv_id == 13 && t >= 650 ? std::min(25.0 * (t - 650), 250.0) : 0.0;
+      EXPECT_NEAR(d, expected, 1e-6) << "t " << t << " sv " << fa.gnss.satellites[i].sv_id;
+      checked += fa.gnss.satellites[i].sv_id == 13 ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(checked, 665);  // sv 13 tracked every epoch
+}
+
+TEST(Scenarios, Seed001GpsPositionPulseOf55mFor20s) {
+  auto base = load("seed001_leo.yaml");
+  auto faulty = load("seed001_gps_pulse.yaml");
+  ScenarioSource a(base), b(faulty);
+  int in_pulse = 0;
+  for (int k = 0; k < 200 * 625; ++k) {  // to 625 s
+    const SensorFrame fa = a.next(), fb = b.next();
+    if (!fa.has_gnss) continue;
+    const double t = seconds(base, fa.time_ns);
+    const double r =
+        navbus::core::earth::radiiOfCurvature(fa.fix.position.latitude_rad).meridian_m +
+        fa.fix.position.height_m;
+    const double dn = (fb.fix.position.latitude_rad - fa.fix.position.latitude_rad) * r;
+    const bool active = t >= 600.0 && t < 620.0;
+    EXPECT_NEAR(dn, active ? 55.0 : 0.0, 1e-3) << "t " << t;
+    in_pulse += active ? 1 : 0;
+  }
+  EXPECT_EQ(in_pulse, 200);  // 20 s at 10 Hz
+}
+
+TEST(Scenarios, Seed003DitherInTheRawStreamAndStuckAccelerometers) {
+  const auto c = load("seed003_laser_ins.yaml");
+  ScenarioSource src(c);
+  std::vector<double> ax_before, ax_after, gx, ay_after;
+  double dv_max = 0;
+  for (int k = 0; k < 100 * 62; ++k) {  // to 62 s
+    const SensorFrame f = src.next();
+    const double t = seconds(c, f.time_ns);
+    for (const auto& s : f.raw.samples) {
+      if (t > 38.0 && t <= 39.0) ax_before.push_back(s.specific_force_b_mps2.x());
+      if (t > 38.0 && t <= 39.0) gx.push_back(s.angular_rate_b_radps.x());
+      if (t > 45.0 && t <= 46.0) ax_after.push_back(s.specific_force_b_mps2.x());
+      if (t > 61.0) ay_after.push_back(s.specific_force_b_mps2.y());
+    }
+    // The navigation-rate increments are dither-stripped: no 0.05 g oscillation in them.
+    dv_max = std::max(dv_max, std::abs(f.increment.delta_vel_b_mps.x() / f.increment.interval_s));
+  }
+  const double rate = 2400.0;
+  // Before its fault, accelerometer x shows all three dither frequencies.
+  const auto peaks = navbus::core::largestPeaks(navbus::core::amplitudeSpectrum(ax_before, rate),
+                                                rate, ax_before.size(), 300, 1200, 3);
+  ASSERT_EQ(peaks.size(), 3u);
+  for (double f : {373.0, 441.0, 409.0}) {
+    EXPECT_TRUE(std::any_of(peaks.begin(), peaks.end(), [&](const auto& p) {
+      return std::abs(p.frequency_hz - f) <= 1;
+    })) << f;
+  }
+  // The gyro shows its dither and the differences to the other two.
+  const auto gspec = navbus::core::amplitudeSpectrum(gx, rate);
+  const auto gpeak = navbus::core::largestPeaks(gspec, rate, gx.size(), 300, 1200, 1);
+  const auto glow = navbus::core::largestPeaks(gspec, rate, gx.size(), 10, 100, 2);
+  ASSERT_EQ(gpeak.size(), 1u);
+  ASSERT_EQ(glow.size(), 2u);
+  EXPECT_NEAR(gpeak[0].frequency_hz, 373.0, 1.0);
+  EXPECT_NEAR(std::min(glow[0].frequency_hz, glow[1].frequency_hz), 36.0, 1.0);
+  EXPECT_NEAR(std::max(glow[0].frequency_hz, glow[1].frequency_hz), 68.0, 1.0);
+  // After 40 s, x is stuck: a constant, no dither at all; y is stuck after 60 s.
+  EXPECT_EQ(*std::min_element(ax_after.begin(), ax_after.end()),
+            *std::max_element(ax_after.begin(), ax_after.end()));
+  EXPECT_EQ(*std::min_element(ay_after.begin(), ay_after.end()),
+            *std::max_element(ay_after.begin(), ay_after.end()));
+  std::printf(
+      "seed 003: accel x peaks %.0f %.0f %.0f Hz before 40 s, constant %.6f m/s^2 after; gyro x "
+      "%.0f Hz, "
+      "trapping %.0f and %.0f Hz\n",
+      peaks[0].frequency_hz, peaks[1].frequency_hz, peaks[2].frequency_hz, ax_after.front(),
+      gpeak[0].frequency_hz, glow[0].frequency_hz, glow[1].frequency_hz);
+  EXPECT_LT(dv_max, 0.01);  // bias 50 ug + noise, far below the 0.05 g dither
+}
+
+TEST(Scenarios, Seed004GnssOutagesAt50To80And110To130s) {
+  const auto c = load("seed004_land_vehicle.yaml");
+  ScenarioSource src(c);
+  int epochs = 0;
+  for (int k = 0; k < 50 * 160; ++k) {
+    const SensorFrame f = src.next();
+    const double t = seconds(c, f.time_ns);
+    const bool out = (t >= 50 && t < 80) || (t >= 110 && t < 130);
+    if (f.has_gnss) {
+      ++epochs;
+      EXPECT_FALSE(out) << "GNSS epoch during an outage at " << t;
+    } else if (std::abs(t - std::round(t)) < 1e-9) {
+      EXPECT_TRUE(out) << "no GNSS epoch at " << t;
+    }
+  }
+  EXPECT_EQ(epochs, 160 - 30 - 20);
+}
+
+TEST(Scenarios, StarTrackerOutageAndBiasFaults) {
+  ScenarioConfig c;
+  c.star_tracker.bias_rad = 0.0;
+  ScenarioConfig f = c;
+  navbus::sim::Fault out;
+  out.kind = navbus::sim::FaultKind::kStarTrackerOutage;
+  out.start_s = 1.0;
+  out.end_s = 2.0;
+  navbus::sim::Fault bias;
+  bias.kind = navbus::sim::FaultKind::kStarTrackerBias;
+  bias.start_s = 3.0;
+  bias.vector = Eigen::Vector3d(0, 0, 1e-4);
+  f.faults = navbus::sim::FaultSchedule({out, bias});
+  ScenarioSource a(c), b(f);
+  for (int k = 0; k < 400; ++k) {
+    const SensorFrame fa = a.next(), fb = b.next();
+    const double t = seconds(c, fa.time_ns);
+    if (!fa.has_star_tracker) continue;
+    EXPECT_EQ(fb.has_star_tracker, !(t >= 1.0 && t < 2.0)) << t;
+    if (fb.has_star_tracker) {
+      const double angle =
+          Eigen::AngleAxisd(fa.star_tracker.q_b_to_i.conjugate() * fb.star_tracker.q_b_to_i)
+              .angle();
+      EXPECT_NEAR(angle, t >= 3.0 ? 1e-4 : 0.0, 1e-12) << t;
+    }
+  }
+}
