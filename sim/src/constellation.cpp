@@ -25,6 +25,10 @@ std::vector<KeplerElements> gpsLikeAlmanac(const ConstellationConfig& c) {
       k.raan_rad = 2.0 * M_PI * p / c.planes;
       // Slots evenly spaced in a plane, phased by plane so that planes do not line up.
       k.mean_anomaly_rad = 2.0 * M_PI * s / c.satellites_per_plane + M_PI * p / (2.0 * c.planes);
+      // Satellite clocks: offsets of a few tens of microseconds and drifts of 1e-11, spread
+      // over the satellites (typical broadcast af0 / af1 magnitudes), fixed per sv id.
+      k.clock_bias_s = 1e-5 * static_cast<double>((k.sv_id * 37) % 11 - 5);
+      k.clock_drift_sps = 1e-12 * static_cast<double>((k.sv_id * 13) % 7 - 3);
       out.push_back(k);
     }
   }
@@ -74,6 +78,15 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> Constellation::eci(int sv_id, double
                              Eigen::AngleAxisd(k.arg_perigee_rad, Eigen::Vector3d::UnitZ()))
                                 .toRotationMatrix();
   return {C * r_pf, C * v_pf};
+}
+
+double Constellation::clockOffset(int sv_id, double t) const {
+  const KeplerElements& k = elements(sv_id);
+  return k.clock_bias_s + k.clock_drift_sps * (t - k.epoch_gps_s);
+}
+
+double Constellation::clockDrift(int sv_id) const {
+  return elements(sv_id).clock_drift_sps;
 }
 
 SatelliteState Constellation::state(int sv_id, double t) const {

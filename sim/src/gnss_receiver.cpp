@@ -68,9 +68,13 @@ GnssEpoch GnssReceiverModel::observe(std::int64_t t_ns, std::int64_t t0_ns,
     m.elevation_rad = elevation;
     m.sat_pos_ecef_m = pos_rot;
     m.sat_vel_ecef_mps = vel_rot;
-    m.pseudorange_m =
-        (pos_rot - rx_pos).norm() + clock_bias + config_.pseudorange_sigma_m * unit(rng);
-    m.pseudorange_rate_mps = los.dot(vel_rot - rx_vel) + clock_drift_mps_ +
+    // The satellite clock runs ahead by dt_sv: the measured range is shortened by c dt_sv, and
+    // the message carries the correction (corrected = measured + c dt_sv).
+    m.sat_clock_correction_m = earth::kSpeedOfLight_mps * constellation_.clockOffset(sv, t - tau);
+    m.sat_clock_drift_mps = earth::kSpeedOfLight_mps * constellation_.clockDrift(sv);
+    m.pseudorange_m = (pos_rot - rx_pos).norm() + clock_bias - m.sat_clock_correction_m +
+                      config_.pseudorange_sigma_m * unit(rng);
+    m.pseudorange_rate_mps = los.dot(vel_rot - rx_vel) + clock_drift_mps_ - m.sat_clock_drift_mps +
                              config_.pseudorange_rate_sigma_mps * unit(rng);
     m.pseudorange_sigma_m = config_.pseudorange_sigma_m;
     m.pseudorange_rate_sigma_mps = config_.pseudorange_rate_sigma_mps;

@@ -24,6 +24,8 @@ struct KeplerElements {
   double arg_perigee_rad{0.0};
   double mean_anomaly_rad{0.0};  ///< at the epoch
   double epoch_gps_s{0.0};
+  double clock_bias_s{0.0};     ///< satellite clock offset at the epoch (almanac af0)
+  double clock_drift_sps{0.0};  ///< satellite clock drift (almanac af1)
 };
 
 /// A GPS-like Walker constellation: `planes` planes 60 deg apart, evenly spaced slots phased
@@ -48,6 +50,9 @@ class Constellation {
       : Constellation(gpsLikeAlmanac(config)) {}
   /// State of satellite sv_id (an id of the almanac) at GPS time t [s].
   SatelliteState state(int sv_id, double gps_time_s) const;
+  /// Satellite clock offset [s] at GPS time t (af0 + af1 (t - epoch)).
+  double clockOffset(int sv_id, double gps_time_s) const;
+  double clockDrift(int sv_id) const;
   /// Inertial (ECI) position and velocity of one satellite.
   std::pair<Eigen::Vector3d, Eigen::Vector3d> eci(int sv_id, double gps_time_s) const;
   const std::vector<KeplerElements>& almanac() const { return almanac_; }
