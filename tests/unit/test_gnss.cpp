@@ -78,13 +78,16 @@ TEST(GnssFix, LeastSquaresErrorMatchesPdopTimesSigma) {
     sum_sq += normalized * normalized;
     worst = std::max(worst, normalized);
     std::vector<navbus::core::RangeObservation> obs;
-    for (const auto& s : epoch.satellites)
-      obs.push_back(
-          {s.sat_pos_ecef_m, s.sat_vel_ecef_mps, s.pseudorange_m, s.pseudorange_rate_mps});
+    for (const auto& s : epoch.satellites) {
+      obs.push_back({s.sat_pos_ecef_m, s.sat_vel_ecef_mps,
+                     s.pseudorange_m + s.sat_clock_correction_m,
+                     s.pseudorange_rate_mps + s.sat_clock_drift_mps});
+    }
     const auto ls = navbus::core::leastSquaresFix(obs);
     clock_err_sq += std::pow(ls.clock_bias_m - cfg.clock_bias_m, 2);
     EXPECT_NEAR(ls.vel_ecef_mps.norm(), 0.0, 1.0);
   }
+  EXPECT_LT(std::sqrt(clock_err_sq / n), 5 * cfg.pseudorange_sigma_m);
   const double rms = std::sqrt(sum_sq / n);
   std::printf(
       "LS fix over %d epochs: RMS error / (PDOP sigma) = %.3f, worst %.2f, clock RMS %.2f m\n", n,
