@@ -94,7 +94,17 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
       [this, topic, kind, id, time](const typename PubSubType::type& m,
                                     const eprosima::fastdds::dds::SampleInfo& info) {
         instances_[{kind, info.instance_handle}] = id(m);
-        ++participant_.health().stream(topic).accepted;  // observed, not validated: a monitor
+        auto& counters = participant_.health().stream(topic);
+        ++counters.accepted;  // observed, not validated: a monitor
+        // Best-effort readers may lose samples: count them from the sequence numbers. A
+        // restarted writer (time going back) starts a new count.
+        auto& tracker = trackers_[kind];
+        auto o = tracker.check(id(m), m.seq(), time(m));
+        if (o.rejection) {
+          tracker.reset(id(m));
+          o = tracker.check(id(m), m.seq(), time(m));
+        }
+        counters.sequence_gaps += o.missing;
         if (auto e = watchdog_.onSample({kind, id(m)}, time(m), steadyNowNs())) publish(*e);
       },
       callbacks);

@@ -10,6 +10,7 @@
 #include <navbus_idl/FaultPubSubTypes.h>
 
 #include "navbus/bus/participant.hpp"
+#include "navbus/bus/validation.hpp"
 #include "stream_watchdog.hpp"
 
 namespace navbus::fault_manager {
@@ -27,6 +28,7 @@ class FaultManagerNode {
 
   bus::Participant& participant_;
   StreamWatchdog watchdog_;
+  std::map<StreamKind, bus::SequenceTracker> trackers_;
   bus::Writer<navbus::FaultDecision> decision_writer_;
   std::map<StreamKind, double> deadline_s_;
   /// DDS instance handle -> sensor id, per stream kind (deadline statuses name the instance).

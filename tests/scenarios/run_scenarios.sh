@@ -24,13 +24,17 @@ for scenario in seed000_aircraft:100:1:0 seed001_leo:200:10:5 seed003_laser_ins:
   check "truth.csv rows" $((imu_hz * seconds)) "$(rows "$work/$name/truth.csv")"
   check "gnss_fix.csv rows" $((gnss_hz * seconds)) "$(rows "$work/$name/gnss_fix.csv")"
   check "star_tracker.csv rows" $((st_hz * seconds)) "$(rows "$work/$name/star_tracker.csv")"
-  # Over the bus, fast pacing, recorded by a separate participant.
+  # Over the bus, fast pacing, recorded by a separate participant (the only reader here).
+  cat > "$work/$name.bus.yaml" <<YAML
+extends: $file
+timing: {min_readers: {imu: 1, raw_imu: 1, gnss: 1, star_tracker: 1}}
+YAML
   topics=(navbus/imu/increment navbus/imu/raw)
   [ "$gnss_hz" -gt 0 ] && topics+=(navbus/gnss/observations navbus/gnss/fix)
   [ "$st_hz" -gt 0 ] && topics+=(navbus/startracker/attitude)
   "$bin/navbus" -d $domain record "${topics[@]}" -o "$work/$name.bus" > "$work/$name.rec.log" 2>&1 &
   rec=$!
-  "$bin/navbus-sensor-sim" --scenario "$file" -d $domain --duration $seconds --pacing fast > "$work/$name.bus.log" 2>&1 \
+  "$bin/navbus-sensor-sim" --scenario "$work/$name.bus.yaml" -d $domain --duration $seconds --pacing fast > "$work/$name.bus.log" 2>&1 \
     || { cat "$work/$name.bus.log"; exit 1; }
   kill -TERM $rec
   wait $rec || true
