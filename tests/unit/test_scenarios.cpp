@@ -35,7 +35,7 @@ TEST(Scenarios, EveryScenarioFileLoads) {
         << e.path();
     ++n;
   }
-  EXPECT_GE(n, 8);
+  EXPECT_GE(n, 9);
 }
 
 TEST(Scenarios, SameSeedSameBitsOtherSeedOtherData) {
