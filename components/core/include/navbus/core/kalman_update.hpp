@@ -1,0 +1,40 @@
+// Kalman measurement update in Joseph form, one scalar measurement at a time, with innovation
+// gating. The test ratio eps^2 / (gate^2 V) is returned for publication (PX4-style: fault state
+// is data); a measurement with ratio > 1 is rejected and leaves the state untouched.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace navbus::core {
+
+struct ScalarUpdateResult {
+  double innovation{0.0};      ///< eps = z - H x (measured minus predicted, in error-state form)
+  double innovation_var{0.0};  ///< V = H P H^T + R
+  double test_ratio{0.0};      ///< eps^2 / (gate^2 V)
+  bool accepted{false};
+};
+
+/// Updates the error state x and covariance P with the scalar measurement z = h x + v,
+/// var(v) = r. `gate_sigma` is the gate in standard deviations (e.g. 5).
+/// Joseph form P = (I - K h) P (I - K h)^T + K r K^T keeps P symmetric positive definite even
+/// with rounding; the result is symmetrized.
+template <int N>
+ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P,
+                                const Eigen::Matrix<double, 1, N>& h, double z, double r,
+                                double gate_sigma) {
+  ScalarUpdateResult out;
+  const Eigen::Matrix<double, N, 1> Ph = P * h.transpose();
+  out.innovation = z - (h * x)(0, 0);
+  out.innovation_var = (h * Ph)(0, 0) + r;
+  out.test_ratio = out.innovation * out.innovation / (gate_sigma * gate_sigma * out.innovation_var);
+  if (!(out.test_ratio <= 1.0) || !(out.innovation_var > 0.0)) return out;
+  const Eigen::Matrix<double, N, 1> K = Ph / out.innovation_var;
+  x += K * out.innovation;
+  const Eigen::Matrix<double, N, N> A = Eigen::Matrix<double, N, N>::Identity() - K * h;
+  P = A * P * A.transpose() + K * r * K.transpose();
+  P = 0.5 * (P + P.transpose());
+  out.accepted = true;
+  return out;
+}
+
+}  // namespace navbus::core
