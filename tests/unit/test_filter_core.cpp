@@ -139,3 +139,85 @@ TEST(JosephUpdate, StaysSymmetricPositiveDefiniteAndGatesOutliers) {
   EXPECT_EQ(x, x0);
   EXPECT_EQ(P, P0);
 }
+
+#include "navbus/core/ins_error_model.hpp"
+#include "navbus/core/rotation.hpp"
+#include "navbus/sim/trajectory.hpp"
+
+namespace {
+/// Error of `est` relative to `truth` in the 17-state convention (position NED m, velocity,
+/// phi with C_est = (I - [phi x]) C_true).
+Vec17 errorOf(const navbus::core::NavState& est, const navbus::core::NavState& truth) {
+  Vec17 e = Vec17::Zero();
+  const earth::Radii r = earth::radiiOfCurvature(truth.position.latitude_rad);
+  e[tc17::kPos.index] = (est.position.latitude_rad - truth.position.latitude_rad) *
+                        (r.meridian_m + truth.position.height_m);
+  e[tc17::kPos.index + 1] = (est.position.longitude_rad - truth.position.longitude_rad) *
+                            (r.prime_vertical_m + truth.position.height_m) *
+                            std::cos(truth.position.latitude_rad);
+  e[tc17::kPos.index + 2] = -(est.position.height_m - truth.position.height_m);
+  e.segment<3>(tc17::kVel.index) = est.vel_ned_mps - truth.vel_ned_mps;
+  const Eigen::Matrix3d M =
+      est.q_b_to_n.toRotationMatrix() * truth.q_b_to_n.toRotationMatrix().transpose();
+  e.segment<3>(tc17::kAtt.index) =
+      Eigen::Vector3d(M(1, 2) - M(2, 1), M(2, 0) - M(0, 2), M(0, 1) - M(1, 0)) / 2.0;
+  return e;
+}
+}  // namespace
+
+TEST(InsErrorModel, TransitionMatrixPredictsTheNonlinearErrorGrowth) {
+  // Given a banked turn at 150 m/s and an estimate with position, velocity, attitude and bias
+  // errors, both mechanized from the same perfect increments for 30 s,
+  navbus::sim::VehicleStart start;
+  start.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 3000.0};
+  start.speed_mps = 150.0;
+  std::vector<navbus::sim::Segment> segs(2);
+  segs[0].duration_s = 3.0;
+  segs[0].roll_rate_radps = 10.0 * M_PI / 180;
+  segs[1].duration_s = 60.0;
+  segs[1].heading_rate_radps = segs[1].yaw_rate_radps = 3.0 * M_PI / 180;
+  navbus::sim::VehicleTrajectory traj(start, segs, earth::GravityModel::kWgs84Normal);
+  navbus::core::StrapdownNed truth, est;
+  truth.initialize(traj.state());
+  Vec17 dx0 = Vec17::Zero();
+  dx0.segment<3>(tc17::kPos.index) << 10.0, -5.0, 3.0;
+  dx0.segment<3>(tc17::kVel.index) << 0.1, -0.05, 0.02;
+  dx0.segment<3>(tc17::kAtt.index) << 1e-4, -2e-4, 5e-4;
+  dx0.segment<3>(tc17::kAccelBias.index) << 1e-3, -5e-4, 2e-3;
+  dx0.segment<3>(tc17::kGyroBias.index) << 1e-6, -2e-6, 3e-6;
+  navbus::core::NavState s0 =
+      perturbed(traj.state(), dx0.segment<3>(tc17::kPos.index), dx0.segment<3>(tc17::kVel.index));
+  s0.q_b_to_n =
+      navbus::core::quaternionFromRotationVector(-dx0.segment<3>(tc17::kAtt.index)) * s0.q_b_to_n;
+  est.initialize(s0);
+  Mat17 Phi = Mat17::Identity();
+  const double dt = 0.01;
+  for (int k = 1; k <= 3000; ++k) {
+    const auto inc = traj.advance(dt);
+    navbus::core::ImuIncrement m{static_cast<std::int64_t>(k) * 10'000'000, dt, inc.delta_vel_b_mps,
+                                 inc.delta_angle_b_rad};
+    // The truth's state at the start of the step drives F.
+    Phi = navbus::core::transitionMatrix(
+              navbus::core::errorDynamics(truth.state(), inc.delta_vel_b_mps / dt,
+                                          earth::GravityModel::kWgs84Normal),
+              dt) *
+          Phi;
+    truth.propagate(m);
+    // The estimate corrects its increments with its bias estimates (truth + error).
+    m.delta_vel_b_mps -= dx0.segment<3>(tc17::kAccelBias.index) * dt;
+    m.delta_angle_b_rad -= dx0.segment<3>(tc17::kGyroBias.index) * dt;
+    est.propagate(m);
+  }
+  // then the linear prediction Phi dx0 matches the nonlinear difference within a few percent.
+  const Vec17 actual = errorOf(est.state(), truth.state());
+  const Vec17 predicted = Phi * dx0;
+  for (const auto& b : {tc17::kPos, tc17::kVel, tc17::kAtt}) {
+    const double rel = (predicted.segment<3>(b.index) - actual.segment<3>(b.index)).norm() /
+                       actual.segment<3>(b.index).norm();
+    std::printf(
+        "error model block at %d: actual %.4e, predicted %.4e, relative difference %.2f %%\n",
+        b.index, actual.segment<3>(b.index).norm(), predicted.segment<3>(b.index).norm(),
+        100 * rel);
+    EXPECT_LT(rel, 0.03) << "block at " << b.index;
+  }
+}

@@ -1,0 +1,28 @@
+// Continuous-time error dynamics of the strapdown INS and the receiver clock over the 17-state
+// layout of state_layout.hpp (phi-angle attitude error, NED position error in metres), and the
+// transition matrix of one propagation step.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "navbus/core/state_layout.hpp"
+#include "navbus/core/strapdown.hpp"
+
+namespace navbus::core {
+
+using Matrix17 = Eigen::Matrix<double, tc17::kSize, tc17::kSize>;
+
+/// F of dx/dt = F dx at `state`, with the specific force in the body frame `f_b`:
+///   d(dr)/dt  = -[w_en x] dr + dv
+///   d(dv)/dt  = [f_n x] phi - (2 w_ie + w_en) x dv - C_b_n dba + (2 g / R) dr_D e_D
+///   d(phi)/dt = -w_in x phi + d(w_en)/d(dv) dv + C_b_n dbg
+///   d(cb)/dt  = cd,  d(cd)/dt = 0           (seed 000 eq. 3)
+/// Errors are estimate minus truth; biases are random constants (seed 000 eq. 1). The small
+/// couplings of position error into the Earth and transport rates are neglected.
+Matrix17 errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
+                       earth::GravityModel gravity);
+
+/// Transition matrix over dt: I + F dt + (F dt)^2 / 2.
+Matrix17 transitionMatrix(const Matrix17& F, double dt);
+
+}  // namespace navbus::core
