@@ -45,6 +45,14 @@ class StrapdownNed {
   /// (the vehicle state cannot be known across missing inertial data).
   void restartAt(std::int64_t time_ns);
 
+  /// Replaces position, velocity and attitude by corrected values (filter feedback), keeping
+  /// the time and the previous increment used by the coning and sculling corrections.
+  void correct(const NavState& corrected) {
+    const std::int64_t t = state_.time_ns;
+    state_ = corrected;
+    state_.time_ns = t;
+  }
+
   const NavState& state() const { return state_; }
   bool initialized() const { return initialized_; }
 

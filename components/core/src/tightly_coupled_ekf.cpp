@@ -1,0 +1,101 @@
+#include "navbus/core/tightly_coupled_ekf.hpp"
+
+#include <cmath>
+
+#include "navbus/core/rotation.hpp"
+
+namespace navbus::core {
+
+using namespace tc17;
+
+void TightlyCoupledEkf::initialize(const NavState& state, double clock_bias_m,
+                                   double clock_drift_mps, const TightlyCoupledConfig& config) {
+  config_ = config;
+  ins_ = StrapdownNed(config.gravity);
+  ins_.initialize(state);
+  clock_bias_m_ = clock_bias_m;
+  clock_drift_mps_ = clock_drift_mps;
+  accel_bias_.setZero();
+  gyro_bias_.setZero();
+  Vector17 sigma;
+  sigma.segment<3>(kPos.index).setConstant(config.pos_sigma_m);
+  sigma.segment<3>(kVel.index).setConstant(config.vel_sigma_mps);
+  sigma.segment<3>(kAtt.index) << config.level_sigma_rad, config.level_sigma_rad,
+      config.heading_sigma_rad;
+  sigma.segment<3>(kAccelBias.index).setConstant(config.accel_bias_sigma_mps2);
+  sigma.segment<3>(kGyroBias.index).setConstant(config.gyro_bias_sigma_radps);
+  sigma[kClockBias.index] = config.clock_bias_sigma_m;
+  sigma[kClockDrift.index] = config.clock_drift_sigma_mps;
+  P_ = sigma.array().square().matrix().asDiagonal();
+  phi_since_update_.setIdentity();
+}
+
+void TightlyCoupledEkf::propagate(const ImuIncrement& raw) {
+  ImuIncrement inc = raw;
+  inc.delta_vel_b_mps -= accel_bias_ * inc.interval_s;
+  inc.delta_angle_b_rad -= gyro_bias_ * inc.interval_s;
+  const double dt = inc.interval_s;
+  // F at the state at the start of the interval (first-order hold of the error dynamics).
+  const Matrix17 Phi =
+      transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, config_.gravity), dt);
+  ins_.propagate(inc);
+  clock_bias_m_ += clock_drift_mps_ * dt;
+  // Discrete process noise: white specific force / rate noise into velocity / attitude
+  // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3).
+  Matrix17 Q = Matrix17::Zero();
+  Q.block<3, 3>(kVel.index, kVel.index)
+      .diagonal()
+      .setConstant(std::pow(config_.accel_noise_mps2_per_sqrthz, 2) * dt);
+  Q.block<3, 3>(kAtt.index, kAtt.index)
+      .diagonal()
+      .setConstant(std::pow(config_.gyro_noise_radps_per_sqrthz, 2) * dt);
+  Q(kClockBias.index, kClockBias.index) = std::pow(config_.clock_bias_noise_m_per_sqrts, 2) * dt;
+  Q(kClockDrift.index, kClockDrift.index) =
+      std::pow(config_.clock_drift_noise_mps_per_sqrts, 2) * dt;
+  P_ = Phi * P_ * Phi.transpose() + Q;
+  P_ = 0.5 * (P_ + P_.transpose());
+  phi_since_update_ = Phi * phi_since_update_;
+}
+
+std::vector<MeasurementReport> TightlyCoupledEkf::update(
+    const std::vector<SatelliteObservation>& sats) {
+  std::vector<MeasurementReport> reports;
+  Vector17 dx = Vector17::Zero();
+  for (const auto& sat : sats) {
+    const RangePrediction p = predictRange(ins_.state(), clock_bias_m_, clock_drift_mps_, sat);
+    // Innovations in the error-state form z = H dx + v: predicted minus measured (seed 000 eq. 5).
+    const double z_range = p.pseudorange_m - sat.pseudorange_m;
+    const double z_rate = p.pseudorange_rate_mps - sat.pseudorange_rate_mps;
+    reports.push_back(
+        {sat.sv_id, false,
+         scalarUpdate<kSize>(dx, P_, p.h_range, z_range, std::pow(sat.pseudorange_sigma_m, 2),
+                             config_.gate_sigma)});
+    reports.push_back(
+        {sat.sv_id, true,
+         scalarUpdate<kSize>(dx, P_, p.h_rate, z_rate, std::pow(sat.pseudorange_rate_sigma_mps, 2),
+                             config_.gate_sigma)});
+  }
+  feedback(dx);
+  phi_since_update_.setIdentity();
+  return reports;
+}
+
+void TightlyCoupledEkf::feedback(const Vector17& dx) {
+  // Errors are estimate minus truth: subtract them from the estimate, then the error state is 0.
+  NavState s = ins_.state();
+  const earth::Radii r = earth::radiiOfCurvature(s.position.latitude_rad);
+  s.position.latitude_rad -= dx[kPos.index] / (r.meridian_m + s.position.height_m);
+  s.position.longitude_rad -= dx[kPos.index + 1] / ((r.prime_vertical_m + s.position.height_m) *
+                                                    std::cos(s.position.latitude_rad));
+  s.position.height_m += dx[kPos.index + 2];
+  s.vel_ned_mps -= dx.segment<3>(kVel.index);
+  // C_est = (I - [phi x]) C_true  =>  C_true = (I + [phi x]) C_est.
+  s.q_b_to_n = (quaternionFromRotationVector(dx.segment<3>(kAtt.index)) * s.q_b_to_n).normalized();
+  ins_.correct(s);
+  accel_bias_ -= dx.segment<3>(kAccelBias.index);
+  gyro_bias_ -= dx.segment<3>(kGyroBias.index);
+  clock_bias_m_ -= dx[kClockBias.index];
+  clock_drift_mps_ -= dx[kClockDrift.index];
+}
+
+}  // namespace navbus::core
