@@ -113,3 +113,107 @@ TEST(TightlyCoupledEkf, Seed000ClosedLoopTracksTheTruthConsistently) {
     EXPECT_LT(r.mean_nees, 3.0 * 9);
   }
 }
+
+#include "navbus/core/aiding_measurements.hpp"
+
+TEST(AidingMeasurements, InnovationsEqualHTimesTheConstructedError) {
+  navbus::core::NavState truth;
+  truth.time_ns = 1'400'000'000'000'000'000;
+  truth.position = {34.0 * M_PI / 180, 128.0 * M_PI / 180, 500e3};
+  truth.vel_ned_mps = Eigen::Vector3d(6000.0, 4000.0, 10.0);
+  truth.q_b_to_n = Eigen::Quaterniond(navbus::core::dcmFromEuler(Eigen::Vector3d(0.3, -0.2, 1.1)));
+  Eigen::Matrix<double, tc17::kSize, 1> dx = Eigen::Matrix<double, tc17::kSize, 1>::Zero();
+  dx.segment<3>(tc17::kPos.index) << 12.0, -7.0, 4.0;
+  dx.segment<3>(tc17::kVel.index) << 0.2, -0.1, 0.05;
+  dx.segment<3>(tc17::kAtt.index) << 2e-5, -3e-5, 5e-5;
+  navbus::core::NavState ins = truth;
+  const earth::Radii r = earth::radiiOfCurvature(truth.position.latitude_rad);
+  ins.position.latitude_rad += dx[0] / (r.meridian_m + truth.position.height_m);
+  ins.position.longitude_rad += dx[1] / ((r.prime_vertical_m + truth.position.height_m) *
+                                         std::cos(truth.position.latitude_rad));
+  ins.position.height_m -= dx[2];
+  ins.vel_ned_mps += dx.segment<3>(tc17::kVel.index);
+  ins.q_b_to_n =
+      navbus::core::quaternionFromRotationVector(-dx.segment<3>(tc17::kAtt.index)) * truth.q_b_to_n;
+  const Eigen::Vector3d one(1, 1, 1);
+  const auto p = navbus::core::positionMeasurement(ins, truth.position, one);
+  // Second order: the INS's radii and latitude differ from the truth's by the error itself.
+  EXPECT_LT((p.z - p.h * dx).norm(), 1e-4);
+  const auto v = navbus::core::velocityMeasurement(ins, truth.vel_ned_mps, one);
+  EXPECT_LT((v.z - v.h * dx).norm(), 1e-12);
+  // The star tracker measures the true attitude in ECI.
+  const Eigen::Matrix3d C_e_i = earth::C_i_e(1e-9 * static_cast<double>(truth.time_ns)).transpose();
+  const Eigen::Quaterniond q_b_i(
+      C_e_i * earth::C_n_e(truth.position.latitude_rad, truth.position.longitude_rad) *
+      truth.q_b_to_n.toRotationMatrix());
+  navbus::core::NavState ins_att = truth;
+  ins_att.q_b_to_n = ins.q_b_to_n;
+  const auto a = navbus::core::attitudeMeasurement(ins_att, q_b_i, one * 1e-6);
+  EXPECT_LT((a.z - a.h * dx).norm(), 1e-9);
+  EXPECT_NEAR(a.r.trace(), 3e-12, 1e-20);  // a rotation keeps the total variance
+}
+
+TEST(TightlyCoupledEkf, Seed001LooselyCoupledWithStarTrackerConverges) {
+  // Seed 001's LEO with its tactical IMU, GNSS fixes and star tracker, 600 s, centralized.
+  auto c = navbus::sensor_sim::parseSimConfig(
+               navbus::bus::loadYamlFile(std::string(NAVBUS_SCENARIO_DIR) + "/seed001_leo.yaml"))
+               .scenario;
+  navbus::sim::ScenarioSource src(c);
+  navbus::sim::SensorFrame f = src.next();
+  navbus::core::TightlyCoupledConfig cfg;
+  cfg.gravity = c.gravity;
+  cfg.accel_noise_mps2_per_sqrthz = c.imu.accel.random_walk;
+  cfg.gyro_noise_radps_per_sqrthz = c.imu.gyro.random_walk;
+  cfg.accel_bias_sigma_mps2 = 100e-6 * 9.80665;
+  cfg.gyro_bias_sigma_radps = 0.01 * M_PI / 180 / 3600;
+  cfg.pos_sigma_m = 5.0;
+  cfg.vel_sigma_mps = 0.2;
+  cfg.level_sigma_rad = cfg.heading_sigma_rad = 1e-4;
+  navbus::core::NavState s0 = f.truth;
+  s0.position.height_m += 3.0;
+  s0.vel_ned_mps += Eigen::Vector3d(0.1, -0.1, 0.05);
+  s0.q_b_to_n =
+      navbus::core::quaternionFromRotationVector(Eigen::Vector3d(5e-5, -5e-5, 8e-5)) * s0.q_b_to_n;
+  navbus::core::TightlyCoupledEkf ekf;
+  ekf.initialize(s0, 0.0, 0.0, cfg);
+  double sum_pos = 0, sum_vel = 0, sum_att = 0;
+  int n = 0;
+  for (int k = 1; k < 200 * 600; ++k) {
+    f = src.next();
+    ekf.propagate(f.increment);
+    if (f.has_gnss) {
+      ekf.update(
+          navbus::core::positionMeasurement(ekf.state(), f.fix.position, f.fix.pos_sigma_ned_m));
+      ekf.update(navbus::core::velocityMeasurement(ekf.state(), f.fix.vel_ned_mps,
+                                                   f.fix.vel_sigma_ned_mps));
+    }
+    if (f.has_star_tracker) {
+      ekf.update(navbus::core::attitudeMeasurement(ekf.state(), f.star_tracker.q_b_to_i,
+                                                   f.star_tracker.sigma_b_rad));
+    }
+    if (k % 200 == 0 && k > 200 * 100) {  // RMS after 100 s of convergence, once per second
+      const auto& e = ekf.state();
+      const auto& t = f.truth;
+      const Eigen::Vector3d dp =
+          earth::geodeticToEcef(e.position) - earth::geodeticToEcef(t.position);
+      const Eigen::AngleAxisd da(e.q_b_to_n * t.q_b_to_n.conjugate());
+      sum_pos += dp.squaredNorm();
+      sum_vel += (e.vel_ned_mps - t.vel_ned_mps).squaredNorm();
+      sum_att += da.angle() * da.angle();
+      ++n;
+    }
+  }
+  const double pos = std::sqrt(sum_pos / n), vel = std::sqrt(sum_vel / n);
+  const double att_arcsec = std::sqrt(sum_att / n) * 180 / M_PI * 3600;
+  std::printf(
+      "seed 001 centralized (LC GNSS + star tracker), 100-600 s RMS: position %.3f m, velocity "
+      "%.4f m/s, "
+      "attitude %.2f arcsec (paper table 5 over 3600 s: 1.331 m, 0.005 m/s, 0.54 arcsec)\n",
+      pos, vel, att_arcsec);
+  EXPECT_LT(pos, 3.0);
+  EXPECT_LT(vel, 0.1);
+  // The star tracker's 5 arcsec-per-axis Gauss-Markov bias (8.7 arcsec in all) is not a state
+  // of this filter, so the attitude follows it: bounded here, the paper's 0.54 arcsec needs the
+  // bias estimated (issue 4).
+  EXPECT_LT(att_arcsec, 20.0);
+}

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <Eigen/Cholesky>
+
 #include "navbus/core/rotation.hpp"
 
 namespace navbus::core {
@@ -78,6 +80,22 @@ std::vector<MeasurementReport> TightlyCoupledEkf::update(
   feedback(dx);
   phi_since_update_.setIdentity();
   return reports;
+}
+
+std::array<ScalarUpdateResult, 3> TightlyCoupledEkf::update(const VectorMeasurement& m) {
+  // Decorrelate the rows (R = L L^T, z' = L^-1 z, H' = L^-1 H) so that scalar updates are exact.
+  const Eigen::Matrix3d L = m.r.llt().matrixL();
+  const Eigen::Vector3d z = L.triangularView<Eigen::Lower>().solve(m.z);
+  const Eigen::Matrix<double, 3, kSize> H = L.triangularView<Eigen::Lower>().solve(m.h);
+  Vector17 dx = Vector17::Zero();
+  std::array<ScalarUpdateResult, 3> out;
+  for (int i = 0; i < 3; ++i) {
+    out[static_cast<std::size_t>(i)] =
+        scalarUpdate<kSize>(dx, P_, H.row(i), z[i], 1.0, config_.gate_sigma);
+  }
+  feedback(dx);
+  phi_since_update_.setIdentity();
+  return out;
 }
 
 void TightlyCoupledEkf::feedback(const Vector17& dx) {

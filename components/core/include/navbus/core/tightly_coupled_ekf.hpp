@@ -4,8 +4,10 @@
 // updates with gating, and the reset of the error state into the navigation state.
 #pragma once
 
+#include <array>
 #include <vector>
 
+#include "navbus/core/aiding_measurements.hpp"
 #include "navbus/core/gnss_measurement.hpp"
 #include "navbus/core/ins_error_model.hpp"
 #include "navbus/core/kalman_update.hpp"
@@ -47,6 +49,10 @@ class TightlyCoupledEkf {
   void propagate(const ImuIncrement& raw);
   /// Processes one epoch of measurements at the current state time; returns one report per row.
   std::vector<MeasurementReport> update(const std::vector<SatelliteObservation>& sats);
+
+  /// Processes a three-component aiding measurement (loosely coupled position, velocity, star
+  /// tracker attitude), one decorrelated row at a time; returns the three row results.
+  std::array<ScalarUpdateResult, 3> update(const VectorMeasurement& m);
 
   const NavState& state() const { return ins_.state(); }
   const Matrix17& covariance() const { return P_; }
