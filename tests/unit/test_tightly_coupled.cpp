@@ -69,6 +69,12 @@ RunResult run(double seconds, std::uint64_t seed) {
                       m.pseudorange_rate_sigma_mps});
     }
     for (const auto& rep : ekf.update(sats)) res.rejected += rep.result.accepted ? 0 : 1;
+    // The GLR diagnostics: two rows per satellite, symmetric positive definite V, K = P H^T V^-1.
+    const auto& diag = ekf.lastEpoch();
+    EXPECT_EQ(diag.h.rows(), static_cast<Eigen::Index>(2 * sats.size()));
+    EXPECT_LT((diag.innovation_cov - diag.innovation_cov.transpose()).norm(),
+              1e-6 * diag.innovation_cov.norm());
+    EXPECT_EQ(diag.k.cols(), diag.h.rows());
     ++res.epochs;
     // NEES of position, velocity and attitude against the truth.
     const auto& e = ekf.state();

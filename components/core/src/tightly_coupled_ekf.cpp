@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 
 #include "navbus/core/rotation.hpp"
 
@@ -61,21 +62,43 @@ void TightlyCoupledEkf::propagate(const ImuIncrement& raw) {
 
 std::vector<MeasurementReport> TightlyCoupledEkf::update(
     const std::vector<SatelliteObservation>& sats) {
+  const auto m = static_cast<Eigen::Index>(2 * sats.size());
+  EpochDiagnostics& d = last_epoch_;
+  d.sv_ids.clear();
+  d.is_rate.clear();
+  d.test_ratio.clear();
+  d.innovation.resize(m);
+  d.h.resize(m, kSize);
+  Eigen::VectorXd r(m);
+  for (std::size_t i = 0; i < sats.size(); ++i) {
+    const auto& sat = sats[i];
+    const RangePrediction p = predictRange(ins_.state(), clock_bias_m_, clock_drift_mps_, sat);
+    const auto row = static_cast<Eigen::Index>(2 * i);
+    // Innovations in the error-state form z = H dx + v: predicted minus measured (seed 000 eq. 5).
+    d.innovation[row] = p.pseudorange_m - sat.pseudorange_m;
+    d.innovation[row + 1] = p.pseudorange_rate_mps - sat.pseudorange_rate_mps;
+    d.h.row(row) = p.h_range;
+    d.h.row(row + 1) = p.h_rate;
+    r[row] = sat.pseudorange_sigma_m * sat.pseudorange_sigma_m;
+    r[row + 1] = sat.pseudorange_rate_sigma_mps * sat.pseudorange_rate_sigma_mps;
+    d.sv_ids.insert(d.sv_ids.end(), {sat.sv_id, sat.sv_id});
+    d.is_rate.insert(d.is_rate.end(), {false, true});
+  }
+  // Batch view from the prior covariance, published for the GLR; the update itself is
+  // sequential (exact for the diagonal R) so that each row can be gated on its own.
+  d.innovation_cov = d.h * P_ * d.h.transpose();
+  d.innovation_cov.diagonal() += r;
+  d.k = P_ * d.h.transpose() * d.innovation_cov.inverse();
+  d.phi = phi_since_update_;
   std::vector<MeasurementReport> reports;
   Vector17 dx = Vector17::Zero();
-  for (const auto& sat : sats) {
-    const RangePrediction p = predictRange(ins_.state(), clock_bias_m_, clock_drift_mps_, sat);
-    // Innovations in the error-state form z = H dx + v: predicted minus measured (seed 000 eq. 5).
-    const double z_range = p.pseudorange_m - sat.pseudorange_m;
-    const double z_rate = p.pseudorange_rate_mps - sat.pseudorange_rate_mps;
+  for (Eigen::Index row = 0; row < m; ++row) {
+    const Eigen::Matrix<double, 1, kSize> h = d.h.row(row);
+    const ScalarUpdateResult res =
+        scalarUpdate<kSize>(dx, P_, h, d.innovation[row], r[row], config_.gate_sigma);
+    d.test_ratio.push_back(res.test_ratio);
     reports.push_back(
-        {sat.sv_id, false,
-         scalarUpdate<kSize>(dx, P_, p.h_range, z_range, std::pow(sat.pseudorange_sigma_m, 2),
-                             config_.gate_sigma)});
-    reports.push_back(
-        {sat.sv_id, true,
-         scalarUpdate<kSize>(dx, P_, p.h_rate, z_rate, std::pow(sat.pseudorange_rate_sigma_mps, 2),
-                             config_.gate_sigma)});
+        {d.sv_ids[static_cast<std::size_t>(row)], d.is_rate[static_cast<std::size_t>(row)], res});
   }
   feedback(dx);
   phi_since_update_.setIdentity();

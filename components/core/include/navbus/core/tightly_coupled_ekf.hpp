@@ -39,6 +39,19 @@ struct MeasurementReport {
   ScalarUpdateResult result;
 };
 
+/// Everything the GLR detector (seed 000 eqs. 6-16) needs from one GNSS epoch, in batch form
+/// from the prior covariance: rows are (pseudorange, rate) per satellite, in order.
+struct EpochDiagnostics {
+  std::vector<int> sv_ids;             ///< per row
+  std::vector<bool> is_rate;           ///< per row
+  Eigen::VectorXd innovation;          ///< predicted minus measured, m rows
+  Eigen::MatrixXd innovation_cov;      ///< V = H P- H^T + R, m x m
+  Eigen::MatrixXd h;                   ///< m x 17
+  Eigen::MatrixXd k;                   ///< 17 x m, K = P- H^T V^-1
+  Matrix17 phi{Matrix17::Identity()};  ///< transition accumulated since the previous epoch
+  std::vector<double> test_ratio;      ///< per row, from the sequential gated update
+};
+
 class TightlyCoupledEkf {
  public:
   using Vector17 = Eigen::Matrix<double, tc17::kSize, 1>;
@@ -62,6 +75,11 @@ class TightlyCoupledEkf {
   double clockDrift() const { return clock_drift_mps_; }
   /// Transition matrix accumulated since the previous update (for the GLR diagnostics).
   const Matrix17& accumulatedPhi() const { return phi_since_update_; }
+  /// Diagnostics of the latest GNSS epoch.
+  const EpochDiagnostics& lastEpoch() const { return last_epoch_; }
+  /// Restarts the integration at a new time without propagating across missing data.
+  void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
+  bool initialized() const { return ins_.initialized(); }
 
  private:
   void feedback(const Vector17& dx);
@@ -70,6 +88,7 @@ class TightlyCoupledEkf {
   StrapdownNed ins_;
   Matrix17 P_{Matrix17::Zero()};
   Matrix17 phi_since_update_{Matrix17::Identity()};
+  EpochDiagnostics last_epoch_;
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
   double clock_bias_m_{0.0};
