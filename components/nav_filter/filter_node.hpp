@@ -17,7 +17,7 @@
 #include "input_sequencer.hpp"
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/validation.hpp"
-#include "navbus/core/strapdown.hpp"
+#include "navbus/core/tightly_coupled_ekf.hpp"
 
 namespace navbus::nav_filter {
 
@@ -30,7 +30,13 @@ struct MeasurementEpoch {
   StreamRank kind;
 };
 
-using FilterInput = std::variant<core::ImuIncrement, MeasurementEpoch>;
+/// A validated GNSS observation epoch: satellite clock corrections applied, ready for the
+/// tightly coupled update.
+struct GnssEpochInput {
+  std::vector<core::SatelliteObservation> satellites;
+};
+
+using FilterInput = std::variant<core::ImuIncrement, MeasurementEpoch, GnssEpochInput>;
 
 class FilterNode {
  public:
@@ -45,6 +51,9 @@ class FilterNode {
   template <class Sample>
   void onMeasurement(bus::StreamGate& gate, const Sample& msg, std::uint32_t id,
                      const std::optional<InputConfig>& expected, StreamRank rank);
+  void onGnssObservations(const navbus::GnssObservationEpoch& msg);
+  void fuseGnss(const GnssEpochInput& epoch);
+  void publishDiagnostics();
   void onDecision(const navbus::FaultDecision& d);
   void onCommand(const navbus::FilterCommand& c);
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
@@ -57,8 +66,11 @@ class FilterNode {
   bus::Participant& participant_;
   FilterConfig config_;
   InputSequencer<FilterInput> sequencer_;
-  core::StrapdownNed strapdown_;
+  core::TightlyCoupledEkf ekf_;  ///< inertial-only mode: propagation without updates
   bus::Writer<navbus::NavigationSolution> solution_writer_;
+  bus::Writer<navbus::FilterDiagnostics> diagnostics_writer_;
+  std::uint64_t diagnostics_seq_{0};
+  std::uint64_t gnss_epochs_fused_{0};
   bus::StreamGate imu_gate_;
   bus::StreamGate gnss_obs_gate_;
   bus::StreamGate gnss_fix_gate_;
