@@ -45,6 +45,10 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   using namespace bus;
   solution_writer_ = p.createWriter<navbus::NavigationSolutionPubSubType>(topic::kNavSolution,
                                                                           profile::kSolutionWriter);
+  if (config_.estimator == Estimator::kTightlyCoupled) {
+    diagnostics_writer_ = p.createWriter<navbus::FilterDiagnosticsPubSubType>(
+        topic::kFilterDiagnostics, profile::kDiagnosticsWriter);
+  }
   p.subscribe<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorReader,
                                               [this](const auto& m, const auto&) { onImu(m); });
   p.subscribe<navbus::GnssObservationEpochPubSubType>(

@@ -33,20 +33,40 @@ std::vector<sim::SensorFrame> makeFrames() {
 
 enum class Delivery { kInTimeOrderSteady, kMeasurementsAheadImuInBursts };
 
-std::vector<std::string> runFilter(int domain, Delivery delivery,
-                                   const std::vector<sim::SensorFrame>& frames) {
+struct Run {
+  std::vector<std::string> solutions;  ///< CSV rows, 17 digits
+  std::vector<std::string> diagnostics;
+  bool tightly_coupled_reached{false};
+};
+
+Run runFilter(int domain, Delivery delivery, const std::vector<sim::SensorFrame>& frames,
+              bool tightly_coupled) {
   const auto dir = test::scratchDir("determinism-" + std::to_string(domain));
-  const std::string cfg = test::writeFile(dir / "filter.yaml", test::filterConfig(domain));
+  std::string yaml = test::filterConfig(domain);
+  if (tightly_coupled) {
+    yaml +=
+        "mode: tightly_coupled\nekf: {accel_noise_ug_per_sqrthz: 50, gyro_arw_deg_per_sqrth: 0.01,"
+        " initial_position_sigma_m: 10, accel_bias_sigma_ug: 1000}\n";
+  }
+  const std::string cfg = test::writeFile(dir / "filter.yaml", yaml);
   test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
 
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(domain, "determinism-test"), shutdown);
-  std::vector<std::string> solutions;
-  me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution,
-                                             bus::profile::kSolutionReader,
-                                             [&](const NavigationSolution& s, const auto&) {
-                                               solutions.push_back(tool::csvRows(s).at(0));
-                                             });
+  Run run;
+  auto& solutions = run.solutions;
+  me.subscribe<NavigationSolutionPubSubType>(
+      bus::topic::kNavSolution, bus::profile::kSolutionReader,
+      [&](const NavigationSolution& s, const auto&) {
+        solutions.push_back(tool::csvRows(s).at(0));
+        run.tightly_coupled_reached =
+            run.tightly_coupled_reached || s.mode() == MODE_TIGHTLY_COUPLED;
+      });
+  me.subscribe<FilterDiagnosticsPubSubType>(bus::topic::kFilterDiagnostics,
+                                            bus::profile::kDiagnosticsReader,
+                                            [&](const FilterDiagnostics& d, const auto&) {
+                                              run.diagnostics.push_back(tool::csvRows(d).at(0));
+                                            });
   test::SensorInputWriters w(me);
   EXPECT_TRUE(test::spinUntil(me, 20s, [&] { return w.matched(); }));
 
@@ -82,7 +102,7 @@ std::vector<std::string> runFilter(int domain, Delivery delivery,
   filter.signal(SIGTERM);
   EXPECT_EQ(filter.wait(10s), 0);
   std::filesystem::remove_all(dir);
-  return solutions;
+  return run;
 }
 
 }  // namespace
@@ -90,12 +110,22 @@ std::vector<std::string> runFilter(int domain, Delivery delivery,
 TEST(Determinism, TwoInterleavingsGiveBitIdenticalSolutions) {
   test::cleanSharedMemory();
   const auto frames = makeFrames();
-  const auto a = runFilter(72, Delivery::kInTimeOrderSteady, frames);
-  const auto b = runFilter(73, Delivery::kMeasurementsAheadImuInBursts, frames);
-  ASSERT_EQ(a.size(), 50u);
-  ASSERT_EQ(b.size(), a.size());
-  // Rows print every double with 17 significant digits: equal text means equal bits.
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]) << "solution " << i;
-  std::printf("determinism: %zu solutions identical across both deliveries\n", a.size());
+  // Inertial-only (domains 72, 73) and tightly coupled, where the order of GNSS epochs relative to
+  // the increments changes the estimate (domains 84, 85).
+  for (const bool tc : {false, true}) {
+    const auto a = runFilter(tc ? 84 : 72, Delivery::kInTimeOrderSteady, frames, tc);
+    const auto b = runFilter(tc ? 85 : 73, Delivery::kMeasurementsAheadImuInBursts, frames, tc);
+    ASSERT_EQ(a.solutions.size(), 50u);
+    ASSERT_EQ(b.solutions.size(), a.solutions.size());
+    // Rows print every double with 17 significant digits: equal text means equal bits.
+    for (std::size_t i = 0; i < a.solutions.size(); ++i)
+      EXPECT_EQ(a.solutions[i], b.solutions[i]) << "solution " << i;
+    EXPECT_EQ(a.tightly_coupled_reached, tc);
+    EXPECT_EQ(a.diagnostics.size(), tc ? 5u : 0u);  // one per GNSS epoch (1 Hz, 5 s)
+    EXPECT_EQ(a.diagnostics, b.diagnostics);
+    std::printf(
+        "determinism (%s): %zu solutions and %zu diagnostics identical across both deliveries\n",
+        tc ? "tightly coupled" : "inertial only", a.solutions.size(), a.diagnostics.size());
+  }
   test::cleanSharedMemory();
 }

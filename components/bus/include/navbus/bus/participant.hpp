@@ -33,6 +33,10 @@ class Writer {
       : writer_(writer), health_(health) {}
   /// Returns false (and logs) if the sample could not be written.
   bool write(const Sample& sample) {
+    if (writer_ == nullptr) {
+      spdlog::error("write on a writer that was never created");
+      return false;
+    }
     if (!writer_->write(const_cast<Sample*>(&sample))) {
       spdlog::error("write on '{}' failed", writer_->get_topic()->get_name());
       return false;
