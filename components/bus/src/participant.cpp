@@ -56,9 +56,11 @@ void Participant::dispatch(ReaderEntry& entry) {
       entry.callbacks.on_liveliness(status);
     }
   }
-  if (changes.is_active(dds::StatusMask::data_available())) {
-    entry.take_all();
-  }
+  // Drain unconditionally rather than only when data_available is set: a sample that arrives
+  // while the flag is being reset would otherwise wait for the next arrival, and a reliable
+  // writer blocked on its full history sends none, a stall seen once in CI over shared memory.
+  // Taking from an empty reader returns at once; the loop runs at least every 20-100 ms.
+  entry.take_all();
 }
 
 void Participant::runDueTimers() {
