@@ -131,15 +131,10 @@ GnssFixSample GnssReceiverModel::fix(const GnssEpoch& epoch, const earth::Geodet
     return f;
   }
   std::normal_distribution<double> unit(0.0, 1.0);
-  const earth::Radii r = earth::radiiOfCurvature(truth_pos.latitude_rad);
   const Eigen::Vector3d dpos_ned(config_.fix_pos_sigma_m * unit(rng),
                                  config_.fix_pos_sigma_m * unit(rng),
                                  config_.fix_pos_sigma_m * unit(rng));
-  f.position = truth_pos;
-  f.position.latitude_rad += dpos_ned.x() / (r.meridian_m + truth_pos.height_m);
-  f.position.longitude_rad +=
-      dpos_ned.y() / ((r.prime_vertical_m + truth_pos.height_m) * std::cos(truth_pos.latitude_rad));
-  f.position.height_m -= dpos_ned.z();
+  f.position = earth::offsetNed(truth_pos, dpos_ned);
   for (int i = 0; i < 3; ++i) {
     f.vel_ned_mps[i] = truth_vel_ned[i] + config_.fix_vel_sigma_mps * unit(rng);
   }

@@ -112,13 +112,7 @@ SensorFrame ScenarioSource::next() {
       s.pseudorange_m += config_.faults.pseudorangeError(s.sv_id, t_s);
     f.fix = receiver_.fix(f.gnss, f.truth.position, f.truth.vel_ned_mps, rng_);
     const Eigen::Vector3d pulse = config_.faults.positionPulse(t_s);
-    if (pulse.squaredNorm() > 0.0) {
-      const earth::Radii r = earth::radiiOfCurvature(f.fix.position.latitude_rad);
-      f.fix.position.latitude_rad += pulse.x() / (r.meridian_m + f.fix.position.height_m);
-      f.fix.position.longitude_rad += pulse.y() / ((r.prime_vertical_m + f.fix.position.height_m) *
-                                                   std::cos(f.fix.position.latitude_rad));
-      f.fix.position.height_m -= pulse.z();
-    }
+    if (pulse.squaredNorm() > 0.0) f.fix.position = earth::offsetNed(f.fix.position, pulse);
   }
   if (config_.star_tracker_every_n_increments > 0 &&
       index_ % config_.star_tracker_every_n_increments == 0) {

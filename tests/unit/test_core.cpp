@@ -132,3 +132,17 @@ TEST(Strapdown, UnmodelledAccelerometerBiasProducesTheSchulerDrift) {
   const double expected = 0.5 * 100e-6 * 9.80665 * 60.0 * 60.0;
   EXPECT_NEAR(dn, expected, 0.02 * expected);
 }
+
+TEST(Earth, NedOffsetAndDifferenceAreInverse) {
+  const earth::Geodetic p{0.6, -2.9, 500.0};
+  const Eigen::Vector3d d(120.0, -75.0, 30.0);
+  const earth::Geodetic q = earth::offsetNed(p, d);
+  // The two use the curvature at q and at p: they agree to second order, |d|^2 / R = 3 mm.
+  EXPECT_LT((earth::differenceNed(q, p) - d).norm(), d.squaredNorm() / 6.3e6);
+  // Against the exact ECEF geometry: the offset is the NED vector at p.
+  const Eigen::Vector3d exact = earth::C_n_e(p.latitude_rad, p.longitude_rad).transpose() *
+                                (earth::geodeticToEcef(q) - earth::geodeticToEcef(p));
+  EXPECT_LT((exact - d).norm(), 0.01);
+  EXPECT_NEAR(earth::differenceNed({0.0, M_PI - 1e-7, 0.0}, {0.0, -M_PI + 1e-7, 0.0}).y(),
+              -2e-7 * 6378137.0, 1e-3);
+}

@@ -9,12 +9,7 @@ using namespace tc17;
 VectorMeasurement positionMeasurement(const NavState& ins, const earth::Geodetic& fix,
                                       const Eigen::Vector3d& sigma) {
   VectorMeasurement m;
-  const earth::Radii r = earth::radiiOfCurvature(ins.position.latitude_rad);
-  m.z = Eigen::Vector3d(
-      (ins.position.latitude_rad - fix.latitude_rad) * (r.meridian_m + ins.position.height_m),
-      std::remainder(ins.position.longitude_rad - fix.longitude_rad, 2.0 * M_PI) *
-          (r.prime_vertical_m + ins.position.height_m) * std::cos(ins.position.latitude_rad),
-      -(ins.position.height_m - fix.height_m));
+  m.z = earth::differenceNed(ins.position, fix);
   m.h.setZero();
   m.h.block<3, 3>(0, kPos.index).setIdentity();
   m.r = sigma.array().square().matrix().asDiagonal();

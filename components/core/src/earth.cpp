@@ -46,6 +46,23 @@ Eigen::Vector3d gravityNed(GravityModel model, const Geodetic& position) {
   return C_n_e(position.latitude_rad, position.longitude_rad).transpose() * g_e;
 }
 
+Geodetic offsetNed(const Geodetic& p, const Eigen::Vector3d& d) {
+  const Radii r = radiiOfCurvature(p.latitude_rad);
+  Geodetic out = p;
+  out.latitude_rad += d.x() / (r.meridian_m + p.height_m);
+  out.longitude_rad += d.y() / ((r.prime_vertical_m + p.height_m) * std::cos(p.latitude_rad));
+  out.height_m -= d.z();
+  return out;
+}
+
+Eigen::Vector3d differenceNed(const Geodetic& a, const Geodetic& b) {
+  const Radii r = radiiOfCurvature(a.latitude_rad);
+  return {(a.latitude_rad - b.latitude_rad) * (r.meridian_m + a.height_m),
+          std::remainder(a.longitude_rad - b.longitude_rad, 2.0 * M_PI) *
+              (r.prime_vertical_m + a.height_m) * std::cos(a.latitude_rad),
+          -(a.height_m - b.height_m)};
+}
+
 Eigen::Vector3d geodeticToEcef(const Geodetic& p) {
   const Radii r = radiiOfCurvature(p.latitude_rad);
   const double cl = std::cos(p.latitude_rad);

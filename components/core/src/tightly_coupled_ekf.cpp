@@ -124,11 +124,7 @@ std::array<ScalarUpdateResult, 3> TightlyCoupledEkf::update(const VectorMeasurem
 void TightlyCoupledEkf::feedback(const Vector17& dx) {
   // Errors are estimate minus truth: subtract them from the estimate, then the error state is 0.
   NavState s = ins_.state();
-  const earth::Radii r = earth::radiiOfCurvature(s.position.latitude_rad);
-  s.position.latitude_rad -= dx[kPos.index] / (r.meridian_m + s.position.height_m);
-  s.position.longitude_rad -= dx[kPos.index + 1] / ((r.prime_vertical_m + s.position.height_m) *
-                                                    std::cos(s.position.latitude_rad));
-  s.position.height_m += dx[kPos.index + 2];
+  s.position = earth::offsetNed(s.position, -dx.segment<3>(kPos.index));
   s.vel_ned_mps -= dx.segment<3>(kVel.index);
   // C_est = (I - [phi x]) C_true  =>  C_true = (I + [phi x]) C_est.
   s.q_b_to_n = (quaternionFromRotationVector(dx.segment<3>(kAtt.index)) * s.q_b_to_n).normalized();

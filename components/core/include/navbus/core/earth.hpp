@@ -56,6 +56,13 @@ Eigen::Vector3d pointMassGravitationEcef(const Eigen::Vector3d& pos_ecef_m);
 
 Eigen::Vector3d geodeticToEcef(const Geodetic& position);
 
+/// The position moved by a small offset in NED metres, with the curvature at `p` (first order
+/// in the offset: for errors, fix noise and fault pulses, not for trajectories).
+Geodetic offsetNed(const Geodetic& p, const Eigen::Vector3d& offset_ned_m);
+
+/// The small difference a - b in NED metres at a (first order; longitude wrapped to +-pi).
+Eigen::Vector3d differenceNed(const Geodetic& a, const Geodetic& b);
+
 /// Exact-to-machine-precision inverse (iterated), valid from the centre of the Earth to orbit.
 Geodetic ecefToGeodetic(const Eigen::Vector3d& pos_ecef_m);
 
