@@ -27,19 +27,35 @@ std::optional<InputConfig> input(const YAML::Node& inputs, const std::string& ke
 }
 }  // namespace
 
+namespace {
+template <class Enum>
+Enum choice(const YAML::Node& node, const std::string& where, const std::string& key,
+            const std::string& fallback, std::initializer_list<std::pair<const char*, Enum>> opts) {
+  const std::string v = bus::get<std::string>(node, where, key, fallback);
+  std::string names;
+  for (const auto& [name, value] : opts) {
+    if (v == name) return value;
+    names += names.empty() ? name : std::string(" | ") + name;
+  }
+  const std::string full = where.empty() ? key : where + "." + key;
+  throw bus::ConfigError("configuration " + full + " = '" + v + "' is not one of " + names);
+}
+}  // namespace
+
 FilterConfig parseFilterConfig(const YAML::Node& root) {
   FilterConfig c;
+  core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
   const double rate = bus::checkRange(bus::get<double>(root, "", "solution_rate_hz", 10.0), 1.0,
                                       1000.0, "solution_rate_hz");
-  c.solution_period_ns = seconds(1.0 / rate);
+  e.solution_period_ns = seconds(1.0 / rate);
   c.sequencer_max_wait_ns =
       seconds(bus::checkRange(bus::get<double>(root, "", "sequencer_max_wait_s", 0.5), 0.001, 60.0,
                               "sequencer_max_wait_s"));
 
   const YAML::Node init = root["initial_state"];
   if (!init) throw bus::ConfigError("configuration initial_state is missing");
-  auto& s = c.initial_state;
+  auto& s = e.initial_state;
   s.position = bus::getGeodeticDeg(init, "initial_state", nullptr);
   s.vel_ned_mps = bus::getVector3(init, "initial_state", "vel_ned_mps", 1.0);
   const Eigen::Vector3d rpy = bus::getRollPitchYawDeg(init, "initial_state");
@@ -48,33 +64,59 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   const YAML::Node inputs = root["inputs"];
   if (!inputs) throw bus::ConfigError("configuration inputs is missing");
   c.imu = *input(inputs, "imu", true);
+  e.imu_period_s = 1e-9 * static_cast<double>(c.imu.period_ns);
   c.gnss_observations = input(inputs, "gnss_observations", false);
+  c.gnss_fix = input(inputs, "gnss_fix", false);
+  c.star_tracker = input(inputs, "star_tracker", false);
 
-  const std::string mode = bus::get<std::string>(root, "", "mode", "inertial_only");
-  if (mode == "inertial_only") {
-    c.estimator = Estimator::kInertialOnly;
-  } else if (mode == "tightly_coupled") {
-    c.estimator = Estimator::kTightlyCoupled;
-    if (!c.gnss_observations) {
-      throw bus::ConfigError("configuration mode = tightly_coupled needs inputs.gnss_observations");
-    }
-  } else {
-    throw bus::ConfigError("configuration mode = '" + mode +
-                           "' is not inertial_only or tightly_coupled");
+  e.aiding = choice<core::AidingMode>(root, "", "mode", "inertial_only",
+                                      {{"inertial_only", core::AidingMode::kInertialOnly},
+                                       {"tightly_coupled", core::AidingMode::kTightlyCoupled},
+                                       {"loosely_coupled", core::AidingMode::kLooselyCoupled},
+                                       {"multi_dimensional", core::AidingMode::kMultiDimensional}});
+  e.fusion = choice<core::FusionStructure>(root, "", "fusion", "centralized",
+                                           {{"centralized", core::FusionStructure::kCentralized},
+                                            {"federated", core::FusionStructure::kFederated},
+                                            {"adaptive", core::FusionStructure::kAdaptive}});
+  e.use_star_tracker = bus::get<bool>(root, "", "star_tracker_updates", false);
+  if (e.aiding == core::AidingMode::kTightlyCoupled && !c.gnss_observations) {
+    throw bus::ConfigError("configuration mode = tightly_coupled needs inputs.gnss_observations");
   }
-  // EKF parameters (both modes propagate the covariance), in the units of seed 000s error budget.
+  if ((e.aiding == core::AidingMode::kLooselyCoupled ||
+       e.aiding == core::AidingMode::kMultiDimensional) &&
+      !c.gnss_fix) {
+    throw bus::ConfigError(
+        "configuration mode = loosely_coupled / multi_dimensional needs "
+        "inputs.gnss_fix");
+  }
+  if (e.use_star_tracker && !c.star_tracker) {
+    throw bus::ConfigError("configuration star_tracker_updates = true needs inputs.star_tracker");
+  }
+  {
+    // Check the structure against the mode once, with the engine's own rule.
+    core::EngineConfig probe = e;
+    probe.fusion = core::FusionStructure::kCentralized;
+    core::NavigationEngine engine(probe);
+    if (e.aiding != core::AidingMode::kInertialOnly && !engine.selectFusion(e.fusion)) {
+      throw bus::ConfigError(
+          "configuration fusion = '" + bus::get<std::string>(root, "", "fusion", "centralized") +
+          "' does not apply to mode '" + bus::get<std::string>(root, "", "mode", "") +
+          "' (federated needs star_tracker_updates; adaptive needs "
+          "loosely_coupled)");
+    }
+  }
+
+  // EKF parameters, in the units of the papers' error budgets.
   const YAML::Node tc = root["ekf"];
   constexpr double kDeg = M_PI / 180.0;
   constexpr double kMicroG = 9.80665e-6;
-  auto& t = c.tightly_coupled;
+  constexpr double kArcsec = kDeg / 3600.0;
+  auto& t = e.tuning;
   const std::string w = "ekf";
-  const std::string gravity = bus::get<std::string>(tc, w, "gravity", "wgs84");
-  if (gravity != "wgs84" && gravity != "point_mass") {
-    throw bus::ConfigError("configuration ekf.gravity = '" + gravity +
-                           "' is not wgs84 or point_mass");
-  }
-  t.gravity = gravity == "wgs84" ? core::earth::GravityModel::kWgs84Normal
-                                 : core::earth::GravityModel::kPointMass;
+  t.gravity =
+      choice<core::earth::GravityModel>(tc, w, "gravity", "wgs84",
+                                        {{"wgs84", core::earth::GravityModel::kWgs84Normal},
+                                         {"point_mass", core::earth::GravityModel::kPointMass}});
   t.accel_noise_mps2_per_sqrthz =
       bus::get<double>(tc, w, "accel_noise_ug_per_sqrthz", 10.0) * kMicroG;
   t.gyro_noise_radps_per_sqrthz =
@@ -91,12 +133,63 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       bus::get<double>(tc, w, "gyro_bias_sigma_deg_per_h", 1.0) * kDeg / 3600.0;
   t.clock_bias_sigma_m = bus::get<double>(tc, w, "initial_clock_bias_sigma_m", 3000.0);
   t.clock_drift_sigma_mps = bus::get<double>(tc, w, "initial_clock_drift_sigma_mps", 1.0);
-  t.gate_sigma =
-      bus::checkRange(bus::get<double>(tc, w, "gate_sigma", 5.0), 1.0, 1e3, "ekf.gate_sigma");
-  c.initial_clock_bias_m = bus::get<double>(tc, w, "initial_clock_bias_m", 0.0);
-  c.initial_clock_drift_mps = bus::get<double>(tc, w, "initial_clock_drift_mps", 0.0);
-  c.gnss_fix = input(inputs, "gnss_fix", false);
-  c.star_tracker = input(inputs, "star_tracker", false);
+  t.gate_sigma = bus::get<double>(tc, w, "gate_sigma", 5.0);
+  if (t.gate_sigma != 0.0) bus::checkRange(t.gate_sigma, 1.0, 1e3, "ekf.gate_sigma (0: off)");
+  for (const auto& [key, value] :
+       {std::pair<const char*, double>{"initial_position_sigma_m", t.pos_sigma_m},
+        {"initial_velocity_sigma_mps", t.vel_sigma_mps},
+        {"initial_level_sigma_mrad", t.level_sigma_rad},
+        {"initial_heading_sigma_mrad", t.heading_sigma_rad},
+        {"accel_bias_sigma_ug", t.accel_bias_sigma_mps2},
+        {"gyro_bias_sigma_deg_per_h", t.gyro_bias_sigma_radps},
+        {"initial_clock_bias_sigma_m", t.clock_bias_sigma_m},
+        {"initial_clock_drift_sigma_mps", t.clock_drift_sigma_mps}}) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      throw bus::ConfigError("configuration ekf." + std::string(key) +
+                             " must be positive and finite (covariance), got " +
+                             std::to_string(value));
+    }
+  }
+  e.initial_clock_bias_m = bus::get<double>(tc, w, "initial_clock_bias_m", 0.0);
+  e.initial_clock_drift_mps = bus::get<double>(tc, w, "initial_clock_drift_mps", 0.0);
+
+  const YAML::Node ad = root["adaptive"];
+  const std::string wa = "adaptive";
+  t.adaptive_window =
+      static_cast<int>(bus::checkRange(bus::get<double>(ad, wa, "window", 50), 2,
+                                       core::InnovationWindow<3>::kMaxLength, "adaptive.window"));
+  t.adaptive_floor_position_m = bus::get<double>(ad, wa, "floor_position_m", 0.3);
+  t.adaptive_floor_velocity_mps = bus::get<double>(ad, wa, "floor_velocity_mps", 0.01);
+  t.adaptive_floor_attitude_rad = bus::get<double>(ad, wa, "floor_attitude_arcsec", 0.2) * kArcsec;
+  t.federated_share =
+      bus::checkRange(bus::get<double>(root["federated"], "federated", "share", 2.0), 1.0, 100.0,
+                      "federated.share");
+
+  const YAML::Node md = root["multi_dimensional"];
+  const std::string wm = "multi_dimensional";
+  auto& m = e.mdf;
+  m.policy = choice<core::MdfPolicy>(md, wm, "policy", "mdf",
+                                     {{"mdf", core::MdfPolicy::kMultiDimensional},
+                                      {"continue", core::MdfPolicy::kContinue},
+                                      {"reset_all", core::MdfPolicy::kResetAll}});
+  m.recovery_s = bus::checkRange(bus::get<double>(md, wm, "recovery_s", 5.0), 0.0, 600.0,
+                                 "multi_dimensional.recovery_s");
+  m.gnss_timeout_s = bus::checkRange(bus::get<double>(md, wm, "gnss_timeout_s", 1.5), 0.01, 600.0,
+                                     "multi_dimensional.gnss_timeout_s");
+  m.constraint_period_s =
+      1.0 / bus::checkRange(bus::get<double>(md, wm, "constraint_rate_hz", 10.0), 0.1, 1000.0,
+                            "multi_dimensional.constraint_rate_hz");
+  m.zupt_sigma_mps = bus::checkRange(bus::get<double>(md, wm, "zupt_sigma_mps", 0.01), 1e-6, 10.0,
+                                     "multi_dimensional.zupt_sigma_mps");
+  m.nhc_sigma_mps = bus::checkRange(bus::get<double>(md, wm, "nhc_sigma_mps", 0.1), 1e-6, 10.0,
+                                    "multi_dimensional.nhc_sigma_mps");
+  const YAML::Node st = md ? md["stationary"] : YAML::Node();
+  const std::string ws = "multi_dimensional.stationary";
+  m.stationarity.window_s =
+      bus::checkRange(bus::get<double>(st, ws, "window_s", 1.0), 0.05, 10.0, ws + ".window_s");
+  m.stationarity.accel_std_mps2 = bus::get<double>(st, ws, "accel_std_mps2", 0.03);
+  m.stationarity.gyro_std_radps = bus::get<double>(st, ws, "gyro_std_dps", 0.3) * kDeg;
+  m.stationarity.speed_mps = bus::get<double>(st, ws, "speed_mps", 0.3);
   return c;
 }
 

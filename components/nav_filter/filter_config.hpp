@@ -6,7 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "navbus/core/tightly_coupled_ekf.hpp"
+#include "navbus/core/navigation_engine.hpp"
 
 namespace navbus::nav_filter {
 
@@ -15,20 +15,9 @@ struct InputConfig {
   std::int64_t period_ns{0};
 };
 
-/// What navbus-filter estimates.
-enum class Estimator {
-  kInertialOnly,   ///< free strapdown mechanization (GNSS and star tracker validated, unused)
-  kTightlyCoupled  ///< 17-state EKF with pseudoranges and rates (seed 000), centralized
-};
-
 struct FilterConfig {
-  Estimator estimator{Estimator::kInertialOnly};
-  core::TightlyCoupledConfig tightly_coupled;
-  double initial_clock_bias_m{0.0};
-  double initial_clock_drift_mps{0.0};
+  core::EngineConfig engine;  ///< aiding mode, fusion structure, tuning, initial state
   std::uint32_t vehicle_id{1};
-  std::int64_t solution_period_ns{100'000'000};
-  core::NavState initial_state;  ///< time is taken from the first increment
   InputConfig imu{1, 10'000'000};
   std::optional<InputConfig> gnss_observations;
   std::optional<InputConfig> gnss_fix;
@@ -36,6 +25,7 @@ struct FilterConfig {
   std::int64_t sequencer_max_wait_ns{500'000'000};
 };
 
+/// Throws bus::ConfigError naming the key and the value on any invalid entry.
 FilterConfig parseFilterConfig(const YAML::Node& root);
 
 }  // namespace navbus::nav_filter

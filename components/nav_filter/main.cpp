@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
                                      shutdown);
     nb::nav_filter::FilterNode node(participant, config);
     spdlog::info("running: vehicle {}, solution every {} ms, IMU sensor {}", config.vehicle_id,
-                 config.solution_period_ns / 1'000'000, config.imu.id);
+                 config.engine.solution_period_ns / 1'000'000, config.imu.id);
     participant.run();
     spdlog::info("summary: {}\n{}", node.summary(), participant.health().summary());
     return static_cast<int>(nb::bus::kExitOk);

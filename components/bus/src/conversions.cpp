@@ -13,6 +13,38 @@ core::ImuIncrement toCore(const navbus::ImuIncrement& msg) {
   return inc;
 }
 
+core::GnssFixMeasurement toCore(const navbus::GnssFix& msg) {
+  core::GnssFixMeasurement f;
+  f.time_ns = static_cast<std::int64_t>(msg.time_gps_ns());
+  f.position = {msg.latitude_rad(), msg.longitude_rad(), msg.height_m()};
+  f.vel_ned_mps = toVector(msg.vel_ned_mps());
+  f.pos_sigma_ned_m = toVector(msg.pos_sigma_ned_m());
+  f.vel_sigma_ned_mps = toVector(msg.vel_sigma_ned_mps());
+  return f;
+}
+
+core::StarAttitudeMeasurement toCore(const navbus::StarTrackerAttitude& msg) {
+  core::StarAttitudeMeasurement st;
+  st.time_ns = static_cast<std::int64_t>(msg.time_gps_ns());
+  const auto& q = msg.q_b_to_i();
+  st.q_b_to_i = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+  st.sigma_b_rad = toVector(msg.sigma_b_rad());
+  return st;
+}
+
+std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& m) {
+  std::vector<core::SatelliteObservation> out;
+  out.reserve(m.satellites().size());
+  for (const auto& s : m.satellites()) {
+    if (!s.valid()) continue;
+    out.push_back({s.sv_id(), toVector(s.sat_pos_ecef_m()), toVector(s.sat_vel_ecef_mps()),
+                   s.pseudorange_m() + s.sat_clock_correction_m(),
+                   s.pseudorange_rate_mps() + s.sat_clock_drift_mps(), s.pseudorange_sigma_m(),
+                   s.pseudorange_rate_sigma_mps()});
+  }
+  return out;
+}
+
 navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id,
                            std::uint64_t seq) {
   navbus::ImuIncrement msg;

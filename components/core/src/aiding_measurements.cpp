@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "navbus/core/rotation.hpp"
+
 namespace navbus::core {
 
 using namespace tc17;
@@ -43,6 +45,27 @@ VectorMeasurement attitudeMeasurement(const NavState& ins, const Eigen::Quaterni
   m.h.block<3, 3>(0, kAtt.index).setIdentity();
   const Eigen::Matrix3d R_b = sigma_b.array().square().matrix().asDiagonal();
   m.r = C_ins * R_b * C_ins.transpose();
+  return m;
+}
+
+VectorMeasurement zeroVelocityMeasurement(const NavState& ins, double sigma_mps) {
+  VectorMeasurement m;
+  m.z = ins.vel_ned_mps;
+  m.h.setZero();
+  m.h.block<3, 3>(0, kVel.index).setIdentity();
+  m.r = Eigen::Matrix3d::Identity() * sigma_mps * sigma_mps;
+  return m;
+}
+
+AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps) {
+  AidingMeasurement<2> m;
+  const Eigen::Matrix3d C_n_b = ins.q_b_to_n.toRotationMatrix().transpose();
+  const Eigen::Vector3d v_b = C_n_b * ins.vel_ned_mps;
+  m.z = v_b.tail<2>();
+  m.h.setZero();
+  m.h.block<2, 3>(0, kVel.index) = C_n_b.bottomRows<2>();
+  m.h.block<2, 3>(0, kAtt.index) = -(C_n_b * skew(ins.vel_ned_mps)).bottomRows<2>();
+  m.r = Eigen::Matrix2d::Identity() * sigma_mps * sigma_mps;
   return m;
 }
 

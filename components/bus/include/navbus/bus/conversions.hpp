@@ -2,10 +2,15 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
+#include <navbus_idl/Gnss.h>
 #include <navbus_idl/Imu.h>
 #include <navbus_idl/Navigation.h>
+#include <navbus_idl/StarTracker.h>
 
+#include "navbus/core/gnss_measurement.hpp"
+#include "navbus/core/navigation_engine.hpp"
 #include "navbus/core/strapdown.hpp"
 
 namespace navbus::bus {
@@ -20,6 +25,13 @@ inline Eigen::Vector3d toVector(const std::array<double, 3>& a) {
 core::ImuIncrement toCore(const navbus::ImuIncrement& msg);
 navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id,
                            std::uint64_t seq);
+
+core::GnssFixMeasurement toCore(const navbus::GnssFix& msg);
+/// The attitude quaternion is renormalized (validation admits |q| within 1e-6 of one).
+core::StarAttitudeMeasurement toCore(const navbus::StarTrackerAttitude& msg);
+/// The valid satellites of an epoch with the satellite clock corrections applied, so that the
+/// core sees corrected pseudoranges and rates.
+std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& msg);
 
 /// Fills time, position, velocity and attitude fields of a solution from a navigation state.
 void fillSolution(const core::NavState& state, navbus::NavigationSolution& out);

@@ -11,11 +11,15 @@
 
 namespace navbus::core {
 
-struct VectorMeasurement {
-  Eigen::Vector3d z;                        ///< innovation, predicted minus measured
-  Eigen::Matrix<double, 3, tc17::kSize> h;  ///< d z / d dx
-  Eigen::Matrix3d r;                        ///< measurement noise covariance
+/// An M-row aiding measurement in error-state form.
+template <int M>
+struct AidingMeasurement {
+  static constexpr int kRows = M;
+  Eigen::Matrix<double, M, 1> z;            ///< innovation, predicted minus measured
+  Eigen::Matrix<double, M, tc17::kSize> h;  ///< d z / d dx
+  Eigen::Matrix<double, M, M> r;            ///< measurement noise covariance
 };
+using VectorMeasurement = AidingMeasurement<3>;
 
 /// GNSS position fix: z = (INS position - fix position) in NED metres (lever arm zero).
 VectorMeasurement positionMeasurement(const NavState& ins, const earth::Geodetic& fix,
@@ -31,5 +35,15 @@ VectorMeasurement velocityMeasurement(const NavState& ins, const Eigen::Vector3d
 VectorMeasurement attitudeMeasurement(const NavState& ins,
                                       const Eigen::Quaterniond& q_b_to_i_measured,
                                       const Eigen::Vector3d& sigma_b_rad);
+
+/// Zero-velocity update while the vehicle stands still (seed 004 eq. 4): z = V_INS - 0 [m/s,
+/// NED], H selects the velocity error.
+VectorMeasurement zeroVelocityMeasurement(const NavState& ins, double sigma_mps);
+
+/// Non-holonomic constraint of a land vehicle (seed 004 eq. 6): the lateral and vertical body
+/// velocities are zero, z = (C_n_b V_INS)_{y,z} [m/s, body]. With C_b_n,est = (I - [phi x])
+/// C_b_n, the body velocity error is C_n_b dV - C_n_b [V x] phi, which gives the velocity and
+/// attitude columns of H.
+AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps);
 
 }  // namespace navbus::core

@@ -3,6 +3,8 @@
 // is data); a measurement with ratio > 1 is rejected and leaves the state untouched.
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
 
 namespace navbus::core {
@@ -15,7 +17,7 @@ struct ScalarUpdateResult {
 };
 
 /// Updates the error state x and covariance P with the scalar measurement z = h x + v,
-/// var(v) = r. `gate_sigma` is the gate in standard deviations (e.g. 5).
+/// var(v) = r. `gate_sigma` is the gate in standard deviations (e.g. 5); <= 0 disables it.
 /// Joseph form P = (I - K h) P (I - K h)^T + K r K^T keeps P symmetric positive definite even
 /// with rounding; the result is symmetrized.
 template <int N>
@@ -26,8 +28,11 @@ ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<do
   const Eigen::Matrix<double, N, 1> Ph = P * h.transpose();
   out.innovation = z - (h * x)(0, 0);
   out.innovation_var = (h * Ph)(0, 0) + r;
-  out.test_ratio = out.innovation * out.innovation / (gate_sigma * gate_sigma * out.innovation_var);
-  if (!(out.test_ratio <= 1.0) || !(out.innovation_var > 0.0)) return out;
+  // Without a gate (gate_sigma <= 0) the ratio is the normalized innovation squared eps^2 / V.
+  const double gate2 = gate_sigma > 0.0 ? gate_sigma * gate_sigma : 1.0;
+  out.test_ratio = out.innovation * out.innovation / (gate2 * out.innovation_var);
+  if (!(out.innovation_var > 0.0) || !std::isfinite(out.test_ratio)) return out;
+  if (gate_sigma > 0.0 && !(out.test_ratio <= 1.0)) return out;
   const Eigen::Matrix<double, N, 1> K = Ph / out.innovation_var;
   x += K * out.innovation;
   const Eigen::Matrix<double, N, N> A = Eigen::Matrix<double, N, N>::Identity() - K * h;

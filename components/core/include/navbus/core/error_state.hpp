@@ -1,0 +1,81 @@
+// An error-state Kalman filter over the 17-state layout: the error estimate x, its covariance
+// P and the set of active states. It knows nothing of the navigation state it corrects; the
+// integrated filter (integrated_filter.hpp) owns the mechanization and applies the feedback.
+#pragma once
+
+#include <array>
+#include <bitset>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "navbus/core/aiding_measurements.hpp"
+#include "navbus/core/ins_error_model.hpp"
+#include "navbus/core/kalman_update.hpp"
+
+namespace navbus::core {
+
+using Vector17 = Eigen::Matrix<double, tc17::kSize, 1>;
+using StateMask = std::bitset<tc17::kSize>;
+
+/// The mask with the given blocks active.
+StateMask maskOf(std::initializer_list<StateBlock> blocks);
+
+class ErrorState {
+ public:
+  void initialize(const Matrix17& P0, const StateMask& active);
+
+  /// x = Phi x, P = Phi P Phi^T + Q on the active states only: an inactive state keeps its
+  /// variance, is not driven by the active ones and does not drive them (seed 004 fig. 9: each
+  /// reduced filter uses its region of the 15-state system matrix).
+  void predict(const Matrix17& Phi, const Matrix17& Q);
+
+  /// Sequential Joseph-form update, rows decorrelated by the Cholesky factor of R, inactive
+  /// columns of H ignored. gate_sigma <= 0 disables gating. Returns one result per row.
+  template <int M>
+  std::array<ScalarUpdateResult, M> update(const AidingMeasurement<M>& m, double gate_sigma);
+
+  /// Covariance reset rules of seed 004 (eq. 12): zero every off-diagonal element, then
+  /// re-initialize the listed variances.
+  void zeroOffDiagonal();
+  void setVariances(const StateBlock& block, double sigma);
+
+  /// Changes the active set (inactive states keep their variance, cross terms removed).
+  void setActive(const StateMask& active);
+
+  /// The navigation state was corrected by dx: the error estimate becomes x - dx.
+  void shift(const Vector17& dx) { x_ -= dx; }
+
+  Vector17& x() { return x_; }
+  const Vector17& x() const { return x_; }
+  Matrix17& P() { return P_; }
+  const Matrix17& P() const { return P_; }
+  const StateMask& active() const { return active_; }
+
+ private:
+  void removeInactiveCoupling();
+
+  Vector17 x_{Vector17::Zero()};
+  Matrix17 P_{Matrix17::Zero()};
+  StateMask active_;
+};
+
+template <int M>
+std::array<ScalarUpdateResult, M> ErrorState::update(const AidingMeasurement<M>& m,
+                                                     double gate_sigma) {
+  using RowMatrix = Eigen::Matrix<double, M, tc17::kSize>;
+  const Eigen::Matrix<double, M, M> L = m.r.llt().matrixL();
+  const Eigen::Matrix<double, M, 1> z = L.template triangularView<Eigen::Lower>().solve(m.z);
+  RowMatrix H = L.template triangularView<Eigen::Lower>().solve(m.h);
+  for (int j = 0; j < tc17::kSize; ++j) {
+    if (!active_[static_cast<std::size_t>(j)]) H.col(j).setZero();
+  }
+  std::array<ScalarUpdateResult, M> out;
+  for (int i = 0; i < M; ++i) {
+    out[static_cast<std::size_t>(i)] =
+        scalarUpdate<tc17::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma);
+  }
+  return out;
+}
+
+}  // namespace navbus::core

@@ -1,0 +1,161 @@
+// The integrated navigation filter: strapdown mechanization with error-state feedback and the
+// fusion structures of seed 001 over the 17-state layout of seed 000.
+//  - centralized: one error-state EKF takes every measurement (seed 001 eqs. 22-23 in
+//    sequential Joseph form);
+//  - federated, no-reset mode: a GNSS/INS and a star-tracker/INS local filter, each with its own
+//    covariance, fused by the master (eqs. 28-29) after every local update; the master estimate
+//    is fed back into the shared mechanization and subtracted from both local estimates, whose
+//    covariances are never reset;
+//  - adaptive: the centralized filter with R of the aiding measurements re-estimated from a
+//    window of innovations (eqs. 30-34).
+// Attitude errors are phi angles in NED (computed C_b_n = (I - [phi x]) C_b_n,true), see
+// state_layout.hpp; all errors are estimate minus truth.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "navbus/core/aiding_measurements.hpp"
+#include "navbus/core/error_state.hpp"
+#include "navbus/core/gnss_measurement.hpp"
+#include "navbus/core/innovation_window.hpp"
+#include "navbus/core/ins_error_model.hpp"
+#include "navbus/core/kalman_update.hpp"
+
+namespace navbus::core {
+
+enum class FusionStructure { kCentralized, kFederated, kAdaptive };
+
+/// What an aiding measurement is: selects the local filter (federated) and the innovation
+/// window (adaptive).
+enum class AidingKind { kPosition, kVelocity, kAttitude, kZeroVelocity, kNonHolonomic };
+
+struct FilterTuning {
+  earth::GravityModel gravity{earth::GravityModel::kWgs84Normal};
+  // Process noise densities.
+  double accel_noise_mps2_per_sqrthz{1e-4};
+  double gyro_noise_radps_per_sqrthz{1e-6};
+  double clock_bias_noise_m_per_sqrts{0.1};
+  double clock_drift_noise_mps_per_sqrts{0.01};
+  // Initial 1-sigma (also the values the covariance reset rules re-initialize to).
+  double pos_sigma_m{40.0};
+  double vel_sigma_mps{1.0};
+  double level_sigma_rad{1e-3};
+  double heading_sigma_rad{5e-3};
+  double accel_bias_sigma_mps2{1e-2};
+  double gyro_bias_sigma_radps{5e-6};
+  double clock_bias_sigma_m{3000.0};
+  double clock_drift_sigma_mps{1.0};
+  double gate_sigma{5.0};  ///< innovation gate in standard deviations; <= 0: no gate
+  // Adaptive structure (seed 001 eqs. 30-34).
+  int adaptive_window{50};                ///< innovations per estimate [epochs]
+  double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]
+  double adaptive_floor_velocity_mps{0.01};
+  double adaptive_floor_attitude_rad{1e-6};
+  // Federated structure: each local filter starts from, and is driven by, share times the
+  // covariance and process noise (information sharing 1/share, Carlson's no-reset mode).
+  double federated_share{2.0};
+};
+
+struct MeasurementReport {
+  int sv_id;
+  bool rate;  ///< false: pseudorange row, true: pseudorange-rate row
+  ScalarUpdateResult result;
+};
+
+/// Everything the GLR detector (seed 000 eqs. 6-16) needs from one GNSS epoch, in batch form
+/// from the prior covariance: rows are (pseudorange, rate) per satellite, in order.
+struct EpochDiagnostics {
+  std::vector<int> sv_ids;             ///< per row
+  std::vector<bool> is_rate;           ///< per row
+  Eigen::VectorXd innovation;          ///< predicted minus measured, m rows
+  Eigen::MatrixXd innovation_cov;      ///< V = H P- H^T + R, m x m
+  Eigen::MatrixXd h;                   ///< m x 17
+  Eigen::MatrixXd k;                   ///< 17 x m, K = P- H^T V^-1
+  Matrix17 phi{Matrix17::Identity()};  ///< transition accumulated since the previous epoch
+  std::vector<double> test_ratio;      ///< per row, from the sequential gated update
+};
+
+class IntegratedFilter {
+ public:
+  /// Number of leading states the federated master fuses: all but the receiver clock, which
+  /// only the GNSS local filter observes.
+  static constexpr int kFusedStates = tc17::kClockBias.index;
+
+  void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
+                  const FilterTuning& tuning, const StateMask& active,
+                  FusionStructure structure = FusionStructure::kCentralized);
+  /// Mechanizes one increment (bias-corrected) and propagates the covariance(s) and the clock.
+  void propagate(const ImuIncrement& raw);
+  /// Processes one epoch of pseudoranges and rates; returns one report per row.
+  std::vector<MeasurementReport> update(const std::vector<SatelliteObservation>& sats);
+  /// Processes an aiding measurement, one decorrelated row at a time.
+  template <int M>
+  std::array<ScalarUpdateResult, M> update(const AidingMeasurement<M>& m, AidingKind kind);
+
+  /// Switches the fusion structure at run time (the estimate carries over; see .cpp).
+  void setStructure(FusionStructure s);
+  FusionStructure structure() const { return structure_; }
+
+  /// Covariance management for the multi-dimensional filter (seed 004).
+  void setActive(const StateMask& active);
+  void zeroOffDiagonal();
+  void resetVariances(const StateBlock& block, double sigma);
+  const StateMask& active() const { return central_.active(); }
+
+  const NavState& state() const { return ins_.state(); }
+  /// The covariance of the estimate: the centralized one, or the master's (federated).
+  const Matrix17& covariance() const { return central_.P(); }
+  const ErrorState& local(int i) const { return local_[static_cast<std::size_t>(i)]; }
+  const Eigen::Vector3d& accelBias() const { return accel_bias_; }
+  const Eigen::Vector3d& gyroBias() const { return gyro_bias_; }
+  double clockBias() const { return clock_bias_m_; }
+  double clockDrift() const { return clock_drift_mps_; }
+  const Matrix17& accumulatedPhi() const { return phi_since_update_; }
+  const EpochDiagnostics& lastEpoch() const { return last_epoch_; }
+  void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
+  bool initialized() const { return ins_.initialized(); }
+  const FilterTuning& tuning() const { return tuning_; }
+
+ private:
+  /// The error state a measurement goes to.
+  ErrorState& target(AidingKind kind);
+  /// Applies the estimate after an update: centralized feedback, or master fusion + feedback.
+  void closeUpdate();
+  void feedback(const Vector17& dx);
+  InnovationWindow<3>* window(AidingKind kind);
+
+  FilterTuning tuning_;
+  FusionStructure structure_{FusionStructure::kCentralized};
+  StrapdownNed ins_;
+  ErrorState central_;               ///< centralized/adaptive filter; master result (federated)
+  std::array<ErrorState, 2> local_;  ///< federated: [0] GNSS/INS, [1] star tracker/INS
+  std::array<InnovationWindow<3>, 3> windows_;  ///< adaptive: position, velocity, attitude
+  Matrix17 phi_since_update_{Matrix17::Identity()};
+  EpochDiagnostics last_epoch_;
+  Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
+  double clock_bias_m_{0.0};
+  double clock_drift_mps_{0.0};
+};
+
+template <int M>
+std::array<ScalarUpdateResult, M> IntegratedFilter::update(const AidingMeasurement<M>& m,
+                                                           AidingKind kind) {
+  AidingMeasurement<M> used = m;
+  ErrorState& es = target(kind);
+  if constexpr (M == 3) {
+    if (InnovationWindow<3>* w = window(kind)) {
+      // Eq. 30: dz = z - H x-; eqs. 31-34 with this epoch's H P- H^T.
+      const Eigen::Vector3d dz = m.z - m.h * es.x();
+      const Eigen::Matrix3d hpht = m.h * es.P() * m.h.transpose();
+      w->push(dz);
+      if (w->full()) used.r = w->adaptedR(hpht);
+    }
+  }
+  const std::array<ScalarUpdateResult, M> out = es.update(used, tuning_.gate_sigma);
+  closeUpdate();
+  return out;
+}
+
+}  // namespace navbus::core

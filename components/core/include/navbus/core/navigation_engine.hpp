@@ -1,0 +1,137 @@
+// The navigation engine: the filter policy between inputs in processing order and the
+// estimate (KF-GINS style: addImu, addGnss..., state). It decides when the filter starts,
+// restarts over inertial gaps, which measurements each aiding mode uses, runs the
+// multi-dimensional stage logic, and marks solution epochs. navbus-filter and the offline
+// runner call the same engine with the same inputs, which is what makes them bit-identical.
+#pragma once
+
+#include <cstdint>
+#include <set>
+#include <vector>
+
+#include "navbus/core/integrated_filter.hpp"
+#include "navbus/core/multi_dimensional.hpp"
+
+namespace navbus::core {
+
+enum class AidingMode {
+  kInertialOnly,     ///< mechanization and covariance propagation, no updates
+  kTightlyCoupled,   ///< pseudoranges and rates (seed 000)
+  kLooselyCoupled,   ///< GNSS position/velocity fixes (+ star tracker when enabled; seed 001)
+  kMultiDimensional  ///< land vehicle: fixes, ZUPT, NHC with the stage logic (seed 004)
+};
+
+enum class EngineMode {
+  kInitializing,
+  kInertialOnly,
+  kInertialLost,
+  kTightlyCoupled,
+  kLooselyCoupled,
+  kMdfF1,
+  kMdfF2,
+  kMdfF3,
+  kMdfF4
+};
+
+/// Engine status bits (the participant maps them to the solution's fault flags).
+enum EngineStatus : std::uint32_t {
+  kStatusImuGap = 1u << 0,
+  kStatusSatelliteExcluded = 1u << 1,
+  kStatusBiasCompensated = 1u << 2,
+};
+
+struct GnssFixMeasurement {
+  std::int64_t time_ns{0};
+  earth::Geodetic position;
+  Eigen::Vector3d vel_ned_mps{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d pos_sigma_ned_m{Eigen::Vector3d::Ones()};
+  Eigen::Vector3d vel_sigma_ned_mps{Eigen::Vector3d::Ones()};
+};
+
+struct StarAttitudeMeasurement {
+  std::int64_t time_ns{0};
+  Eigen::Quaterniond q_b_to_i{Eigen::Quaterniond::Identity()};  ///< body -> ECI
+  Eigen::Vector3d sigma_b_rad{Eigen::Vector3d::Ones()};
+};
+
+struct EngineConfig {
+  AidingMode aiding{AidingMode::kInertialOnly};
+  FusionStructure fusion{FusionStructure::kCentralized};
+  FilterTuning tuning;
+  bool use_star_tracker{false};  ///< loosely coupled: star-tracker attitude updates
+  MdfConfig mdf;                 ///< multi-dimensional mode only
+  double imu_period_s{0.01};     ///< nominal increment interval (stationarity window)
+  NavState initial_state;        ///< time is taken from the first increment
+  double initial_clock_bias_m{0.0};
+  double initial_clock_drift_mps{0.0};
+  std::int64_t solution_period_ns{100'000'000};
+};
+
+struct EngineCounters {
+  std::uint64_t imu_used{0}, imu_gaps{0};
+  std::uint64_t gnss_epochs_fused{0}, fixes_fused{0}, star_fused{0};
+  std::uint64_t zero_velocity_updates{0}, nonholonomic_updates{0};
+  std::uint64_t rows_gated{0};  ///< measurement rows refused by the innovation gate
+  std::uint64_t stage_switches{0};
+};
+
+class NavigationEngine {
+ public:
+  explicit NavigationEngine(const EngineConfig& config);
+
+  /// Integrates one increment; true when the state time reached a solution epoch.
+  bool addImu(const ImuIncrement& inc);
+  /// Fuses a pseudorange epoch (tightly coupled mode); true when fused (diagnostics ready).
+  bool addGnssEpoch(const std::vector<SatelliteObservation>& satellites);
+  void addGnssFix(const GnssFixMeasurement& fix);
+  void addStarAttitude(const StarAttitudeMeasurement& st);
+
+  // Commands.
+  void excludeSatellite(int sv_id);
+  void readmitSatellite(int sv_id);
+  /// Adds a bias (accelerometer [m/s^2] or gyro [rad/s], body axis 0..2) to the compensation.
+  void compensateBias(bool accelerometer, int axis, double bias);
+  /// False when the structure does not apply to the aiding mode (see the .cpp).
+  bool selectFusion(FusionStructure s);
+  void markInertialLost();
+  void reset();
+
+  bool initialized() const { return filter_.initialized(); }
+  const NavState& state() const { return filter_.state(); }
+  const Matrix17& covariance() const { return filter_.covariance(); }
+  Eigen::Vector3d accelBias() const { return filter_.accelBias() + accel_compensation_; }
+  Eigen::Vector3d gyroBias() const { return filter_.gyroBias() + gyro_compensation_; }
+  double clockBias() const { return filter_.clockBias(); }
+  double clockDrift() const { return filter_.clockDrift(); }
+  EngineMode mode() const { return mode_; }
+  FusionStructure fusion() const { return filter_.structure(); }
+  const EngineConfig& config() const { return config_; }
+  std::uint32_t status() const { return status_; }
+  const EngineCounters& counters() const { return counters_; }
+  const EpochDiagnostics& lastEpoch() const { return filter_.lastEpoch(); }
+  const IntegratedFilter& filter() const { return filter_; }
+
+ private:
+  StateMask baseMask() const;
+  EngineMode aidedMode() const;
+  void applyStage(const StageDecision& d);
+  void constraintUpdate();
+  void countGated(const ScalarUpdateResult* results, int n);
+
+  EngineConfig config_;
+  IntegratedFilter filter_;
+  StationarityDetector stationarity_;
+  StageSelector stages_;
+  EngineMode mode_{EngineMode::kInitializing};
+  std::uint32_t status_{0};
+  EngineCounters counters_;
+  std::set<int> excluded_;
+  std::vector<SatelliteObservation> used_;  ///< reused buffer of the satellites fused
+  Eigen::Vector3d accel_compensation_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d gyro_compensation_{Eigen::Vector3d::Zero()};
+  std::int64_t next_output_ns_{0};
+  std::int64_t last_fix_ns_{-1};
+  std::int64_t next_constraint_ns_{0};
+};
+
+}  // namespace navbus::core

@@ -1,0 +1,60 @@
+#include "navbus/core/error_state.hpp"
+
+namespace navbus::core {
+
+StateMask maskOf(std::initializer_list<StateBlock> blocks) {
+  StateMask m;
+  for (const StateBlock& b : blocks) {
+    for (int i = b.index; i < b.end(); ++i) m.set(static_cast<std::size_t>(i));
+  }
+  return m;
+}
+
+void ErrorState::initialize(const Matrix17& P0, const StateMask& active) {
+  x_.setZero();
+  P_ = P0;
+  active_ = active;
+  removeInactiveCoupling();
+}
+
+void ErrorState::predict(const Matrix17& Phi_full, const Matrix17& Q_full) {
+  Matrix17 Phi = Phi_full;
+  Matrix17 Q = Q_full;
+  for (int i = 0; i < tc17::kSize; ++i) {
+    if (active_[static_cast<std::size_t>(i)]) continue;
+    Phi.row(i).setZero();
+    Phi.col(i).setZero();
+    Phi(i, i) = 1.0;
+    Q.row(i).setZero();
+    Q.col(i).setZero();
+  }
+  x_ = Phi * x_;
+  P_ = Phi * P_ * Phi.transpose() + Q;
+  P_ = 0.5 * (P_ + P_.transpose());
+}
+
+void ErrorState::zeroOffDiagonal() {
+  P_ = Matrix17(P_.diagonal().asDiagonal());
+}
+
+void ErrorState::setVariances(const StateBlock& block, double sigma) {
+  for (int i = block.index; i < block.end(); ++i) P_(i, i) = sigma * sigma;
+}
+
+void ErrorState::setActive(const StateMask& active) {
+  active_ = active;
+  removeInactiveCoupling();
+}
+
+void ErrorState::removeInactiveCoupling() {
+  for (int i = 0; i < tc17::kSize; ++i) {
+    if (active_[static_cast<std::size_t>(i)]) continue;
+    const double v = P_(i, i);
+    P_.row(i).setZero();
+    P_.col(i).setZero();
+    P_(i, i) = v;
+    x_[i] = 0.0;
+  }
+}
+
+}  // namespace navbus::core

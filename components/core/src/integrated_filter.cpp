@@ -1,0 +1,215 @@
+#include "navbus/core/integrated_filter.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "navbus/core/information_fusion.hpp"
+#include "navbus/core/rotation.hpp"
+
+namespace navbus::core {
+
+using namespace tc17;
+
+namespace {
+constexpr std::size_t kGnssLocal = 0;
+constexpr std::size_t kStarLocal = 1;
+}  // namespace
+
+void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
+                                  double clock_drift_mps, const FilterTuning& tuning,
+                                  const StateMask& active, FusionStructure structure) {
+  tuning_ = tuning;
+  ins_ = StrapdownNed(tuning.gravity);
+  ins_.initialize(state);
+  clock_bias_m_ = clock_bias_m;
+  clock_drift_mps_ = clock_drift_mps;
+  accel_bias_.setZero();
+  gyro_bias_.setZero();
+  Vector17 sigma;
+  sigma.segment<3>(kPos.index).setConstant(tuning.pos_sigma_m);
+  sigma.segment<3>(kVel.index).setConstant(tuning.vel_sigma_mps);
+  sigma.segment<3>(kAtt.index) << tuning.level_sigma_rad, tuning.level_sigma_rad,
+      tuning.heading_sigma_rad;
+  sigma.segment<3>(kAccelBias.index).setConstant(tuning.accel_bias_sigma_mps2);
+  sigma.segment<3>(kGyroBias.index).setConstant(tuning.gyro_bias_sigma_radps);
+  sigma[kClockBias.index] = tuning.clock_bias_sigma_m;
+  sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
+  central_.initialize(sigma.array().square().matrix().asDiagonal(), active);
+  const Eigen::Vector3d floor_pos = Eigen::Vector3d::Constant(tuning.adaptive_floor_position_m);
+  windows_[0].configure(tuning.adaptive_window, floor_pos);
+  windows_[1].configure(tuning.adaptive_window,
+                        Eigen::Vector3d::Constant(tuning.adaptive_floor_velocity_mps));
+  windows_[2].configure(tuning.adaptive_window,
+                        Eigen::Vector3d::Constant(tuning.adaptive_floor_attitude_rad));
+  phi_since_update_.setIdentity();
+  structure_ = FusionStructure::kCentralized;
+  setStructure(structure);
+}
+
+void IntegratedFilter::setStructure(FusionStructure s) {
+  if (s == FusionStructure::kFederated && structure_ != FusionStructure::kFederated) {
+    // The locals start from the current estimate with 1/share of its information each; their
+    // fusion gives back the current covariance.
+    for (ErrorState& l : local_) {
+      l.initialize(central_.P() * tuning_.federated_share, central_.active());
+    }
+  }
+  if (s == FusionStructure::kAdaptive && structure_ != FusionStructure::kAdaptive) {
+    for (auto& w : windows_) w.clear();  // statistics of a new run of innovations
+  }
+  // Federated -> centralized/adaptive: central_ already holds the master covariance.
+  structure_ = s;
+}
+
+void IntegratedFilter::propagate(const ImuIncrement& raw) {
+  ImuIncrement inc = raw;
+  inc.delta_vel_b_mps -= accel_bias_ * inc.interval_s;
+  inc.delta_angle_b_rad -= gyro_bias_ * inc.interval_s;
+  const double dt = inc.interval_s;
+  // F at the state at the start of the interval (first-order hold of the error dynamics).
+  const Matrix17 Phi =
+      transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, tuning_.gravity), dt);
+  ins_.propagate(inc);
+  clock_bias_m_ += clock_drift_mps_ * dt;
+  // Discrete process noise: white specific force / rate noise into velocity / attitude
+  // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3).
+  Matrix17 Q = Matrix17::Zero();
+  Q.block<3, 3>(kVel.index, kVel.index)
+      .diagonal()
+      .setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt);
+  Q.block<3, 3>(kAtt.index, kAtt.index)
+      .diagonal()
+      .setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt);
+  Q(kClockBias.index, kClockBias.index) = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
+  Q(kClockDrift.index, kClockDrift.index) =
+      std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
+  if (structure_ == FusionStructure::kFederated) {
+    for (ErrorState& l : local_) l.predict(Phi, Q * tuning_.federated_share);
+  }
+  // The master (federated) covariance is propagated too, so that it is valid between updates.
+  central_.predict(Phi, Q);
+  phi_since_update_ = Phi * phi_since_update_;
+}
+
+ErrorState& IntegratedFilter::target(AidingKind kind) {
+  if (structure_ != FusionStructure::kFederated) return central_;
+  return kind == AidingKind::kAttitude ? local_[kStarLocal] : local_[kGnssLocal];
+}
+
+InnovationWindow<3>* IntegratedFilter::window(AidingKind kind) {
+  if (structure_ != FusionStructure::kAdaptive) return nullptr;
+  switch (kind) {
+    case AidingKind::kPosition:
+      return &windows_[0];
+    case AidingKind::kVelocity:
+      return &windows_[1];
+    case AidingKind::kAttitude:
+      return &windows_[2];
+    default:
+      return nullptr;
+  }
+}
+
+std::vector<MeasurementReport> IntegratedFilter::update(
+    const std::vector<SatelliteObservation>& sats) {
+  ErrorState& es = structure_ == FusionStructure::kFederated ? local_[kGnssLocal] : central_;
+  const auto m = static_cast<Eigen::Index>(2 * sats.size());
+  EpochDiagnostics& d = last_epoch_;
+  d.sv_ids.clear();
+  d.is_rate.clear();
+  d.test_ratio.clear();
+  d.innovation.resize(m);
+  d.h.resize(m, kSize);
+  Eigen::VectorXd r(m);
+  for (std::size_t i = 0; i < sats.size(); ++i) {
+    const auto& sat = sats[i];
+    const RangePrediction p = predictRange(ins_.state(), clock_bias_m_, clock_drift_mps_, sat);
+    const auto row = static_cast<Eigen::Index>(2 * i);
+    // Innovations in the error-state form z = H dx + v: predicted minus measured (seed 000 eq. 5).
+    d.innovation[row] = p.pseudorange_m - sat.pseudorange_m;
+    d.innovation[row + 1] = p.pseudorange_rate_mps - sat.pseudorange_rate_mps;
+    d.h.row(row) = p.h_range;
+    d.h.row(row + 1) = p.h_rate;
+    r[row] = sat.pseudorange_sigma_m * sat.pseudorange_sigma_m;
+    r[row + 1] = sat.pseudorange_rate_sigma_mps * sat.pseudorange_rate_sigma_mps;
+    d.sv_ids.insert(d.sv_ids.end(), {sat.sv_id, sat.sv_id});
+    d.is_rate.insert(d.is_rate.end(), {false, true});
+  }
+  // Batch view from the prior covariance, published for the GLR; the update itself is
+  // sequential (exact for the diagonal R) so that each row can be gated on its own.
+  d.innovation_cov = d.h * es.P() * d.h.transpose();
+  d.innovation_cov.diagonal() += r;
+  d.k = es.P() * d.h.transpose() * d.innovation_cov.inverse();
+  d.phi = phi_since_update_;
+  std::vector<MeasurementReport> reports;
+  reports.reserve(static_cast<std::size_t>(m));
+  for (Eigen::Index row = 0; row < m; ++row) {
+    AidingMeasurement<1> one;
+    one.z[0] = d.innovation[row];
+    one.h = d.h.row(row);
+    one.r(0, 0) = r[row];
+    const ScalarUpdateResult res = es.update(one, tuning_.gate_sigma)[0];
+    d.test_ratio.push_back(res.test_ratio);
+    reports.push_back(
+        {d.sv_ids[static_cast<std::size_t>(row)], d.is_rate[static_cast<std::size_t>(row)], res});
+  }
+  closeUpdate();
+  return reports;
+}
+
+void IntegratedFilter::closeUpdate() {
+  if (structure_ == FusionStructure::kFederated) {
+    // Master fusion (eqs. 28-29) of the shared states; the clock comes from the GNSS local.
+    const FusedEstimate<kFusedStates> f =
+        fuseInformation<kFusedStates>(local_[kGnssLocal], local_[kStarLocal]);
+    Vector17 dx = Vector17::Zero();
+    dx.head<kFusedStates>() = f.x;
+    dx.tail<kSize - kFusedStates>() = local_[kGnssLocal].x().tail<kSize - kFusedStates>();
+    Matrix17 P = Matrix17::Zero();
+    P.topLeftCorner<kFusedStates, kFusedStates>() = f.P;
+    P.bottomRightCorner<kSize - kFusedStates, kSize - kFusedStates>() =
+        local_[kGnssLocal].P().bottomRightCorner<kSize - kFusedStates, kSize - kFusedStates>();
+    central_.initialize(P, central_.active());
+    // No-reset mode: the locals keep their covariances; their estimates are now relative to
+    // the corrected mechanization.
+    for (ErrorState& l : local_) l.shift(dx);
+    feedback(dx);
+  } else {
+    feedback(central_.x());
+    central_.x().setZero();
+  }
+  phi_since_update_.setIdentity();
+}
+
+void IntegratedFilter::feedback(const Vector17& dx) {
+  // Errors are estimate minus truth: subtract them from the estimate, then the error state is 0.
+  NavState s = ins_.state();
+  s.position = earth::offsetNed(s.position, -dx.segment<3>(kPos.index));
+  s.vel_ned_mps -= dx.segment<3>(kVel.index);
+  // C_est = (I - [phi x]) C_true  =>  C_true = (I + [phi x]) C_est.
+  s.q_b_to_n = (quaternionFromRotationVector(dx.segment<3>(kAtt.index)) * s.q_b_to_n).normalized();
+  ins_.correct(s);
+  accel_bias_ -= dx.segment<3>(kAccelBias.index);
+  gyro_bias_ -= dx.segment<3>(kGyroBias.index);
+  clock_bias_m_ -= dx[kClockBias.index];
+  clock_drift_mps_ -= dx[kClockDrift.index];
+}
+
+void IntegratedFilter::setActive(const StateMask& active) {
+  central_.setActive(active);
+  for (ErrorState& l : local_) l.setActive(active);
+}
+
+void IntegratedFilter::zeroOffDiagonal() {
+  central_.zeroOffDiagonal();
+  for (ErrorState& l : local_) l.zeroOffDiagonal();
+}
+
+void IntegratedFilter::resetVariances(const StateBlock& block, double sigma) {
+  central_.setVariances(block, sigma);
+  for (ErrorState& l : local_) l.setVariances(block, sigma * std::sqrt(tuning_.federated_share));
+}
+
+}  // namespace navbus::core

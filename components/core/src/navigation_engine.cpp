@@ -1,0 +1,260 @@
+#include "navbus/core/navigation_engine.hpp"
+
+#include <cmath>
+
+namespace navbus::core {
+
+using namespace tc17;
+
+namespace {
+EngineMode stageMode(MdfStage s) {
+  switch (s) {
+    case MdfStage::kF1ZeroVelocity:
+      return EngineMode::kMdfF1;
+    case MdfStage::kF2Gnss:
+      return EngineMode::kMdfF2;
+    case MdfStage::kF3Recovery:
+      return EngineMode::kMdfF3;
+    case MdfStage::kF4Constraint:
+      return EngineMode::kMdfF4;
+  }
+  return EngineMode::kMdfF2;
+}
+}  // namespace
+
+NavigationEngine::NavigationEngine(const EngineConfig& config) : config_(config) {
+  used_.reserve(32);
+  reset();
+}
+
+void NavigationEngine::reset() {
+  filter_ = IntegratedFilter();
+  mode_ = EngineMode::kInitializing;
+  status_ = 0;
+  excluded_.clear();
+  accel_compensation_.setZero();
+  gyro_compensation_.setZero();
+  last_fix_ns_ = -1;
+  stationarity_.configure(config_.mdf.stationarity, config_.imu_period_s);
+  stages_.configure(config_.mdf);
+  stages_.restart();
+}
+
+StateMask NavigationEngine::baseMask() const {
+  // The receiver clock is a state only when pseudoranges are used.
+  if (config_.aiding == AidingMode::kTightlyCoupled || config_.aiding == AidingMode::kInertialOnly)
+    return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift});
+  return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias});
+}
+
+bool NavigationEngine::addImu(const ImuIncrement& raw) {
+  ImuIncrement inc = raw;
+  inc.delta_vel_b_mps -= accel_compensation_ * inc.interval_s;
+  inc.delta_angle_b_rad -= gyro_compensation_ * inc.interval_s;
+  const auto interval_ns = static_cast<std::int64_t>(std::llround(inc.interval_s * 1e9));
+  const std::int64_t start_ns = inc.time_ns - interval_ns;
+  const std::int64_t period = config_.solution_period_ns;
+  if (!filter_.initialized()) {
+    NavState s = config_.initial_state;
+    s.time_ns = start_ns;
+    filter_.initialize(s, config_.initial_clock_bias_m, config_.initial_clock_drift_mps,
+                       config_.tuning, baseMask(), config_.fusion);
+    next_output_ns_ = (start_ns / period + 1) * period;
+    next_constraint_ns_ = start_ns;
+  } else if (start_ns - filter_.state().time_ns > interval_ns / 2) {
+    // Inertial data is missing between the state time and this interval: nothing can be
+    // propagated across the gap, so restart the integration and flag the solution.
+    filter_.restartAt(start_ns);
+    status_ |= kStatusImuGap;
+    ++counters_.imu_gaps;
+    next_output_ns_ = (start_ns / period + 1) * period;
+    next_constraint_ns_ = start_ns;
+  }
+  filter_.propagate(inc);
+  ++counters_.imu_used;
+  if (mode_ == EngineMode::kInitializing || mode_ == EngineMode::kInertialLost) {
+    // Back to inertial navigation; aided modes resume with the next measurement.
+    mode_ = EngineMode::kInertialOnly;
+  }
+  if (config_.aiding == AidingMode::kMultiDimensional) {
+    const double speed = filter_.state().vel_ned_mps.head<2>().norm();
+    stationarity_.update(inc, speed);
+    if (stationarity_.ready()) {
+      const bool gnss =
+          last_fix_ns_ >= 0 &&
+          1e-9 * static_cast<double>(inc.time_ns - last_fix_ns_) <= config_.mdf.gnss_timeout_s;
+      applyStage(stages_.update(stationarity_.stationary(), gnss, inc.time_ns));
+      constraintUpdate();
+    }
+  }
+  if (filter_.state().time_ns >= next_output_ns_) {
+    next_output_ns_ = (filter_.state().time_ns / period + 1) * period;
+    return true;
+  }
+  return false;
+}
+
+void NavigationEngine::applyStage(const StageDecision& d) {
+  mode_ = stageMode(d.stage);
+  if (!d.changed) return;
+  ++counters_.stage_switches;
+  const FilterTuning& t = config_.tuning;
+  if (config_.mdf.policy == MdfPolicy::kMultiDimensional) {
+    filter_.setActive(stageMask(d.stage));
+  }
+  const StateBlock horizontal_att{kAtt.index, 2};
+  const StateBlock heading{kAtt.index + 2, 1};
+  switch (d.reset) {
+    case CovarianceReset::kNone:
+      break;
+    case CovarianceReset::kFs:
+      filter_.zeroOffDiagonal();
+      break;
+    case CovarianceReset::kFsA:
+      filter_.zeroOffDiagonal();
+      filter_.resetVariances(horizontal_att, t.level_sigma_rad);
+      filter_.resetVariances(kVel, t.vel_sigma_mps);
+      break;
+    case CovarianceReset::kAll:
+      filter_.resetVariances(kAccelBias, t.accel_bias_sigma_mps2);
+      filter_.resetVariances(kGyroBias, t.gyro_bias_sigma_radps);
+      [[fallthrough]];
+    case CovarianceReset::kFsI:
+      filter_.zeroOffDiagonal();
+      filter_.resetVariances(kPos, t.pos_sigma_m);
+      filter_.resetVariances(kVel, t.vel_sigma_mps);
+      filter_.resetVariances(horizontal_att, t.level_sigma_rad);
+      filter_.resetVariances(heading, t.heading_sigma_rad);
+      break;
+  }
+}
+
+void NavigationEngine::constraintUpdate() {
+  const std::int64_t t = filter_.state().time_ns;
+  if (t < next_constraint_ns_) return;
+  next_constraint_ns_ =
+      t + static_cast<std::int64_t>(std::llround(config_.mdf.constraint_period_s * 1e9));
+  const MdfStage stage = stages_.stage();
+  if (stage == MdfStage::kF1ZeroVelocity) {
+    const auto r =
+        filter_.update(zeroVelocityMeasurement(filter_.state(), config_.mdf.zupt_sigma_mps),
+                       AidingKind::kZeroVelocity);
+    countGated(r.data(), 3);
+    ++counters_.zero_velocity_updates;
+  } else if (stage == MdfStage::kF4Constraint &&
+             config_.mdf.policy == MdfPolicy::kMultiDimensional) {
+    const auto r =
+        filter_.update(nonHolonomicMeasurement(filter_.state(), config_.mdf.nhc_sigma_mps),
+                       AidingKind::kNonHolonomic);
+    countGated(r.data(), 2);
+    ++counters_.nonholonomic_updates;
+  }
+}
+
+void NavigationEngine::countGated(const ScalarUpdateResult* results, int n) {
+  for (int i = 0; i < n; ++i) counters_.rows_gated += results[i].accepted ? 0 : 1;
+}
+
+EngineMode NavigationEngine::aidedMode() const {
+  return config_.aiding == AidingMode::kTightlyCoupled ? EngineMode::kTightlyCoupled
+                                                       : EngineMode::kLooselyCoupled;
+}
+
+bool NavigationEngine::addGnssEpoch(const std::vector<SatelliteObservation>& satellites) {
+  if (config_.aiding != AidingMode::kTightlyCoupled || !filter_.initialized() ||
+      mode_ == EngineMode::kInertialLost) {
+    return false;
+  }
+  used_.clear();
+  for (const auto& s : satellites) {
+    // Excluded satellites (by command) stay out; the diagnostics carry at most 24 satellites.
+    if (excluded_.count(s.sv_id) == 0 && used_.size() < 24) used_.push_back(s);
+  }
+  if (used_.empty()) return false;
+  for (const auto& rep : filter_.update(used_)) counters_.rows_gated += rep.result.accepted ? 0 : 1;
+  ++counters_.gnss_epochs_fused;
+  mode_ = aidedMode();
+  return true;
+}
+
+void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
+  if (!filter_.initialized() || mode_ == EngineMode::kInertialLost) return;
+  if (config_.aiding == AidingMode::kMultiDimensional) {
+    last_fix_ns_ = fix.time_ns;
+    if (!stationarity_.ready()) return;
+    // GNSS availability changes the stage at once, so that the first fix after an outage
+    // is used by F3 with the FS/I reset already applied.
+    applyStage(stages_.update(stationarity_.stationary(), true, fix.time_ns));
+    const MdfStage s = stages_.stage();
+    if (s != MdfStage::kF2Gnss && s != MdfStage::kF3Recovery) return;  // stationary: ZUPT only
+  } else if (config_.aiding != AidingMode::kLooselyCoupled) {
+    return;
+  }
+  const auto p =
+      filter_.update(positionMeasurement(filter_.state(), fix.position, fix.pos_sigma_ned_m),
+                     AidingKind::kPosition);
+  countGated(p.data(), 3);
+  const auto v =
+      filter_.update(velocityMeasurement(filter_.state(), fix.vel_ned_mps, fix.vel_sigma_ned_mps),
+                     AidingKind::kVelocity);
+  countGated(v.data(), 3);
+  ++counters_.fixes_fused;
+  if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();
+}
+
+void NavigationEngine::addStarAttitude(const StarAttitudeMeasurement& st) {
+  if (!config_.use_star_tracker || !filter_.initialized() || mode_ == EngineMode::kInertialLost ||
+      config_.aiding == AidingMode::kInertialOnly ||
+      config_.aiding == AidingMode::kMultiDimensional)
+    return;
+  const auto a = filter_.update(attitudeMeasurement(filter_.state(), st.q_b_to_i, st.sigma_b_rad),
+                                AidingKind::kAttitude);
+  countGated(a.data(), 3);
+  ++counters_.star_fused;
+  mode_ = aidedMode();
+}
+
+void NavigationEngine::excludeSatellite(int sv_id) {
+  excluded_.insert(sv_id);
+  status_ |= kStatusSatelliteExcluded;
+}
+
+void NavigationEngine::readmitSatellite(int sv_id) {
+  excluded_.erase(sv_id);
+  if (excluded_.empty()) status_ &= ~static_cast<std::uint32_t>(kStatusSatelliteExcluded);
+}
+
+void NavigationEngine::compensateBias(bool accelerometer, int axis, double bias) {
+  (accelerometer ? accel_compensation_ : gyro_compensation_)[axis] += bias;
+  status_ |= kStatusBiasCompensated;
+}
+
+bool NavigationEngine::selectFusion(FusionStructure s) {
+  // Federated needs two local filters (GNSS/INS and star tracker/INS); the adaptive R is
+  // estimated for the loosely coupled position, velocity and attitude measurements; the
+  // multi-dimensional filter switches the dimension of one centralized filter.
+  bool ok = false;
+  switch (s) {
+    case FusionStructure::kCentralized:
+      ok = config_.aiding != AidingMode::kInertialOnly;
+      break;
+    case FusionStructure::kFederated:
+      ok = (config_.aiding == AidingMode::kLooselyCoupled ||
+            config_.aiding == AidingMode::kTightlyCoupled) &&
+           config_.use_star_tracker;
+      break;
+    case FusionStructure::kAdaptive:
+      ok = config_.aiding == AidingMode::kLooselyCoupled;
+      break;
+  }
+  if (!ok) return false;
+  config_.fusion = s;
+  if (filter_.initialized()) filter_.setStructure(s);
+  return true;
+}
+
+void NavigationEngine::markInertialLost() {
+  if (filter_.initialized()) mode_ = EngineMode::kInertialLost;
+}
+
+}  // namespace navbus::core

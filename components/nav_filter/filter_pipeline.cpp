@@ -1,0 +1,353 @@
+#include "filter_pipeline.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <spdlog/spdlog.h>
+
+#include "navbus/bus/conversions.hpp"
+#include "navbus/bus/topics.hpp"
+
+namespace navbus::nav_filter {
+
+namespace {
+
+std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const FilterConfig& c) {
+  std::vector<InputSequencer<FilterInput>::ExpectedStream> s;
+  s.push_back({{kRankImu, c.imu.id}, c.imu.period_ns});
+  if (c.gnss_observations)
+    s.push_back({{kRankGnssObs, c.gnss_observations->id}, c.gnss_observations->period_ns});
+  if (c.gnss_fix) s.push_back({{kRankGnssFix, c.gnss_fix->id}, c.gnss_fix->period_ns});
+  if (c.star_tracker)
+    s.push_back({{kRankStarTracker, c.star_tracker->id}, c.star_tracker->period_ns});
+  return s;
+}
+
+constexpr std::uint32_t kStreamLostFlags =
+    navbus::FAULT_IMU_STREAM_LOST | navbus::FAULT_GNSS_STREAM_LOST | navbus::FAULT_ST_STREAM_LOST |
+    navbus::FAULT_RAW_IMU_LOST;
+
+std::uint32_t faultFlags(std::uint32_t engine_status) {
+  std::uint32_t f = 0;
+  if (engine_status & core::kStatusImuGap) f |= navbus::FAULT_IMU_GAP;
+  if (engine_status & core::kStatusSatelliteExcluded) f |= navbus::FAULT_SATELLITE_EXCLUDED;
+  if (engine_status & core::kStatusBiasCompensated) f |= navbus::FAULT_SENSOR_AXIS;
+  return f;
+}
+
+}  // namespace
+
+navbus::FilterMode toIdl(core::EngineMode mode) {
+  switch (mode) {
+    case core::EngineMode::kInitializing:
+      return navbus::MODE_INITIALIZING;
+    case core::EngineMode::kInertialOnly:
+      return navbus::MODE_INERTIAL_ONLY;
+    case core::EngineMode::kInertialLost:
+      return navbus::MODE_INERTIAL_LOST;
+    case core::EngineMode::kTightlyCoupled:
+      return navbus::MODE_TIGHTLY_COUPLED;
+    case core::EngineMode::kLooselyCoupled:
+      return navbus::MODE_LOOSELY_COUPLED;
+    case core::EngineMode::kMdfF1:
+      return navbus::MODE_MDF_F1_ZUPT;
+    case core::EngineMode::kMdfF2:
+      return navbus::MODE_MDF_F2_GNSS;
+    case core::EngineMode::kMdfF3:
+      return navbus::MODE_MDF_F3_RECOVERY;
+    case core::EngineMode::kMdfF4:
+      return navbus::MODE_MDF_F4_CIF;
+  }
+  return navbus::MODE_INITIALIZING;
+}
+
+navbus::FusionStructure toIdl(core::FusionStructure s, core::AidingMode aiding) {
+  if (aiding == core::AidingMode::kInertialOnly) return navbus::FUSION_NONE;
+  switch (s) {
+    case core::FusionStructure::kCentralized:
+      return navbus::FUSION_CENTRALIZED;
+    case core::FusionStructure::kFederated:
+      return navbus::FUSION_FEDERATED;
+    case core::FusionStructure::kAdaptive:
+      return navbus::FUSION_ADAPTIVE;
+  }
+  return navbus::FUSION_NONE;
+}
+
+FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks)
+    : config_(config),
+      sinks_(std::move(sinks)),
+      sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
+      engine_(config.engine),
+      imu_gate_(bus::topic::kImuIncrement, health.stream(bus::topic::kImuIncrement)),
+      gnss_obs_gate_(bus::topic::kGnssObservations, health.stream(bus::topic::kGnssObservations)),
+      gnss_fix_gate_(bus::topic::kGnssFix, health.stream(bus::topic::kGnssFix)),
+      star_gate_(bus::topic::kStarTracker, health.stream(bus::topic::kStarTracker)) {}
+
+void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
+                           FilterInput input) {
+  switch (sequencer_.push(id, time_ns, std::move(input))) {
+    case InputSequencer<FilterInput>::PushResult::kQueued:
+      break;
+    case InputSequencer<FilterInput>::PushResult::kLate:
+      gate.unaccept();
+      gate.reject({navbus::REJECT_LATE, "time_gps_ns", static_cast<double>(time_ns)}, id.sensor_id);
+      break;
+    case InputSequencer<FilterInput>::PushResult::kUnexpected:
+      gate.unaccept();
+      gate.reject(
+          {navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id.sensor_id)},
+          id.sensor_id);
+      break;
+  }
+}
+
+template <class Sample>
+bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, std::uint32_t id,
+                           const std::optional<InputConfig>& expected) {
+  if (!gate.admit(msg, id, msg.seq(), msg.time_gps_ns())) return false;
+  if (!expected) {
+    gate.unaccept();
+    gate.reject({navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id)}, id);
+    return false;
+  }
+  return true;
+}
+
+void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
+  if (!imu_gate_.admit(msg, msg.sensor_id(), msg.seq(), msg.time_gps_ns())) return;
+  queue(imu_gate_, {kRankImu, msg.sensor_id()}, static_cast<std::int64_t>(msg.time_gps_ns()),
+        bus::toCore(msg));
+}
+
+void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
+  if (!admit(gnss_obs_gate_, m, m.receiver_id(), config_.gnss_observations)) return;
+  queue(gnss_obs_gate_, {kRankGnssObs, m.receiver_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
+        GnssEpochInput{bus::toCore(m)});
+}
+
+void FilterPipeline::onGnssFix(const navbus::GnssFix& m) {
+  if (!admit(gnss_fix_gate_, m, m.receiver_id(), config_.gnss_fix)) return;
+  queue(gnss_fix_gate_, {kRankGnssFix, m.receiver_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
+        bus::toCore(m));
+}
+
+void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
+  if (!admit(star_gate_, m, m.tracker_id(), config_.star_tracker)) return;
+  queue(star_gate_, {kRankStarTracker, m.tracker_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
+        bus::toCore(m));
+}
+
+void FilterPipeline::pump(std::int64_t now_ns) {
+  sequencer_.release(now_ns,
+                     [this](StreamId, std::int64_t, const FilterInput& in) { process(in); });
+}
+
+void FilterPipeline::process(const FilterInput& input) {
+  if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {
+    if (engine_.addImu(*inc)) publishSolution();
+  } else if (const auto* epoch = std::get_if<GnssEpochInput>(&input)) {
+    if (engine_.addGnssEpoch(epoch->satellites)) publishDiagnostics();
+  } else if (const auto* fix = std::get_if<core::GnssFixMeasurement>(&input)) {
+    engine_.addGnssFix(*fix);
+  } else if (const auto* st = std::get_if<core::StarAttitudeMeasurement>(&input)) {
+    engine_.addStarAttitude(*st);
+  }
+}
+
+void FilterPipeline::publishDiagnostics() {
+  if (!sinks_.diagnostics) return;
+  const core::EpochDiagnostics& d = engine_.lastEpoch();
+  navbus::FilterDiagnostics msg;
+  msg.vehicle_id(config_.vehicle_id);
+  msg.seq(++diagnostics_seq_);
+  msg.time_gps_ns(static_cast<std::uint64_t>(engine_.state().time_ns));
+  const auto m = static_cast<std::uint16_t>(d.h.rows());
+  msg.n(static_cast<std::uint16_t>(core::tc17::kSize));
+  msg.m(m);
+  const std::pair<const char*, core::StateBlock> blocks[] = {
+      {"pos_ned", core::tc17::kPos},           {"vel_ned", core::tc17::kVel},
+      {"phi_ned", core::tc17::kAtt},           {"accel_bias", core::tc17::kAccelBias},
+      {"gyro_bias", core::tc17::kGyroBias},    {"clock_bias", core::tc17::kClockBias},
+      {"clock_drift", core::tc17::kClockDrift}};
+  const char* units[] = {"m", "m/s", "rad", "m/s^2", "rad/s", "m", "m/s"};
+  for (std::size_t i = 0; i < 7; ++i) {
+    navbus::StateBlock b;
+    b.name(blocks[i].first);
+    b.index(static_cast<std::uint16_t>(blocks[i].second.index));
+    b.dof(static_cast<std::uint16_t>(blocks[i].second.dof));
+    b.unit(units[i]);
+    msg.state_layout().push_back(b);
+  }
+  for (std::size_t r = 0; r < m; ++r) {
+    navbus::MeasurementRow row;
+    row.kind(d.is_rate[r] ? navbus::MEAS_PSEUDORANGE_RATE : navbus::MEAS_PSEUDORANGE);
+    row.sv_id(static_cast<std::uint16_t>(d.sv_ids[r]));
+    msg.rows().push_back(row);
+    msg.innovation().push_back(d.innovation[static_cast<Eigen::Index>(r)]);
+    msg.test_ratio().push_back(d.test_ratio[r]);
+  }
+  // Row-major matrices.
+  auto append = [](const auto& M, auto& out) {
+    for (Eigen::Index i = 0; i < M.rows(); ++i)
+      for (Eigen::Index j = 0; j < M.cols(); ++j) out.push_back(M(i, j));
+  };
+  append(d.innovation_cov, msg.innovation_cov());
+  append(d.h, msg.h());
+  append(d.k, msg.k());
+  append(d.phi, msg.phi());
+  sinks_.diagnostics(msg);
+}
+
+void FilterPipeline::publishSolution() {
+  if (!engine_.initialized()) return;
+  navbus::NavigationSolution sol;
+  sol.vehicle_id(config_.vehicle_id);
+  sol.seq(++solution_seq_);
+  bus::fillSolution(engine_.state(), sol);
+  // Sigmas from the filter covariance: propagated only (inertial-only mode) or updated.
+  const core::Matrix17& P = engine_.covariance();
+  auto sigma3 = [&P](const core::StateBlock& b) {
+    return bus::toArray(P.block<3, 3>(b.index, b.index).diagonal().cwiseSqrt());
+  };
+  sol.pos_sigma_ned_m(sigma3(core::tc17::kPos));
+  sol.vel_sigma_ned_mps(sigma3(core::tc17::kVel));
+  sol.att_sigma_ned_rad(sigma3(core::tc17::kAtt));
+  sol.accel_bias_sigma_b_mps2(sigma3(core::tc17::kAccelBias));
+  sol.gyro_bias_sigma_b_radps(sigma3(core::tc17::kGyroBias));
+  sol.clock_bias_m(engine_.clockBias());
+  sol.clock_drift_mps(engine_.clockDrift());
+  sol.clock_bias_sigma_m(std::sqrt(P(core::tc17::kClockBias.index, core::tc17::kClockBias.index)));
+  sol.clock_drift_sigma_mps(
+      std::sqrt(P(core::tc17::kClockDrift.index, core::tc17::kClockDrift.index)));
+  sol.covariance_valid(true);
+  // Biases: estimated plus those compensated by command.
+  sol.accel_bias_b_mps2(bus::toArray(engine_.accelBias()));
+  sol.gyro_bias_b_radps(bus::toArray(engine_.gyroBias()));
+  sol.mode(toIdl(engine_.mode()));
+  sol.fusion(toIdl(engine_.fusion(), config_.engine.aiding));
+  sol.active_fault_flags(stream_flags_ | faultFlags(engine_.status()));
+  sol.imu_samples_used(engine_.counters().imu_used);
+  sinks_.solution(sol);
+}
+
+void FilterPipeline::publishHeldSolution() {
+  if (engine_.mode() == core::EngineMode::kInertialLost) publishSolution();
+}
+
+bool FilterPipeline::degraded() const {
+  return (stream_flags_ & kStreamLostFlags) != 0;
+}
+
+void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
+  std::uint32_t flag = 0;
+  bool is_imu = false;
+  switch (d.source()) {
+    case navbus::SOURCE_IMU_STREAM:
+      if (d.sensor_id() != config_.imu.id) return;
+      flag = navbus::FAULT_IMU_STREAM_LOST;
+      is_imu = true;
+      break;
+    case navbus::SOURCE_IMU_RAW_STREAM:
+      flag = navbus::FAULT_RAW_IMU_LOST;
+      break;
+    case navbus::SOURCE_GNSS_OBS_STREAM:
+    case navbus::SOURCE_GNSS_FIX_STREAM:
+      flag = navbus::FAULT_GNSS_STREAM_LOST;
+      break;
+    case navbus::SOURCE_ST_STREAM:
+      flag = navbus::FAULT_ST_STREAM_LOST;
+      break;
+    default:
+      spdlog::warn("decision {} ({}) concerns a detector this filter does not use; ignored",
+                   d.decision_id(), d.detector());
+      return;
+  }
+  ++decisions_applied_;
+  if (d.action() == navbus::ACTION_STREAM_LOST) {
+    stream_flags_ |= flag;
+    if (is_imu) {
+      sequencer_.setActive({kRankImu, config_.imu.id}, false);
+      engine_.markInertialLost();
+    }
+    spdlog::warn("decision {} ({}): stream source {} id {} lost; flags 0x{:x}", d.decision_id(),
+                 d.detector(), static_cast<int>(d.source()), d.sensor_id(), stream_flags_);
+  } else if (d.action() == navbus::ACTION_STREAM_RESTORED) {
+    stream_flags_ &= ~flag;
+    spdlog::info("decision {} ({}): stream source {} id {} restored; flags 0x{:x}", d.decision_id(),
+                 d.detector(), static_cast<int>(d.source()), d.sensor_id(), stream_flags_);
+  }
+  publishHeldSolution();
+}
+
+bool FilterPipeline::onCommand(const navbus::FilterCommand& c) {
+  if (c.vehicle_id() != config_.vehicle_id) return true;  // for another vehicle: not ours
+  bool applied = true;
+  std::string why = "bad field";
+  switch (c.kind()) {
+    case navbus::CMD_EXCLUDE_SATELLITE:
+      engine_.excludeSatellite(c.sv_id());
+      break;
+    case navbus::CMD_READMIT_SATELLITE:
+      engine_.readmitSatellite(c.sv_id());
+      break;
+    case navbus::CMD_COMPENSATE_BIAS:
+      if (c.axis() > 2 || !std::isfinite(c.bias()) ||
+          (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)) {
+        applied = false;
+        break;
+      }
+      engine_.compensateBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias());
+      break;
+    case navbus::CMD_SELECT_FUSION:
+      switch (c.fusion()) {
+        case navbus::FUSION_CENTRALIZED:
+          applied = engine_.selectFusion(core::FusionStructure::kCentralized);
+          break;
+        case navbus::FUSION_FEDERATED:
+          applied = engine_.selectFusion(core::FusionStructure::kFederated);
+          break;
+        case navbus::FUSION_ADAPTIVE:
+          applied = engine_.selectFusion(core::FusionStructure::kAdaptive);
+          break;
+        default:
+          applied = config_.engine.aiding == core::AidingMode::kInertialOnly;
+      }
+      why = "fusion structure not available in the configured mode";
+      break;
+    case navbus::CMD_SELECT_MODE:
+      // The aiding mode follows the configured inputs; only the current one is accepted.
+      applied = c.mode() == toIdl(engine_.mode());
+      why = "aiding mode is set by the configuration";
+      break;
+    case navbus::CMD_RESET:
+      engine_.reset();
+      break;
+  }
+  if (applied) {
+    ++commands_applied_;
+    spdlog::info("command {} from '{}' applied (kind {})", c.command_id(), c.issuer(),
+                 static_cast<int>(c.kind()));
+  } else {
+    ++commands_refused_;
+    spdlog::warn("command {} from '{}' refused: kind {}: {}", c.command_id(), c.issuer(),
+                 static_cast<int>(c.kind()), why);
+  }
+  return applied;
+}
+
+std::string FilterPipeline::summary() const {
+  const core::EngineCounters& n = engine_.counters();
+  std::ostringstream out;
+  out << "increments integrated " << n.imu_used << ", solutions published " << solution_seq_
+      << ", inertial gaps " << n.imu_gaps << ", GNSS epochs fused " << n.gnss_epochs_fused
+      << ", fixes fused " << n.fixes_fused << ", star-tracker attitudes fused " << n.star_fused
+      << ", ZUPTs " << n.zero_velocity_updates << ", NHC updates " << n.nonholonomic_updates
+      << ", rows gated " << n.rows_gated << ", stage switches " << n.stage_switches
+      << ", decisions applied " << decisions_applied_ << ", commands applied " << commands_applied_
+      << " refused " << commands_refused_ << ", sequencer timeouts " << sequencer_.timeouts()
+      << ", pending " << sequencer_.pending();
+  return out.str();
+}
+
+}  // namespace navbus::nav_filter

@@ -1,0 +1,96 @@
+// navbus-filter's processing without DDS: validate each sample (bus::StreamGate), merge the
+// streams in time order (InputSequencer), run the navigation engine (components/core), and
+// build the solution and diagnostics messages. The participant (filter_node.hpp) feeds it from
+// DataReaders and writes what it emits; the offline runner (`navbus offline`) feeds it from
+// the simulator directly, so both run the very same code on the same samples.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <navbus_idl/Fault.h>
+#include <navbus_idl/Gnss.h>
+#include <navbus_idl/Imu.h>
+#include <navbus_idl/Navigation.h>
+#include <navbus_idl/StarTracker.h>
+
+#include "filter_config.hpp"
+#include "input_sequencer.hpp"
+#include "navbus/bus/health.hpp"
+#include "navbus/bus/validation.hpp"
+#include "navbus/core/navigation_engine.hpp"
+
+namespace navbus::nav_filter {
+
+/// Stream ranks: at equal times the increment is integrated before measurements are used.
+enum StreamRank : int { kRankImu = 0, kRankGnssObs = 1, kRankGnssFix = 2, kRankStarTracker = 3 };
+
+/// A validated GNSS observation epoch: satellite clock corrections applied.
+struct GnssEpochInput {
+  std::vector<core::SatelliteObservation> satellites;
+};
+
+using FilterInput = std::variant<core::ImuIncrement, GnssEpochInput, core::GnssFixMeasurement,
+                                 core::StarAttitudeMeasurement>;
+
+class FilterPipeline {
+ public:
+  struct Sinks {
+    std::function<void(const navbus::NavigationSolution&)> solution;
+    std::function<void(const navbus::FilterDiagnostics&)> diagnostics;  ///< may be empty
+  };
+
+  FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks);
+
+  void onImu(const navbus::ImuIncrement& msg);
+  void onGnssObservations(const navbus::GnssObservationEpoch& msg);
+  void onGnssFix(const navbus::GnssFix& msg);
+  void onStarTracker(const navbus::StarTrackerAttitude& msg);
+  void onDecision(const navbus::FaultDecision& d);
+  /// Returns false when the command was refused (wrong field or not available in this mode).
+  bool onCommand(const navbus::FilterCommand& c);
+
+  /// Processes every input that can no longer be preceded by another; `now_ns` is the clock
+  /// that bounds the wait for a silent stream (steady time on the bus, data time offline).
+  void pump(std::int64_t now_ns);
+  /// While inertial data is lost, the last solution is republished (held, not propagated).
+  void publishHeldSolution();
+
+  /// Some stream is currently lost (the participant reports DEGRADED).
+  bool degraded() const;
+  const core::NavigationEngine& engine() const { return engine_; }
+  std::string summary() const;
+
+ private:
+  template <class Sample>
+  bool admit(bus::StreamGate& gate, const Sample& msg, std::uint32_t id,
+             const std::optional<InputConfig>& expected);
+  void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
+  void process(const FilterInput& input);
+  void publishSolution();
+  void publishDiagnostics();
+
+  FilterConfig config_;
+  Sinks sinks_;
+  InputSequencer<FilterInput> sequencer_;
+  core::NavigationEngine engine_;
+  bus::StreamGate imu_gate_;
+  bus::StreamGate gnss_obs_gate_;
+  bus::StreamGate gnss_fix_gate_;
+  bus::StreamGate star_gate_;
+  std::uint32_t stream_flags_{0};  ///< FAULT_*_STREAM_LOST bits: facts from decisions
+  std::uint64_t solution_seq_{0};
+  std::uint64_t diagnostics_seq_{0};
+  std::uint64_t decisions_applied_{0};
+  std::uint64_t commands_applied_{0};
+  std::uint64_t commands_refused_{0};
+};
+
+/// IDL names of the engine's modes and structures.
+navbus::FilterMode toIdl(core::EngineMode mode);
+navbus::FusionStructure toIdl(core::FusionStructure s, core::AidingMode aiding);
+
+}  // namespace navbus::nav_filter
