@@ -143,6 +143,15 @@ void FilterPipeline::pump(std::int64_t now_ns) {
                      [this](StreamId, std::int64_t, const FilterInput& in) { process(in); });
 }
 
+void FilterPipeline::flush(std::int64_t now_ns) {
+  // Each round may set one silent stream aside after the bounded wait; there are at most as
+  // many rounds as streams.
+  for (int round = 0; round < 8 && sequencer_.pending() > 0; ++round) {
+    now_ns += config_.sequencer_max_wait_ns;
+    pump(now_ns);
+  }
+}
+
 void FilterPipeline::process(const FilterInput& input) {
   if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {
     if (engine_.addImu(*inc)) publishSolution();

@@ -56,6 +56,9 @@ class FilterPipeline {
   /// Processes every input that can no longer be preceded by another; `now_ns` is the clock
   /// that bounds the wait for a silent stream (steady time on the bus, data time offline).
   void pump(std::int64_t now_ns);
+  /// End of input (offline): releases everything still held, as the bounded wait would on
+  /// the bus once every stream has fallen silent.
+  void flush(std::int64_t now_ns);
   /// While inertial data is lost, the last solution is republished (held, not propagated).
   void publishHeldSolution();
 

@@ -10,6 +10,7 @@
 
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 
+#include "evaluation.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
 #include "topic_registry.hpp"
@@ -144,7 +145,7 @@ void runFor(nb::bus::Participant& p, double duration_s, const std::function<bool
 
 int main(int argc, char** argv) {
   nb::bus::ShutdownSignal shutdown;
-  CLI::App app{"navbus: inspect and record the navbus DDS bus", "navbus"};
+  CLI::App app{"navbus: inspect and record the navbus DDS bus; offline evaluation", "navbus"};
   nb::bus::CommonOptions common;
   nb::bus::addCommonOptions(app, common, false);
   app.require_subcommand(1);
@@ -178,7 +179,70 @@ int main(int argc, char** argv) {
   record_cmd->add_option("--duration", duration_s,
                          "stop after this many seconds (0: until SIGINT)");
 
+  nb::tool::OfflineOptions offline;
+  auto* offline_cmd = app.add_subcommand(
+      "offline", "run a scenario through the filter without DDS; write solution, truth, error CSV");
+  offline_cmd->add_option("--scenario", offline.scenario, "scenario YAML (sim/scenarios)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  offline_cmd->add_option("--filter", offline.filter, "navbus-filter YAML (config/)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  offline_cmd->add_option("--seed", offline.seed, "random seed (0: the scenario's)");
+  offline_cmd
+      ->add_option("--duration", offline.duration_s,
+                   "seconds of data (0: the scenario's timing.duration_s)")
+      ->check(CLI::Range(0.0, 1e6));
+  offline_cmd->add_option("-o,--out", offline.out_dir, "output directory (created)")->required();
+
+  nb::tool::MonteCarloOptions mc;
+  bool mc_no_perturb = false;
+  auto* mc_cmd = app.add_subcommand(
+      "montecarlo", "Monte Carlo over seeds: RMS and max errors, average NEES with its 95% band");
+  mc_cmd->add_option("--scenario", mc.scenario, "scenario YAML")
+      ->required()
+      ->check(CLI::ExistingFile);
+  mc_cmd->add_option("--filter", mc.filters, "navbus-filter YAML, repeatable (one row each)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  mc_cmd
+      ->add_option("--fusion", mc.fusions,
+                   "override `fusion` of every filter: centralized federated adaptive")
+      ->delimiter(',');
+  mc_cmd
+      ->add_option("--policy", mc.policies,
+                   "override multi_dimensional.policy: mdf continue reset_all")
+      ->delimiter(',');
+  mc_cmd->add_option("--runs", mc.runs, "runs per configuration")->check(CLI::Range(1, 100000));
+  mc_cmd->add_option("--first-seed", mc.first_seed, "seed of the first run (then +1 per run)")
+      ->check(CLI::Range(1ull, 1ull << 60));
+  mc_cmd->add_option("--duration", mc.duration_s, "seconds of data (0: the scenario's)")
+      ->check(CLI::Range(0.0, 1e6));
+  mc_cmd->add_option("--from", mc.from_s, "statistics from this many seconds after the start")
+      ->check(CLI::Range(0.0, 1e6));
+  mc_cmd->add_flag("--no-perturb", mc_no_perturb,
+                   "start every run at the true initial state instead of a draw from the "
+                   "filter's initial sigmas");
+  mc_cmd
+      ->add_option("--recovery-after", mc.recovery_after_s,
+                   "instants [s after start] after which to measure the convergence time")
+      ->delimiter(',');
+  mc_cmd
+      ->add_option("--recovery-threshold", mc.recovery_threshold_m,
+                   "horizontal position error [m] that counts as converged")
+      ->check(CLI::Range(1e-6, 1e6));
+  mc_cmd
+      ->add_option("--recovery-window", mc.recovery_window_s,
+                   "the error must stay below the threshold this long [s]")
+      ->check(CLI::Range(0.0, 1e6));
+
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) -> int {
+    // Offline work: no DDS participant at all.
+    if (*offline_cmd) return nb::tool::runOfflineCommand(offline);
+    if (*mc_cmd) {
+      mc.perturb_initial = !mc_no_perturb;
+      return nb::tool::runMonteCarloCommand(mc);
+    }
     auto options = nb::bus::participantOptions(common, yaml, "navbus");
     if (*topics_cmd) {
       DiscoveryListener listener;

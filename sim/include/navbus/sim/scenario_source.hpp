@@ -47,6 +47,8 @@ class ScenarioSource {
   explicit ScenarioSource(const ScenarioConfig& config);
   SensorFrame next();
   std::int64_t index() const { return index_; }
+  /// The truth at the current time (before the first next(): the initial state).
+  core::NavState truth() const { return trajectory_->state(); }
   const ScenarioConfig& config() const { return config_; }
 
  private:

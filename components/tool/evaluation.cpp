@@ -1,0 +1,296 @@
+#include "evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <spdlog/spdlog.h>
+
+#include "formatters.hpp"
+#include "navbus/bus/app.hpp"
+#include "navbus/bus/config.hpp"
+#include "navbus/core/rotation.hpp"
+#include "offline_runner.hpp"
+
+namespace navbus::tool {
+
+namespace {
+
+constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
+
+OfflineSetup loadSetup(const std::string& scenario, const YAML::Node& filter_yaml,
+                       std::uint64_t seed, double duration_s) {
+  OfflineSetup s;
+  s.sim = sensor_sim::parseSimConfig(bus::loadYamlFile(scenario));
+  if (seed != 0) s.sim.scenario.seed = seed;
+  s.filter = nav_filter::parseFilterConfig(filter_yaml);
+  s.duration_s = duration_s > 0.0 ? duration_s : s.sim.duration_s;
+  if (!(s.duration_s > 0.0)) {
+    throw bus::ConfigError("scenario " + scenario +
+                           " has no timing.duration_s; give --duration (seconds of data)");
+  }
+  return s;
+}
+
+std::string fmt(double v) {
+  return formatNumber(v);
+}
+
+void writeTruthHeader(std::ofstream& f) {
+  f << "time_gps_ns,latitude_rad,longitude_rad,height_m,vel_ned_mps[0],vel_ned_mps[1],"
+       "vel_ned_mps[2],roll_rad,pitch_rad,yaw_rad\n";
+}
+
+void writeErrorHeader(std::ofstream& f) {
+  f << "time_gps_ns,mode,pos_err_ned_m[0],pos_err_ned_m[1],pos_err_ned_m[2],vel_err_ned_mps[0],"
+       "vel_err_ned_mps[1],vel_err_ned_mps[2],att_err_ned_rad[0],att_err_ned_rad[1],"
+       "att_err_ned_rad[2],pos_sigma_ned_m[0],pos_sigma_ned_m[1],pos_sigma_ned_m[2],"
+       "vel_sigma_ned_mps[0],vel_sigma_ned_mps[1],vel_sigma_ned_mps[2],att_sigma_ned_rad[0],"
+       "att_sigma_ned_rad[1],att_sigma_ned_rad[2],nees9\n";
+}
+
+/// Statistics of a set of runs of one configuration.
+struct Stats {
+  double sum_pos2{0}, sum_vel2{0}, sum_att2{0};
+  double max_pos{0}, max_vel{0}, max_att{0};
+  std::size_t n{0};
+  // NEES: per epoch index, summed over runs.
+  std::vector<double> nees_sum;
+  std::vector<int> nees_runs;
+  std::vector<double> recovery_s;  ///< per run and instant; NaN when not converged
+};
+
+void accumulate(Stats& st, const OfflineResult& r, std::int64_t from_ns, const MonteCarloOptions& o,
+                std::int64_t start_ns) {
+  std::size_t k = 0;
+  for (const EpochError& e : r.errors) {
+    if (e.time_ns < from_ns) continue;
+    const double p = e.pos_ned_m.norm(), v = e.vel_ned_mps.norm(), a = e.att_ned_rad.norm();
+    st.sum_pos2 += p * p;
+    st.sum_vel2 += v * v;
+    st.sum_att2 += a * a;
+    st.max_pos = std::max(st.max_pos, p);
+    st.max_vel = std::max(st.max_vel, v);
+    st.max_att = std::max(st.max_att, a);
+    ++st.n;
+    if (st.nees_sum.size() <= k) {
+      st.nees_sum.resize(k + 1, 0.0);
+      st.nees_runs.resize(k + 1, 0);
+    }
+    st.nees_sum[k] += e.nees9;
+    ++st.nees_runs[k];
+    ++k;
+  }
+  for (double t_s : o.recovery_after_s) {
+    // Convergence: the first time after t from which the horizontal position error stays below
+    // the threshold for the whole window.
+    const std::int64_t t0 = start_ns + static_cast<std::int64_t>(std::llround(t_s * 1e9));
+    const std::int64_t window = static_cast<std::int64_t>(std::llround(o.recovery_window_s * 1e9));
+    double found = std::nan("");
+    for (std::size_t i = 0; i < r.errors.size(); ++i) {
+      const EpochError& e = r.errors[i];
+      if (e.time_ns < t0 || e.time_ns > t0 + window) continue;
+      bool stays = true;
+      for (std::size_t j = i; j < r.errors.size() && r.errors[j].time_ns <= e.time_ns + window;
+           ++j) {
+        if (r.errors[j].pos_ned_m.head<2>().norm() >= o.recovery_threshold_m) {
+          stays = false;
+          break;
+        }
+      }
+      if (stays) {
+        found = 1e-9 * static_cast<double>(e.time_ns - t0);
+        break;
+      }
+    }
+    st.recovery_s.push_back(found);
+  }
+}
+
+double median(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+}  // namespace
+
+double chiSquareQuantile(double p, double dof) {
+  // Inverse normal by Acklam's rational approximation (|error| < 1.2e-9), then Wilson-Hilferty.
+  const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,  -2.759285104469687e+02,
+                      1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+  const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                      6.680131188771972e+01, -1.328068155288572e+01};
+  const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                      -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+  const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                      3.754408661907416e+00};
+  double z;
+  if (p < 0.02425) {
+    const double q = std::sqrt(-2 * std::log(p));
+    z = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
+  } else if (p > 1 - 0.02425) {
+    const double q = std::sqrt(-2 * std::log(1 - p));
+    z = -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
+  } else {
+    const double q = p - 0.5, r = q * q;
+    z = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
+  }
+  const double h = 2.0 / (9.0 * dof);
+  return dof * std::pow(1.0 - h + z * std::sqrt(h), 3);
+}
+
+int runOfflineCommand(const OfflineOptions& o) {
+  const OfflineSetup setup =
+      loadSetup(o.scenario, bus::loadYamlFile(o.filter), o.seed, o.duration_s);
+  std::filesystem::create_directories(o.out_dir);
+  std::ofstream sol_f(o.out_dir + "/solution.csv"), truth_f(o.out_dir + "/truth.csv"),
+      err_f(o.out_dir + "/error.csv");
+  if (!sol_f || !truth_f || !err_f) {
+    throw bus::ConfigError("cannot write into --out " + o.out_dir);
+  }
+  sol_f << csvHeader<navbus::NavigationSolution>() << "\n";
+  writeTruthHeader(truth_f);
+  writeErrorHeader(err_f);
+  const OfflineResult r = runOffline(setup, [&](const navbus::NavigationSolution& s,
+                                                const core::NavState& t, const EpochError& e) {
+    for (const auto& row : csvRows(s)) sol_f << row << "\n";
+    const Eigen::Vector3d rpy = core::eulerFromDcm(t.q_b_to_n.toRotationMatrix());
+    truth_f << t.time_ns << "," << fmt(t.position.latitude_rad) << ","
+            << fmt(t.position.longitude_rad) << "," << fmt(t.position.height_m) << ","
+            << fmt(t.vel_ned_mps.x()) << "," << fmt(t.vel_ned_mps.y()) << ","
+            << fmt(t.vel_ned_mps.z()) << "," << fmt(rpy.x()) << "," << fmt(rpy.y()) << ","
+            << fmt(rpy.z()) << "\n";
+    err_f << e.time_ns << "," << e.mode;
+    for (const Eigen::Vector3d* v :
+         {&e.pos_ned_m, &e.vel_ned_mps, &e.att_ned_rad, &e.pos_sigma_ned_m, &e.vel_sigma_ned_mps,
+          &e.att_sigma_ned_rad}) {
+      err_f << "," << fmt(v->x()) << "," << fmt(v->y()) << "," << fmt(v->z());
+    }
+    err_f << "," << fmt(e.nees9) << "\n";
+  });
+  spdlog::info("offline: scenario '{}' seed {}: {} solutions ({} without a truth sample); {}",
+               setup.sim.scenario.name, setup.sim.scenario.seed, r.solutions,
+               r.solutions_without_truth, r.summary);
+  spdlog::info("wrote {}/solution.csv, truth.csv, error.csv", o.out_dir);
+  return bus::kExitOk;
+}
+
+int runMonteCarloCommand(const MonteCarloOptions& o) {
+  struct Variant {
+    std::string label;
+    YAML::Node yaml;
+  };
+  std::vector<Variant> variants;
+  for (const std::string& file : o.filters) {
+    const std::string stem = std::filesystem::path(file).stem().string();
+    std::vector<std::string> fusions = o.fusions.empty() ? std::vector<std::string>{""} : o.fusions;
+    std::vector<std::string> policies =
+        o.policies.empty() ? std::vector<std::string>{""} : o.policies;
+    for (const auto& fu : fusions) {
+      for (const auto& po : policies) {
+        YAML::Node y = YAML::Clone(bus::loadYamlFile(file));
+        std::string label = stem;
+        if (!fu.empty()) {
+          y["fusion"] = fu;
+          label += " " + fu;
+        }
+        if (!po.empty()) {
+          y["multi_dimensional"]["policy"] = po;
+          label += " " + po;
+        }
+        variants.push_back({label, y});
+      }
+    }
+  }
+  std::printf(
+      "Monte Carlo: scenario %s, %d runs per configuration (seeds %llu..%llu)%s\n",
+      o.scenario.c_str(), o.runs, static_cast<unsigned long long>(o.first_seed),
+      static_cast<unsigned long long>(o.first_seed + static_cast<std::uint64_t>(o.runs) - 1),
+      o.perturb_initial ? ", initial state drawn from the filter's initial sigmas" : "");
+  struct Row {
+    std::string label;
+    Stats st;
+  };
+  std::vector<Row> rows;
+  for (const Variant& v : variants) {
+    Row row{v.label, {}};
+    for (int i = 0; i < o.runs; ++i) {
+      const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
+      OfflineSetup setup = loadSetup(o.scenario, v.yaml, seed, o.duration_s);
+      const core::NavState truth0 = initialTruth(setup.sim.scenario);
+      setup.filter.engine.initial_state =
+          o.perturb_initial
+              ? perturbedInitialState(truth0, setup.filter.engine.tuning, seed * 1000003ull + 17ull)
+              : truth0;
+      const OfflineResult r = runOffline(setup);
+      const std::int64_t start = setup.sim.scenario.start_time_ns;
+      accumulate(row.st, r, start + static_cast<std::int64_t>(std::llround(o.from_s * 1e9)), o,
+                 start);
+      std::fprintf(stderr, "\r[%s] run %d/%d", v.label.c_str(), i + 1, o.runs);
+      std::fflush(stderr);
+    }
+    std::fprintf(stderr, "\n");
+    rows.push_back(std::move(row));
+  }
+  const double dof = 9.0;
+  const double lo = chiSquareQuantile(0.025, dof * o.runs) / o.runs;
+  const double hi = chiSquareQuantile(0.975, dof * o.runs) / o.runs;
+  std::printf("\nerrors from %.0f s; RMS and max of the 3-D error norms over all epochs and runs\n",
+              o.from_s);
+  std::printf("%-34s %9s %9s %10s %10s %10s %10s %8s %16s %8s\n", "configuration", "pos RMS m",
+              "pos max m", "vel RMS m/s", "vel max", "att RMS \"", "att max \"", "NEES(9)",
+              "95% band", "in band");
+  for (const Row& r : rows) {
+    const Stats& s = r.st;
+    const double n = static_cast<double>(s.n > 0 ? s.n : 1);
+    double nees_mean = 0;
+    int in_band = 0, epochs = 0;
+    for (std::size_t k = 0; k < s.nees_sum.size(); ++k) {
+      if (s.nees_runs[k] != o.runs) continue;  // epochs every run reached
+      const double avg = s.nees_sum[k] / o.runs;
+      nees_mean += avg;
+      in_band += (avg >= lo && avg <= hi) ? 1 : 0;
+      ++epochs;
+    }
+    nees_mean /= std::max(epochs, 1);
+    std::printf("%-34s %9.3f %9.3f %10.4f %10.4f %10.2f %10.2f %8.2f [%6.2f,%6.2f] %7.1f%%\n",
+                r.label.c_str(), std::sqrt(s.sum_pos2 / n), s.max_pos, std::sqrt(s.sum_vel2 / n),
+                s.max_vel, std::sqrt(s.sum_att2 / n) * kArcsecPerRad, s.max_att * kArcsecPerRad,
+                nees_mean, lo, hi, 100.0 * in_band / std::max(epochs, 1));
+  }
+  if (!o.recovery_after_s.empty()) {
+    std::printf(
+        "\nconvergence after each instant: median over runs of the time until the "
+        "horizontal position error stays below %.2f m for %.0f s (runs not converged "
+        "within the window in brackets)\n",
+        o.recovery_threshold_m, o.recovery_window_s);
+    std::printf("%-34s", "configuration");
+    for (double t : o.recovery_after_s) std::printf("   after %5.1f s", t);
+    std::printf("\n");
+    for (const Row& r : rows) {
+      std::printf("%-34s", r.label.c_str());
+      const std::size_t m = o.recovery_after_s.size();
+      for (std::size_t j = 0; j < m; ++j) {
+        std::vector<double> v;
+        int missing = 0;
+        for (std::size_t i = j; i < r.st.recovery_s.size(); i += m) {
+          v.push_back(r.st.recovery_s[i]);
+          missing += std::isnan(r.st.recovery_s[i]) ? 1 : 0;
+        }
+        std::printf("   %8.2f s (%d)", median(v), missing);
+      }
+      std::printf("\n");
+    }
+  }
+  return bus::kExitOk;
+}
+
+}  // namespace navbus::tool

@@ -1,0 +1,43 @@
+// `navbus offline` and `navbus montecarlo`: the offline runner driven from the command line,
+// files and summary tables.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace navbus::tool {
+
+struct OfflineOptions {
+  std::string scenario;
+  std::string filter;
+  std::uint64_t seed{0};   ///< 0: the scenario's own
+  double duration_s{0.0};  ///< 0: the scenario's
+  std::string out_dir;
+};
+
+/// Writes solution.csv, truth.csv and error.csv (columns in the README); returns an exit code.
+int runOfflineCommand(const OfflineOptions& o);
+
+struct MonteCarloOptions {
+  std::string scenario;
+  std::vector<std::string> filters;   ///< one table row (or more, see below) per file
+  std::vector<std::string> fusions;   ///< optional: override `fusion` of each filter file
+  std::vector<std::string> policies;  ///< optional: override multi_dimensional.policy
+  int runs{10};
+  std::uint64_t first_seed{1};
+  double duration_s{0.0};
+  double from_s{0.0};          ///< statistics from this many seconds after the start
+  bool perturb_initial{true};  ///< draw the initial state from the filter's initial sigmas
+  std::vector<double> recovery_after_s;  ///< convergence times after these instants
+  double recovery_threshold_m{3.0};      ///< horizontal position error that counts as converged
+  double recovery_window_s{15.0};        ///< ... and must stay below it this long
+};
+
+int runMonteCarloCommand(const MonteCarloOptions& o);
+
+/// Quantile of the chi-square distribution (Wilson-Hilferty; relative error < 1e-3 for the
+/// degrees of freedom used here).
+double chiSquareQuantile(double p, double dof);
+
+}  // namespace navbus::tool

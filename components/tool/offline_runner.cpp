@@ -1,0 +1,106 @@
+#include "offline_runner.hpp"
+
+#include <deque>
+#include <random>
+
+#include <navbus_idl/Fault.h>
+
+#include "filter_pipeline.hpp"
+#include "frame_publisher.hpp"
+#include "navbus/bus/conversions.hpp"
+#include "navbus/bus/health.hpp"
+#include "navbus/core/rotation.hpp"
+#include "navbus/sim/scenario_source.hpp"
+
+namespace navbus::tool {
+
+core::NavState initialTruth(const sim::ScenarioConfig& scenario) {
+  return sim::ScenarioSource(scenario).truth();
+}
+
+core::NavState perturbedInitialState(const core::NavState& truth, const core::FilterTuning& t,
+                                     std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  core::NavState s = truth;
+  const Eigen::Vector3d dp(t.pos_sigma_m * n(rng), t.pos_sigma_m * n(rng), t.pos_sigma_m * n(rng));
+  s.position = core::earth::offsetNed(s.position, dp);
+  s.vel_ned_mps += Eigen::Vector3d(n(rng), n(rng), n(rng)) * t.vel_sigma_mps;
+  const Eigen::Vector3d phi(t.level_sigma_rad * n(rng), t.level_sigma_rad * n(rng),
+                            t.heading_sigma_rad * n(rng));
+  // C_est = (I - [phi x]) C_true.
+  s.q_b_to_n = (core::quaternionFromRotationVector(-phi) * s.q_b_to_n).normalized();
+  return s;
+}
+
+EpochError epochError(const core::NavState& e, const core::NavState& t) {
+  EpochError out;
+  out.time_ns = e.time_ns;
+  out.pos_ned_m = core::earth::differenceNed(e.position, t.position);
+  out.vel_ned_mps = e.vel_ned_mps - t.vel_ned_mps;
+  const Eigen::Matrix3d M =
+      e.q_b_to_n.toRotationMatrix() * t.q_b_to_n.toRotationMatrix().transpose();
+  out.att_ned_rad = Eigen::Vector3d(M(1, 2) - M(2, 1), M(2, 0) - M(0, 2), M(0, 1) - M(1, 0)) / 2.0;
+  return out;
+}
+
+OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
+  OfflineResult result;
+  const sensor_sim::SimConfig& sim = setup.sim;
+  sim::ScenarioSource source(sim.scenario);
+  bus::HealthCounters health("navbus-offline");
+  std::deque<core::NavState> truths;
+  const nav_filter::FilterPipeline* pipeline_ptr = nullptr;
+  auto on_solution = [&](const navbus::NavigationSolution& sol) {
+    ++result.solutions;
+    const auto t = static_cast<std::int64_t>(sol.time_gps_ns());
+    while (!truths.empty() && truths.front().time_ns < t) truths.pop_front();
+    if (truths.empty() || truths.front().time_ns != t) {
+      ++result.solutions_without_truth;
+      return;
+    }
+    const core::NavigationEngine& engine = pipeline_ptr->engine();
+    EpochError err = epochError(engine.state(), truths.front());
+    const core::Matrix17& P = engine.covariance();
+    using namespace core::tc17;
+    err.pos_sigma_ned_m = P.block<3, 3>(kPos.index, kPos.index).diagonal().cwiseSqrt();
+    err.vel_sigma_ned_mps = P.block<3, 3>(kVel.index, kVel.index).diagonal().cwiseSqrt();
+    err.att_sigma_ned_rad = P.block<3, 3>(kAtt.index, kAtt.index).diagonal().cwiseSqrt();
+    Eigen::Matrix<double, 9, 1> d;
+    d << err.pos_ned_m, err.vel_ned_mps, err.att_ned_rad;
+    const Eigen::Matrix<double, 9, 9> P9 = P.topLeftCorner<9, 9>();
+    err.nees9 = d.dot(P9.ldlt().solve(d));
+    err.mode = static_cast<int>(sol.mode());
+    result.errors.push_back(err);
+    if (hook) hook(sol, truths.front(), err);
+  };
+  nav_filter::FilterPipeline pipeline(setup.filter, health, {on_solution, nullptr});
+  pipeline_ptr = &pipeline;
+
+  const auto period_ns = sim.scenario.imu_period_ns;
+  const auto total = static_cast<std::int64_t>(
+      std::llround(setup.duration_s * 1e9 / static_cast<double>(period_ns)));
+  std::uint64_t n_imu = 0, n_obs = 0, n_fix = 0, n_star = 0;
+  // The same samples, in the same order and with the same sequence numbers as the simulator
+  // participant publishes them (frame_publisher.cpp).
+  while (source.index() < total) {
+    const sim::SensorFrame f = source.next();
+    truths.push_back(f.truth);
+    pipeline.onImu(bus::toIdl(f.increment, sim.imu_sensor_id, ++n_imu));
+    if (sim.publish_gnss && f.has_gnss) {
+      pipeline.onGnssObservations(sensor_sim::toIdl(f.gnss, sim.gnss_receiver_id, ++n_obs));
+      pipeline.onGnssFix(sensor_sim::toIdl(f.fix, sim.gnss_receiver_id, ++n_fix));
+    }
+    if (sim.publish_star_tracker && f.has_star_tracker) {
+      pipeline.onStarTracker(sensor_sim::toIdl(f.star_tracker, sim.star_tracker_id, ++n_star));
+    }
+    // Data time bounds the wait for a silent stream (the bus uses steady time).
+    pipeline.pump(f.increment.time_ns);
+  }
+  // End of data: whatever waits for a stream that will not speak again is released.
+  pipeline.flush(sim.scenario.start_time_ns + total * period_ns);
+  result.summary = pipeline.summary();
+  return result;
+}
+
+}  // namespace navbus::tool
