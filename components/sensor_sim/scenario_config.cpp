@@ -112,16 +112,14 @@ std::vector<sim::Segment> parseSegments(const YAML::Node& list) {
 }
 
 void parseTriad(const YAML::Node& imu, const std::string& prefix, double bias_unit, double bi_unit,
-                double rw_unit, const std::string& rw_key, sim::TriadErrors& t,
-                std::mt19937_64& rng) {
+                double rw_unit, const std::string& rw_key, sim::TriadErrors& t) {
   const std::string w = "imu";
   t.bias = bus::getVector3(imu, w, prefix + "bias" + (prefix == "accel_" ? "_ug" : "_deg_per_h"),
                            bias_unit);
-  // Random-constant biases (seeds 000, 004): drawn once per Monte Carlo seed.
+  // Random-constant biases (seeds 000, 004): drawn by the IMU model from the scenario seed, so
+  // that --seed N gives new biases.
   const std::string sigma_key = prefix + "bias_sigma" + (prefix == "accel_" ? "_ug" : "_deg_per_h");
-  const double sigma = get<double>(imu, w, sigma_key, 0.0) * bias_unit;
-  std::normal_distribution<double> unit(0.0, 1.0);
-  for (int i = 0; i < 3; ++i) t.bias[i] += sigma * unit(rng);
+  t.random_constant_sigma = get<double>(imu, w, sigma_key, 0.0) * bias_unit;
   t.bias_instability =
       get<double>(imu, w, prefix + "bias_instability" + (prefix == "accel_" ? "_ug" : "_deg_per_h"),
                   0.0) *
@@ -197,7 +195,6 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   auto& s = c.scenario;
   s.name = get<std::string>(root, "", "name", "default");
   s.seed = get<std::uint64_t>(root, "", "seed", 1);
-  std::mt19937_64 rng(s.seed * 4 + 5);  // draws made while loading (random-constant biases)
 
   const YAML::Node veh = root["vehicle"];
   const YAML::Node orbit = root["orbit"];
@@ -300,10 +297,9 @@ SimConfig parseSimConfig(const YAML::Node& root) {
       st_hz > 0 ? ratio(imu_hz, st_hz, "timing.star_tracker_rate_hz") : 0;
 
   const YAML::Node imu = root["imu"];
-  parseTriad(imu, "accel_", kMicroG, kMicroG, kMicroG, "accel_noise_ug_per_sqrthz", s.imu.accel,
-             rng);
+  parseTriad(imu, "accel_", kMicroG, kMicroG, kMicroG, "accel_noise_ug_per_sqrthz", s.imu.accel);
   parseTriad(imu, "gyro_", kDegPerHour, kDegPerHour, kDeg / 60.0, "gyro_arw_deg_per_sqrth",
-             s.imu.gyro, rng);
+             s.imu.gyro);
   // Seed 004 gives the gyro white noise as a rate density [deg/s/sqrt(Hz)]; same quantity.
   if (imu && imu["gyro_noise_dps_per_sqrthz"]) {
     s.imu.gyro.random_walk = get<double>(imu, "imu", "gyro_noise_dps_per_sqrthz", 0.0) * kDeg;

@@ -159,6 +159,17 @@ int runOfflineCommand(const OfflineOptions& o) {
   sol_f << csvHeader<navbus::NavigationSolution>() << "\n";
   writeTruthHeader(truth_f);
   writeErrorHeader(err_f);
+  {
+    // The truth at the start, in the units of the filter configuration's initial_state.
+    const core::NavState t0 = initialTruth(setup.sim.scenario);
+    const Eigen::Vector3d rpy = core::eulerFromDcm(t0.q_b_to_n.toRotationMatrix()) * 180.0 / M_PI;
+    spdlog::info(
+        "scenario start (truth): latitude_deg {:.9f}, longitude_deg {:.9f}, height_m {:.3f}, "
+        "vel_ned_mps [{:.6f}, {:.6f}, {:.6f}], roll_deg {:.6f}, pitch_deg {:.6f}, yaw_deg {:.6f}",
+        t0.position.latitude_rad * 180.0 / M_PI, t0.position.longitude_rad * 180.0 / M_PI,
+        t0.position.height_m, t0.vel_ned_mps.x(), t0.vel_ned_mps.y(), t0.vel_ned_mps.z(), rpy.x(),
+        rpy.y(), rpy.z());
+  }
   const OfflineResult r = runOffline(setup, [&](const navbus::NavigationSolution& s,
                                                 const core::NavState& t, const EpochError& e) {
     for (const auto& row : csvRows(s)) sol_f << row << "\n";

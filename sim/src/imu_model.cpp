@@ -24,6 +24,9 @@ ImuErrorModel::ImuErrorModel(const ImuSpec& spec, std::uint64_t seed)
       accel_sm_(scaleAndMisalignment(spec.accel)),
       gyro_sm_(scaleAndMisalignment(spec.gyro)),
       rng_(seed) {
+  // Random-constant biases first, from this model's own stream: a new seed, new biases.
+  for (int i = 0; i < 3; ++i) spec_.accel.bias[i] += spec.accel.random_constant_sigma * unit_(rng_);
+  for (int i = 0; i < 3; ++i) spec_.gyro.bias[i] += spec.gyro.random_constant_sigma * unit_(rng_);
   // The bias-instability state starts in its stationary distribution.
   const double accel_s = kFlickerFloorFactor / kGaussMarkovPeakFactor * spec.accel.bias_instability;
   const double gyro_s = kFlickerFloorFactor / kGaussMarkovPeakFactor * spec.gyro.bias_instability;

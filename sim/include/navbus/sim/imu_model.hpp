@@ -15,9 +15,12 @@ namespace navbus::sim {
 /// Errors of one sensor triad (accelerometers or gyros), SI.
 struct TriadErrors {
   Eigen::Vector3d bias{Eigen::Vector3d::Zero()};  ///< constant (turn-on) bias [m/s^2 | rad/s]
-  double bias_instability{0.0};                   ///< Allan floor B of the bias [m/s^2 | rad/s]
-  double bias_correlation_time_s{100.0};          ///< Gauss-Markov correlation time modelling B
-  double random_walk{0.0};  ///< white-noise density [m/s/sqrt(s) | rad/sqrt(s)]
+  /// 1-sigma of a random-constant bias drawn per axis from the model's seed and added to `bias`
+  /// (seeds 000, 004: a new value for every Monte Carlo seed) [m/s^2 | rad/s].
+  double random_constant_sigma{0.0};
+  double bias_instability{0.0};           ///< Allan floor B of the bias [m/s^2 | rad/s]
+  double bias_correlation_time_s{100.0};  ///< Gauss-Markov correlation time modelling B
+  double random_walk{0.0};                ///< white-noise density [m/s/sqrt(s) | rad/sqrt(s)]
   Eigen::Vector3d scale_factor{Eigen::Vector3d::Zero()};  ///< [-], e.g. 20e-6 for 20 ppm
   /// Axis misalignment [rad]: xy, xz, yx, yz, zx, zy; sensed_i = sum_j (I + M)_ij true_j.
   Eigen::Matrix<double, 6, 1> misalignment{Eigen::Matrix<double, 6, 1>::Zero()};
