@@ -105,13 +105,13 @@ void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time
 template <class Sample>
 bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, std::uint32_t id,
                            const std::optional<InputConfig>& expected) {
-  if (!gate.admit(msg, id, msg.seq(), msg.time_gps_ns())) return false;
   if (!expected) {
-    gate.unaccept();
-    gate.reject({navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id)}, id);
+    // A stream this configuration does not use (e.g. pseudoranges in loosely coupled mode):
+    // counted in the summary, not validated, not a rejection of bad data.
+    ++unused_samples_;
     return false;
   }
-  return true;
+  return gate.admit(msg, id, msg.seq(), msg.time_gps_ns());
 }
 
 void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {

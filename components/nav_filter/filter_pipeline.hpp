@@ -90,6 +90,7 @@ class FilterPipeline {
   std::uint64_t decisions_applied_{0};
   std::uint64_t commands_applied_{0};
   std::uint64_t commands_refused_{0};
+  std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
 };
 
 /// IDL names of the engine's modes and structures.

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "formatters.hpp"
@@ -104,4 +105,63 @@ TEST(OfflineEqualsBus, LandVehicleMultiDimensionalFilter) {
 
 TEST(OfflineEqualsBus, LeoFederatedGnssAndStarTracker) {
   runCase({87, "seed001_leo.yaml", "filter_seed001_lc.yaml", "fusion: federated\n", 3, 40.0});
+}
+
+// Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->
+// federated -> adaptive, and a structure that does not apply is refused (the solution keeps the
+// last one).
+TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
+  constexpr int kDomain = 88;
+  test::cleanSharedMemory();
+  const auto dir = test::scratchDir("fusion-switch");
+  const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
+  const std::string sim_cfg = test::writeFile(
+      dir / "sim.yaml", "extends: " + std::string(NAVBUS_SOURCE_DIR) +
+                            "/sim/scenarios/seed001_leo.yaml\n" + domain +
+                            "timing: {duration_s: 0, pacing: realtime,\n"
+                            "  min_readers: {imu: 1, raw_imu: 0, gnss: 1, star_tracker: 1}}\n");
+  const std::string filter_cfg =
+      test::writeFile(dir / "filter.yaml", "extends: " + std::string(NAVBUS_SOURCE_DIR) +
+                                               "/config/filter_seed001_lc.yaml\n" + domain);
+  bus::ShutdownSignal shutdown;
+  bus::Participant me(test::testParticipant(kDomain, "fusion-switch-test"), shutdown);
+  std::vector<FusionStructure> seen;
+  me.subscribe<NavigationSolutionPubSubType>(
+      bus::topic::kNavSolution, bus::profile::kSolutionReader,
+      [&](const NavigationSolution& s, const auto&) { seen.push_back(s.fusion()); });
+  auto commands = me.createWriter<FilterCommandPubSubType>(bus::topic::kFilterCommand,
+                                                           bus::profile::kDecisionWriter);
+  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
+  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg}, (dir / "sim.log").string());
+  ASSERT_TRUE(test::spinUntil(me, 30s, [&] { return seen.size() >= 5; }))
+      << test::readFile(dir / "filter.log");
+  EXPECT_EQ(seen.back(), FUSION_CENTRALIZED);
+  std::uint64_t id = 0;
+  auto select = [&](FusionStructure f) {
+    FilterCommand c;
+    c.command_id(++id);
+    c.vehicle_id(1);
+    c.kind(CMD_SELECT_FUSION);
+    c.fusion(f);
+    c.issuer("fusion-switch-test");
+    ASSERT_TRUE(commands.write(c));
+  };
+  for (FusionStructure f : {FUSION_FEDERATED, FUSION_ADAPTIVE}) {
+    select(f);
+    EXPECT_TRUE(test::spinUntil(me, 10s, [&] { return seen.back() == f; }))
+        << "structure " << static_cast<int>(f) << " not reached";
+  }
+  select(FUSION_NONE);  // not a structure of a loosely coupled filter: refused
+  const std::size_t before = seen.size();
+  test::spinUntil(me, 10s, [&] { return seen.size() >= before + 10; });
+  EXPECT_EQ(seen.back(), FUSION_ADAPTIVE);
+  sim.signal(SIGTERM);
+  filter.signal(SIGTERM);
+  EXPECT_EQ(sim.wait(10s), 0);
+  EXPECT_EQ(filter.wait(10s), 0);
+  const std::string log = test::readFile(dir / "filter.log");
+  EXPECT_NE(log.find("refused"), std::string::npos) << log;
+  EXPECT_NE(log.find("commands applied 2 refused 1"), std::string::npos) << log;
+  test::cleanSharedMemory();
+  std::filesystem::remove_all(dir);
 }
