@@ -1,0 +1,138 @@
+// Cost per filter cycle of each fusion structure (seed 001 table 6 measured 0.22-0.23 ms per
+// cycle in their simulation), as ratios to the bare mechanization measured in the same run, and
+// heap allocations per cycle in the steady state (counted by replacing operator new).
+// Prints figures; asserts nothing about time (a busy machine is slower, not wrong).
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/core/navigation_engine.hpp"
+#include "navbus/sim/scenario_source.hpp"
+#include "scenario_config.hpp"
+
+namespace {
+std::atomic<std::uint64_t> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+
+namespace {
+
+namespace core = navbus::core;
+
+struct Input {
+  core::ImuIncrement inc;
+  bool has_fix{false}, has_star{false}, has_epoch{false};
+  core::GnssFixMeasurement fix;
+  core::StarAttitudeMeasurement star;
+  std::vector<core::SatelliteObservation> sats;
+};
+
+std::vector<Input> makeInputs(const navbus::sim::ScenarioConfig& c, int n) {
+  navbus::sim::ScenarioSource src(c);
+  std::vector<Input> out(static_cast<std::size_t>(n));
+  for (auto& in : out) {
+    const auto f = src.next();
+    in.inc = f.increment;
+    if (f.has_gnss) {
+      in.has_fix = in.has_epoch = true;
+      in.fix = {f.fix.time_ns, f.fix.position, f.fix.vel_ned_mps, f.fix.pos_sigma_ned_m,
+                f.fix.vel_sigma_ned_mps};
+      for (const auto& m : f.gnss.satellites) {
+        in.sats.push_back({m.sv_id, m.sat_pos_ecef_m, m.sat_vel_ecef_mps,
+                           m.pseudorange_m + m.sat_clock_correction_m,
+                           m.pseudorange_rate_mps + m.sat_clock_drift_mps, m.pseudorange_sigma_m,
+                           m.pseudorange_rate_sigma_mps});
+      }
+    }
+    if (f.has_star_tracker) {
+      in.has_star = true;
+      in.star = {f.star_tracker.time_ns, f.star_tracker.q_b_to_i, f.star_tracker.sigma_b_rad};
+    }
+  }
+  return out;
+}
+
+struct Result {
+  double us_per_cycle;
+  double allocations_per_cycle;
+};
+
+Result run(core::EngineConfig cfg, const std::vector<Input>& inputs, bool aid) {
+  core::NavigationEngine engine(cfg);
+  const std::size_t warmup = inputs.size() / 10;
+  std::uint64_t alloc0 = 0;
+  auto t0 = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    if (i == warmup) {
+      alloc0 = g_allocations.load();
+      t0 = std::chrono::steady_clock::now();
+    }
+    const Input& in = inputs[i];
+    engine.addImu(in.inc);
+    if (!aid) continue;
+    if (in.has_epoch && cfg.aiding == core::AidingMode::kTightlyCoupled)
+      engine.addGnssEpoch(in.sats);
+    if (in.has_fix) engine.addGnssFix(in.fix);
+    if (in.has_star) engine.addStarAttitude(in.star);
+  }
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cycles = static_cast<double>(inputs.size() - warmup);
+  return {1e6 * s / cycles, static_cast<double>(g_allocations.load() - alloc0) / cycles};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string dir = argc > 1 ? argv[1] : "sim/scenarios";
+  const int n = argc > 2 ? std::atoi(argv[2]) : 40000;
+  auto leo =
+      navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(dir + "/seed001_leo.yaml"))
+          .scenario;
+  const auto inputs = makeInputs(leo, n);
+  core::EngineConfig cfg;
+  cfg.tuning.gravity = leo.gravity;
+  cfg.imu_period_s = 0.005;
+  {
+    navbus::sim::ScenarioSource s(leo);
+    cfg.initial_state = s.truth();
+  }
+  cfg.aiding = core::AidingMode::kInertialOnly;
+  const Result base = run(cfg, inputs, false);
+  std::printf("seed 001 inputs, %d IMU cycles at 200 Hz (GPS 10 Hz, star tracker 5 Hz)\n", n);
+  std::printf("%-36s %10s %8s %14s\n", "configuration", "us/cycle", "ratio", "allocs/cycle");
+  std::printf("%-36s %10.2f %8.2f %14.3f\n", "mechanization + covariance (base)", base.us_per_cycle,
+              1.0, base.allocations_per_cycle);
+  cfg.aiding = core::AidingMode::kLooselyCoupled;
+  cfg.use_star_tracker = true;
+  for (auto [name, fusion] :
+       {std::pair{"loosely coupled, centralized", core::FusionStructure::kCentralized},
+        std::pair{"loosely coupled, federated", core::FusionStructure::kFederated},
+        std::pair{"loosely coupled, adaptive", core::FusionStructure::kAdaptive}}) {
+    cfg.fusion = fusion;
+    const Result r = run(cfg, inputs, true);
+    std::printf("%-36s %10.2f %8.2f %14.3f\n", name, r.us_per_cycle,
+                r.us_per_cycle / base.us_per_cycle, r.allocations_per_cycle);
+  }
+  cfg.aiding = core::AidingMode::kTightlyCoupled;
+  cfg.use_star_tracker = false;
+  cfg.fusion = core::FusionStructure::kCentralized;
+  const Result tc = run(cfg, inputs, true);
+  std::printf("%-36s %10.2f %8.2f %14.3f\n", "tightly coupled (pseudoranges)", tc.us_per_cycle,
+              tc.us_per_cycle / base.us_per_cycle, tc.allocations_per_cycle);
+  return 0;
+}
