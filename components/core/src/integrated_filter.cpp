@@ -112,7 +112,7 @@ InnovationWindow<3>* IntegratedFilter::window(AidingKind kind) {
   }
 }
 
-std::vector<MeasurementReport> IntegratedFilter::update(
+const std::vector<MeasurementReport>& IntegratedFilter::update(
     const std::vector<SatelliteObservation>& sats) {
   ErrorState& es = structure_ == FusionStructure::kFederated ? local_[kGnssLocal] : central_;
   const auto m = static_cast<Eigen::Index>(2 * sats.size());
@@ -143,8 +143,8 @@ std::vector<MeasurementReport> IntegratedFilter::update(
   d.innovation_cov.diagonal() += r;
   d.k = es.P() * d.h.transpose() * d.innovation_cov.inverse();
   d.phi = phi_since_update_;
-  std::vector<MeasurementReport> reports;
-  reports.reserve(static_cast<std::size_t>(m));
+  std::vector<MeasurementReport>& reports = reports_;
+  reports.clear();
   for (Eigen::Index row = 0; row < m; ++row) {
     AidingMeasurement<1> one;
     one.z[0] = d.innovation[row];
@@ -156,7 +156,7 @@ std::vector<MeasurementReport> IntegratedFilter::update(
         {d.sv_ids[static_cast<std::size_t>(row)], d.is_rate[static_cast<std::size_t>(row)], res});
   }
   closeUpdate();
-  return reports;
+  return reports_;
 }
 
 void IntegratedFilter::closeUpdate() {

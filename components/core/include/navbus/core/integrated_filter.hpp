@@ -87,8 +87,9 @@ class IntegratedFilter {
                   FusionStructure structure = FusionStructure::kCentralized);
   /// Mechanizes one increment (bias-corrected) and propagates the covariance(s) and the clock.
   void propagate(const ImuIncrement& raw);
-  /// Processes one epoch of pseudoranges and rates; returns one report per row.
-  std::vector<MeasurementReport> update(const std::vector<SatelliteObservation>& sats);
+  /// Processes one epoch of pseudoranges and rates; returns one report per row (a buffer
+  /// reused from epoch to epoch, valid until the next call).
+  const std::vector<MeasurementReport>& update(const std::vector<SatelliteObservation>& sats);
   /// Processes an aiding measurement, one decorrelated row at a time.
   template <int M>
   std::array<ScalarUpdateResult, M> update(const AidingMeasurement<M>& m, AidingKind kind);
@@ -133,6 +134,7 @@ class IntegratedFilter {
   std::array<InnovationWindow<3>, 3> windows_;  ///< adaptive: position, velocity, attitude
   Matrix17 phi_since_update_{Matrix17::Identity()};
   EpochDiagnostics last_epoch_;
+  std::vector<MeasurementReport> reports_;
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
   double clock_bias_m_{0.0};
