@@ -13,7 +13,7 @@ namespace tool = navbus::tool;
 namespace {
 
 const std::string kScenarios = NAVBUS_SCENARIO_DIR;
-const std::string kConfig = std::string(NAVBUS_SCENARIO_DIR) + "/../../config";
+const std::string kConfig = NAVBUS_CONFIG_DIR;
 
 struct Errors {
   double pos_rms{0}, vel_rms{0}, att_rms_arcsec{0}, pos_max{0}, hpos_max{0}, nees{0};
