@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include <spdlog/spdlog.h>
 
@@ -84,33 +85,17 @@ void accumulate(Stats& st, const OfflineResult& r, std::int64_t from_ns, const M
     ++k;
   }
   for (double t_s : o.recovery_after_s) {
-    // Convergence: the first time after t from which the horizontal position error stays below
-    // the threshold for the whole window.
     const std::int64_t t0 = start_ns + static_cast<std::int64_t>(std::llround(t_s * 1e9));
-    const std::int64_t window = static_cast<std::int64_t>(std::llround(o.recovery_window_s * 1e9));
-    double found = std::nan("");
-    for (std::size_t i = 0; i < r.errors.size(); ++i) {
-      const EpochError& e = r.errors[i];
-      if (e.time_ns < t0 || e.time_ns > t0 + window) continue;
-      bool stays = true;
-      for (std::size_t j = i; j < r.errors.size() && r.errors[j].time_ns <= e.time_ns + window;
-           ++j) {
-        if (r.errors[j].pos_ned_m.head<2>().norm() >= o.recovery_threshold_m) {
-          stays = false;
-          break;
-        }
-      }
-      if (stays) {
-        found = 1e-9 * static_cast<double>(e.time_ns - t0);
-        break;
-      }
-    }
-    st.recovery_s.push_back(found);
+    st.recovery_s.push_back(
+        convergenceTime(r.errors, t0, o.recovery_threshold_m, o.recovery_window_s));
   }
 }
 
+/// Median with runs that never converged counted as infinitely slow.
 double median(std::vector<double> v) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
+  for (double& x : v) {
+    if (std::isnan(x)) x = std::numeric_limits<double>::infinity();
+  }
   if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());
   const std::size_t m = v.size() / 2;
@@ -118,6 +103,26 @@ double median(std::vector<double> v) {
 }
 
 }  // namespace
+
+double convergenceTime(const std::vector<EpochError>& errors, std::int64_t t0_ns,
+                       double threshold_m, double window_s) {
+  // The first epoch after t0 from which the horizontal position error stays below the
+  // threshold for the whole window.
+  const auto window = static_cast<std::int64_t>(std::llround(window_s * 1e9));
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    const EpochError& e = errors[i];
+    if (e.time_ns < t0_ns || e.time_ns > t0_ns + window) continue;
+    bool stays = true;
+    for (std::size_t j = i; j < errors.size() && errors[j].time_ns <= e.time_ns + window; ++j) {
+      if (errors[j].pos_ned_m.head<2>().norm() >= threshold_m) {
+        stays = false;
+        break;
+      }
+    }
+    if (stays) return 1e-9 * static_cast<double>(e.time_ns - t0_ns);
+  }
+  return std::nan("");
+}
 
 double chiSquareQuantile(double p, double dof) {
   // Inverse normal by Acklam's rational approximation (|error| < 1.2e-9), then Wilson-Hilferty.
@@ -280,8 +285,8 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
   if (!o.recovery_after_s.empty()) {
     std::printf(
         "\nconvergence after each instant: median over runs of the time until the "
-        "horizontal position error stays below %.2f m for %.0f s (runs not converged "
-        "within the window in brackets)\n",
+        "horizontal position error stays below %.2f m for %.0f s; runs that do not converge "
+        "within the window (count in brackets) count as slowest\n",
         o.recovery_threshold_m, o.recovery_window_s);
     std::printf("%-34s", "configuration");
     for (double t : o.recovery_after_s) std::printf("   after %5.1f s", t);
@@ -296,7 +301,12 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
           v.push_back(r.st.recovery_s[i]);
           missing += std::isnan(r.st.recovery_s[i]) ? 1 : 0;
         }
-        std::printf("   %8.2f s (%d)", median(v), missing);
+        const double med = median(v);
+        if (std::isinf(med)) {
+          std::printf("   %6s%4.0f s (%d)", ">", o.recovery_window_s, missing);
+        } else {
+          std::printf("   %8.2f s (%d)", med, missing);
+        }
       }
       std::printf("\n");
     }

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "offline_runner.hpp"
+
 namespace navbus::tool {
 
 struct OfflineOptions {
@@ -35,6 +37,11 @@ struct MonteCarloOptions {
 };
 
 int runMonteCarloCommand(const MonteCarloOptions& o);
+
+/// Seconds after t0 until the horizontal position error stays below threshold_m for window_s
+/// (NaN when that does not happen within the window after t0).
+double convergenceTime(const std::vector<EpochError>& errors, std::int64_t t0_ns,
+                       double threshold_m, double window_s);
 
 /// Quantile of the chi-square distribution (Wilson-Hilferty; relative error < 1e-3 for the
 /// degrees of freedom used here).

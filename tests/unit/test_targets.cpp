@@ -1,6 +1,8 @@
 // Issue 4's targets with fixed seeds and small run counts (the full counts are the benchmark
 // commands in the README): scenarios through the offline runner, errors against the truth.
+#include <algorithm>
 #include <cmath>
+#include <map>
 
 #include <gtest/gtest.h>
 
@@ -19,6 +21,25 @@ struct Errors {
   double pos_rms{0}, vel_rms{0}, att_rms_arcsec{0}, pos_max{0}, hpos_max{0}, nees{0};
   std::size_t n{0};
 };
+
+constexpr std::int64_t kStart = 1'400'000'000'000'000'000;  // the scenarios' start time
+
+/// Runs one scenario with a filter from the truth's initial state; the whole result.
+tool::OfflineResult runResult(const std::string& scenario, const std::string& filter,
+                              std::uint64_t seed, double duration_s,
+                              const std::function<void(YAML::Node&)>& edit_filter) {
+  YAML::Node fy = YAML::Clone(navbus::bus::loadYamlFile(kConfig + "/" + filter));
+  edit_filter(fy);
+  tool::OfflineSetup s;
+  s.sim =
+      navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(kScenarios + "/" + scenario));
+  s.sim.scenario.seed = seed;
+  s.filter = navbus::nav_filter::parseFilterConfig(fy);
+  s.duration_s = duration_s;
+  s.filter.engine.initial_state = tool::initialTruth(s.sim.scenario);
+  EXPECT_EQ(s.sim.scenario.start_time_ns, kStart);
+  return tool::runOffline(s);
+}
 
 /// Runs one scenario/filter/seed from `from_s` to `to_s` (relative to the start).
 Errors run(const std::string& scenario, const std::string& filter, std::uint64_t seed,
@@ -121,21 +142,39 @@ TEST(Targets, Seed000TightlyCoupledIsConsistent) {
   EXPECT_LT(nees, hi);
 }
 
-TEST(Targets, Seed004MultiDimensionalFilterBoundsTheOutageErrors) {
-  // Given the land vehicle with its two GNSS outages (50-80 s, 110-130 s),
+TEST(Targets, Seed004MultiDimensionalFilterConvergesFasterThanTheInterruptedFilter) {
+  // Given the land vehicle with its two GNSS outages (50-80 s, 110-130 s) and three filters:
+  // the MDF, case I (the 15-state filter interrupted in the outage, resumed as it was) and
+  // case II (resumed with its covariance re-initialized),
   auto policy = [](const char* p) {
     return [p](YAML::Node& y) { y["multi_dimensional"]["policy"] = p; };
   };
-  for (std::uint64_t seed : {1u, 2u, 3u}) {
-    const Errors mdf = run("seed004_land_vehicle.yaml", "filter_seed004_mdf.yaml", seed, 160, 50,
-                           135, false, policy("mdf"));
-    const Errors cont = run("seed004_land_vehicle.yaml", "filter_seed004_mdf.yaml", seed, 160, 50,
-                            135, false, policy("continue"));
-    std::printf("seed004 seed %llu, 50-135 s max horizontal error: MDF %.2f m, case I %.2f m\n",
-                static_cast<unsigned long long>(seed), mdf.hpos_max, cont.hpos_max);
-    // then the non-holonomic F4 keeps the horizontal error below the continued 15-state filter's.
-    EXPECT_LT(mdf.hpos_max, cont.hpos_max);
+  std::map<std::string, std::vector<double>> recovery;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    for (const char* p : {"mdf", "continue", "reset_all"}) {
+      const tool::OfflineResult r =
+          runResult("seed004_land_vehicle.yaml", "filter_seed004_mdf.yaml", seed, 160, policy(p));
+      for (double t : {80.0, 130.0}) {
+        const double s =
+            tool::convergenceTime(r.errors, kStart + static_cast<std::int64_t>(t * 1e9), 1.5, 10.0);
+        recovery[p].push_back(std::isnan(s) ? 1e9 : s);  // never converged: slowest
+      }
+    }
   }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  const double mdf = median(recovery["mdf"]), one = median(recovery["continue"]),
+               two = median(recovery["reset_all"]);
+  std::printf(
+      "seed004, 5 seeds x 2 outages, median time to stay below 1.5 m for 10 s: MDF %.2f s, "
+      "case I %.3g s, case II %.2f s (1e9: not within 10 s)\n",
+      mdf, one, two);
+  // then the MDF converges faster than case I (seed 004 fig. 7). Against case II the ordering
+  // is not robust at this sample size (the closing note of issue 4 gives the 40-run figures).
+  EXPECT_LT(mdf, one);
+  EXPECT_LT(two, one);
 }
 
 TEST(ChiSquare, QuantilesMatchTables) {

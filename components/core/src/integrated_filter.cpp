@@ -63,7 +63,7 @@ void IntegratedFilter::setStructure(FusionStructure s) {
   structure_ = s;
 }
 
-void IntegratedFilter::propagate(const ImuIncrement& raw) {
+void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   ImuIncrement inc = raw;
   inc.delta_vel_b_mps -= accel_bias_ * inc.interval_s;
   inc.delta_angle_b_rad -= gyro_bias_ * inc.interval_s;
@@ -73,6 +73,7 @@ void IntegratedFilter::propagate(const ImuIncrement& raw) {
       transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, tuning_.gravity), dt);
   ins_.propagate(inc);
   clock_bias_m_ += clock_drift_mps_ * dt;
+  if (suspend_filter) return;
   // Discrete process noise: white specific force / rate noise into velocity / attitude
   // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3).
   Matrix17 Q = Matrix17::Zero();

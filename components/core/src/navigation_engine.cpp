@@ -70,7 +70,12 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
     next_output_ns_ = (start_ns / period + 1) * period;
     next_constraint_ns_ = start_ns;
   }
-  filter_.propagate(inc);
+  // Seed 004's comparison cases stop the filter during an outage (the mechanization runs on);
+  // it resumes with the covariance it had (case I) or a re-initialized one (case II).
+  const bool suspended = config_.aiding == AidingMode::kMultiDimensional &&
+                         config_.mdf.policy != MdfPolicy::kMultiDimensional &&
+                         stages_.stage() == MdfStage::kF4Constraint;
+  filter_.propagate(inc, suspended);
   ++counters_.imu_used;
   if (mode_ == EngineMode::kInitializing || mode_ == EngineMode::kInertialLost) {
     // Back to inertial navigation; aided modes resume with the next measurement.

@@ -85,8 +85,10 @@ class IntegratedFilter {
   void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
                   const FilterTuning& tuning, const StateMask& active,
                   FusionStructure structure = FusionStructure::kCentralized);
-  /// Mechanizes one increment (bias-corrected) and propagates the covariance(s) and the clock.
-  void propagate(const ImuIncrement& raw);
+  /// Mechanizes one increment (bias-corrected) and propagates the clock and, unless
+  /// `suspend_filter` (the filter is not run: seed 004's case I during an outage), the
+  /// covariance(s).
+  void propagate(const ImuIncrement& raw, bool suspend_filter = false);
   /// Processes one epoch of pseudoranges and rates; returns one report per row (a buffer
   /// reused from epoch to epoch, valid until the next call).
   const std::vector<MeasurementReport>& update(const std::vector<SatelliteObservation>& sats);

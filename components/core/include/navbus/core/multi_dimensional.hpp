@@ -24,8 +24,9 @@ namespace navbus::core {
 enum class MdfStage { kF1ZeroVelocity, kF2Gnss, kF3Recovery, kF4Constraint };
 
 /// How the land-vehicle filter handles stops and outages: the multi-dimensional filter, or the
-/// comparison cases of seed 004 (I: the 15-state filter simply continues through the outage;
-/// II: the 15-state covariance is re-initialized entirely when GNSS returns).
+/// comparison cases of seed 004 (section IV.3): the 15-state filter is interrupted during the
+/// outage (the mechanization runs on, the covariance is not propagated) and, when GNSS returns,
+/// I: resumes as it was; II: resumes with its whole covariance re-initialized.
 enum class MdfPolicy { kMultiDimensional, kContinue, kResetAll };
 
 enum class CovarianceReset { kNone, kFs, kFsA, kFsI, kAll };
