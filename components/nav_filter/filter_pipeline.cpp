@@ -348,14 +348,14 @@ bool FilterPipeline::onCommand(const navbus::FilterCommand& c) {
 std::string FilterPipeline::summary() const {
   const core::EngineCounters& n = engine_.counters();
   std::ostringstream out;
-  out << "increments integrated " << n.imu_used << ", solutions published " << solution_seq_
-      << ", inertial gaps " << n.imu_gaps << ", GNSS epochs fused " << n.gnss_epochs_fused
-      << ", fixes fused " << n.fixes_fused << ", star-tracker attitudes fused " << n.star_fused
-      << ", ZUPTs " << n.zero_velocity_updates << ", NHC updates " << n.nonholonomic_updates
-      << ", rows gated " << n.rows_gated << ", stage switches " << n.stage_switches
-      << ", decisions applied " << decisions_applied_ << ", commands applied " << commands_applied_
-      << " refused " << commands_refused_ << ", sequencer timeouts " << sequencer_.timeouts()
-      << ", pending " << sequencer_.pending();
+  out << "increments integrated " << n.imu_used << " refused by the engine " << n.imu_refused
+      << ", solutions published " << solution_seq_ << ", inertial gaps " << n.imu_gaps
+      << ", GNSS epochs fused " << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
+      << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
+      << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
+      << ", stage switches " << n.stage_switches << ", decisions applied " << decisions_applied_
+      << ", commands applied " << commands_applied_ << " refused " << commands_refused_
+      << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending();
   return out.str();
 }
 

@@ -286,3 +286,33 @@ TEST(NavigationEngine, RefusesStructuresThatDoNotApply) {
   core::NavigationEngine ins(c);
   EXPECT_FALSE(ins.selectFusion(core::FusionStructure::kCentralized));
 }
+
+TEST(NavigationEngine, RefusesIncrementsThatDoNotFollowTheStateTime) {
+  // Given an engine that has integrated two increments,
+  core::EngineConfig c;
+  c.initial_state = movingTruth(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  core::NavigationEngine e(c);
+  core::ImuIncrement inc;
+  inc.interval_s = 0.01;
+  inc.delta_vel_b_mps = Eigen::Vector3d(0, 0, -9.8 * 0.01);
+  inc.time_ns = 1'000'000'000;
+  e.addImu(inc);
+  inc.time_ns += 10'000'000;
+  e.addImu(inc);
+  const core::NavState before = e.state();
+  // when an increment repeats a time, goes back, or has a bad interval,
+  inc.time_ns -= 10'000'000;
+  e.addImu(inc);
+  inc.time_ns -= 1'000'000'000;
+  e.addImu(inc);
+  inc.time_ns = 1'030'000'000;
+  inc.interval_s = -0.01;
+  e.addImu(inc);
+  inc.interval_s = std::nan("");
+  e.addImu(inc);
+  // then none is integrated and each is counted.
+  EXPECT_EQ(e.counters().imu_refused, 4u);
+  EXPECT_EQ(e.counters().imu_used, 2u);
+  EXPECT_EQ(e.state().time_ns, before.time_ns);
+  EXPECT_EQ(e.state().vel_ned_mps, before.vel_ned_mps);
+}

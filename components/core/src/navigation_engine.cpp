@@ -51,9 +51,18 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
   ImuIncrement inc = raw;
   inc.delta_vel_b_mps -= accel_compensation_ * inc.interval_s;
   inc.delta_angle_b_rad -= gyro_compensation_ * inc.interval_s;
+  if (!(inc.interval_s > 0.0 && inc.interval_s < 1.0) || !inc.delta_vel_b_mps.allFinite() ||
+      !inc.delta_angle_b_rad.allFinite()) {
+    ++counters_.imu_refused;
+    return false;
+  }
   const auto interval_ns = static_cast<std::int64_t>(std::llround(inc.interval_s * 1e9));
   const std::int64_t start_ns = inc.time_ns - interval_ns;
   const std::int64_t period = config_.solution_period_ns;
+  if (filter_.initialized() && start_ns < filter_.state().time_ns - interval_ns / 2) {
+    ++counters_.imu_refused;  // overlaps or precedes what is already integrated
+    return false;
+  }
   if (!filter_.initialized()) {
     NavState s = config_.initial_state;
     s.time_ns = start_ns;

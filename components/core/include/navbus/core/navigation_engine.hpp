@@ -69,6 +69,9 @@ struct EngineConfig {
 
 struct EngineCounters {
   std::uint64_t imu_used{0}, imu_gaps{0};
+  /// Increments refused: interval not positive and finite, or not after the state time (an
+  /// embedding application may call the engine without the bus validation).
+  std::uint64_t imu_refused{0};
   std::uint64_t gnss_epochs_fused{0}, fixes_fused{0}, star_fused{0};
   std::uint64_t zero_velocity_updates{0}, nonholonomic_updates{0};
   std::uint64_t rows_gated{0};  ///< measurement rows refused by the innovation gate
@@ -79,7 +82,8 @@ class NavigationEngine {
  public:
   explicit NavigationEngine(const EngineConfig& config);
 
-  /// Integrates one increment; true when the state time reached a solution epoch.
+  /// Integrates one increment; true when the state time reached a solution epoch. An increment
+  /// with a bad interval or one that does not follow the state time is refused and counted.
   bool addImu(const ImuIncrement& inc);
   /// Fuses a pseudorange epoch (tightly coupled mode); true when fused (diagnostics ready).
   bool addGnssEpoch(const std::vector<SatelliteObservation>& satellites);
