@@ -53,6 +53,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       seconds(bus::checkRange(bus::get<double>(root, "", "sequencer_max_wait_s", 0.5), 0.001, 60.0,
                               "sequencer_max_wait_s"));
 
+  c.solution_writer_profile =
+      bus::get<std::string>(root, "", "solution_writer_profile", c.solution_writer_profile);
   const YAML::Node init = root["initial_state"];
   if (!init) throw bus::ConfigError("configuration initial_state is missing");
   auto& s = e.initial_state;

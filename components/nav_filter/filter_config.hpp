@@ -3,9 +3,11 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 
 #include <yaml-cpp/yaml.h>
 
+#include "navbus/bus/topics.hpp"
 #include "navbus/core/navigation_engine.hpp"
 
 namespace navbus::nav_filter {
@@ -23,6 +25,9 @@ struct FilterConfig {
   std::optional<InputConfig> gnss_fix;
   std::optional<InputConfig> star_tracker;
   std::int64_t sequencer_max_wait_ns{500'000'000};
+  /// QoS profile of the solution writer (qos/navbus_qos.xml): navbus_solution_writer, or
+  /// navbus_solution_writer_lossless for recording fast-paced runs.
+  std::string solution_writer_profile{bus::profile::kSolutionWriter};
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid entry.

@@ -28,7 +28,7 @@ bool publishesDiagnostics(const FilterConfig& c) {
 FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
     : participant_(p),
       solution_writer_(p.createWriter<navbus::NavigationSolutionPubSubType>(
-          bus::topic::kNavSolution, bus::profile::kSolutionWriter)),
+          bus::topic::kNavSolution, config.solution_writer_profile)),
       diagnostics_writer_(
           publishesDiagnostics(config)
               ? p.createWriter<navbus::FilterDiagnosticsPubSubType>(

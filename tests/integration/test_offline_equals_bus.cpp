@@ -44,8 +44,11 @@ void runCase(const Case& c) {
   const std::string sim_cfg = test::writeFile(
       dir / "sim.yaml", "extends: " + scenario + "\n" + domain +
                             "timing: {duration_s: " + std::to_string(c.duration_s) + "}\n");
+  // Every solution must reach the test even though the data runs through at full speed.
   const std::string filter_cfg = test::writeFile(
-      dir / "filter.yaml", "extends: " + filter_base + "\n" + domain + c.filter_extra);
+      dir / "filter.yaml", "extends: " + filter_base + "\n" + domain +
+                               "solution_writer_profile: navbus_solution_writer_lossless\n" +
+                               c.filter_extra);
   const std::string fm_cfg = test::writeFile(dir / "fm.yaml", domain);
 
   // Offline first: no DDS at all.
