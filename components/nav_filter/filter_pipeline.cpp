@@ -289,8 +289,8 @@ void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
   publishHeldSolution();
 }
 
-bool FilterPipeline::onCommand(const navbus::FilterCommand& c) {
-  if (c.vehicle_id() != config_.vehicle_id) return true;  // for another vehicle: not ours
+void FilterPipeline::onCommand(const navbus::FilterCommand& c) {
+  if (c.vehicle_id() != config_.vehicle_id) return;  // for another vehicle: not ours
   bool applied = true;
   std::string why = "bad field";
   switch (c.kind()) {
@@ -342,7 +342,6 @@ bool FilterPipeline::onCommand(const navbus::FilterCommand& c) {
     spdlog::warn("command {} from '{}' refused: kind {}: {}", c.command_id(), c.issuer(),
                  static_cast<int>(c.kind()), why);
   }
-  return applied;
 }
 
 std::string FilterPipeline::summary() const {

@@ -50,8 +50,9 @@ class FilterPipeline {
   void onGnssFix(const navbus::GnssFix& msg);
   void onStarTracker(const navbus::StarTrackerAttitude& msg);
   void onDecision(const navbus::FaultDecision& d);
-  /// Returns false when the command was refused (wrong field or not available in this mode).
-  bool onCommand(const navbus::FilterCommand& c);
+  /// Applies a command; a refused one (wrong field, not available in this mode) is logged and
+  /// counted in the summary.
+  void onCommand(const navbus::FilterCommand& c);
 
   /// Processes every input that can no longer be preceded by another; `now_ns` is the clock
   /// that bounds the wait for a silent stream (steady time on the bus, data time offline).
