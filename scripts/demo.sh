@@ -6,6 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
+mkdir -p build   # a fresh clone has no build/ yet: the build log goes there
 bash scripts/build.sh > build/demo-build.log 2>&1 || { tail -50 build/demo-build.log; exit 1; }
 bin=build/bin
 domain=${NAVBUS_DEMO_DOMAIN:-0}

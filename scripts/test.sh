@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every test (ctest, two at a time).
+# Installs what is missing, builds, and runs every test (ctest, two at a time), then the
+# README's demo command from a fresh clone of the committed tree (tests/fresh_clone).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
-cd build
-ctest --output-on-failure -j2 --timeout 300
+(cd build && ctest --output-on-failure -j2 --timeout 300)
+bash tests/fresh_clone/run_demo.sh
