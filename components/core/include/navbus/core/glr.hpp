@@ -1,0 +1,218 @@
+// Generalized likelihood ratio fault detection and isolation for the tightly coupled filter
+// (seed 000 eqs. 6-16, after Willsky and Jones 1976), as an independent monitor of a running
+// filter: it needs only what the filter publishes per measurement epoch (innovations eps,
+// their covariance V, H, the gain K actually applied, and the transition Phi since the
+// previous epoch), see doc/glr_closed_loop.md for the signature recursions of navbus's
+// feedback filter.
+//
+// Hypotheses (one scalar magnitude each, the "directions" T of eq. 16):
+//   - a step in each accelerometer and gyro bias (state faults, eq. 7) [m/s^2, rad/s];
+//   - per satellite, a step [m] and a ramp [m/s] in its pseudorange and a step in its
+//     pseudorange rate [m/s] (measurement faults, eq. 8).
+// Positive magnitudes are what the sensor adds: an accelerometer reading high, a pseudorange
+// reading long. For every hypothesised onset theta in a sliding window of M epochs the monitor
+// accumulates f (eq. 9) and R (eq. 10) over groups of directions: the six IMU directions, and
+// the three directions of each satellite. The group statistic l = 1/2 f^T R^+ f (eq. 12) with
+// the magnitude nu = R^+ f (eq. 11) is compared with h (eq. 13); isolation projects onto single
+// directions (eqs. 14-15: f* = T^T f, R* = T^T R T): INS against GNSS first, then which axis or
+// which satellite. R is ill-conditioned when two directions have (nearly) the same signature
+// (a pseudorange step and ramp one epoch after onset; x-accelerometer and y-gyro in straight
+// flight): the group statistic uses a rank-revealing factorization of R scaled to unit
+// diagonal and drops directions whose information is within `rank_tolerance` of dependent,
+// and isolation reports such directions as ambiguous instead of picking one.
+//
+// Fixed-capacity storage, allocated once in configure(): update() allocates nothing.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "navbus/core/ins_error_model.hpp"
+#include "navbus/core/state_layout.hpp"
+
+namespace navbus::core {
+
+namespace glr {
+inline constexpr int kStates = tc17::kSize;
+inline constexpr int kMaxSatellites = 24;  ///< satellites per epoch (the engine fuses <= 24)
+inline constexpr int kMaxRows = 2 * kMaxSatellites;
+inline constexpr int kImuDirections = 6;  ///< accelerometer x y z, gyro x y z
+inline constexpr int kSatDirections = 3;  ///< pseudorange step, pseudorange ramp, rate step
+inline constexpr int kMaxDirections = kImuDirections + kSatDirections * kMaxSatellites;
+inline constexpr int kMaxWindow = 100;  ///< largest configurable window M [epochs]
+
+using RowVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRows, 1>;
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, kMaxRows>;
+using HMatrix = Eigen::Matrix<double, Eigen::Dynamic, kStates, Eigen::RowMajor, kMaxRows, kStates>;
+using KMatrix = Eigen::Matrix<double, kStates, Eigen::Dynamic, 0, kStates, kMaxRows>;
+using SignatureMatrix = Eigen::Matrix<double, kStates, Eigen::Dynamic, 0, kStates, kMaxDirections>;
+using DirectionVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDirections, 1>;
+}  // namespace glr
+
+enum class GlrFault { kAccelStep, kGyroStep, kRangeStep, kRangeRamp, kRateStep };
+
+/// One direction T: what is faulty and how.
+struct GlrHypothesis {
+  GlrFault fault{GlrFault::kAccelStep};
+  int axis{0};   ///< body axis 0..2 for IMU faults
+  int sv_id{0};  ///< satellite for measurement faults
+  bool isImu() const { return fault == GlrFault::kAccelStep || fault == GlrFault::kGyroStep; }
+};
+
+struct GlrConfig {
+  int window{20};  ///< M: hypothesised onsets kept [measurement epochs]
+  /// h: a fault is declared when l = 1/2 f^T R^+ f >= h for some group and onset (eq. 13).
+  double threshold{35.718};
+  /// Isolation: a runner-up direction whose statistic is within this many units of log-
+  /// likelihood of the best one explains the data about as well (likelihood ratio e^margin):
+  /// the decision names both.
+  double ambiguity_margin{2.0};
+  /// Directions whose share of information, after scaling R to unit diagonal, falls below
+  /// this are treated as dependent on the others (rank-revealing factorization).
+  double rank_tolerance{1e-6};
+  bool imu_steps{true};
+  bool range_steps{true};
+  bool range_ramps{true};
+  bool rate_steps{true};
+};
+
+/// One measurement epoch of the monitored filter, SI units, rows in the filter's order.
+struct GlrEpoch {
+  std::int64_t time_ns{0};
+  int rows{0};
+  std::array<int, glr::kMaxRows> sv_id{};
+  std::array<bool, glr::kMaxRows> is_rate{};  ///< false: pseudorange row
+  glr::RowVector innovation;                  ///< eps = predicted - measured [m, m/s]
+  glr::RowMatrix innovation_cov;              ///< V = H P- H^T + R
+  glr::HMatrix h;                             ///< rows x 17
+  glr::KMatrix k;                      ///< 17 x rows: the gain applied (0 columns for unused rows)
+  Matrix17 phi{Matrix17::Identity()};  ///< transition from the previous epoch to this one
+};
+
+struct GlrCandidate {
+  GlrHypothesis hypothesis;
+  double statistic{0.0};  ///< l* = 1/2 f*^2 / R* (eqs. 14-15 with T this direction)
+  double magnitude{0.0};  ///< nu* = f* / R* [m/s^2, rad/s, m or m/s]
+};
+
+enum class GlrSourceClass { kNone, kImu, kSatellite };
+
+struct GlrResult {
+  bool valid{false};              ///< false: the epoch was refused (see GlrMonitor::refused())
+  bool detected{false};           ///< statistic >= threshold
+  double statistic{0.0};          ///< largest group statistic l over onsets and groups
+  double threshold{0.0};          ///< h
+  int onset_epochs_ago{0};        ///< theta of the largest statistic: 0 = this epoch
+  std::int64_t onset_time_ns{0};  ///< the fault began after this time (epoch theta - 1)
+  GlrSourceClass source{GlrSourceClass::kNone};
+  double imu_statistic{0.0};        ///< IMU group l at the onset
+  double satellite_statistic{0.0};  ///< best satellite group l at the onset
+  double imu_significance{0.0};     ///< -log10 P(chi2(rank) >= 2 l) of the IMU group
+  double satellite_significance{0.0};
+  int imu_rank{0};
+  int satellite_rank{0};
+  int candidate_count{0};  ///< directions in `candidates` (best first, same class)
+  std::array<GlrCandidate, 3> candidates{};
+  bool ambiguous{false};    ///< candidates[1] explains the data about as well as [0]
+  double correlation{0.0};  ///< of the signatures of candidates [0] and [1], -1..1
+};
+
+class GlrMonitor {
+ public:
+  GlrMonitor();
+  explicit GlrMonitor(const GlrConfig& config);
+  void configure(const GlrConfig& config);
+  /// Forgets every onset and the previous epoch (after a gap in the monitored epochs, or when
+  /// the filter was reconfigured so that old signatures no longer describe it).
+  void reset();
+
+  /// Processes one epoch; refuses (valid = false, counted) an epoch with more rows than
+  /// supported, non-finite values or an innovation covariance that is not positive definite.
+  const GlrResult& update(const GlrEpoch& epoch);
+
+  /// A quarantined satellite is still monitored but cannot trigger a detection.
+  void setQuarantined(int sv_id, bool quarantined);
+  bool quarantined(int sv_id) const;
+
+  const GlrConfig& config() const { return config_; }
+  const GlrResult& last() const { return result_; }
+  /// Onsets currently in the window (age 0 = the latest epoch, count - 1 = the oldest).
+  int onsetCount() const { return onset_count_; }
+  /// f (eq. 9) and R (eq. 10) of one direction at one onset; r = 0 if unknown.
+  struct DirectionSums {
+    double f{0.0};
+    double r{0.0};
+  };
+  DirectionSums directionSums(int onset_age, const GlrHypothesis& h) const;
+  /// Group statistics l = 1/2 f^T R^+ f at one onset: the six IMU directions, or the three of
+  /// one satellite (0 if the satellite is unknown).
+  double imuStatistic(int onset_age) const;
+  double satelliteStatistic(int onset_age, int sv_id) const;
+  std::uint64_t epochs() const { return epochs_; }
+  std::uint64_t refused() const { return refused_; }
+
+ private:
+  struct Onset {
+    std::int64_t time_ns{0};        ///< epoch theta
+    std::int64_t ramp_start_ns{0};  ///< epoch theta - 1: where the hypothesised ramp is 0
+    glr::SignatureMatrix mu;        ///< state signatures before this epoch's update
+    glr::DirectionVector f;         ///< eq. 9, per direction
+    Eigen::Matrix<double, glr::kImuDirections, glr::kImuDirections> r_imu;  ///< eq. 10
+    std::array<Eigen::Matrix3d, glr::kMaxSatellites> r_sat;
+  };
+  struct Slot {
+    int sv_id{0};
+    std::uint64_t last_seen{0};
+    int range_row{-1}, rate_row{-1};            ///< rows this epoch, -1 if absent
+    int prev_range_row{-1}, prev_rate_row{-1};  ///< rows at the previous epoch
+    bool quarantined{false};
+  };
+
+  bool validate(const GlrEpoch& e) const;
+  void assignSlots(const GlrEpoch& e);
+  void prepareEpoch(const GlrEpoch& e);
+  void propagate(Onset& o);
+  void startOnset(const GlrEpoch& e);
+  void accumulate(Onset& o);
+  void evaluate();
+  const Onset& onset(int age) const;
+  void isolate(const Onset& o, int onset_age);
+  /// Measurement-fault input D of `direction` (0..2 of a slot) at `row` for onset `o`.
+  double measurementInput(const Onset& o, int direction, std::int64_t time_ns) const;
+  int directions() const { return glr::kImuDirections + glr::kSatDirections * slots_used_; }
+
+  GlrConfig config_;
+  std::vector<Onset> onsets_;  ///< ring buffer, capacity window
+  int onset_head_{0};          ///< index of the oldest onset
+  int onset_count_{0};
+  std::array<Slot, glr::kMaxSatellites> slots_{};
+  int slots_used_{0};
+  std::array<int, 33> slot_of_sv_{};  ///< PRN 1..32 -> slot + 1 (0: none)
+
+  // Per-epoch quantities (current epoch k) and what the recursion keeps of epoch k-1.
+  bool have_previous_{false};
+  std::int64_t time_ns_{0}, prev_time_ns_{0};
+  int rows_{0};
+  glr::HMatrix h_, prev_h_;
+  glr::KMatrix prev_k_;
+  glr::RowMatrix v_inv_;
+  glr::RowVector w_;                                      ///< V^-1 eps
+  Eigen::Matrix<double, glr::kMaxRows, glr::kStates> u_;  ///< V^-1 H (first rows_ rows)
+  Matrix17 s_;                                            ///< H^T V^-1 H
+  Eigen::Matrix<double, glr::kStates, 1> a_;              ///< H^T V^-1 eps
+  Matrix17 b_;                                            ///< Phi_k (I - K_{k-1} H_{k-1})
+  glr::KMatrix g_;                                        ///< Phi_k K_{k-1}
+  glr::SignatureMatrix scratch_;
+
+  GlrResult result_;
+  std::uint64_t epochs_{0};
+  std::uint64_t refused_{0};
+};
+
+/// Name of a hypothesis for logs and messages, e.g. "accelerometer x step", "sv 13 range ramp".
+const char* glrFaultName(GlrFault fault);
+
+}  // namespace navbus::core

@@ -1,0 +1,362 @@
+// GLR (seed 000 eqs. 6-16) against a brute-force reference: a linear closed-loop error-state
+// filter (feedback after every update, as navbus's filter does) is simulated with and without
+// a fault; the difference of the two innovation sequences is the fault signature by
+// definition, and the explicit regression of the faulty innovations on it gives f, R, the
+// magnitude and the statistic the monitor must reproduce with its recursions.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+
+#include "navbus/core/chi_square.hpp"
+#include "navbus/core/glr.hpp"
+
+namespace nc = navbus::core;
+using nc::GlrFault;
+using nc::GlrHypothesis;
+using nc::Matrix17;
+using Vector17 = Eigen::Matrix<double, 17, 1>;
+
+namespace {
+
+constexpr int kSats = 4;
+constexpr int kRows = 2 * kSats;
+constexpr std::int64_t kSecond = 1'000'000'000;
+const int kSvIds[kSats] = {3, 6, 9, 13};
+
+/// A linear system with the 17-state layout: random but fixed Phi (biases and clock as random
+/// constants / random walk), pseudorange-like and rate-like rows, a Kalman filter's gains.
+class ClosedLoop {
+ public:
+  explicit ClosedLoop(std::uint64_t seed) : rng_(seed) {
+    std::normal_distribution<double> n(0.0, 1.0);
+    phi_ = Matrix17::Identity();
+    // Position <- velocity, velocity <- attitude and accelerometer bias, attitude <- gyro
+    // bias, clock <- drift, plus small random couplings among the navigation states.
+    for (int i = 0; i < 3; ++i) {
+      phi_(i, 3 + i) = 1.0;
+      phi_(3 + i, 9 + i) = -1.0;
+      phi_(6 + i, 12 + i) = 1.0;
+    }
+    phi_(3, 7) = -9.8;
+    phi_(4, 6) = 9.8;
+    phi_(15, 16) = 1.0;
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < 9; ++j) phi_(i, j) += 0.01 * n(rng_);
+    q_ = Vector17::Constant(1e-6).asDiagonal();
+    for (int i = 0; i < 3; ++i) q_(3 + i, 3 + i) = 1e-4;
+    q_(15, 15) = 0.01;
+    q_(16, 16) = 1e-4;
+    p_ = Vector17::Constant(1.0).asDiagonal();
+    for (int s = 0; s < kSats; ++s) {
+      Eigen::Vector3d los(n(rng_), n(rng_), n(rng_));
+      los_[s] = los.normalized();
+    }
+  }
+
+  /// One epoch: propagate the covariance, compute H, V, K for this epoch.
+  void nextEpoch() {
+    p_ = phi_ * p_ * phi_.transpose() + q_;
+    h_.setZero(kRows, 17);
+    for (int s = 0; s < kSats; ++s) {
+      h_.block<1, 3>(2 * s, 0) = -los_[s].transpose();
+      h_(2 * s, 15) = 1.0;
+      h_.block<1, 3>(2 * s + 1, 3) = -los_[s].transpose();
+      h_(2 * s + 1, 16) = 1.0;
+    }
+    r_ = Eigen::VectorXd::Constant(kRows, 1.0).asDiagonal();
+    for (int s = 0; s < kSats; ++s) r_(2 * s + 1, 2 * s + 1) = 0.01;
+    v_ = h_ * p_ * h_.transpose() + r_;
+    k_ = p_ * h_.transpose() * v_.inverse();
+    const Matrix17 a = Matrix17::Identity() - k_ * h_;
+    p_ = a * p_ * a.transpose() + k_ * r_ * k_.transpose();
+    // Slowly rotating geometry, so that the gains change from epoch to epoch.
+    for (auto& l : los_) l = (l + 0.01 * Eigen::Vector3d(l.y(), -l.x(), 0.0)).normalized();
+  }
+
+  const Matrix17& phi() const { return phi_; }
+  const Eigen::MatrixXd& h() const { return h_; }
+  const Eigen::MatrixXd& k() const { return k_; }
+  const Eigen::MatrixXd& v() const { return v_; }
+  const Eigen::MatrixXd& r() const { return r_; }
+  const Matrix17& q() const { return q_; }
+  std::mt19937_64& rng() { return rng_; }
+
+ private:
+  std::mt19937_64 rng_;
+  Matrix17 phi_, q_, p_;
+  Eigen::MatrixXd h_, k_, v_, r_;
+  Eigen::Vector3d los_[kSats];
+};
+
+struct Fault {
+  GlrHypothesis h;
+  int onset_epoch{0};  ///< first epoch whose interval / measurement carries the fault
+  double magnitude{0.0};
+};
+
+/// Error state of the closed loop with its epoch matrices, simulated forward.
+struct LoopRun {
+  std::vector<Eigen::VectorXd> innovations;
+  std::vector<nc::GlrEpoch> epochs;
+};
+
+int biasState(const GlrHypothesis& h) {
+  return (h.fault == GlrFault::kAccelStep ? 9 : 12) + h.axis;
+}
+
+int rowOf(const GlrHypothesis& h) {
+  for (int s = 0; s < kSats; ++s)
+    if (kSvIds[s] == h.sv_id) return 2 * s + (h.fault == GlrFault::kRateStep ? 1 : 0);
+  return -1;
+}
+
+/// Simulates `epochs` epochs of the closed loop: truth error dx (estimate minus truth),
+/// innovations eps = H dx + v - (measurement fault), correction dx -= K eps. With `noise` false
+/// the run is the deterministic response to the fault alone: its innovations are the signature.
+LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& faults, bool noise) {
+  ClosedLoop loop(seed);
+  std::mt19937_64 rng(seed * 7 + 1);
+  std::normal_distribution<double> n(0.0, noise ? 1.0 : 0.0);
+  Vector17 dx = Vector17::Zero();
+  LoopRun run;
+  for (int k = 0; k < epochs; ++k) {
+    loop.nextEpoch();
+    // Interval (k-1, k]: a state fault starting at epoch `onset` enters at its start.
+    Vector17 w;
+    for (int i = 0; i < 17; ++i) w[i] = std::sqrt(loop.q()(i, i)) * n(rng);
+    Vector17 before = dx;
+    for (const Fault& f : faults) {
+      if (f.h.isImu() && k == f.onset_epoch) before[biasState(f.h)] -= f.magnitude;
+    }
+    dx = loop.phi() * before + (k > 0 ? w : Vector17::Zero());
+    Eigen::VectorXd eps = loop.h() * dx;
+    for (int r = 0; r < kRows; ++r) eps[r] += std::sqrt(loop.r()(r, r)) * n(rng);
+    for (const Fault& f : faults) {
+      if (f.h.isImu() || k < f.onset_epoch) continue;
+      const double value = f.h.fault == GlrFault::kRangeRamp
+                               ? f.magnitude * static_cast<double>(k - f.onset_epoch + 1)
+                               : f.magnitude;
+      eps[rowOf(f.h)] -= value;  // predicted minus measured: a long range lowers it
+    }
+    dx -= loop.k() * eps;
+    nc::GlrEpoch e;
+    e.time_ns = (k + 1) * kSecond;
+    e.rows = kRows;
+    for (int s = 0; s < kSats; ++s) {
+      e.sv_id[static_cast<std::size_t>(2 * s)] = kSvIds[s];
+      e.sv_id[static_cast<std::size_t>(2 * s + 1)] = kSvIds[s];
+      e.is_rate[static_cast<std::size_t>(2 * s + 1)] = true;
+    }
+    e.innovation = eps;
+    e.innovation_cov = loop.v();
+    e.h = loop.h();
+    e.k = loop.k();
+    e.phi = loop.phi();
+    run.innovations.push_back(eps);
+    run.epochs.push_back(e);
+  }
+  return run;
+}
+
+/// Brute force: f and R of one direction for onset `onset` at epoch `k`, from the explicit
+/// signature (noise-free faulty run with unit magnitude).
+nc::GlrMonitor::DirectionSums bruteForce(std::uint64_t seed, const LoopRun& data,
+                                         const GlrHypothesis& h, int onset, int k) {
+  const LoopRun sig = simulate(seed, k + 1, {{h, onset, 1.0}}, false);
+  nc::GlrMonitor::DirectionSums out;
+  for (int i = onset; i <= k; ++i) {
+    const Eigen::MatrixXd v_inv = data.epochs[static_cast<std::size_t>(i)].innovation_cov.inverse();
+    const Eigen::VectorXd& rho = sig.innovations[static_cast<std::size_t>(i)];
+    out.f += rho.dot(v_inv * data.innovations[static_cast<std::size_t>(i)]);
+    out.r += rho.dot(v_inv * rho);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(ChiSquare, TailProbabilitiesMatchTables) {
+  EXPECT_NEAR(nc::chiSquareSurvival(3.841459, 1), 0.05, 1e-6);
+  EXPECT_NEAR(nc::chiSquareSurvival(12.591587, 6), 0.05, 1e-6);
+  EXPECT_NEAR(nc::chiSquareSurvival(35.718, 17), 0.005, 2e-6);  // seed 000's threshold
+  EXPECT_NEAR(nc::chiSquareSurvival(7.814728, 3), 0.05, 1e-6);
+  EXPECT_DOUBLE_EQ(nc::chiSquareSurvival(0.0, 3), 1.0);
+  // Far in the tail the significance keeps growing instead of underflowing.
+  EXPECT_NEAR(nc::chiSquareSignificance(3.841459, 1), -std::log10(0.05), 1e-5);
+  EXPECT_GT(nc::chiSquareSignificance(3000.0, 6), 600.0);
+  EXPECT_GT(nc::chiSquareSignificance(3000.0, 3), nc::chiSquareSignificance(3000.0, 6));
+}
+
+TEST(Glr, SignatureSumsEqualTheExplicitRegression) {
+  // Given a closed-loop run with a range ramp on sv 9 from epoch 12 and an x-gyro step from
+  // epoch 15, when the monitor processes it, then for every direction and onset in the
+  // window f and R equal the brute-force regression on the simulated signatures.
+  const std::uint64_t seed = 11;
+  const std::vector<Fault> faults = {{{GlrFault::kRangeRamp, 0, 9}, 12, 0.5},
+                                     {{GlrFault::kGyroStep, 0, 0}, 15, 0.01}};
+  const LoopRun run = simulate(seed, 30, faults, true);
+  nc::GlrConfig cfg;
+  cfg.window = 10;
+  nc::GlrMonitor glr(cfg);
+  for (const auto& e : run.epochs) ASSERT_TRUE(glr.update(e).valid);
+  const int k = 29;
+  ASSERT_EQ(glr.onsetCount(), 10);
+  const GlrHypothesis hyps[] = {{GlrFault::kAccelStep, 0, 0}, {GlrFault::kAccelStep, 2, 0},
+                                {GlrFault::kGyroStep, 0, 0},  {GlrFault::kGyroStep, 1, 0},
+                                {GlrFault::kRangeStep, 0, 3}, {GlrFault::kRangeRamp, 0, 9},
+                                {GlrFault::kRateStep, 0, 13}, {GlrFault::kRangeRamp, 0, 6}};
+  for (int age = 0; age < glr.onsetCount(); ++age) {
+    for (const auto& h : hyps) {
+      const auto got = glr.directionSums(age, h);
+      const auto want = bruteForce(seed, run, h, k - age, k);
+      EXPECT_NEAR(got.r, want.r, 1e-7 * std::max(1.0, std::abs(want.r)))
+          << nc::glrFaultName(h.fault) << " axis " << h.axis << " sv " << h.sv_id << " age " << age;
+      EXPECT_NEAR(got.f, want.f, 1e-7 * std::max(1.0, std::abs(want.f)))
+          << nc::glrFaultName(h.fault) << " axis " << h.axis << " sv " << h.sv_id << " age " << age;
+    }
+  }
+}
+
+TEST(Glr, GroupStatisticEqualsTheJointRegression) {
+  // The IMU group statistic is 1/2 f^T R^-1 f over the six bias directions jointly.
+  const std::uint64_t seed = 5;
+  const LoopRun run = simulate(seed, 25, {{{GlrFault::kAccelStep, 1, 0}, 14, 0.02}}, true);
+  nc::GlrConfig cfg;
+  cfg.window = 8;
+  nc::GlrMonitor glr(cfg);
+  for (const auto& e : run.epochs) glr.update(e);
+  const int k = 24, age = 5, onset = k - age;
+  std::vector<LoopRun> sigs;
+  for (int j = 0; j < 6; ++j) {
+    sigs.push_back(simulate(
+        seed, k + 1, {{{j < 3 ? GlrFault::kAccelStep : GlrFault::kGyroStep, j % 3, 0}, onset, 1.0}},
+        false));
+  }
+  Eigen::Matrix<double, 6, 6> R = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> f = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int i = onset; i <= k; ++i) {
+    const auto idx = static_cast<std::size_t>(i);
+    Eigen::MatrixXd rho(kRows, 6);
+    for (int j = 0; j < 6; ++j) rho.col(j) = sigs[static_cast<std::size_t>(j)].innovations[idx];
+    const Eigen::MatrixXd v_inv = run.epochs[idx].innovation_cov.inverse();
+    R += rho.transpose() * v_inv * rho;
+    f += rho.transpose() * v_inv * run.innovations[idx];
+  }
+  const double want = 0.5 * f.dot(R.ldlt().solve(f));
+  EXPECT_NEAR(glr.imuStatistic(age), want, 1e-6 * want);
+}
+
+TEST(Glr, LargeFaultsAreDetectedIsolatedAndSized) {
+  struct Case {
+    Fault fault;
+    nc::GlrSourceClass source;
+  };
+  const Case cases[] = {
+      {{{GlrFault::kRangeStep, 0, 6}, 20, 40.0}, nc::GlrSourceClass::kSatellite},
+      {{{GlrFault::kRangeRamp, 0, 13}, 20, 2.0}, nc::GlrSourceClass::kSatellite},
+      {{{GlrFault::kRateStep, 0, 3}, 20, 1.0}, nc::GlrSourceClass::kSatellite},
+      {{{GlrFault::kAccelStep, 2, 0}, 20, 0.5}, nc::GlrSourceClass::kImu},
+  };
+  for (const Case& c : cases) {
+    const LoopRun run = simulate(21, 40, {c.fault}, true);
+    nc::GlrMonitor glr;
+    nc::GlrResult detection, later;
+    int detected_at = -1;
+    for (std::size_t k = 0; k < run.epochs.size(); ++k) {
+      const auto& r = glr.update(run.epochs[k]);
+      if (r.detected && detected_at < 0) {
+        detection = r;
+        detected_at = static_cast<int>(k);
+      }
+      if (detected_at >= 0 && static_cast<int>(k) == detected_at + 10) later = r;
+    }
+    const std::string what = nc::glrFaultName(c.fault.h.fault);
+    ASSERT_TRUE(detection.detected) << what;
+    EXPECT_LE(detected_at, c.fault.onset_epoch + 3) << what;
+    // Isolated at detection: the source class and the direction.
+    EXPECT_EQ(detection.source, c.source) << what;
+    EXPECT_EQ(detection.candidates[0].hypothesis.sv_id, c.fault.h.sv_id) << what;
+    EXPECT_EQ(detection.candidates[0].hypothesis.axis, c.fault.h.axis) << what;
+    // The onset: the fault began after epoch onset - 1 (time onset * 1 s here), within 2.
+    EXPECT_NEAR(static_cast<double>(detection.onset_time_ns) / kSecond, c.fault.onset_epoch, 2.01)
+        << what;
+    // Ten epochs later the estimate has settled: the fault kind, magnitude within 10 % (the
+    // magnitudes are large against their standard errors 1 / sqrt(R*)), onset.
+    ASSERT_TRUE(later.detected) << what;
+    const nc::GlrCandidate& best = later.candidates[0];
+    EXPECT_EQ(best.hypothesis.fault, c.fault.h.fault) << what;
+    EXPECT_EQ(best.hypothesis.sv_id, c.fault.h.sv_id) << what;
+    EXPECT_EQ(best.hypothesis.axis, c.fault.h.axis) << what;
+    EXPECT_NEAR(best.magnitude, c.fault.magnitude, 0.1 * c.fault.magnitude) << what;
+    EXPECT_NEAR(static_cast<double>(later.onset_time_ns) / kSecond, c.fault.onset_epoch, 1.01)
+        << what;
+  }
+}
+
+TEST(Glr, StatisticIsChiSquareWithoutFault) {
+  // Under no fault, 2 l* of one direction at a fixed onset age is chi-square(1) and the IMU
+  // group's 2 l is chi-square(6): measured mean and 95 % quantile over 20 independent runs.
+  std::vector<double> scalar, group;
+  for (std::uint64_t seed = 100; seed < 120; ++seed) {
+    const LoopRun run = simulate(seed, 400, {}, true);
+    nc::GlrMonitor glr;
+    for (std::size_t k = 0; k < run.epochs.size(); ++k) {
+      glr.update(run.epochs[k]);
+      if (k < 40 || k % 20 != 0) continue;  // independent windows (M = 20)
+      const auto s = glr.directionSums(19, {GlrFault::kRangeStep, 0, 9});
+      scalar.push_back(s.f * s.f / s.r);
+      group.push_back(2.0 * glr.imuStatistic(19));
+    }
+  }
+  auto quantile = [](std::vector<double> v, double q) {
+    std::sort(v.begin(), v.end());
+    return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+  };
+  auto mean = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x;
+    return s / static_cast<double>(v.size());
+  };
+  ASSERT_GE(scalar.size(), 300u);
+  EXPECT_NEAR(mean(scalar), 1.0, 0.2);
+  EXPECT_NEAR(quantile(scalar, 0.95), 3.84, 1.0);
+  EXPECT_NEAR(mean(group), 6.0, 0.8);
+  EXPECT_NEAR(quantile(group, 0.95), 12.59, 2.5);
+}
+
+TEST(Glr, DependentDirectionsDoNotInflateTheStatistic) {
+  // One epoch after onset a pseudorange step and a ramp have the same signature: the group
+  // statistic counts them once (rank 2 of 3, with the rate step), and stays finite.
+  const LoopRun run = simulate(3, 12, {}, true);
+  nc::GlrMonitor glr;
+  for (const auto& e : run.epochs) glr.update(e);
+  const auto step = glr.directionSums(0, {GlrFault::kRangeStep, 0, 3});
+  const auto ramp = glr.directionSums(0, {GlrFault::kRangeRamp, 0, 3});
+  EXPECT_NEAR(step.r, ramp.r, 1e-12 * step.r);
+  const double l = glr.satelliteStatistic(0, 3);
+  EXPECT_TRUE(std::isfinite(l));
+  EXPECT_LT(l, 30.0);
+}
+
+TEST(Glr, RefusesBadEpochsAndCountsThem) {
+  const LoopRun run = simulate(4, 3, {}, true);
+  nc::GlrMonitor glr;
+  nc::GlrEpoch bad = run.epochs[0];
+  bad.innovation[2] = std::nan("");
+  EXPECT_FALSE(glr.update(bad).valid);
+  bad = run.epochs[0];
+  bad.innovation_cov(0, 0) = -1.0;
+  EXPECT_FALSE(glr.update(bad).valid);
+  bad = run.epochs[0];
+  bad.sv_id[0] = 40;
+  EXPECT_FALSE(glr.update(bad).valid);
+  EXPECT_EQ(glr.refused(), 3u);
+  EXPECT_TRUE(glr.update(run.epochs[0]).valid);
+  EXPECT_FALSE(glr.update(run.epochs[0]).valid);  // same time again: not after the previous
+  EXPECT_EQ(glr.refused(), 4u);
+}
