@@ -1,5 +1,6 @@
-// navbus-fault-manager's participant logic: stream watchdogs on every sensor stream, turned
-// into published fault decisions.
+// navbus-fault-manager's participant: owns the readers and writers and feeds the DDS-free
+// FaultPipeline (fault_pipeline.hpp). The DDS requested deadline and liveliness of the
+// watchdog readers time the stream watchdogs; the diagnostics reader feeds the GLR.
 #pragma once
 
 #include <cstdint>
@@ -9,34 +10,28 @@
 #include <fastdds/rtps/common/InstanceHandle.h>
 #include <navbus_idl/FaultPubSubTypes.h>
 
+#include "fault_pipeline.hpp"
 #include "navbus/bus/participant.hpp"
-#include "navbus/bus/validation.hpp"
-#include "stream_watchdog.hpp"
 
 namespace navbus::fault_manager {
 
 class FaultManagerNode {
  public:
-  explicit FaultManagerNode(bus::Participant& participant);
-  std::string summary() const;
+  FaultManagerNode(bus::Participant& participant, const FaultManagerConfig& config);
+  std::string summary() const { return pipeline_.summary(); }
 
  private:
   template <class PubSubType, class IdFn, class TimeFn>
   void watch(const std::string& topic, const std::string& profile, StreamKind kind, IdFn id,
              TimeFn time);
-  void publish(const WatchdogEvent& e);
 
   bus::Participant& participant_;
-  StreamWatchdog watchdog_;
-  std::map<StreamKind, bus::SequenceTracker> trackers_;
   bus::Writer<navbus::FaultDecision> decision_writer_;
-  std::map<StreamKind, double> deadline_s_;
+  bus::Writer<navbus::FilterCommand> command_writer_;
+  FaultPipeline pipeline_;
   /// DDS instance handle -> sensor id, per stream kind (deadline statuses name the instance).
   std::map<std::pair<StreamKind, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>
       instances_;
-  std::uint32_t next_decision_id_{1};
-  std::uint64_t lost_decisions_{0};
-  std::uint64_t restored_decisions_{0};
 };
 
 }  // namespace navbus::fault_manager

@@ -1,4 +1,6 @@
-// navbus-fault-manager: stream watchdogs on every sensor stream, publishing fault decisions.
+// navbus-fault-manager: stream watchdogs and the GLR of seed 000 on the filter's diagnostics,
+// publishing decisions (facts) and filter commands (requests).
+#include "fault_config.hpp"
 #include "fault_manager_node.hpp"
 #include "navbus/bus/app.hpp"
 
@@ -7,7 +9,8 @@ namespace nb = navbus;
 int main(int argc, char** argv) {
   nb::bus::ShutdownSignal shutdown;
   CLI::App app{
-      "navbus-fault-manager: sensor stream watchdogs and fault decisions on the navbus DDS bus",
+      "navbus-fault-manager: stream watchdogs and GLR fault detection and isolation (seed 000) "
+      "on the navbus DDS bus; publishes fault decisions and filter commands",
       "navbus-fault-manager"};
   nb::bus::CommonOptions common;
   nb::bus::addCommonOptions(app, common, false);
@@ -15,10 +18,13 @@ int main(int argc, char** argv) {
       "Exit codes: 0 stopped by SIGINT/SIGTERM, 1 runtime error, 2 configuration error, 3 DDS "
       "error.");
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) {
+    const nb::fault_manager::FaultManagerConfig config =
+        nb::fault_manager::parseFaultManagerConfig(yaml);
     nb::bus::Participant participant(
         nb::bus::participantOptions(common, yaml, "navbus-fault-manager"), shutdown);
-    nb::fault_manager::FaultManagerNode node(participant);
-    spdlog::info("running: watching IMU, raw IMU, GNSS and star-tracker streams");
+    nb::fault_manager::FaultManagerNode node(participant, config);
+    spdlog::info("running: watching IMU, raw IMU, GNSS and star-tracker streams; GLR {}",
+                 config.glr.enabled ? "on navbus/nav/diagnostics" : "disabled");
     participant.run();
     spdlog::info("summary: {}\n{}", node.summary(), participant.health().summary());
     return static_cast<int>(nb::bus::kExitOk);

@@ -53,6 +53,23 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       seconds(bus::checkRange(bus::get<double>(root, "", "sequencer_max_wait_s", 0.5), 0.001, 60.0,
                               "sequencer_max_wait_s"));
 
+  const YAML::Node rec = root["recovery"];
+  c.recovery_history_ns = seconds(bus::checkRange(
+      bus::get<double>(rec, "recovery", "history_s", 40.0), 0.0, 600.0, "recovery.history_s"));
+  c.recovery_snapshot_period_ns =
+      seconds(bus::checkRange(bus::get<double>(rec, "recovery", "snapshot_period_s", 1.0), 0.01,
+                              60.0, "recovery.snapshot_period_s"));
+  c.recovery_onset_margin_ns =
+      seconds(bus::checkRange(bus::get<double>(rec, "recovery", "exclusion_margin_s", 5.0), 0.0,
+                              60.0, "recovery.exclusion_margin_s"));
+  c.max_accel_compensation_mps2 =
+      bus::checkRange(bus::get<double>(rec, "recovery", "max_accel_compensation_mg", 50.0), 0.0,
+                      1e4, "recovery.max_accel_compensation_mg") *
+      9.80665e-3;
+  c.max_gyro_compensation_radps =
+      bus::checkRange(bus::get<double>(rec, "recovery", "max_gyro_compensation_deg_per_h", 200.0),
+                      0.0, 1e6, "recovery.max_gyro_compensation_deg_per_h") *
+      M_PI / 180.0 / 3600.0;
   c.solution_writer_profile =
       bus::get<std::string>(root, "", "solution_writer_profile", c.solution_writer_profile);
   const YAML::Node init = root["initial_state"];

@@ -25,6 +25,15 @@ struct FilterConfig {
   std::optional<InputConfig> gnss_fix;
   std::optional<InputConfig> star_tracker;
   std::int64_t sequencer_max_wait_ns{500'000'000};
+  /// Recovery from a fault found late (input_history.hpp): data kept to restore the filter
+  /// to before a fault's onset [ns] (0: off), and the spacing of the engine snapshots.
+  std::int64_t recovery_history_ns{40'000'000'000};
+  std::int64_t recovery_snapshot_period_ns{1'000'000'000};
+  /// A satellite is excluded from this long before the estimated onset [ns].
+  std::int64_t recovery_onset_margin_ns{5'000'000'000};
+  /// Largest bias a CMD_COMPENSATE_BIAS may add [m/s^2, rad/s]; beyond, refused.
+  double max_accel_compensation_mps2{0.5};
+  double max_gyro_compensation_radps{1e-3};
   /// QoS profile of the solution writer (qos/navbus_qos.xml): navbus_solution_writer, or
   /// navbus_solution_writer_lossless for recording fast-paced runs.
   std::string solution_writer_profile{bus::profile::kSolutionWriter};

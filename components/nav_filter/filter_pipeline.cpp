@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include <spdlog/spdlog.h>
 
@@ -20,6 +21,7 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   if (c.gnss_fix) s.push_back({{kRankGnssFix, c.gnss_fix->id}, c.gnss_fix->period_ns});
   if (c.star_tracker)
     s.push_back({{kRankStarTracker, c.star_tracker->id}, c.star_tracker->period_ns});
+  s.push_back({{kRankCommand, 0}, 0, true});
   return s;
 }
 
@@ -78,6 +80,7 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
     : config_(config),
       sinks_(std::move(sinks)),
       sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
+      history_(config.recovery_history_ns, config.recovery_snapshot_period_ns),
       engine_(config.engine),
       imu_gate_(bus::topic::kImuIncrement, health.stream(bus::topic::kImuIncrement)),
       gnss_obs_gate_(bus::topic::kGnssObservations, health.stream(bus::topic::kGnssObservations)),
@@ -123,7 +126,7 @@ void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
 void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
   if (!admit(gnss_obs_gate_, m, m.receiver_id(), config_.gnss_observations)) return;
   queue(gnss_obs_gate_, {kRankGnssObs, m.receiver_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
-        GnssEpochInput{bus::toCore(m)});
+        GnssEpochInput{static_cast<std::int64_t>(m.time_gps_ns()), bus::toCore(m)});
 }
 
 void FilterPipeline::onGnssFix(const navbus::GnssFix& m) {
@@ -139,8 +142,9 @@ void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
 }
 
 void FilterPipeline::pump(std::int64_t now_ns) {
-  sequencer_.release(now_ns,
-                     [this](StreamId, std::int64_t, const FilterInput& in) { process(in); });
+  sequencer_.release(now_ns, [this](StreamId, std::int64_t time_ns, const FilterInput& in) {
+    process(time_ns, in);
+  });
 }
 
 void FilterPipeline::flush(std::int64_t now_ns) {
@@ -152,15 +156,26 @@ void FilterPipeline::flush(std::int64_t now_ns) {
   }
 }
 
-void FilterPipeline::process(const FilterInput& input) {
+std::int64_t FilterPipeline::timeOf(const FilterInput& input) {
+  return std::visit([](const auto& in) -> std::int64_t { return in.time_ns; }, input);
+}
+
+void FilterPipeline::process(std::int64_t time_ns, const FilterInput& input) {
+  if (const auto* cmd = std::get_if<CommandInput>(&input); cmd != nullptr && !replaying_) {
+    executeCommand(cmd->command);  // checks, records and applies it (or restores and replays)
+    return;
+  }
+  history_.record(time_ns, input, engine_);
   if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {
-    if (engine_.addImu(*inc)) publishSolution();
+    if (engine_.addImu(*inc) && !replaying_) publishSolution();
   } else if (const auto* epoch = std::get_if<GnssEpochInput>(&input)) {
-    if (engine_.addGnssEpoch(epoch->satellites)) publishDiagnostics();
+    if (engine_.addGnssEpoch(epoch->satellites) && !replaying_) publishDiagnostics();
   } else if (const auto* fix = std::get_if<core::GnssFixMeasurement>(&input)) {
     engine_.addGnssFix(*fix);
   } else if (const auto* st = std::get_if<core::StarAttitudeMeasurement>(&input)) {
     engine_.addStarAttitude(*st);
+  } else if (const auto* cmd = std::get_if<CommandInput>(&input)) {
+    applyToEngine(cmd->command);  // re-processed after a rollback: checked when it first came
   }
 }
 
@@ -172,26 +187,13 @@ void FilterPipeline::publishDiagnostics() {
   msg.seq(++diagnostics_seq_);
   msg.time_gps_ns(static_cast<std::uint64_t>(engine_.state().time_ns));
   const auto m = static_cast<std::uint16_t>(d.h.rows());
-  msg.n(static_cast<std::uint16_t>(core::tc17::kSize));
+  bus::fillTc17Layout(msg);
   msg.m(m);
-  const std::pair<const char*, core::StateBlock> blocks[] = {
-      {"pos_ned", core::tc17::kPos},           {"vel_ned", core::tc17::kVel},
-      {"phi_ned", core::tc17::kAtt},           {"accel_bias", core::tc17::kAccelBias},
-      {"gyro_bias", core::tc17::kGyroBias},    {"clock_bias", core::tc17::kClockBias},
-      {"clock_drift", core::tc17::kClockDrift}};
-  const char* units[] = {"m", "m/s", "rad", "m/s^2", "rad/s", "m", "m/s"};
-  for (std::size_t i = 0; i < 7; ++i) {
-    navbus::StateBlock b;
-    b.name(blocks[i].first);
-    b.index(static_cast<std::uint16_t>(blocks[i].second.index));
-    b.dof(static_cast<std::uint16_t>(blocks[i].second.dof));
-    b.unit(units[i]);
-    msg.state_layout().push_back(b);
-  }
   for (std::size_t r = 0; r < m; ++r) {
     navbus::MeasurementRow row;
     row.kind(d.is_rate[r] ? navbus::MEAS_PSEUDORANGE_RATE : navbus::MEAS_PSEUDORANGE);
     row.sv_id(static_cast<std::uint16_t>(d.sv_ids[r]));
+    row.used(d.used[r]);
     msg.rows().push_back(row);
     msg.innovation().push_back(d.innovation[static_cast<Eigen::Index>(r)]);
     msg.test_ratio().push_back(d.test_ratio[r]);
@@ -249,11 +251,21 @@ bool FilterPipeline::degraded() const {
 }
 
 void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
+  // Decisions are facts (idl/Fault.idl): the filter acts on commands only. It counts what it
+  // saw so that the summary shows decisions that came without a command.
+  ++decisions_seen_;
+  spdlog::info("decision {} ({}): event {} source {} sv {} axis {} statistic {:.4g} / {:.4g}",
+               d.decision_id(), d.detector(), static_cast<int>(d.event()),
+               static_cast<int>(d.source()), d.sv_id(), d.axis(), d.test_statistic(),
+               d.threshold());
+}
+
+bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
   std::uint32_t flag = 0;
   bool is_imu = false;
-  switch (d.source()) {
+  switch (c.sensor()) {
     case navbus::SOURCE_IMU_STREAM:
-      if (d.sensor_id() != config_.imu.id) return;
+      if (c.sensor_id() != config_.imu.id) return false;
       flag = navbus::FAULT_IMU_STREAM_LOST;
       is_imu = true;
       break;
@@ -268,70 +280,68 @@ void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
       flag = navbus::FAULT_ST_STREAM_LOST;
       break;
     default:
-      spdlog::warn("decision {} ({}) concerns a detector this filter does not use; ignored",
-                   d.decision_id(), d.detector());
-      return;
+      return false;
   }
-  ++decisions_applied_;
-  if (d.action() == navbus::ACTION_STREAM_LOST) {
+  if (c.kind() == navbus::CMD_EXCLUDE_STREAM) {
     stream_flags_ |= flag;
     if (is_imu) {
       sequencer_.setActive({kRankImu, config_.imu.id}, false);
       engine_.markInertialLost();
     }
-    spdlog::warn("decision {} ({}): stream source {} id {} lost; flags 0x{:x}", d.decision_id(),
-                 d.detector(), static_cast<int>(d.source()), d.sensor_id(), stream_flags_);
-  } else if (d.action() == navbus::ACTION_STREAM_RESTORED) {
+  } else {
     stream_flags_ &= ~flag;
-    spdlog::info("decision {} ({}): stream source {} id {} restored; flags 0x{:x}", d.decision_id(),
-                 d.detector(), static_cast<int>(d.source()), d.sensor_id(), stream_flags_);
   }
+  spdlog::log(c.kind() == navbus::CMD_EXCLUDE_STREAM ? spdlog::level::warn : spdlog::level::info,
+              "stream source {} id {} {}; flags 0x{:x}", static_cast<int>(c.sensor()),
+              c.sensor_id(), c.kind() == navbus::CMD_EXCLUDE_STREAM ? "lost" : "restored",
+              stream_flags_);
   publishHeldSolution();
+  return true;
 }
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c) {
   if (c.vehicle_id() != config_.vehicle_id) return;  // for another vehicle: not ours
-  bool applied = true;
-  std::string why = "bad field";
-  switch (c.kind()) {
-    case navbus::CMD_EXCLUDE_SATELLITE:
-      engine_.excludeSatellite(c.sv_id());
-      break;
-    case navbus::CMD_READMIT_SATELLITE:
-      engine_.readmitSatellite(c.sv_id());
-      break;
-    case navbus::CMD_COMPENSATE_BIAS:
-      if (c.axis() > 2 || !std::isfinite(c.bias()) ||
-          (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)) {
-        applied = false;
-        break;
-      }
-      engine_.compensateBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias());
-      break;
-    case navbus::CMD_SELECT_FUSION:
-      switch (c.fusion()) {
-        case navbus::FUSION_CENTRALIZED:
-          applied = engine_.selectFusion(core::FusionStructure::kCentralized);
-          break;
-        case navbus::FUSION_FEDERATED:
-          applied = engine_.selectFusion(core::FusionStructure::kFederated);
-          break;
-        case navbus::FUSION_ADAPTIVE:
-          applied = engine_.selectFusion(core::FusionStructure::kAdaptive);
-          break;
-        default:
-          applied = config_.engine.aiding == core::AidingMode::kInertialOnly;
-      }
-      why = "fusion structure not available in the configured mode";
-      break;
-    case navbus::CMD_SELECT_MODE:
-      // The aiding mode follows the configured inputs; only the current one is accepted.
-      applied = c.mode() == toIdl(engine_.mode());
-      why = "aiding mode is set by the configuration";
-      break;
-    case navbus::CMD_RESET:
-      engine_.reset();
-      break;
+  if (c.kind() == navbus::CMD_EXCLUDE_STREAM || c.kind() == navbus::CMD_READMIT_STREAM) {
+    // About the merge itself (a lost stream must stop holding it): at once.
+    const bool applied = applyStreamCommand(c);
+    (applied ? commands_applied_ : commands_refused_)++;
+    if (!applied)
+      spdlog::warn(
+          "command {} from '{}' refused: stream source {} id {} is not a stream of this "
+          "filter",
+          c.command_id(), c.issuer(), static_cast<int>(c.sensor()), c.sensor_id());
+    return;
+  }
+  const auto time_ns = static_cast<std::int64_t>(c.time_gps_ns());
+  if (time_ns > 0 && sequencer_.push({kRankCommand, 0}, time_ns, CommandInput{time_ns, c}) ==
+                         InputSequencer<FilterInput>::PushResult::kQueued) {
+    return;  // takes effect in order, at its data time
+  }
+  if (time_ns > 0) ++commands_late_;
+  executeCommand(c);
+}
+
+void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
+  std::string why;
+  bool applied = false;
+  if (auto refusal = checkCommand(c)) {
+    why = *refusal;
+  } else if (recoversFromOnset(c) && history_.rollback(restorePoint(c), engine_, replay_)) {
+    // Restored to before the onset: the command applies there, and what followed is
+    // re-processed without the fault (nothing is published meanwhile: those solutions went out).
+    const std::int64_t restored_ns = engine_.state().time_ns;
+    history_.record(restored_ns, CommandInput{restored_ns, c}, engine_);
+    applied = applyToEngine(c);
+    replaying_ = true;
+    for (const FilterInput& item : replay_) process(timeOf(item), item);
+    replaying_ = false;
+    spdlog::warn("command {}: filter restored to {:.3f} s (onset {:.3f} s), {} inputs re-processed",
+                 c.command_id(), 1e-9 * static_cast<double>(restored_ns),
+                 1e-9 * static_cast<double>(c.onset_time_gps_ns()), replay_.size());
+  } else {
+    history_.record(engine_.state().time_ns, CommandInput{engine_.state().time_ns, c}, engine_);
+    applied = applyToEngine(c);
+    why = "not available in the configured mode";
   }
   if (applied) {
     ++commands_applied_;
@@ -344,6 +354,97 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c) {
   }
 }
 
+core::SatelliteScope toCore(navbus::SatelliteScope s) {
+  switch (s) {
+    case navbus::SCOPE_PSEUDORANGE:
+      return core::SatelliteScope::kRange;
+    case navbus::SCOPE_PSEUDORANGE_RATE:
+      return core::SatelliteScope::kRate;
+    default:
+      return core::SatelliteScope::kAll;
+  }
+}
+
+std::int64_t FilterPipeline::restorePoint(const navbus::FilterCommand& c) const {
+  // The onset is an estimate: a satellite is excluded from a margin before it (using one
+  // satellite fewer for a few seconds costs little); a bias is compensated from the onset
+  // itself (earlier would add the bias where there was none).
+  const auto onset = static_cast<std::int64_t>(c.onset_time_gps_ns());
+  return c.kind() == navbus::CMD_EXCLUDE_SATELLITE ? onset - config_.recovery_onset_margin_ns
+                                                   : onset;
+}
+
+bool FilterPipeline::recoversFromOnset(const navbus::FilterCommand& c) const {
+  return history_.enabled() && c.onset_time_gps_ns() > 0 &&
+         (c.kind() == navbus::CMD_EXCLUDE_SATELLITE || c.kind() == navbus::CMD_COMPENSATE_BIAS ||
+          c.kind() == navbus::CMD_RELEARN_BIAS);
+}
+
+std::optional<std::string> FilterPipeline::checkCommand(const navbus::FilterCommand& c) const {
+  switch (c.kind()) {
+    case navbus::CMD_EXCLUDE_SATELLITE:
+    case navbus::CMD_READMIT_SATELLITE:
+      if (c.sv_id() < 1 || c.sv_id() > 32) return fmt::format("sv_id {} outside 1..32", c.sv_id());
+      return std::nullopt;
+    case navbus::CMD_COMPENSATE_BIAS:
+    case navbus::CMD_RELEARN_BIAS: {
+      if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
+        return fmt::format("sensor {} is not an accelerometer or gyro",
+                           static_cast<int>(c.sensor()));
+      if (c.axis() > 2) return fmt::format("axis {} outside 0..2", c.axis());
+      const bool accel = c.sensor() == navbus::SOURCE_ACCELEROMETER;
+      const double limit =
+          accel ? config_.max_accel_compensation_mps2 : config_.max_gyro_compensation_radps;
+      if (!std::isfinite(c.bias_sigma()) || c.bias_sigma() < 0.0 || c.bias_sigma() > limit)
+        return fmt::format("bias_sigma {} outside 0..{}", c.bias_sigma(), limit);
+      if (!std::isfinite(c.bias()) || std::abs(c.bias()) > limit)
+        return fmt::format(
+            "bias {} outside +-{} ({})", c.bias(), limit,
+            accel ? "m/s^2, max_accel_compensation_mg" : "rad/s, max_gyro_compensation_deg_per_h");
+      return std::nullopt;
+    }
+    default:
+      return std::nullopt;
+  }
+}
+
+bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
+  switch (c.kind()) {
+    case navbus::CMD_EXCLUDE_SATELLITE:
+      engine_.excludeSatellite(c.sv_id(), toCore(c.scope()));
+      return true;
+    case navbus::CMD_READMIT_SATELLITE:
+      engine_.readmitSatellite(c.sv_id(), toCore(c.scope()));
+      return true;
+    case navbus::CMD_RELEARN_BIAS:
+      engine_.relearnBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias_sigma());
+      return true;
+    case navbus::CMD_COMPENSATE_BIAS:
+      engine_.compensateBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias(),
+                             c.bias_sigma());
+      return true;
+    case navbus::CMD_SELECT_FUSION:
+      switch (c.fusion()) {
+        case navbus::FUSION_CENTRALIZED:
+          return engine_.selectFusion(core::FusionStructure::kCentralized);
+        case navbus::FUSION_FEDERATED:
+          return engine_.selectFusion(core::FusionStructure::kFederated);
+        case navbus::FUSION_ADAPTIVE:
+          return engine_.selectFusion(core::FusionStructure::kAdaptive);
+        default:
+          return config_.engine.aiding == core::AidingMode::kInertialOnly;
+      }
+    case navbus::CMD_SELECT_MODE:
+      // The aiding mode follows the configured inputs; only the current one is accepted.
+      return c.mode() == toIdl(engine_.mode());
+    case navbus::CMD_RESET:
+      engine_.reset();
+      return true;
+    default:
+      return false;
+  }
+}
+
 std::string FilterPipeline::summary() const {
   const core::EngineCounters& n = engine_.counters();
   std::ostringstream out;
@@ -352,9 +453,11 @@ std::string FilterPipeline::summary() const {
       << ", GNSS epochs fused " << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
       << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
       << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
-      << ", stage switches " << n.stage_switches << ", decisions applied " << decisions_applied_
-      << ", commands applied " << commands_applied_ << " refused " << commands_refused_
-      << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending();
+      << ", stage switches " << n.stage_switches << ", decisions seen " << decisions_seen_
+      << ", commands applied " << commands_applied_ << " refused " << commands_refused_ << " late "
+      << commands_late_ << ", sequencer timeouts " << sequencer_.timeouts() << ", pending "
+      << sequencer_.pending() << ", recoveries from onset " << history_.rollbacks()
+      << " (onset beyond history " << history_.outOfReach() << ")";
   return out.str();
 }
 

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -18,6 +20,7 @@
 #include <navbus_idl/StarTracker.h>
 
 #include "filter_config.hpp"
+#include "input_history.hpp"
 #include "input_sequencer.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/validation.hpp"
@@ -25,16 +28,30 @@
 
 namespace navbus::nav_filter {
 
-/// Stream ranks: at equal times the increment is integrated before measurements are used.
-enum StreamRank : int { kRankImu = 0, kRankGnssObs = 1, kRankGnssFix = 2, kRankStarTracker = 3 };
+/// Stream ranks: at equal times the increment is integrated before measurements are used, and
+/// a command follows the measurements of its data time (the epoch its decision was taken at).
+enum StreamRank : int {
+  kRankImu = 0,
+  kRankGnssObs = 1,
+  kRankGnssFix = 2,
+  kRankStarTracker = 3,
+  kRankCommand = 4
+};
 
 /// A validated GNSS observation epoch: satellite clock corrections applied.
 struct GnssEpochInput {
+  std::int64_t time_ns{0};
   std::vector<core::SatelliteObservation> satellites;
 };
 
+/// A command to the engine, at its data time (FilterCommand::time_gps_ns).
+struct CommandInput {
+  std::int64_t time_ns{0};
+  navbus::FilterCommand command;
+};
+
 using FilterInput = std::variant<core::ImuIncrement, GnssEpochInput, core::GnssFixMeasurement,
-                                 core::StarAttitudeMeasurement>;
+                                 core::StarAttitudeMeasurement, CommandInput>;
 
 class FilterPipeline {
  public:
@@ -49,9 +66,14 @@ class FilterPipeline {
   void onGnssObservations(const navbus::GnssObservationEpoch& msg);
   void onGnssFix(const navbus::GnssFix& msg);
   void onStarTracker(const navbus::StarTrackerAttitude& msg);
+  /// Decisions are facts: counted and logged, never acted on (commands are).
   void onDecision(const navbus::FaultDecision& d);
-  /// Applies a command; a refused one (wrong field, not available in this mode) is logged and
-  /// counted in the summary.
+  /// A command: stream commands act at once; engine commands enter the deterministic order at
+  /// their data time (a sporadic stream: they never hold the merge up). A command whose time
+  /// has already been passed is late: it acts at once, and one that answers a fault with an
+  /// estimated onset restores the filter to before the onset and re-processes what followed
+  /// (input_history.hpp), so the state afterwards is the same as if it had come in time. A
+  /// refused one (wrong field, not available in this mode) is logged and counted.
   void onCommand(const navbus::FilterCommand& c);
 
   /// Processes every input that can no longer be preceded by another; `now_ns` is the clock
@@ -73,13 +95,24 @@ class FilterPipeline {
   bool admit(bus::StreamGate& gate, const Sample& msg, std::uint32_t id,
              const std::optional<InputConfig>& expected);
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
-  void process(const FilterInput& input);
+  void process(std::int64_t time_ns, const FilterInput& input);
+  static std::int64_t timeOf(const FilterInput& input);
+  /// Why a command cannot be applied (field and value), or nothing.
+  std::optional<std::string> checkCommand(const navbus::FilterCommand& c) const;
+  bool applyToEngine(const navbus::FilterCommand& c);
+  void executeCommand(const navbus::FilterCommand& c);
+  bool recoversFromOnset(const navbus::FilterCommand& c) const;
+  std::int64_t restorePoint(const navbus::FilterCommand& c) const;
   void publishSolution();
   void publishDiagnostics();
+  bool applyStreamCommand(const navbus::FilterCommand& c);
 
   FilterConfig config_;
   Sinks sinks_;
   InputSequencer<FilterInput> sequencer_;
+  InputHistory<FilterInput> history_;
+  std::deque<FilterInput> replay_;
+  bool replaying_{false};
   core::NavigationEngine engine_;
   bus::StreamGate imu_gate_;
   bus::StreamGate gnss_obs_gate_;
@@ -88,11 +121,14 @@ class FilterPipeline {
   std::uint32_t stream_flags_{0};  ///< FAULT_*_STREAM_LOST bits: facts from decisions
   std::uint64_t solution_seq_{0};
   std::uint64_t diagnostics_seq_{0};
-  std::uint64_t decisions_applied_{0};
+  std::uint64_t decisions_seen_{0};
   std::uint64_t commands_applied_{0};
   std::uint64_t commands_refused_{0};
+  std::uint64_t commands_late_{0};
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
 };
+
+core::SatelliteScope toCore(navbus::SatelliteScope s);
 
 /// IDL names of the engine's modes and structures.
 navbus::FilterMode toIdl(core::EngineMode mode);

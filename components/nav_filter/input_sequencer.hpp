@@ -7,7 +7,9 @@
 // lets a 100 Hz IMU run ahead of a 1 Hz receiver without waiting a whole second. A stream that
 // holds the head back for longer than `max_wait` (wall time) is set aside until it delivers
 // again: the bounded wait that keeps a dead sensor from stalling navigation (counted in
-// timeouts()). A stream is also set aside when it is declared lost.
+// timeouts()). A stream is also set aside when it is declared lost. A sporadic stream (commands)
+// promises nothing and holds nothing back: its samples are ordered by their time when they
+// arrive before that time has been passed, and are late otherwise.
 // Pure logic: the caller supplies wall time.
 #pragma once
 
@@ -35,13 +37,16 @@ class InputSequencer {
   struct ExpectedStream {
     StreamId id;
     std::int64_t period_ns;  ///< promise: consecutive samples are at least this far apart
+    /// Sporadic: no promise at all (e.g. commands). Its samples take their place in the order
+    /// when they arrive in time, but it never holds the others back.
+    bool sporadic{false};
   };
   enum class PushResult { kQueued, kLate, kUnexpected };
 
   InputSequencer(std::vector<ExpectedStream> expected, std::int64_t max_wait_ns)
       : max_wait_ns_(max_wait_ns) {
     for (const auto& e : expected) {
-      streams_.emplace(e.id, State{e.period_ns});
+      streams_.emplace(e.id, State{e.period_ns, e.sporadic});
     }
   }
 
@@ -112,6 +117,7 @@ class InputSequencer {
   };
   struct State {
     std::int64_t period_ns;
+    bool sporadic{false};
     bool seen{false};
     bool active{true};
     std::int64_t last_time_ns{0};
@@ -121,7 +127,7 @@ class InputSequencer {
   std::vector<StreamId> blockingStreams(const Key& key) const {
     std::vector<StreamId> out;
     for (const auto& [id, s] : streams_) {
-      if (id == key.stream || !s.active) continue;
+      if (id == key.stream || !s.active || s.sporadic) continue;
       const Key earliest_next{s.last_time_ns + s.period_ns, id};
       if (!s.seen || earliest_next < key) out.push_back(id);
     }

@@ -1,6 +1,7 @@
 #include "frame_publisher.hpp"
 
 #include <cmath>
+#include <type_traits>
 
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
@@ -105,7 +106,7 @@ template <class Sample>
 bool FramePublisher::writeReliably(bus::Writer<Sample>& writer, const Sample& sample) {
   while (!writer.write(sample)) {
     // max_blocking_time elapsed with the history full: a reliable reader is behind.
-    ++counts_.write_retries;
+    ++write_retries_;
     if (participant_.stopping()) {
       return false;
     }
@@ -114,29 +115,16 @@ bool FramePublisher::writeReliably(bus::Writer<Sample>& writer, const Sample& sa
 }
 
 bool FramePublisher::publish(const sim::SensorFrame& f) {
-  // Order within a frame: the increment first, then the measurements valid at its end time.
-  const std::uint64_t k = counts_.imu + 1;
-  if (!writeReliably(imu_, bus::toIdl(f.increment, config_.imu_sensor_id, k))) return false;
-  ++counts_.imu;
-  if (config_.publish_raw) {
-    if (!writeReliably(raw_, toIdl(f.raw, config_.imu_sensor_id, counts_.raw + 1))) return false;
-    ++counts_.raw;
-  }
-  if (config_.publish_gnss && f.has_gnss) {
-    if (!writeReliably(gnss_, toIdl(f.gnss, config_.gnss_receiver_id, counts_.gnss_epochs + 1)))
-      return false;
-    ++counts_.gnss_epochs;
-    if (!writeReliably(fix_, toIdl(f.fix, config_.gnss_receiver_id, counts_.gnss_fixes + 1)))
-      return false;
-    ++counts_.gnss_fixes;
-  }
-  if (config_.publish_star_tracker && f.has_star_tracker) {
-    if (!writeReliably(star_,
-                       toIdl(f.star_tracker, config_.star_tracker_id, counts_.star_tracker + 1)))
-      return false;
-    ++counts_.star_tracker;
-  }
-  return true;
+  return emitFrame(f, config_, counts_, [this](const auto& sample) {
+    using T = std::decay_t<decltype(sample)>;
+    if constexpr (std::is_same_v<T, navbus::ImuIncrement>) return writeReliably(imu_, sample);
+    if constexpr (std::is_same_v<T, navbus::ImuRawBlock>) return writeReliably(raw_, sample);
+    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
+      return writeReliably(gnss_, sample);
+    if constexpr (std::is_same_v<T, navbus::GnssFix>) return writeReliably(fix_, sample);
+    if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>)
+      return writeReliably(star_, sample);
+  });
 }
 
 bool FramePublisher::readersMatched() const {

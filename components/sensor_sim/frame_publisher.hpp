@@ -10,6 +10,7 @@
 #include <navbus_idl/ImuPubSubTypes.h>
 #include <navbus_idl/StarTrackerPubSubTypes.h>
 
+#include "navbus/bus/conversions.hpp"
 #include "navbus/bus/participant.hpp"
 #include "navbus/sim/samples.hpp"
 #include "scenario_config.hpp"
@@ -24,6 +25,37 @@ navbus::GnssFix toIdl(const sim::GnssFixSample& fix, std::uint32_t receiver_id, 
 navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_t tracker_id,
                                   std::uint64_t seq);
 
+/// Sequence numbers of the last samples emitted per stream.
+struct FrameSequence {
+  std::uint64_t imu{0}, raw{0}, gnss_epochs{0}, gnss_fixes{0}, star_tracker{0};
+};
+
+/// The bus samples of one simulator frame, in emit order (the increment first, then the raw
+/// block, then the measurements valid at its end time), with their sequence numbers: the one
+/// definition of what the simulator participant publishes, shared by FramePublisher and
+/// `navbus offline`. `emit(sample)` returns false to stop; the sequence advances per sample
+/// emitted. Returns false if stopped.
+template <class Emit>
+bool emitFrame(const sim::SensorFrame& f, const SimConfig& c, FrameSequence& seq, Emit&& emit) {
+  if (!emit(bus::toIdl(f.increment, c.imu_sensor_id, seq.imu + 1))) return false;
+  ++seq.imu;
+  if (c.publish_raw) {
+    if (!emit(toIdl(f.raw, c.imu_sensor_id, seq.raw + 1))) return false;
+    ++seq.raw;
+  }
+  if (c.publish_gnss && f.has_gnss) {
+    if (!emit(toIdl(f.gnss, c.gnss_receiver_id, seq.gnss_epochs + 1))) return false;
+    ++seq.gnss_epochs;
+    if (!emit(toIdl(f.fix, c.gnss_receiver_id, seq.gnss_fixes + 1))) return false;
+    ++seq.gnss_fixes;
+  }
+  if (c.publish_star_tracker && f.has_star_tracker) {
+    if (!emit(toIdl(f.star_tracker, c.star_tracker_id, seq.star_tracker + 1))) return false;
+    ++seq.star_tracker;
+  }
+  return true;
+}
+
 class FramePublisher {
  public:
   FramePublisher(bus::Participant& participant, const SimConfig& config);
@@ -37,10 +69,9 @@ class FramePublisher {
   /// Waits (bounded) until every written sample is acknowledged by the reliable readers.
   void flush();
 
-  struct Counts {
-    std::uint64_t imu{0}, raw{0}, gnss_epochs{0}, gnss_fixes{0}, star_tracker{0}, write_retries{0};
-  };
-  const Counts& counts() const { return counts_; }
+  /// Samples written per stream, and writes retried because a reliable reader was behind.
+  const FrameSequence& counts() const { return counts_; }
+  std::uint64_t writeRetries() const { return write_retries_; }
 
  private:
   template <class Sample>
@@ -53,7 +84,8 @@ class FramePublisher {
   bus::Writer<navbus::GnssObservationEpoch> gnss_;
   bus::Writer<navbus::GnssFix> fix_;
   bus::Writer<navbus::StarTrackerAttitude> star_;
-  Counts counts_;
+  FrameSequence counts_;
+  std::uint64_t write_retries_{0};
 };
 
 }  // namespace navbus::sensor_sim

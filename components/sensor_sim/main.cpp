@@ -124,7 +124,8 @@ int main(int argc, char** argv) {
         "summary: published {} IMU increments, {} raw blocks, {} GNSS epochs, {} GNSS fixes, "
         "{} star-tracker attitudes ({:.3f} s of data), {} write retries",
         n.imu, n.raw, n.gnss_epochs, n.gnss_fixes, n.star_tracker,
-        static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9, n.write_retries);
+        static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9,
+        publisher.writeRetries());
     return static_cast<int>(nb::bus::kExitOk);
   });
 }

@@ -1,14 +1,19 @@
 #include "evaluation.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <mutex>
+#include <thread>
 
 #include <spdlog/spdlog.h>
 
+#include "fault_config.hpp"
+#include "fault_evaluation.hpp"
 #include "formatters.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
@@ -22,8 +27,11 @@ namespace {
 constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
 
 OfflineSetup loadSetup(const std::string& scenario, const YAML::Node& filter_yaml,
-                       std::uint64_t seed, double duration_s) {
+                       std::uint64_t seed, double duration_s,
+                       const std::string& fault_manager = "") {
   OfflineSetup s;
+  if (!fault_manager.empty())
+    s.fault_manager = fault_manager::parseFaultManagerConfig(bus::loadYamlFile(fault_manager));
   s.sim = sensor_sim::parseSimConfig(bus::loadYamlFile(scenario));
   if (seed != 0) s.sim.scenario.seed = seed;
   s.filter = nav_filter::parseFilterConfig(filter_yaml);
@@ -154,7 +162,7 @@ double chiSquareQuantile(double p, double dof) {
 
 int runOfflineCommand(const OfflineOptions& o) {
   const OfflineSetup setup =
-      loadSetup(o.scenario, bus::loadYamlFile(o.filter), o.seed, o.duration_s);
+      loadSetup(o.scenario, bus::loadYamlFile(o.filter), o.seed, o.duration_s, o.fault_manager);
   std::filesystem::create_directories(o.out_dir);
   std::ofstream sol_f(o.out_dir + "/solution.csv"), truth_f(o.out_dir + "/truth.csv"),
       err_f(o.out_dir + "/error.csv");
@@ -195,7 +203,20 @@ int runOfflineCommand(const OfflineOptions& o) {
   spdlog::info("offline: scenario '{}' seed {}: {} solutions ({} without a truth sample); {}",
                setup.sim.scenario.name, setup.sim.scenario.seed, r.solutions,
                r.solutions_without_truth, r.summary);
-  spdlog::info("wrote {}/solution.csv, truth.csv, error.csv", o.out_dir);
+  if (setup.fault_manager) {
+    std::ofstream dec_f(o.out_dir + "/decisions.csv"), cmd_f(o.out_dir + "/commands.csv");
+    dec_f << csvHeader<navbus::FaultDecision>() << "\n";
+    for (const auto& d : r.decisions)
+      for (const auto& row : csvRows(d)) dec_f << row << "\n";
+    cmd_f << csvHeader<navbus::FilterCommand>() << "\n";
+    for (const auto& c : r.commands)
+      for (const auto& row : csvRows(c)) cmd_f << row << "\n";
+    spdlog::info("fault manager: {}", r.fault_summary);
+    spdlog::info("wrote {}/solution.csv, truth.csv, error.csv, decisions.csv, commands.csv",
+                 o.out_dir);
+  } else {
+    spdlog::info("wrote {}/solution.csv, truth.csv, error.csv", o.out_dir);
+  }
   return bus::kExitOk;
 }
 
@@ -236,23 +257,60 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
     Stats st;
   };
   std::vector<Row> rows;
+  struct FaultTable {
+    std::string label;
+    std::optional<sim::Fault> fault;
+    std::vector<FaultRunOutcome> runs;
+    double hours;
+  };
+  std::vector<FaultTable> fault_tables;
   for (const Variant& v : variants) {
     Row row{v.label, {}};
+    // Runs in parallel (one per core unless --threads), gathered in seed order.
+    std::vector<OfflineResult> results(static_cast<std::size_t>(o.runs));
+    std::vector<OfflineSetup> setups(static_cast<std::size_t>(o.runs));
     for (int i = 0; i < o.runs; ++i) {
       const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
-      OfflineSetup setup = loadSetup(o.scenario, v.yaml, seed, o.duration_s);
+      OfflineSetup& setup = setups[static_cast<std::size_t>(i)];
+      setup = loadSetup(o.scenario, v.yaml, seed, o.duration_s, o.fault_manager);
       const core::NavState truth0 = initialTruth(setup.sim.scenario);
       setup.filter.engine.initial_state =
           o.perturb_initial
               ? perturbedInitialState(truth0, setup.filter.engine.tuning, seed * 1000003ull + 17ull)
               : truth0;
-      const OfflineResult r = runOffline(setup);
+    }
+    std::atomic<int> next{0}, done{0};
+    std::mutex progress;
+    auto worker = [&] {
+      for (int i = next++; i < o.runs; i = next++) {
+        results[static_cast<std::size_t>(i)] = runOffline(setups[static_cast<std::size_t>(i)]);
+        const std::lock_guard<std::mutex> lock(progress);
+        std::fprintf(stderr, "\r[%s] run %d/%d", v.label.c_str(), ++done, o.runs);
+        std::fflush(stderr);
+      }
+    };
+    const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+    const int threads = std::min(o.runs, o.threads > 0 ? o.threads : static_cast<int>(hw));
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    std::vector<FaultRunOutcome> outcomes;
+    std::optional<sim::Fault> fault;
+    for (int i = 0; i < o.runs; ++i) {
+      const OfflineSetup& setup = setups[static_cast<std::size_t>(i)];
+      const OfflineResult& r = results[static_cast<std::size_t>(i)];
       const std::int64_t start = setup.sim.scenario.start_time_ns;
       accumulate(row.st, r, start + static_cast<std::int64_t>(std::llround(o.from_s * 1e9)), o,
                  start);
-      std::fprintf(stderr, "\r[%s] run %d/%d", v.label.c_str(), i + 1, o.runs);
-      std::fflush(stderr);
+      if (setup.fault_manager) {
+        fault = detectableFault(setup.sim.scenario.faults);
+        outcomes.push_back(
+            evaluateRun(r, fault, start, o.first_seed + static_cast<std::uint64_t>(i)));
+      }
     }
+    if (!outcomes.empty())
+      fault_tables.push_back({v.label, fault, outcomes, setups[0].duration_s / 3600.0});
     std::fprintf(stderr, "\n");
     rows.push_back(std::move(row));
   }
@@ -282,6 +340,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
                 s.max_vel, std::sqrt(s.sum_att2 / n) * kArcsecPerRad, s.max_att * kArcsecPerRad,
                 nees_mean, lo, hi, 100.0 * in_band / std::max(epochs, 1));
   }
+  for (const FaultTable& t : fault_tables) printFaultTable(t.label, t.fault, t.runs, t.hours);
   if (!o.recovery_after_s.empty()) {
     std::printf(
         "\nconvergence after each instant: median over runs of the time until the "

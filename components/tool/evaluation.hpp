@@ -16,6 +16,7 @@ struct OfflineOptions {
   std::uint64_t seed{0};   ///< 0: the scenario's own
   double duration_s{0.0};  ///< 0: the scenario's
   std::string out_dir;
+  std::string fault_manager;  ///< navbus-fault-manager YAML: run the fault pipeline too
 };
 
 /// Writes solution.csv, truth.csv and error.csv (columns in the README); returns an exit code.
@@ -34,6 +35,8 @@ struct MonteCarloOptions {
   std::vector<double> recovery_after_s;  ///< convergence times after these instants
   double recovery_threshold_m{3.0};      ///< horizontal position error that counts as converged
   double recovery_window_s{15.0};        ///< ... and must stay below it this long
+  std::string fault_manager;  ///< navbus-fault-manager YAML: run and evaluate the fault pipeline
+  int threads{0};             ///< parallel runs (0: one per core)
 };
 
 int runMonteCarloCommand(const MonteCarloOptions& o);

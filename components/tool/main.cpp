@@ -194,6 +194,11 @@ int main(int argc, char** argv) {
                    "seconds of data (0: the scenario's timing.duration_s)")
       ->check(CLI::Range(0.0, 1e6));
   offline_cmd->add_option("-o,--out", offline.out_dir, "output directory (created)")->required();
+  offline_cmd
+      ->add_option("--fault-manager", offline.fault_manager,
+                   "navbus-fault-manager YAML: run the fault pipeline (GLR) in the same process, "
+                   "its commands to the filter; writes decisions.csv and commands.csv")
+      ->check(CLI::ExistingFile);
 
   nb::tool::MonteCarloOptions mc;
   bool mc_no_perturb = false;
@@ -214,6 +219,13 @@ int main(int argc, char** argv) {
                    "override multi_dimensional.policy: mdf continue reset_all")
       ->delimiter(',');
   mc_cmd->add_option("--runs", mc.runs, "runs per configuration")->check(CLI::Range(1, 100000));
+  mc_cmd
+      ->add_option("--fault-manager", mc.fault_manager,
+                   "navbus-fault-manager YAML: run the fault pipeline and report detection time, "
+                   "isolation, magnitude error and false alarms per configuration")
+      ->check(CLI::ExistingFile);
+  mc_cmd->add_option("--threads", mc.threads, "parallel runs (0: one per core)")
+      ->check(CLI::Range(0, 256));
   mc_cmd->add_option("--first-seed", mc.first_seed, "seed of the first run (then +1 per run)")
       ->check(CLI::Range(1ull, 1ull << 60));
   mc_cmd->add_option("--duration", mc.duration_s, "seconds of data (0: the scenario's)")

@@ -61,20 +61,38 @@ const char* enumName(navbus::FaultSource v) {
   }
   return "UNKNOWN";
 }
-const char* enumName(navbus::FaultAction v) {
+const char* enumName(navbus::FaultEvent v) {
   switch (v) {
-    case navbus::ACTION_NONE:
-      return "NONE";
-    case navbus::ACTION_STREAM_LOST:
+    case navbus::EVENT_STREAM_LOST:
       return "STREAM_LOST";
-    case navbus::ACTION_STREAM_RESTORED:
+    case navbus::EVENT_STREAM_RESTORED:
       return "STREAM_RESTORED";
-    case navbus::ACTION_EXCLUDE:
-      return "EXCLUDE";
-    case navbus::ACTION_READMIT:
-      return "READMIT";
-    case navbus::ACTION_COMPENSATE:
-      return "COMPENSATE";
+    case navbus::EVENT_FAULT_DETECTED:
+      return "FAULT_DETECTED";
+    case navbus::EVENT_FAULT_CLEARED:
+      return "FAULT_CLEARED";
+  }
+  return "UNKNOWN";
+}
+const char* enumName(navbus::FaultShape v) {
+  switch (v) {
+    case navbus::SHAPE_NONE:
+      return "NONE";
+    case navbus::SHAPE_STEP:
+      return "STEP";
+    case navbus::SHAPE_RAMP:
+      return "RAMP";
+  }
+  return "UNKNOWN";
+}
+const char* enumName(navbus::SatelliteScope v) {
+  switch (v) {
+    case navbus::SCOPE_ALL:
+      return "ALL";
+    case navbus::SCOPE_PSEUDORANGE:
+      return "PSEUDORANGE";
+    case navbus::SCOPE_PSEUDORANGE_RATE:
+      return "PSEUDORANGE_RATE";
   }
   return "UNKNOWN";
 }
@@ -92,6 +110,12 @@ const char* enumName(navbus::CommandKind v) {
       return "SELECT_MODE";
     case navbus::CMD_RESET:
       return "RESET";
+    case navbus::CMD_EXCLUDE_STREAM:
+      return "EXCLUDE_STREAM";
+    case navbus::CMD_READMIT_STREAM:
+      return "READMIT_STREAM";
+    case navbus::CMD_RELEARN_BIAS:
+      return "RELEARN_BIAS";
   }
   return "UNKNOWN";
 }

@@ -22,7 +22,9 @@ namespace navbus::tool {
 const char* enumName(navbus::FilterMode v);
 const char* enumName(navbus::FusionStructure v);
 const char* enumName(navbus::FaultSource v);
-const char* enumName(navbus::FaultAction v);
+const char* enumName(navbus::FaultEvent v);
+const char* enumName(navbus::FaultShape v);
+const char* enumName(navbus::SatelliteScope v);
 const char* enumName(navbus::CommandKind v);
 const char* enumName(navbus::ParticipantState v);
 const char* enumName(navbus::MeasurementKind v);
@@ -142,7 +144,8 @@ void visitFields(const navbus::FilterDiagnostics& m, V& v) {
   v.text("state_layout", layout.str());
   std::ostringstream rows;
   for (const auto& r : m.rows())
-    rows << enumName(r.kind()) << ":" << r.sv_id() << ":" << r.axis() << " ";
+    rows << enumName(r.kind()) << ":" << r.sv_id() << ":" << r.axis() << (r.used() ? "" : ":unused")
+         << " ";
   v.text("rows", rows.str());
   v("innovation", m.innovation());
   v("innovation_cov", m.innovation_cov());
@@ -155,15 +158,23 @@ template <class V>
 void visitFields(const navbus::FaultDecision& m, V& v) {
   v("decision_id", m.decision_id());
   v("time_gps_ns", m.time_gps_ns());
+  v("event", m.event());
   v("source", m.source());
   v("sensor_id", m.sensor_id());
   v("sv_id", m.sv_id());
   v("axis", m.axis());
+  v("shape", m.shape());
   v("test_statistic", m.test_statistic());
   v("threshold", m.threshold());
   v("magnitude", m.magnitude());
   v("onset_time_gps_ns", m.onset_time_gps_ns());
-  v("action", m.action());
+  v("ambiguous", m.ambiguous());
+  std::ostringstream candidates;
+  for (const auto& c : m.candidates()) {
+    candidates << enumName(c.source()) << ":" << c.sv_id() << ":" << c.axis() << ":"
+               << enumName(c.shape()) << ":" << c.statistic() << ":" << c.magnitude() << " ";
+  }
+  v.text("candidates", candidates.str());
   v("detector", m.detector());
 }
 template <class V>
@@ -171,10 +182,16 @@ void visitFields(const navbus::FilterCommand& m, V& v) {
   v("command_id", m.command_id());
   v("vehicle_id", m.vehicle_id());
   v("kind", m.kind());
+  v("decision_id", m.decision_id());
+  v("time_gps_ns", m.time_gps_ns());
+  v("onset_time_gps_ns", m.onset_time_gps_ns());
   v("sv_id", m.sv_id());
+  v("scope", m.scope());
   v("sensor", m.sensor());
+  v("sensor_id", m.sensor_id());
   v("axis", m.axis());
   v("bias", m.bias());
+  v("bias_sigma", m.bias_sigma());
   v("fusion", m.fusion());
   v("mode", m.mode());
   v("issuer", m.issuer());

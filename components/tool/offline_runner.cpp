@@ -2,9 +2,11 @@
 
 #include <deque>
 #include <random>
+#include <type_traits>
 
 #include <navbus_idl/Fault.h>
 
+#include "fault_pipeline.hpp"
 #include "filter_pipeline.hpp"
 #include "frame_publisher.hpp"
 #include "navbus/bus/conversions.hpp"
@@ -74,32 +76,57 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     result.errors.push_back(err);
     if (hook) hook(sol, truths.front(), err);
   };
-  nav_filter::FilterPipeline pipeline(setup.filter, health, {on_solution, nullptr});
+  // The fault manager's pipeline, when configured, sees every diagnostics sample as the
+  // filter emits it and its commands go back to the filter at once.
+  std::optional<fault_manager::FaultPipeline> faults;
+  nav_filter::FilterPipeline* filter_ptr = nullptr;
+  if (setup.fault_manager) {
+    faults.emplace(*setup.fault_manager, health,
+                   fault_manager::FaultPipeline::Sinks{
+                       [&](const navbus::FaultDecision& d) { result.decisions.push_back(d); },
+                       [&](const navbus::FilterCommand& c) {
+                         result.commands.push_back(c);
+                         filter_ptr->onCommand(c);
+                       }});
+  }
+  std::function<void(const navbus::FilterDiagnostics&)> on_diagnostics;
+  if (faults)
+    on_diagnostics = [&](const navbus::FilterDiagnostics& d) { faults->onDiagnostics(d); };
+  nav_filter::FilterPipeline pipeline(setup.filter, health, {on_solution, on_diagnostics});
   pipeline_ptr = &pipeline;
+  filter_ptr = &pipeline;
 
   const auto period_ns = sim.scenario.imu_period_ns;
   const auto total = static_cast<std::int64_t>(
       std::llround(setup.duration_s * 1e9 / static_cast<double>(period_ns)));
-  std::uint64_t n_imu = 0, n_obs = 0, n_fix = 0, n_star = 0;
-  // The same samples, in the same order and with the same sequence numbers as the simulator
-  // participant publishes them (frame_publisher.cpp).
+  sensor_sim::FrameSequence seq;
+  auto feed = [&pipeline](const auto& sample) {
+    using T = std::decay_t<decltype(sample)>;
+    if constexpr (std::is_same_v<T, navbus::ImuIncrement>) pipeline.onImu(sample);
+    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
+      pipeline.onGnssObservations(sample);
+    if constexpr (std::is_same_v<T, navbus::GnssFix>) pipeline.onGnssFix(sample);
+    if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) pipeline.onStarTracker(sample);
+    return true;  // raw blocks: for the fault manager's dither monitor (not offline yet)
+  };
+  sensor_sim::SimConfig emitted = sim;
+  emitted.publish_raw = false;  // nothing offline reads them
   while (source.index() < total) {
     const sim::SensorFrame f = source.next();
     truths.push_back(f.truth);
-    pipeline.onImu(bus::toIdl(f.increment, sim.imu_sensor_id, ++n_imu));
-    if (sim.publish_gnss && f.has_gnss) {
-      pipeline.onGnssObservations(sensor_sim::toIdl(f.gnss, sim.gnss_receiver_id, ++n_obs));
-      pipeline.onGnssFix(sensor_sim::toIdl(f.fix, sim.gnss_receiver_id, ++n_fix));
-    }
-    if (sim.publish_star_tracker && f.has_star_tracker) {
-      pipeline.onStarTracker(sensor_sim::toIdl(f.star_tracker, sim.star_tracker_id, ++n_star));
-    }
+    // The same samples, in the same order and with the same sequence numbers as the
+    // simulator participant publishes them.
+    sensor_sim::emitFrame(f, emitted, seq, feed);
     // Data time bounds the wait for a silent stream (the bus uses steady time).
     pipeline.pump(f.increment.time_ns);
   }
   // End of data: whatever waits for a stream that will not speak again is released.
   pipeline.flush(sim.scenario.start_time_ns + total * period_ns);
   result.summary = pipeline.summary();
+  if (faults) {
+    result.fault_summary = faults->summary();
+    result.max_glr_statistic = faults->glr().counters().max_statistic;
+  }
   return result;
 }
 

@@ -5,12 +5,15 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <navbus_idl/Fault.h>
 #include <navbus_idl/Navigation.h>
 #include <Eigen/Core>
 
+#include "fault_config.hpp"
 #include "filter_config.hpp"
 #include "navbus/core/strapdown.hpp"
 #include "scenario_config.hpp"
@@ -33,6 +36,9 @@ struct EpochError {
 struct OfflineSetup {
   sensor_sim::SimConfig sim;
   nav_filter::FilterConfig filter;
+  /// The fault manager's pipeline in the same process (GLR on the filter's diagnostics, its
+  /// commands to the filter); none: the filter runs alone.
+  std::optional<fault_manager::FaultManagerConfig> fault_manager;
   double duration_s{0.0};  ///< of simulated data
 };
 
@@ -41,6 +47,10 @@ struct OfflineResult {
   std::uint64_t solutions{0};
   std::uint64_t solutions_without_truth{0};  ///< solution times between truth samples
   std::string summary;                       ///< the pipeline's counters
+  std::string fault_summary;                 ///< the fault pipeline's counters
+  std::vector<navbus::FaultDecision> decisions;
+  std::vector<navbus::FilterCommand> commands;
+  double max_glr_statistic{0.0};
 };
 
 using SolutionHook = std::function<void(const navbus::NavigationSolution&,

@@ -21,10 +21,10 @@ struct Observed {
   std::vector<std::pair<Clock::time_point, FaultDecision>> decisions;
 };
 
-bool hasDecision(const Observed& o, FaultSource src, FaultAction action, std::size_t from = 0) {
+bool hasDecision(const Observed& o, FaultSource src, FaultEvent event, std::size_t from = 0) {
   for (std::size_t i = from; i < o.decisions.size(); ++i) {
     const auto& d = o.decisions[i].second;
-    if (d.source() == src && d.action() == action) return true;
+    if (d.source() == src && d.event() == event) return true;
   }
   return false;
 }
@@ -88,7 +88,7 @@ TEST(ThreeProcesses, SolutionRateStreamLossDecisionModeChangeAndRecovery) {
     EXPECT_EQ(s.mode(), MODE_INERTIAL_ONLY);
     EXPECT_TRUE(std::isfinite(s.latitude_rad()) && std::isfinite(s.height_m()));
   }
-  EXPECT_FALSE(hasDecision(seen, SOURCE_IMU_STREAM, ACTION_STREAM_LOST));
+  EXPECT_FALSE(hasDecision(seen, SOURCE_IMU_STREAM, EVENT_STREAM_LOST));
 
   // When the simulator dies without a goodbye (SIGKILL),
   const std::size_t decisions_before = seen.decisions.size();
@@ -97,11 +97,11 @@ TEST(ThreeProcesses, SolutionRateStreamLossDecisionModeChangeAndRecovery) {
   // then the fault manager decides the IMU stream is lost within its deadline, and the filter
   // publishes a solution in mode INERTIAL_LOST with the fault flag set.
   ASSERT_TRUE(test::spinUntil(me, 5s, [&] {
-    return hasDecision(seen, SOURCE_IMU_STREAM, ACTION_STREAM_LOST, decisions_before);
+    return hasDecision(seen, SOURCE_IMU_STREAM, EVENT_STREAM_LOST, decisions_before);
   })) << test::readFile(dir / "fm.log");
   double decision_latency_s = 0;
   for (const auto& [when, d] : seen.decisions) {
-    if (d.source() == SOURCE_IMU_STREAM && d.action() == ACTION_STREAM_LOST) {
+    if (d.source() == SOURCE_IMU_STREAM && d.event() == EVENT_STREAM_LOST) {
       decision_latency_s = std::chrono::duration<double>(when - killed_at).count();
       EXPECT_EQ(d.detector().to_string(), "watchdog");
       EXPECT_DOUBLE_EQ(d.threshold(), 0.25);  // the watchdog reader's requested deadline
@@ -133,7 +133,7 @@ TEST(ThreeProcesses, SolutionRateStreamLossDecisionModeChangeAndRecovery) {
   ASSERT_TRUE(test::spinUntil(
       me, 30s,
       [&] {
-        return hasDecision(seen, SOURCE_IMU_STREAM, ACTION_STREAM_RESTORED, decisions_mid) &&
+        return hasDecision(seen, SOURCE_IMU_STREAM, EVENT_STREAM_RESTORED, decisions_mid) &&
                seen.solutions.back().second.mode() == MODE_INERTIAL_ONLY &&
                (seen.solutions.back().second.active_fault_flags() & FAULT_IMU_STREAM_LOST) == 0;
       }))

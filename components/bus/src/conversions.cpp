@@ -73,4 +73,83 @@ void fillSolution(const core::NavState& s, navbus::NavigationSolution& out) {
   out.yaw_rad(rpy.z());
 }
 
+namespace {
+struct LayoutEntry {
+  const char* name;
+  core::StateBlock block;
+  const char* unit;
+};
+constexpr LayoutEntry kTc17Layout[] = {{"pos_ned", core::tc17::kPos, "m"},
+                                       {"vel_ned", core::tc17::kVel, "m/s"},
+                                       {"phi_ned", core::tc17::kAtt, "rad"},
+                                       {"accel_bias", core::tc17::kAccelBias, "m/s^2"},
+                                       {"gyro_bias", core::tc17::kGyroBias, "rad/s"},
+                                       {"clock_bias", core::tc17::kClockBias, "m"},
+                                       {"clock_drift", core::tc17::kClockDrift, "m/s"}};
+}  // namespace
+
+void fillTc17Layout(navbus::FilterDiagnostics& msg) {
+  msg.n(static_cast<std::uint16_t>(core::tc17::kSize));
+  msg.state_layout().clear();
+  for (const LayoutEntry& e : kTc17Layout) {
+    navbus::StateBlock b;
+    b.name(e.name);
+    b.index(static_cast<std::uint16_t>(e.block.index));
+    b.dof(static_cast<std::uint16_t>(e.block.dof));
+    b.unit(e.unit);
+    msg.state_layout().push_back(b);
+  }
+}
+
+std::optional<Rejection> toGlrEpoch(const navbus::FilterDiagnostics& msg, core::GlrEpoch& out) {
+  constexpr std::size_t n = core::tc17::kSize;
+  if (msg.n() != n)
+    return Rejection{navbus::REJECT_INCONSISTENT, "n", static_cast<double>(msg.n())};
+  const auto& layout = msg.state_layout();
+  if (layout.size() != std::size(kTc17Layout))
+    return Rejection{navbus::REJECT_INCONSISTENT, "state_layout.size()",
+                     static_cast<double>(layout.size())};
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    const LayoutEntry& e = kTc17Layout[i];
+    if (layout[i].name() != e.name || layout[i].index() != e.block.index ||
+        layout[i].dof() != e.block.dof)
+      return Rejection{navbus::REJECT_INCONSISTENT, "state_layout[" + std::to_string(i) + "]",
+                       static_cast<double>(layout[i].index())};
+  }
+  const std::size_t m = msg.m();
+  if (m > static_cast<std::size_t>(core::glr::kMaxRows))
+    return Rejection{navbus::REJECT_OUT_OF_RANGE, "m", static_cast<double>(m)};
+  for (std::size_t r = 0; r < m; ++r) {
+    const auto kind = msg.rows()[r].kind();
+    if (kind != navbus::MEAS_PSEUDORANGE && kind != navbus::MEAS_PSEUDORANGE_RATE)
+      return Rejection{navbus::REJECT_INCONSISTENT, "rows[" + std::to_string(r) + "].kind",
+                       static_cast<double>(kind)};
+  }
+  const auto rows = static_cast<Eigen::Index>(m);
+  out.time_ns = static_cast<std::int64_t>(msg.time_gps_ns());
+  out.rows = static_cast<int>(m);
+  out.innovation.resize(rows);
+  out.innovation_cov.resize(rows, rows);
+  out.h.resize(rows, static_cast<Eigen::Index>(n));
+  out.k.resize(static_cast<Eigen::Index>(n), rows);
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const auto ur = static_cast<std::size_t>(r);
+    out.sv_id[ur] = msg.rows()[ur].sv_id();
+    out.is_rate[ur] = msg.rows()[ur].kind() == navbus::MEAS_PSEUDORANGE_RATE;
+    out.innovation[r] = msg.innovation()[ur];
+    for (Eigen::Index c = 0; c < rows; ++c)
+      out.innovation_cov(r, c) = msg.innovation_cov()[ur * m + static_cast<std::size_t>(c)];
+    for (std::size_t j = 0; j < n; ++j) {
+      out.h(r, static_cast<Eigen::Index>(j)) = msg.h()[ur * n + j];
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t c = 0; c < m; ++c)
+      out.k(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) = msg.k()[i * m + c];
+    for (std::size_t j = 0; j < n; ++j)
+      out.phi(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = msg.phi()[i * n + j];
+  }
+  return std::nullopt;
+}
+
 }  // namespace navbus::bus

@@ -91,6 +91,8 @@ const char* rejectReasonName(navbus::RejectReason reason) {
       return "late";
     case navbus::REJECT_UNEXPECTED_SOURCE:
       return "unexpected_source";
+    case navbus::REJECT_INCONSISTENT:
+      return "inconsistent";
   }
   return "unknown";
 }

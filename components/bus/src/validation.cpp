@@ -170,6 +170,48 @@ std::optional<Rejection> validate(const navbus::StarTrackerAttitude& s, const Va
   return std::nullopt;
 }
 
+std::optional<Rejection> validate(const navbus::FilterDiagnostics& s, const ValidationLimits&) {
+  const std::size_t n = s.n(), m = s.m();
+  auto inconsistent = [](const char* field, std::size_t got) {
+    return Rejection{navbus::REJECT_INCONSISTENT, field, static_cast<double>(got)};
+  };
+  if (n == 0) return inconsistent("n", n);
+  if (m == 0) return inconsistent("m", m);
+  if (s.rows().size() != m) return inconsistent("rows.size()", s.rows().size());
+  if (s.innovation().size() != m) return inconsistent("innovation.size()", s.innovation().size());
+  if (s.innovation_cov().size() != m * m)
+    return inconsistent("innovation_cov.size()", s.innovation_cov().size());
+  if (s.h().size() != m * n) return inconsistent("h.size()", s.h().size());
+  if (s.k().size() != n * m) return inconsistent("k.size()", s.k().size());
+  if (s.phi().size() != n * n) return inconsistent("phi.size()", s.phi().size());
+  auto finiteSeq = [](const auto& seq, const char* name) -> std::optional<Rejection> {
+    for (std::size_t i = 0; i < seq.size(); ++i) {
+      if (!std::isfinite(seq[i]))
+        return Rejection{navbus::REJECT_NOT_FINITE, indexed(name, i), seq[i]};
+    }
+    return std::nullopt;
+  };
+  if (auto r = finiteSeq(s.innovation(), "innovation")) return r;
+  if (auto r = finiteSeq(s.innovation_cov(), "innovation_cov")) return r;
+  if (auto r = finiteSeq(s.h(), "h")) return r;
+  if (auto r = finiteSeq(s.k(), "k")) return r;
+  if (auto r = finiteSeq(s.phi(), "phi")) return r;
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto& row = s.rows()[i];
+    const bool ranging =
+        row.kind() == navbus::MEAS_PSEUDORANGE || row.kind() == navbus::MEAS_PSEUDORANGE_RATE;
+    if (ranging && (row.sv_id() < 1 || row.sv_id() > 32)) {
+      return Rejection{navbus::REJECT_UNKNOWN_SATELLITE, indexed("rows", i) + ".sv_id",
+                       static_cast<double>(row.sv_id())};
+    }
+    if (!(s.innovation_cov()[i * m + i] > 0.0)) {
+      return Rejection{navbus::REJECT_OUT_OF_RANGE, indexed("innovation_cov", i * m + i),
+                       s.innovation_cov()[i * m + i]};
+    }
+  }
+  return std::nullopt;
+}
+
 SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::uint64_t seq,
                                                 std::uint64_t time_ns) {
   Outcome out;

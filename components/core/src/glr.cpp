@@ -389,41 +389,64 @@ double GlrMonitor::satelliteStatistic(int age, int sv_id) const {
       .statistic;
 }
 
+double GlrMonitor::onsetStatistic(const Onset& o) const {
+  double l = 0.0;
+  if (config_.imu_steps) {
+    l = fitGroup<kImuDirections>(o.r_imu, o.f.head<kImuDirections>(), config_.rank_tolerance)
+            .statistic;
+  }
+  for (int s = 0; s < slots_used_; ++s) {
+    if (slots_[static_cast<std::size_t>(s)].quarantined) continue;
+    const Eigen::Vector3d f = o.f.segment<kSatDirections>(satColumn(s, 0));
+    l = std::max(
+        l, fitGroup<kSatDirections>(o.r_sat[static_cast<std::size_t>(s)], f, config_.rank_tolerance)
+               .statistic);
+  }
+  return l;
+}
+
 void GlrMonitor::evaluate() {
   result_ = GlrResult{};
   result_.valid = true;
   result_.threshold = config_.threshold;
   int best_age = -1;
-  for (int i = 0; i < onset_count_; ++i) {
-    const Onset& o = onsets_[static_cast<std::size_t>((onset_head_ + i) % config_.window)];
-    const int age = onset_count_ - 1 - i;
-    double l = 0.0;
-    if (config_.imu_steps) {
-      l = fitGroup<kImuDirections>(o.r_imu, o.f.head<kImuDirections>(), config_.rank_tolerance)
-              .statistic;
-    }
-    for (int s = 0; s < slots_used_; ++s) {
-      if (slots_[static_cast<std::size_t>(s)].quarantined) continue;
-      const Eigen::Vector3d f = o.f.segment<kSatDirections>(satColumn(s, 0));
-      l = std::max(l, fitGroup<kSatDirections>(o.r_sat[static_cast<std::size_t>(s)], f,
-                                               config_.rank_tolerance)
-                          .statistic);
-    }
-    if (best_age < 0 || l > result_.statistic) {
-      result_.statistic = l;
+  double best = 0.0;
+  for (int age = 0; age < onset_count_; ++age) {
+    const double l = onsetStatistic(onset(age));
+    if (best_age < 0 || l > best) {
+      best = l;
       best_age = age;
     }
   }
   if (best_age < 0) return;
-  result_.detected = result_.statistic >= config_.threshold;
-  const int i = onset_count_ - 1 - best_age;
-  isolate(onsets_[static_cast<std::size_t>((onset_head_ + i) % config_.window)], best_age);
+  isolate(onset(best_age), best_age, result_);
+  result_.statistic = best;
+  result_.detected = best >= config_.threshold;
 }
 
-void GlrMonitor::isolate(const Onset& o, int onset_age) {
-  GlrResult& r = result_;
+GlrResult GlrMonitor::isolationAt(int onset_age) const {
+  GlrResult r;
+  if (onset_age < 0 || onset_age >= onset_count_) return r;
+  r.valid = true;
+  r.threshold = config_.threshold;
+  const Onset& o = onset(onset_age);
+  isolate(o, onset_age, r);
+  r.statistic = onsetStatistic(o);
+  r.detected = r.statistic >= config_.threshold;
+  return r;
+}
+
+int GlrMonitor::onsetAge(std::int64_t onset_time_ns) const {
+  for (int age = 0; age < onset_count_; ++age) {
+    if (onset(age).ramp_start_ns == onset_time_ns) return age;
+  }
+  return -1;
+}
+
+void GlrMonitor::isolate(const Onset& o, int onset_age, GlrResult& r) const {
   r.onset_epochs_ago = onset_age;
   r.onset_time_ns = o.ramp_start_ns;
+  r.onset_censored = onset_count_ == config_.window && onset_age == onset_count_ - 1;
   // INS against GNSS (seed 000 sec. 3): the group whose statistic is least likely under no
   // fault, given its number of identifiable directions.
   if (config_.imu_steps) {
@@ -458,6 +481,7 @@ void GlrMonitor::isolate(const Onset& o, int onset_age) {
   auto scalar = [](double f, double rjj, GlrCandidate& c) {
     c.statistic = rjj > 0.0 ? 0.5 * f * f / rjj : 0.0;
     c.magnitude = rjj > 0.0 ? f / rjj : 0.0;
+    c.magnitude_sigma = rjj > 0.0 ? 1.0 / std::sqrt(rjj) : INFINITY;
   };
   if (imu) {
     for (int j = 0; j < kImuDirections; ++j) {
@@ -493,15 +517,33 @@ void GlrMonitor::isolate(const Onset& o, int onset_age) {
   for (int i = 0; i < r.candidate_count; ++i)
     r.candidates[static_cast<std::size_t>(i)] =
         all[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
-  if (r.candidate_count >= 2) {
-    r.ambiguous = r.candidates[1].statistic >= r.candidates[0].statistic - config_.ambiguity_margin;
-    if (imu) {
-      const int a = column[static_cast<std::size_t>(order[0])];
-      const int b = column[static_cast<std::size_t>(order[1])];
-      const double den = std::sqrt(o.r_imu(a, a) * o.r_imu(b, b));
-      r.correlation = den > 0.0 ? o.r_imu(a, b) / den : 0.0;
+  if (r.candidate_count < 2) return;
+  r.ambiguous = r.candidates[1].statistic >= r.candidates[0].statistic - config_.ambiguity_margin;
+  if (!imu) return;
+  // The IMU direction whose signature is closest to the best one's: if they are nearly
+  // collinear the data cannot tell them apart, whatever their statistics say (a signature
+  // from a misplaced onset can favour either).
+  auto corr = [&o](int a, int b) {
+    const double den = std::sqrt(o.r_imu(a, a) * o.r_imu(b, b));
+    return den > 0.0 ? o.r_imu(a, b) / den : 0.0;
+  };
+  const int best = column[static_cast<std::size_t>(order[0])];
+  int twin = -1;
+  for (int j = 0; j < kImuDirections; ++j) {
+    if (j != best && (twin < 0 || std::abs(corr(best, j)) > std::abs(corr(best, twin)))) twin = j;
+  }
+  if (std::abs(corr(best, twin)) >= config_.ambiguity_correlation) {
+    r.ambiguous = true;
+    for (int i = 0; i < count; ++i) {
+      if (column[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])] == twin) {
+        r.candidates[1] = all[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+      }
     }
   }
+  const int second = r.candidates[1].hypothesis.fault == GlrFault::kAccelStep
+                         ? r.candidates[1].hypothesis.axis
+                         : 3 + r.candidates[1].hypothesis.axis;
+  r.correlation = corr(best, second);
 }
 
 }  // namespace navbus::core

@@ -120,6 +120,7 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   EpochDiagnostics& d = last_epoch_;
   d.sv_ids.clear();
   d.is_rate.clear();
+  d.used.clear();
   d.test_ratio.clear();
   d.innovation.resize(m);
   d.h.resize(m, kSize);
@@ -142,22 +143,55 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   // sequential (exact for the diagonal R) so that each row can be gated on its own.
   d.innovation_cov = d.h * es.P() * d.h.transpose();
   d.innovation_cov.diagonal() += r;
-  d.k = es.P() * d.h.transpose() * d.innovation_cov.inverse();
   d.phi = phi_since_update_;
+  prior_P_ = es.P();
   std::vector<MeasurementReport>& reports = reports_;
   reports.clear();
   for (Eigen::Index row = 0; row < m; ++row) {
-    AidingMeasurement<1> one;
-    one.z[0] = d.innovation[row];
-    one.h = d.h.row(row);
-    one.r(0, 0) = r[row];
-    const ScalarUpdateResult res = es.update(one, tuning_.gate_sigma)[0];
+    ScalarUpdateResult res;
+    const SatelliteObservation& sat = sats[static_cast<std::size_t>(row / 2)];
+    const bool fuse = row % 2 == 0 ? sat.use_range : sat.use_rate;
+    if (fuse) {
+      AidingMeasurement<1> one;
+      one.z[0] = d.innovation[row];
+      one.h = d.h.row(row);
+      one.r(0, 0) = r[row];
+      res = es.update(one, tuning_.gate_sigma)[0];
+    } else {
+      // Monitored only: the innovation test of the row, no update.
+      res.innovation = d.innovation[row];
+      res.innovation_var = d.innovation_cov(row, row);
+      const double gate = tuning_.gate_sigma > 0.0 ? tuning_.gate_sigma : 1.0;
+      res.test_ratio = res.innovation * res.innovation / (gate * gate * res.innovation_var);
+    }
     d.test_ratio.push_back(res.test_ratio);
-    reports.push_back(
-        {d.sv_ids[static_cast<std::size_t>(row)], d.is_rate[static_cast<std::size_t>(row)], res});
+    d.used.push_back(res.accepted);
+    reports.push_back({d.sv_ids[static_cast<std::size_t>(row)],
+                       d.is_rate[static_cast<std::size_t>(row)], fuse, res});
   }
+  appliedGain();
   closeUpdate();
   return reports_;
+}
+
+void IntegratedFilter::appliedGain() {
+  // The gain the sequential updates applied in total: for the accepted rows a (diagonal R),
+  // K_a = P- H_a^T V_aa^-1, the batch gain over those rows; 0 for the others. Decoupling the
+  // other rows in V (identity block) gives it in one solve.
+  EpochDiagnostics& d = last_epoch_;
+  const Eigen::Index m = d.h.rows();
+  applied_cov_ = d.innovation_cov;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (d.used[static_cast<std::size_t>(i)]) continue;
+    applied_cov_.row(i).setZero();
+    applied_cov_.col(i).setZero();
+    applied_cov_(i, i) = 1.0;
+  }
+  applied_llt_.compute(applied_cov_);
+  d.k = applied_llt_.solve(d.h * prior_P_).transpose();
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (!d.used[static_cast<std::size_t>(i)]) d.k.col(i).setZero();
+  }
 }
 
 void IntegratedFilter::closeUpdate() {
@@ -206,6 +240,11 @@ void IntegratedFilter::setActive(const StateMask& active) {
 void IntegratedFilter::zeroOffDiagonal() {
   central_.zeroOffDiagonal();
   for (ErrorState& l : local_) l.zeroOffDiagonal();
+}
+
+void IntegratedFilter::addVariance(int state, double variance) {
+  central_.P()(state, state) += variance;
+  for (ErrorState& l : local_) l.P()(state, state) += variance * tuning_.federated_share;
 }
 
 void IntegratedFilter::resetVariances(const StateBlock& block, double sigma) {

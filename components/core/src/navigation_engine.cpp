@@ -179,13 +179,24 @@ bool NavigationEngine::addGnssEpoch(const std::vector<SatelliteObservation>& sat
       mode_ == EngineMode::kInertialLost) {
     return false;
   }
+  // Excluded measurements stay in the epoch, monitored only (their innovations go to the
+  // diagnostics for the readmission test); the diagnostics carry at most 24 satellites.
   used_.clear();
+  bool any = false;
   for (const auto& s : satellites) {
-    // Excluded satellites (by command) stay out; the diagnostics carry at most 24 satellites.
-    if (excluded_.count(s.sv_id) == 0 && used_.size() < 24) used_.push_back(s);
+    if (used_.size() >= static_cast<std::size_t>(kMaxEpochSatellites)) break;
+    SatelliteObservation o = s;
+    const auto it = excluded_.find(s.sv_id);
+    const std::uint8_t mask = it == excluded_.end() ? 0 : it->second;
+    o.use_range = (mask & static_cast<std::uint8_t>(SatelliteScope::kRange)) == 0;
+    o.use_rate = (mask & static_cast<std::uint8_t>(SatelliteScope::kRate)) == 0;
+    any = any || o.use_range || o.use_rate;
+    used_.push_back(o);
   }
-  if (used_.empty()) return false;
-  for (const auto& rep : filter_.update(used_)) counters_.rows_gated += rep.result.accepted ? 0 : 1;
+  if (!any) return false;
+  for (const auto& rep : filter_.update(used_)) {
+    counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
+  }
   ++counters_.gnss_epochs_fused;
   mode_ = aidedMode();
   return true;
@@ -228,18 +239,27 @@ void NavigationEngine::addStarAttitude(const StarAttitudeMeasurement& st) {
   mode_ = aidedMode();
 }
 
-void NavigationEngine::excludeSatellite(int sv_id) {
-  excluded_.insert(sv_id);
+void NavigationEngine::excludeSatellite(int sv_id, SatelliteScope scope) {
+  excluded_[sv_id] |= static_cast<std::uint8_t>(scope);
   status_ |= kStatusSatelliteExcluded;
 }
 
-void NavigationEngine::readmitSatellite(int sv_id) {
-  excluded_.erase(sv_id);
+void NavigationEngine::readmitSatellite(int sv_id, SatelliteScope scope) {
+  auto it = excluded_.find(sv_id);
+  if (it != excluded_.end()) {
+    it->second &= static_cast<std::uint8_t>(~static_cast<std::uint8_t>(scope));
+    if (it->second == 0) excluded_.erase(it);
+  }
   if (excluded_.empty()) status_ &= ~static_cast<std::uint32_t>(kStatusSatelliteExcluded);
 }
 
-void NavigationEngine::compensateBias(bool accelerometer, int axis, double bias) {
+void NavigationEngine::compensateBias(bool accelerometer, int axis, double bias,
+                                      double bias_sigma) {
   (accelerometer ? accel_compensation_ : gyro_compensation_)[axis] += bias;
+  if (filter_.initialized() && bias_sigma > 0.0) {
+    const int state = (accelerometer ? kAccelBias.index : kGyroBias.index) + axis;
+    filter_.addVariance(state, bias_sigma * bias_sigma);
+  }
   status_ |= kStatusBiasCompensated;
 }
 

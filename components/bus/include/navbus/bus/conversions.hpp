@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include <navbus_idl/Gnss.h>
@@ -9,6 +10,8 @@
 #include <navbus_idl/Navigation.h>
 #include <navbus_idl/StarTracker.h>
 
+#include "navbus/bus/validation.hpp"
+#include "navbus/core/glr.hpp"
 #include "navbus/core/gnss_measurement.hpp"
 #include "navbus/core/navigation_engine.hpp"
 #include "navbus/core/strapdown.hpp"
@@ -32,6 +35,13 @@ core::StarAttitudeMeasurement toCore(const navbus::StarTrackerAttitude& msg);
 /// The valid satellites of an epoch with the satellite clock corrections applied, so that the
 /// core sees corrected pseudoranges and rates.
 std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& msg);
+
+/// The tightly coupled filter's state layout (core::tc17) as the diagnostics declare it.
+void fillTc17Layout(navbus::FilterDiagnostics& msg);
+
+/// A validated diagnostics sample (validate() passed) as the GLR's epoch; a rejection when
+/// its state layout is not core::tc17's or it has more rows than the GLR supports.
+std::optional<Rejection> toGlrEpoch(const navbus::FilterDiagnostics& msg, core::GlrEpoch& out);
 
 /// Fills time, position, velocity and attitude fields of a solution from a navigation state.
 void fillSolution(const core::NavState& state, navbus::NavigationSolution& out);

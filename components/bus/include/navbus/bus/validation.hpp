@@ -9,6 +9,7 @@
 
 #include <navbus_idl/Gnss.h>
 #include <navbus_idl/Imu.h>
+#include <navbus_idl/Navigation.h>
 #include <navbus_idl/StarTracker.h>
 
 namespace navbus::bus {
@@ -41,6 +42,9 @@ std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const Validation
 std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s, const ValidationLimits& l);
 std::optional<Rejection> validate(const navbus::GnssFix& s, const ValidationLimits& l);
 std::optional<Rejection> validate(const navbus::StarTrackerAttitude& s, const ValidationLimits& l);
+/// Sizes consistent with n and m, finite values, satellite ids 1..32 on ranging rows,
+/// positive innovation variances.
+std::optional<Rejection> validate(const navbus::FilterDiagnostics& s, const ValidationLimits& l);
 
 /// Tracks time and sequence per sensor id of one stream.
 class SequenceTracker {

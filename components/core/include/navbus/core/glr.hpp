@@ -30,6 +30,7 @@
 
 #include <Eigen/Core>
 
+#include "navbus/core/gnss_measurement.hpp"
 #include "navbus/core/ins_error_model.hpp"
 #include "navbus/core/state_layout.hpp"
 
@@ -37,7 +38,7 @@ namespace navbus::core {
 
 namespace glr {
 inline constexpr int kStates = tc17::kSize;
-inline constexpr int kMaxSatellites = 24;  ///< satellites per epoch (the engine fuses <= 24)
+inline constexpr int kMaxSatellites = kMaxEpochSatellites;
 inline constexpr int kMaxRows = 2 * kMaxSatellites;
 inline constexpr int kImuDirections = 6;  ///< accelerometer x y z, gyro x y z
 inline constexpr int kSatDirections = 3;  ///< pseudorange step, pseudorange ramp, rate step
@@ -70,6 +71,10 @@ struct GlrConfig {
   /// likelihood of the best one explains the data about as well (likelihood ratio e^margin):
   /// the decision names both.
   double ambiguity_margin{2.0};
+  /// Isolation: an IMU direction whose signature correlates with the best one's at least this
+  /// much (|R_ab| / sqrt(R_aa R_bb)) cannot be told apart from it with the data at hand
+  /// (x-accelerometer and y-gyro in straight flight): the decision names both.
+  double ambiguity_correlation{0.95};
   /// Directions whose share of information, after scaling R to unit diagonal, falls below
   /// this are treated as dependent on the others (rank-revealing factorization).
   double rank_tolerance{1e-6};
@@ -94,8 +99,9 @@ struct GlrEpoch {
 
 struct GlrCandidate {
   GlrHypothesis hypothesis;
-  double statistic{0.0};  ///< l* = 1/2 f*^2 / R* (eqs. 14-15 with T this direction)
-  double magnitude{0.0};  ///< nu* = f* / R* [m/s^2, rad/s, m or m/s]
+  double statistic{0.0};        ///< l* = 1/2 f*^2 / R* (eqs. 14-15 with T this direction)
+  double magnitude{0.0};        ///< nu* = f* / R* [m/s^2, rad/s, m or m/s]
+  double magnitude_sigma{0.0};  ///< standard error of nu*: 1 / sqrt(R*)
 };
 
 enum class GlrSourceClass { kNone, kImu, kSatellite };
@@ -116,7 +122,10 @@ struct GlrResult {
   int satellite_rank{0};
   int candidate_count{0};  ///< directions in `candidates` (best first, same class)
   std::array<GlrCandidate, 3> candidates{};
-  bool ambiguous{false};    ///< candidates[1] explains the data about as well as [0]
+  bool ambiguous{false};  ///< candidates[1] explains the data about as well as [0]
+  /// The onset is the oldest of a full window: the fault may have begun earlier, and the
+  /// signatures from this onset on do not describe what came before (isolation uncertain).
+  bool onset_censored{false};
   double correlation{0.0};  ///< of the signatures of candidates [0] and [1], -1..1
 };
 
@@ -150,6 +159,12 @@ class GlrMonitor {
   /// Group statistics l = 1/2 f^T R^+ f at one onset: the six IMU directions, or the three of
   /// one satellite (0 if the satellite is unknown).
   double imuStatistic(int onset_age) const;
+  /// Isolation (eqs. 14-16) at the onset of the given age, as update() reports it for the
+  /// onset of the largest statistic; `detected` compares that onset's statistic with h.
+  GlrResult isolationAt(int onset_age) const;
+  /// Age of the onset whose fault began after `onset_time_ns` (GlrResult::onset_time_ns), or
+  /// -1 when it has left the window.
+  int onsetAge(std::int64_t onset_time_ns) const;
   double satelliteStatistic(int onset_age, int sv_id) const;
   std::uint64_t epochs() const { return epochs_; }
   std::uint64_t refused() const { return refused_; }
@@ -179,7 +194,8 @@ class GlrMonitor {
   void accumulate(Onset& o);
   void evaluate();
   const Onset& onset(int age) const;
-  void isolate(const Onset& o, int onset_age);
+  void isolate(const Onset& o, int onset_age, GlrResult& r) const;
+  double onsetStatistic(const Onset& o) const;
   /// Measurement-fault input D of `direction` (0..2 of a slot) at `row` for onset `o`.
   double measurementInput(const Onset& o, int direction, std::int64_t time_ns) const;
   int directions() const { return glr::kImuDirections + glr::kSatDirections * slots_used_; }

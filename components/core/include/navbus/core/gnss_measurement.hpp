@@ -10,6 +10,10 @@
 
 namespace navbus::core {
 
+/// Satellites the filter processes per epoch at most (the diagnostics and the GLR are sized
+/// for it).
+inline constexpr int kMaxEpochSatellites = 24;
+
 /// One satellite's corrected measurements (satellite clock applied, positions in the ECEF frame
 /// of reception time, Sagnac applied).
 struct SatelliteObservation {
@@ -20,6 +24,8 @@ struct SatelliteObservation {
   double pseudorange_rate_mps{0.0};
   double pseudorange_sigma_m{1.0};
   double pseudorange_rate_sigma_mps{0.1};
+  bool use_range{true};  ///< false: the pseudorange is excluded (monitored, not fused)
+  bool use_rate{true};   ///< false: the pseudorange rate is excluded
 };
 
 struct RangePrediction {

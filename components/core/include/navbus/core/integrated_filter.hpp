@@ -15,6 +15,8 @@
 #include <array>
 #include <vector>
 
+#include <Eigen/Cholesky>
+
 #include "navbus/core/aiding_measurements.hpp"
 #include "navbus/core/error_state.hpp"
 #include "navbus/core/gnss_measurement.hpp"
@@ -59,19 +61,21 @@ struct FilterTuning {
 
 struct MeasurementReport {
   int sv_id;
-  bool rate;  ///< false: pseudorange row, true: pseudorange-rate row
+  bool rate;   ///< false: pseudorange row, true: pseudorange-rate row
+  bool fused;  ///< offered to the update (false: excluded, monitored only)
   ScalarUpdateResult result;
 };
 
 /// Everything the GLR detector (seed 000 eqs. 6-16) needs from one GNSS epoch, in batch form
 /// from the prior covariance: rows are (pseudorange, rate) per satellite, in order.
 struct EpochDiagnostics {
-  std::vector<int> sv_ids;             ///< per row
-  std::vector<bool> is_rate;           ///< per row
-  Eigen::VectorXd innovation;          ///< predicted minus measured, m rows
-  Eigen::MatrixXd innovation_cov;      ///< V = H P- H^T + R, m x m
-  Eigen::MatrixXd h;                   ///< m x 17
-  Eigen::MatrixXd k;                   ///< 17 x m, K = P- H^T V^-1
+  std::vector<int> sv_ids;         ///< per row
+  std::vector<bool> is_rate;       ///< per row
+  std::vector<bool> used;          ///< per row: fused (false: gated, or monitored only)
+  Eigen::VectorXd innovation;      ///< predicted minus measured, m rows
+  Eigen::MatrixXd innovation_cov;  ///< V = H P- H^T + R, m x m
+  Eigen::MatrixXd h;               ///< m x 17
+  Eigen::MatrixXd k;  ///< 17 x m: the gain applied, P- H_u^T V_uu^-1 on the used rows, 0 elsewhere
   Matrix17 phi{Matrix17::Identity()};  ///< transition accumulated since the previous epoch
   std::vector<double> test_ratio;      ///< per row, from the sequential gated update
 };
@@ -90,7 +94,9 @@ class IntegratedFilter {
   /// covariance(s).
   void propagate(const ImuIncrement& raw, bool suspend_filter = false);
   /// Processes one epoch of pseudoranges and rates; returns one report per row (a buffer
-  /// reused from epoch to epoch, valid until the next call).
+  /// reused from epoch to epoch, valid until the next call). Rows a satellite's use_range /
+  /// use_rate exclude are monitored only: their innovations are in the diagnostics (for the
+  /// fault monitor's readmission test) but they do not update the filter.
   const std::vector<MeasurementReport>& update(const std::vector<SatelliteObservation>& sats);
   /// Processes an aiding measurement, one decorrelated row at a time.
   template <int M>
@@ -104,6 +110,8 @@ class IntegratedFilter {
   void setActive(const StateMask& active);
   void zeroOffDiagonal();
   void resetVariances(const StateBlock& block, double sigma);
+  /// Adds `variance` to one state's variance (a correction of uncertain size was applied).
+  void addVariance(int state, double variance);
   const StateMask& active() const { return central_.active(); }
 
   const NavState& state() const { return ins_.state(); }
@@ -126,6 +134,8 @@ class IntegratedFilter {
   /// Applies the estimate after an update: centralized feedback, or master fusion + feedback.
   void closeUpdate();
   void feedback(const Vector17& dx);
+  /// Sets the diagnostics' K to the gain the epoch's sequential updates applied.
+  void appliedGain();
   InnovationWindow<3>* window(AidingKind kind);
 
   FilterTuning tuning_;
@@ -136,6 +146,9 @@ class IntegratedFilter {
   std::array<InnovationWindow<3>, 3> windows_;  ///< adaptive: position, velocity, attitude
   Matrix17 phi_since_update_{Matrix17::Identity()};
   EpochDiagnostics last_epoch_;
+  Matrix17 prior_P_{Matrix17::Zero()};  ///< P- of the latest GNSS epoch
+  Eigen::MatrixXd applied_cov_;         ///< V with the unused rows decoupled (reused storage)
+  Eigen::LLT<Eigen::MatrixXd> applied_llt_;
   std::vector<MeasurementReport> reports_;
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};

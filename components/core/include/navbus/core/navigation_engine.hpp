@@ -6,7 +6,7 @@
 #pragma once
 
 #include <cstdint>
-#include <set>
+#include <map>
 #include <vector>
 
 #include "navbus/core/integrated_filter.hpp"
@@ -39,6 +39,9 @@ enum EngineStatus : std::uint32_t {
   kStatusSatelliteExcluded = 1u << 1,
   kStatusBiasCompensated = 1u << 2,
 };
+
+/// Which measurements of a satellite an exclusion concerns (bit mask).
+enum class SatelliteScope : std::uint8_t { kRange = 1, kRate = 2, kAll = 3 };
 
 struct GnssFixMeasurement {
   std::int64_t time_ns{0};
@@ -91,10 +94,17 @@ class NavigationEngine {
   void addStarAttitude(const StarAttitudeMeasurement& st);
 
   // Commands.
-  void excludeSatellite(int sv_id);
-  void readmitSatellite(int sv_id);
+  /// Stops fusing the scope's measurements of sv_id (they stay in the diagnostics, monitored).
+  void excludeSatellite(int sv_id, SatelliteScope scope = SatelliteScope::kAll);
+  void readmitSatellite(int sv_id, SatelliteScope scope = SatelliteScope::kAll);
   /// Adds a bias (accelerometer [m/s^2] or gyro [rad/s], body axis 0..2) to the compensation.
-  void compensateBias(bool accelerometer, int axis, double bias);
+  /// `bias_sigma` [same unit] is the compensation's own uncertainty: added to the bias
+  /// variance, so that the filter can still estimate what the compensation missed.
+  void compensateBias(bool accelerometer, int axis, double bias, double bias_sigma = 0.0);
+  /// A bias step of unknown size: its variance grows by sigma^2 and the filter re-estimates it.
+  void relearnBias(bool accelerometer, int axis, double sigma) {
+    compensateBias(accelerometer, axis, 0.0, sigma);
+  }
   /// False when the structure does not apply to the aiding mode (see the .cpp).
   bool selectFusion(FusionStructure s);
   void markInertialLost();
@@ -129,7 +139,7 @@ class NavigationEngine {
   EngineMode mode_{EngineMode::kInitializing};
   std::uint32_t status_{0};
   EngineCounters counters_;
-  std::set<int> excluded_;
+  std::map<int, std::uint8_t> excluded_;    ///< sv -> SatelliteScope bits excluded
   std::vector<SatelliteObservation> used_;  ///< reused buffer of the satellites fused
   Eigen::Vector3d accel_compensation_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_compensation_{Eigen::Vector3d::Zero()};

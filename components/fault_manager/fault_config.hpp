@@ -1,0 +1,36 @@
+// navbus-fault-manager configuration (YAML), converted to SI here. Unknown keys in the
+// sections below are errors naming the key, so that a misspelled setting is not ignored.
+#pragma once
+
+#include <cstdint>
+
+#include <yaml-cpp/yaml.h>
+
+#include "navbus/core/glr.hpp"
+
+namespace navbus::fault_manager {
+
+struct GlrDetectorConfig {
+  bool enabled{true};
+  core::GlrConfig glr;
+  bool exclude_satellites{true};  ///< command the exclusion of an isolated satellite
+  bool compensate_imu{true};      ///< command the compensation of an isolated IMU bias step
+  /// The compensation waits until the magnitude's standard error is at most this share of it
+  /// (or the onset leaves the window); the decision itself is published at detection.
+  double compensation_relative_sigma{0.05};
+  /// Readmission of an excluded satellite (still monitored by the filter, outside the GLR):
+  /// every normalized innovation |eps| / sqrt(V) of its rows at most `readmit_sigma` for
+  /// `readmit_after_s` of consecutive epochs.
+  double readmit_sigma{3.0};
+  double readmit_after_s{30.0};
+};
+
+struct FaultManagerConfig {
+  std::uint32_t vehicle_id{1};  ///< the filter monitored and commanded
+  GlrDetectorConfig glr;
+};
+
+/// Throws bus::ConfigError naming the key and the value on any invalid or unknown entry.
+FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root);
+
+}  // namespace navbus::fault_manager

@@ -1,0 +1,149 @@
+#include "fault_pipeline.hpp"
+
+#include <sstream>
+
+#include <spdlog/spdlog.h>
+
+#include "navbus/bus/topics.hpp"
+
+namespace navbus::fault_manager {
+
+navbus::FaultSource toSource(StreamKind k) {
+  switch (k) {
+    case StreamKind::kImu:
+      return navbus::SOURCE_IMU_STREAM;
+    case StreamKind::kImuRaw:
+      return navbus::SOURCE_IMU_RAW_STREAM;
+    case StreamKind::kGnssObservations:
+      return navbus::SOURCE_GNSS_OBS_STREAM;
+    case StreamKind::kGnssFix:
+      return navbus::SOURCE_GNSS_FIX_STREAM;
+    case StreamKind::kStarTracker:
+      return navbus::SOURCE_ST_STREAM;
+  }
+  return navbus::SOURCE_IMU_STREAM;
+}
+
+const char* kindName(StreamKind k) {
+  switch (k) {
+    case StreamKind::kImu:
+      return "imu";
+    case StreamKind::kImuRaw:
+      return "imu-raw";
+    case StreamKind::kGnssObservations:
+      return "gnss-observations";
+    case StreamKind::kGnssFix:
+      return "gnss-fix";
+    case StreamKind::kStarTracker:
+      return "star-tracker";
+  }
+  return "?";
+}
+
+namespace {
+const char* topicOf(StreamKind k) {
+  switch (k) {
+    case StreamKind::kImu:
+      return bus::topic::kImuIncrement;
+    case StreamKind::kImuRaw:
+      return bus::topic::kImuRaw;
+    case StreamKind::kGnssObservations:
+      return bus::topic::kGnssObservations;
+    case StreamKind::kGnssFix:
+      return bus::topic::kGnssFix;
+    case StreamKind::kStarTracker:
+      return bus::topic::kStarTracker;
+  }
+  return bus::topic::kImuIncrement;
+}
+}  // namespace
+
+FaultPipeline::FaultPipeline(const FaultManagerConfig& config, bus::HealthCounters& health,
+                             Sinks sinks)
+    : config_(config),
+      health_(health),
+      sinks_(std::move(sinks)),
+      glr_(config.glr),
+      diagnostics_gate_(bus::topic::kFilterDiagnostics,
+                        health.stream(bus::topic::kFilterDiagnostics)) {}
+
+void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
+                                   std::uint64_t time_gps_ns, std::int64_t wall_now_ns) {
+  // Best-effort watchdog readers may lose samples: count them from the sequence numbers. A
+  // restarted writer (time going back) starts a new count.
+  auto& tracker = trackers_[kind];
+  auto o = tracker.check(sensor_id, seq, time_gps_ns);
+  if (o.rejection) {
+    tracker.reset(sensor_id);
+    o = tracker.check(sensor_id, seq, time_gps_ns);
+  }
+  auto& counters = health_.stream(topicOf(kind));
+  ++counters.accepted;  // observed, not validated: a monitor
+  counters.sequence_gaps += o.missing;
+  if (auto e = watchdog_.onSample({kind, sensor_id}, time_gps_ns, wall_now_ns)) onWatchdogEvent(*e);
+}
+
+void FaultPipeline::onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id,
+                                     std::int64_t wall_now_ns) {
+  if (auto e = watchdog_.onDeadlineMissed({kind, sensor_id}, wall_now_ns)) onWatchdogEvent(*e);
+}
+
+void FaultPipeline::onWritersGone(StreamKind kind, std::int64_t wall_now_ns) {
+  for (const auto& e : watchdog_.onWritersGone(kind, wall_now_ns)) onWatchdogEvent(e);
+}
+
+void FaultPipeline::onWatchdogEvent(const WatchdogEvent& e) {
+  navbus::FaultDecision d;
+  d.time_gps_ns(e.last_time_gps_ns);
+  d.event(e.lost ? navbus::EVENT_STREAM_LOST : navbus::EVENT_STREAM_RESTORED);
+  d.source(toSource(e.key.kind));
+  d.sensor_id(e.key.sensor_id);
+  d.shape(navbus::SHAPE_NONE);
+  d.test_statistic(e.silence_s);
+  d.threshold(deadline_s_[e.key.kind]);
+  d.onset_time_gps_ns(e.last_time_gps_ns);
+  d.detector("watchdog");
+  const std::uint32_t id = decide(d);
+  (e.lost ? lost_ : restored_)++;
+  spdlog::warn("decision {}: {} stream {} {} (silent {:.3f} s)", id, kindName(e.key.kind),
+               e.key.sensor_id, e.lost ? "LOST" : "RESTORED", e.silence_s);
+  navbus::FilterCommand c;
+  c.kind(e.lost ? navbus::CMD_EXCLUDE_STREAM : navbus::CMD_READMIT_STREAM);
+  c.decision_id(id);
+  c.time_gps_ns(e.last_time_gps_ns);
+  c.sensor(d.source());
+  c.sensor_id(e.key.sensor_id);
+  command(c);
+}
+
+void FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
+  if (msg.vehicle_id() != config_.vehicle_id) {
+    ++other_vehicles_;
+    return;
+  }
+  if (!diagnostics_gate_.admit(msg, msg.vehicle_id(), msg.seq(), msg.time_gps_ns())) return;
+  glr_.onDiagnostics(msg, *this);
+}
+
+std::uint32_t FaultPipeline::decide(navbus::FaultDecision& d) {
+  d.decision_id(next_decision_id_++);
+  if (sinks_.decision) sinks_.decision(d);
+  return d.decision_id();
+}
+
+void FaultPipeline::command(navbus::FilterCommand& c) {
+  c.command_id(next_command_id_++);
+  c.vehicle_id(config_.vehicle_id);
+  c.issuer("fault-manager");
+  if (sinks_.command) sinks_.command(c);
+}
+
+std::string FaultPipeline::summary() const {
+  std::ostringstream out;
+  out << "decisions published " << decisions() << " (stream lost " << lost_ << ", restored "
+      << restored_ << "), commands published " << commands() << "; " << glr_.summary();
+  if (other_vehicles_ > 0) out << "; diagnostics of other vehicles ignored " << other_vehicles_;
+  return out.str();
+}
+
+}  // namespace navbus::fault_manager

@@ -1,0 +1,73 @@
+// navbus-fault-manager's processing without DDS, the shape of navbus-filter's FilterPipeline:
+// stream events and the filter's diagnostics in; decisions (facts) and commands (requests)
+// out through sinks. One detector per file beside it: stream_watchdog (silence), glr_detector
+// (seed 000). The participant (fault_manager_node.hpp) owns the readers and writers and feeds
+// it; `navbus offline` runs it in the same process as the filter pipeline.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+
+#include <navbus_idl/Fault.h>
+#include <navbus_idl/Navigation.h>
+
+#include "fault_config.hpp"
+#include "fault_output.hpp"
+#include "glr_detector.hpp"
+#include "navbus/bus/health.hpp"
+#include "navbus/bus/validation.hpp"
+#include "stream_watchdog.hpp"
+
+namespace navbus::fault_manager {
+
+class FaultPipeline : private FaultOutput {
+ public:
+  struct Sinks {
+    std::function<void(const navbus::FaultDecision&)> decision;
+    std::function<void(const navbus::FilterCommand&)> command;
+  };
+
+  FaultPipeline(const FaultManagerConfig& config, bus::HealthCounters& health, Sinks sinks);
+
+  // Stream watchdogs (wall times from the participant's steady clock).
+  /// A sample of a watched stream; `seq` counts samples a best-effort reader lost.
+  void onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
+                      std::uint64_t time_gps_ns, std::int64_t wall_now_ns);
+  void onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id, std::int64_t wall_now_ns);
+  void onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
+  /// The watchdog deadline of a stream kind [s], quoted as the decisions' threshold.
+  void setDeadline(StreamKind kind, double deadline_s) { deadline_s_[kind] = deadline_s; }
+
+  /// The monitored filter's diagnostics (validated here; other vehicles are ignored).
+  void onDiagnostics(const navbus::FilterDiagnostics& msg);
+
+  const GlrDetector& glr() const { return glr_; }
+  std::uint64_t decisions() const { return next_decision_id_ - 1; }
+  std::uint64_t commands() const { return next_command_id_ - 1; }
+  std::string summary() const;
+
+ private:
+  std::uint32_t decide(navbus::FaultDecision& d) override;
+  void command(navbus::FilterCommand& c) override;
+  void onWatchdogEvent(const WatchdogEvent& e);
+
+  FaultManagerConfig config_;
+  bus::HealthCounters& health_;
+  Sinks sinks_;
+  StreamWatchdog watchdog_;
+  GlrDetector glr_;
+  bus::StreamGate diagnostics_gate_;
+  std::map<StreamKind, bus::SequenceTracker> trackers_;
+  std::map<StreamKind, double> deadline_s_;
+  std::uint32_t next_decision_id_{1};
+  std::uint64_t next_command_id_{1};
+  std::uint64_t lost_{0}, restored_{0}, other_vehicles_{0};
+};
+
+/// The IDL source of a watched stream kind, and its name for logs.
+navbus::FaultSource toSource(StreamKind kind);
+const char* kindName(StreamKind kind);
+
+}  // namespace navbus::fault_manager

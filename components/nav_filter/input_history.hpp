@@ -1,0 +1,87 @@
+// Bounded history of what the filter processed, for recovery from a fault found late: engine
+// snapshots taken at most every `snapshot_period` of data time, and every input and command
+// processed since the oldest snapshot kept. A fault command with an estimated onset restores
+// the latest snapshot whose state time is not after the onset, applies the command there, and
+// re-processes everything that followed, so that the contamination accumulated since the onset
+// (e.g. a ramping satellite pulled into the position, a bias step absorbed into the estimates)
+// is gone rather than slowly forgotten. The engine is deterministic, so the result is the
+// same whenever the command arrives. Pure logic, DDS-free.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <variant>
+
+#include <navbus_idl/Fault.h>
+
+#include "navbus/core/navigation_engine.hpp"
+
+namespace navbus::nav_filter {
+
+template <class Input>
+class InputHistory {
+ public:
+  using Item = Input;
+
+  InputHistory(std::int64_t span_ns, std::int64_t snapshot_period_ns)
+      : span_ns_(span_ns), snapshot_period_ns_(snapshot_period_ns) {}
+
+  bool enabled() const { return span_ns_ > 0; }
+
+  /// Called before `engine` processes `item` at data time `time_ns`.
+  void record(std::int64_t time_ns, const Item& item, const core::NavigationEngine& engine) {
+    if (!enabled()) return;
+    if (snapshots_.empty() || time_ns - snapshots_.back().time_ns >= snapshot_period_ns_) {
+      snapshots_.push_back({time_ns, first_index_ + items_.size(), engine});
+    }
+    items_.push_back(item);
+    // Forget snapshots (and the items before them) older than the span, keeping one.
+    while (snapshots_.size() > 1 && time_ns - snapshots_[1].time_ns >= span_ns_) {
+      snapshots_.pop_front();
+    }
+    while (first_index_ < snapshots_.front().first_item) {
+      items_.pop_front();
+      ++first_index_;
+    }
+  }
+
+  /// Restores the engine to the latest snapshot whose state is not later than `onset_ns` and
+  /// returns the items processed since (to be re-processed by the caller, who records them
+  /// again). False when the history does not reach back to the onset.
+  bool rollback(std::int64_t onset_ns, core::NavigationEngine& engine, std::deque<Item>& replay) {
+    if (!enabled()) return false;
+    for (std::size_t i = snapshots_.size(); i-- > 0;) {
+      const Snapshot& s = snapshots_[i];
+      if (!s.engine.initialized() || s.engine.state().time_ns > onset_ns) continue;
+      engine = s.engine;
+      replay.clear();
+      const std::size_t from = s.first_item - first_index_;
+      replay.insert(replay.end(), items_.begin() + static_cast<std::ptrdiff_t>(from), items_.end());
+      items_.erase(items_.begin() + static_cast<std::ptrdiff_t>(from), items_.end());
+      snapshots_.erase(snapshots_.begin() + static_cast<std::ptrdiff_t>(i), snapshots_.end());
+      ++rollbacks_;
+      return true;
+    }
+    ++out_of_reach_;
+    return false;
+  }
+
+  std::uint64_t rollbacks() const { return rollbacks_; }
+  std::uint64_t outOfReach() const { return out_of_reach_; }
+
+ private:
+  struct Snapshot {
+    std::int64_t time_ns;    ///< data time of the first item after it
+    std::size_t first_item;  ///< absolute index of that item
+    core::NavigationEngine engine;
+  };
+  std::int64_t span_ns_;
+  std::int64_t snapshot_period_ns_;
+  std::deque<Snapshot> snapshots_;
+  std::deque<Item> items_;
+  std::size_t first_index_{0};  ///< absolute index of items_.front()
+  std::uint64_t rollbacks_{0};
+  std::uint64_t out_of_reach_{0};
+};
+
+}  // namespace navbus::nav_filter
