@@ -3,7 +3,10 @@
 // Determinism). Two scenarios: the seed-004 land vehicle with the multi-dimensional filter
 // (ZUPT, NHC, stage switches, resets) and 40 s of the seed-001 LEO with GNSS fixes and the
 // star tracker in the federated structure.
+#include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <navbus_idl/FaultPubSubTypes.h>
@@ -165,6 +168,130 @@ TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
   const std::string log = test::readFile(dir / "filter.log");
   EXPECT_NE(log.find("refused"), std::string::npos) << log;
   EXPECT_NE(log.find("commands applied 2 refused 1"), std::string::npos) << log;
+  test::cleanSharedMemory();
+  std::filesystem::remove_all(dir);
+}
+
+// The fault loop over the bus (seed 000, 35 s in real time): a 25 m/s pseudorange ramp on
+// sv 13 from 20 s -> the fault manager's GLR decides (detector "glr", sv 13, ramp, onset) ->
+// it commands the exclusion of sv 13's pseudorange -> the filter takes the command in its
+// deterministic order, restores itself to before the onset and re-processes -> the solution
+// is flagged and recovers. Decision and solutions are read by this test's subscribers, and the
+// solutions are bit-identical to `navbus offline` running the same loop in one process.
+TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
+  constexpr int kDomain = 89;
+  test::cleanSharedMemory();
+  const auto dir = test::scratchDir("fault-loop");
+  const std::string src = NAVBUS_SOURCE_DIR;
+  const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
+  const std::string sim_cfg = test::writeFile(
+      dir / "sim.yaml", "extends: " + src + "/sim/scenarios/seed000_aircraft.yaml\n" + domain +
+                            "timing: {duration_s: 35, pacing: realtime}\n"
+                            "faults:\n  - {type: pseudorange_ramp, sv_id: 13, start_s: 20, "
+                            "slope_mps: 25, saturation_m: 250}\n");
+  const std::string filter_cfg = test::writeFile(
+      dir / "filter.yaml", "extends: " + src + "/config/filter_seed000_tc.yaml\n" + domain +
+                               "solution_writer_profile: navbus_solution_writer_lossless\n");
+  const std::string fm_cfg =
+      test::writeFile(dir / "fm.yaml", "extends: " + src + "/config/fault_manager.yaml\n" + domain);
+
+  test::ChildProcess offline(NAVBUS_TOOL_EXE,
+                             {"offline", "--scenario", sim_cfg, "--filter", filter_cfg,
+                              "--fault-manager", fm_cfg, "-o", (dir / "offline").string()},
+                             (dir / "offline.log").string());
+  ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
+  const std::vector<std::string> expected = readCsvRows(dir / "offline" / "solution.csv");
+  ASSERT_EQ(expected.size(), 350u);
+
+  bus::ShutdownSignal shutdown;
+  bus::Participant me(test::testParticipant(kDomain, "fault-loop-test"), shutdown);
+  std::vector<std::string> rows;
+  std::vector<NavigationSolution> solutions;
+  std::vector<FaultDecision> decisions;
+  std::vector<FilterCommand> commands;
+  me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution,
+                                             bus::profile::kSolutionReader,
+                                             [&](const NavigationSolution& s, const auto&) {
+                                               if (s.mode() == MODE_INERTIAL_LOST) return;
+                                               rows.push_back(tool::csvRows(s).at(0));
+                                               solutions.push_back(s);
+                                             });
+  me.subscribe<FaultDecisionPubSubType>(
+      bus::topic::kFaultDecision, bus::profile::kDecisionReader,
+      [&](const FaultDecision& d, const auto&) { decisions.push_back(d); });
+  me.subscribe<FilterCommandPubSubType>(
+      bus::topic::kFilterCommand, bus::profile::kDecisionReader,
+      [&](const FilterCommand& c, const auto&) { commands.push_back(c); });
+  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
+  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
+  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg}, (dir / "sim.log").string());
+  while (sim.running()) me.spinOnce(50ms);
+  EXPECT_EQ(sim.wait(1s), 0) << test::readFile(dir / "sim.log");
+  test::spinUntil(me, 20s, [&] { return rows.size() >= expected.size(); });
+  me.spinOnce(500ms);
+  filter.signal(SIGTERM);
+  fm.signal(SIGTERM);
+  EXPECT_EQ(filter.wait(10s), 0);
+  EXPECT_EQ(fm.wait(10s), 0);
+  const std::string filter_log = test::readFile(dir / "filter.log");
+
+  // The decision: the GLR isolated sv 13's pseudorange as a ramp near 25 m/s, onset near 20 s.
+  const auto glr = std::find_if(decisions.begin(), decisions.end(), [](const FaultDecision& d) {
+    return d.detector() == "glr" && d.event() == EVENT_FAULT_DETECTED;
+  });
+  ASSERT_NE(glr, decisions.end()) << test::readFile(dir / "fm.log");
+  EXPECT_EQ(glr->source(), SOURCE_SATELLITE);
+  EXPECT_EQ(glr->sv_id(), 13);
+  EXPECT_GE(glr->test_statistic(), glr->threshold());
+  const double start_s = 1.4e9;
+  const double decided_s = 1e-9 * static_cast<double>(glr->time_gps_ns()) - start_s;
+  const double onset_s = 1e-9 * static_cast<double>(glr->onset_time_gps_ns()) - start_s;
+  EXPECT_GT(decided_s, 20.0);
+  EXPECT_LT(decided_s, 30.0);
+  EXPECT_NEAR(onset_s, 20.0, 2.0);
+  // The command that follows it.
+  const auto exclusion =
+      std::find_if(commands.begin(), commands.end(), [&](const FilterCommand& c) {
+        return c.kind() == CMD_EXCLUDE_SATELLITE && c.decision_id() == glr->decision_id();
+      });
+  ASSERT_NE(exclusion, commands.end());
+  EXPECT_EQ(exclusion->sv_id(), 13);
+  EXPECT_EQ(exclusion->scope(), SCOPE_PSEUDORANGE);
+  // The filter acted on it in order (not late), from before the onset.
+  EXPECT_NE(filter_log.find("late 0"), std::string::npos) << filter_log;
+  EXPECT_NE(filter_log.find("recoveries from onset 1"), std::string::npos) << filter_log;
+  // The solutions after the decision carry the exclusion flag.
+  ASSERT_FALSE(solutions.empty());
+  EXPECT_TRUE(solutions.back().active_fault_flags() & FAULT_SATELLITE_EXCLUDED);
+  // The offline loop's error after the decision: back to the fault-free level.
+  {
+    std::ifstream in(dir / "offline" / "error.csv");
+    std::string line;
+    std::getline(in, line);
+    double worst_after = 0.0;
+    while (std::getline(in, line)) {
+      std::vector<double> v;
+      std::stringstream ss(line);
+      std::string cell;
+      while (std::getline(ss, cell, ',')) v.push_back(std::atof(cell.c_str()));
+      const double t = 1e-9 * v[0] - start_s;
+      const double err = std::sqrt(v[2] * v[2] + v[3] * v[3] + v[4] * v[4]);
+      if (t > decided_s + 1.0) worst_after = std::max(worst_after, err);
+    }
+    EXPECT_LT(worst_after, 60.0) << "3-D position error after the exclusion";
+  }
+  // Bus and offline: the same loop, the same bits.
+  ASSERT_EQ(rows.size(), expected.size()) << filter_log;
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i] != expected[i] && differing++ < 3) {
+      ADD_FAILURE() << "solution " << i << " differs:\n bus:     " << rows[i]
+                    << "\n offline: " << expected[i];
+    }
+  }
+  EXPECT_EQ(differing, 0u);
+  std::printf("fault loop: decision at %.1f s (onset %.1f s), %zu solutions bit-identical: %s\n",
+              decided_s, onset_s, rows.size(), differing == 0 ? "yes" : "NO");
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }
