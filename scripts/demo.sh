@@ -38,8 +38,13 @@ grep -h -A6 "summary" "$out/fault_manager.log" | sed 's/.*summary: /fault-manage
 solutions=$(($(wc -l < "$out/record/navbus_nav_solution.csv") - 1))
 decisions=$(($(wc -l < "$out/record/navbus_fault_decision.csv") - 1))
 echo "recorder:      $solutions solutions and $decisions fault decisions recorded in $out/record"
-awk -F, 'NR==2 {lat0=$4; lon0=$5; h0=$6} NR>1 && $45=="INERTIAL_ONLY" {lat=$4; lon=$5; h=$6; t=$3}
+# CSV columns are read by their header names (see the README's CSV section).
+awk -F, 'NR==1 {for (i = 1; i <= NF; ++i) c[$i] = i; next}
+  NR==2 {lat0=$c["latitude_rad"]; lon0=$c["longitude_rad"]; h0=$c["height_m"]}
+  $c["mode"]=="INERTIAL_ONLY" {lat=$c["latitude_rad"]; lon=$c["longitude_rad"]; h=$c["height_m"]; t=1}
   END { if (t) printf("last inertial solution: drift north %.3f m, east %.3f m, up %.3f m from the first solution\n",
         (lat-lat0)*6.3567e6, (lon-lon0)*6.3567e6*cos(lat0), h-h0) }' "$out/record/navbus_nav_solution.csv"
-cut -d, -f3,11 "$out/record/navbus_fault_decision.csv" | tail -n +2 | sort | uniq -c | awk '{print "decision:      " $0}'
+awk -F, 'NR==1 {for (i = 1; i <= NF; ++i) c[$i] = i; next}
+  {print "decision:      " $c["detector"] " " $c["event"] " " $c["source"]}' \
+  "$out/record/navbus_fault_decision.csv" | sort | uniq -c
 echo "logs and CSV files: $out"

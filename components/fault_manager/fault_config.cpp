@@ -11,7 +11,7 @@ namespace {
 
 void checkKeys(const YAML::Node& node, const std::string& where,
                const std::set<std::string>& allowed) {
-  if (!node) return;
+  if (!node || node.IsNull()) return;  // absent or empty: every default
   if (!node.IsMap()) throw bus::ConfigError("configuration " + where + " must be a map");
   for (const auto& kv : node) {
     const auto key = kv.first.as<std::string>();

@@ -81,7 +81,7 @@ kill -TERM $rec_pid
 wait $rec_pid || true
 
 solutions=$(($(wc -l < "$work/rec/navbus_nav_solution.csv") - 1))
-lost=$(grep -c "IMU_STREAM,.*STREAM_LOST" "$work/rec/navbus_fault_decision.csv" || true)
+lost=$(grep -c "STREAM_LOST,IMU_STREAM," "$work/rec/navbus_fault_decision.csv" || true)
 echo "observer namespace recorded $solutions solutions and $lost IMU stream-lost decisions"
 cat "$work/sim.log"
 status=0

@@ -17,9 +17,16 @@ constexpr int kRangeStep = 0;
 constexpr int kRangeRamp = 1;
 constexpr int kRateStep = 2;
 
-/// Column of a satellite slot's direction.
+/// Index of a satellite slot's direction in f (three per slot).
 constexpr int satColumn(int slot, int direction) {
   return kImuDirections + kSatDirections * slot + direction;
+}
+
+/// Column of a slot's propagated signature in mu: the pseudorange step and the rate step. A
+/// ramp is not propagated: it is the sum of steps begun at each later epoch, weighted by the
+/// epoch spacing (doc: ramps), formed from the step columns of the newer onsets.
+constexpr int muColumn(int slot, int direction) {
+  return kImuDirections + 2 * slot + (direction == kRateStep ? 1 : 0);
 }
 
 /// The bias state a column-j IMU direction steps: accelerometer x y z, gyro x y z.
@@ -109,6 +116,7 @@ void GlrMonitor::configure(const GlrConfig& config) {
     o.f.resize(kMaxDirections);
   }
   scratch_.resize(kStates, kMaxDirections);
+  mu_support_.resize(kStates, kMaxDirections);
   reset();
 }
 
@@ -142,7 +150,7 @@ void GlrMonitor::setQuarantined(int sv_id, bool quarantined) {
     slots_[static_cast<std::size_t>(slot)].last_seen = epochs_;
     slot_of_sv_[static_cast<std::size_t>(sv_id)] = slot + 1;
     for (Onset& o : onsets_) {
-      o.mu.middleCols<kSatDirections>(satColumn(slot, 0)).setZero();
+      o.mu.middleCols<2>(muColumn(slot, 0)).setZero();
       o.f.segment<kSatDirections>(satColumn(slot, 0)).setZero();
       o.r_sat[static_cast<std::size_t>(slot)].setZero();
     }
@@ -198,7 +206,7 @@ void GlrMonitor::assignSlots(const GlrEpoch& e) {
       slots_[static_cast<std::size_t>(slot)].sv_id = sv;
       slot_of_sv_[static_cast<std::size_t>(sv)] = slot + 1;
       for (Onset& o : onsets_) {
-        o.mu.middleCols<kSatDirections>(satColumn(slot, 0)).setZero();
+        o.mu.middleCols<2>(muColumn(slot, 0)).setZero();
         o.f.segment<kSatDirections>(satColumn(slot, 0)).setZero();
         o.r_sat[static_cast<std::size_t>(slot)].setZero();
       }
@@ -226,9 +234,22 @@ void GlrMonitor::prepareEpoch(const GlrEpoch& e) {
   v_inv_.setIdentity(m, m);
   llt.solveInPlace(v_inv_);
   w_.noalias() = v_inv_ * e.innovation;
-  u_.topRows(m).noalias() = v_inv_ * e.h;
-  s_.noalias() = e.h.transpose() * u_.topRows(m);
-  a_.noalias() = e.h.transpose() * w_;
+  // The statistics see the state only through H: everything below lives on H's support (the
+  // states some row measures: position, velocity and clock in tightly coupled mode), which
+  // makes S mu an 8 x 8 product instead of 17 x 17.
+  support_size_ = 0;
+  for (int j = 0; j < kStates; ++j) {
+    if (!e.h.col(j).isZero(0.0)) support_[static_cast<std::size_t>(support_size_++)] = j;
+  }
+  const int k = support_size_;
+  h_support_.resize(m, k);
+  for (int c = 0; c < k; ++c) h_support_.col(c) = e.h.col(support_[static_cast<std::size_t>(c)]);
+  u_.resize(m, k);
+  u_.noalias() = v_inv_ * h_support_;
+  s_.resize(k, k);
+  s_.noalias() = h_support_.transpose() * u_;
+  a_.resize(k);
+  a_.noalias() = h_support_.transpose() * w_;
 }
 
 double GlrMonitor::measurementInput(const Onset& o, int direction, std::int64_t time_ns) const {
@@ -239,21 +260,17 @@ double GlrMonitor::measurementInput(const Onset& o, int direction, std::int64_t 
 
 void GlrMonitor::propagate(Onset& o) {
   // mu_k = Phi_k (mu_{k-1} - K_{k-1} rho_{k-1}) = B mu_{k-1} - G D_{k-1}  (doc eq. C3).
-  const int n = directions();
+  const int n = propagatedColumns();
   scratch_.leftCols(n).noalias() = b_ * o.mu.leftCols(n);
   o.mu.leftCols(n) = scratch_.leftCols(n);
+  const bool range = config_.range_steps || config_.range_ramps;
   for (int s = 0; s < slots_used_; ++s) {
     const Slot& slot = slots_[static_cast<std::size_t>(s)];
-    if (slot.prev_range_row >= 0) {
-      if (config_.range_steps)
-        o.mu.col(satColumn(s, kRangeStep)) -=
-            g_.col(slot.prev_range_row) * measurementInput(o, kRangeStep, prev_time_ns_);
-      if (config_.range_ramps && prev_time_ns_ > o.ramp_start_ns)
-        o.mu.col(satColumn(s, kRangeRamp)) -=
-            g_.col(slot.prev_range_row) * measurementInput(o, kRangeRamp, prev_time_ns_);
-    }
+    if (slot.prev_range_row >= 0 && range)
+      o.mu.col(muColumn(s, kRangeStep)) -=
+          g_.col(slot.prev_range_row) * measurementInput(o, kRangeStep, prev_time_ns_);
     if (slot.prev_rate_row >= 0 && config_.rate_steps)
-      o.mu.col(satColumn(s, kRateStep)) -=
+      o.mu.col(muColumn(s, kRateStep)) -=
           g_.col(slot.prev_rate_row) * measurementInput(o, kRateStep, prev_time_ns_);
   }
 }
@@ -278,43 +295,62 @@ void GlrMonitor::startOnset(const GlrEpoch& e) {
   }
 }
 
-void GlrMonitor::accumulate(Onset& o) {
+void GlrMonitor::accumulate(Onset& o, RampSums& ramp) {
   // rho_c = H mu_c + d_c e_{row_c}; f_c += rho_c^T V^-1 eps; R_cd += rho_c^T V^-1 rho_d
-  // (eqs. 9-10), with z_c = H^T V^-1 rho_c = S mu_c + d_c U_{row_c}^T.
-  const int n = directions();
-  auto z = scratch_.leftCols(n);
-  z.noalias() = s_ * o.mu.leftCols(n);
-  o.f.head(n).noalias() += o.mu.leftCols(n).transpose() * a_;
-  const auto imu = o.mu.leftCols<kImuDirections>();
-  o.r_imu.noalias() += imu.transpose() * z.leftCols<kImuDirections>();
+  // (eqs. 9-10), with z_c = H^T V^-1 rho_c = S mu_c + d_c U_{row_c}^T, all on H's support.
+  const int n = propagatedColumns();
+  const int k = support_size_;
+  auto ms = mu_support_.topLeftCorner(k, n);
+  for (int r = 0; r < k; ++r) ms.row(r) = o.mu.row(support_[static_cast<std::size_t>(r)]).head(n);
+  auto z = scratch_.topLeftCorner(k, n);
+  z.noalias() = s_ * ms;
+  o.f.head<kImuDirections>().noalias() += ms.leftCols<kImuDirections>().transpose() * a_;
+  o.r_imu.noalias() += ms.leftCols<kImuDirections>().transpose() * z.leftCols<kImuDirections>();
+  // The onset's share of the ramps: a step from this epoch on, weighted by its spacing.
+  const double spacing_s = 1e-9 * static_cast<double>(o.time_ns - o.ramp_start_ns);
   for (int s = 0; s < slots_used_; ++s) {
     const Slot& slot = slots_[static_cast<std::size_t>(s)];
-    const int c0 = satColumn(s, 0);
-    std::array<int, kSatDirections> row{slot.range_row, slot.range_row, slot.rate_row};
-    if (!config_.range_steps) row[kRangeStep] = -1;
-    if (!config_.range_ramps) row[kRangeRamp] = -1;
-    if (!config_.rate_steps) row[kRateStep] = -1;
+    // Directions (range step, ramp, rate step): signature mu, z (on the support), input d, row.
+    std::array<SupportVector, kSatDirections> mu, zc;
     std::array<double, kSatDirections> d{};
-    for (int j = 0; j < kSatDirections; ++j) {
-      if (row[static_cast<std::size_t>(j)] < 0) continue;
-      d[static_cast<std::size_t>(j)] = measurementInput(o, j, time_ns_);
-      z.col(c0 + j) +=
-          d[static_cast<std::size_t>(j)] * u_.row(row[static_cast<std::size_t>(j)]).transpose();
-      o.f[c0 + j] += d[static_cast<std::size_t>(j)] * w_[row[static_cast<std::size_t>(j)]];
+    const std::array<int, kSatDirections> row{slot.range_row, slot.range_row, slot.rate_row};
+    mu[kRangeStep] = ms.col(muColumn(s, kRangeStep));
+    mu[kRateStep] = ms.col(muColumn(s, kRateStep));
+    zc[kRangeStep] = z.col(muColumn(s, kRangeStep));
+    zc[kRateStep] = z.col(muColumn(s, kRateStep));
+    if (slot.range_row >= 0) {
+      d[kRangeStep] = measurementInput(o, kRangeStep, time_ns_);
+      zc[kRangeStep] += d[kRangeStep] * u_.row(slot.range_row).transpose();
     }
-    Eigen::Matrix3d& r = o.r_sat[static_cast<std::size_t>(s)];
-    r.noalias() +=
-        o.mu.middleCols<kSatDirections>(c0).transpose() * z.middleCols<kSatDirections>(c0);
+    if (slot.rate_row >= 0 && config_.rate_steps) {
+      d[kRateStep] = measurementInput(o, kRateStep, time_ns_);
+      zc[kRateStep] += d[kRateStep] * u_.row(slot.rate_row).transpose();
+    }
+    RampSums::Slot& r = ramp.slots[static_cast<std::size_t>(s)];
+    r.mu += spacing_s * mu[kRangeStep];
+    r.z += spacing_s * zc[kRangeStep];
+    r.d += spacing_s * d[kRangeStep];
+    mu[kRangeRamp] = r.mu;
+    zc[kRangeRamp] = r.z;
+    d[kRangeRamp] = r.d;
+    std::array<bool, kSatDirections> on{config_.range_steps, config_.range_ramps,
+                                        config_.rate_steps};
+    Eigen::Matrix3d& R = o.r_sat[static_cast<std::size_t>(s)];
     for (int i = 0; i < kSatDirections; ++i) {
-      const int ri = row[static_cast<std::size_t>(i)];
-      if (ri < 0) continue;
-      const double di = d[static_cast<std::size_t>(i)];
+      const auto ui = static_cast<std::size_t>(i);
+      if (!on[ui]) continue;
+      o.f[satColumn(s, i)] += mu[ui].dot(a_) + (row[ui] >= 0 ? d[ui] * w_[row[ui]] : 0.0);
       for (int j = 0; j < kSatDirections; ++j) {
-        // d_i e_ri^T V^-1 (H mu_j + d_j e_rj)
-        double v = u_.row(ri).dot(o.mu.col(c0 + j));
-        const int rj = row[static_cast<std::size_t>(j)];
-        if (rj >= 0) v += d[static_cast<std::size_t>(j)] * v_inv_(ri, rj);
-        r(i, j) += di * v;
+        const auto uj = static_cast<std::size_t>(j);
+        if (!on[uj]) continue;
+        // rho_i^T V^-1 rho_j = mu_i^T z_j + d_i e_ri^T V^-1 (H mu_j + d_j e_rj)
+        double v = mu[ui].dot(zc[uj]);
+        if (row[ui] >= 0 && d[ui] != 0.0) {
+          double t = u_.row(row[ui]).dot(mu[uj]);
+          if (row[uj] >= 0) t += d[uj] * v_inv_(row[ui], row[uj]);
+          v += d[ui] * t;
+        }
+        R(i, j) += v;
       }
     }
   }
@@ -341,8 +377,9 @@ const GlrResult& GlrMonitor::update(const GlrEpoch& e) {
       propagate(onsets_[static_cast<std::size_t>((onset_head_ + i) % config_.window)]);
     startOnset(e);
   }
-  for (int i = 0; i < onset_count_; ++i)
-    accumulate(onsets_[static_cast<std::size_t>((onset_head_ + i) % config_.window)]);
+  // Newest onset first: the ramp of an onset sums the steps of the newer ones.
+  ramp_sums_.clear(slots_used_, support_size_);
+  for (int age = 0; age < onset_count_; ++age) accumulate(onsetAt(age), ramp_sums_);
   prev_h_ = e.h;
   prev_k_ = e.k;
   have_previous_ = true;
@@ -350,9 +387,17 @@ const GlrResult& GlrMonitor::update(const GlrEpoch& e) {
   return result_;
 }
 
-const GlrMonitor::Onset& GlrMonitor::onset(int age) const {
+int GlrMonitor::onsetIndex(int age) const {
   const int i = onset_count_ - 1 - std::clamp(age, 0, std::max(onset_count_ - 1, 0));
-  return onsets_[static_cast<std::size_t>((onset_head_ + i) % config_.window)];
+  return (onset_head_ + i) % config_.window;
+}
+
+GlrMonitor::Onset& GlrMonitor::onsetAt(int age) {
+  return onsets_[static_cast<std::size_t>(onsetIndex(age))];
+}
+
+const GlrMonitor::Onset& GlrMonitor::onset(int age) const {
+  return onsets_[static_cast<std::size_t>(onsetIndex(age))];
 }
 
 GlrMonitor::DirectionSums GlrMonitor::directionSums(int age, const GlrHypothesis& h) const {

@@ -191,14 +191,32 @@ class GlrMonitor {
   void prepareEpoch(const GlrEpoch& e);
   void propagate(Onset& o);
   void startOnset(const GlrEpoch& e);
-  void accumulate(Onset& o);
+  /// Running sums over the onsets newer than the one being accumulated: the ramp signature.
+  using SupportVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, glr::kStates, 1>;
+  struct RampSums {
+    struct Slot {
+      SupportVector mu, z;
+      double d{0.0};
+    };
+    std::array<Slot, glr::kMaxSatellites> slots;
+    void clear(int n, int support) {
+      for (int s = 0; s < n; ++s) {
+        slots[static_cast<std::size_t>(s)].mu.setZero(support);
+        slots[static_cast<std::size_t>(s)].z.setZero(support);
+        slots[static_cast<std::size_t>(s)].d = 0.0;
+      }
+    }
+  };
+  void accumulate(Onset& o, RampSums& ramp);
+  Onset& onsetAt(int age);
+  int onsetIndex(int age) const;
   void evaluate();
   const Onset& onset(int age) const;
   void isolate(const Onset& o, int onset_age, GlrResult& r) const;
   double onsetStatistic(const Onset& o) const;
   /// Measurement-fault input D of `direction` (0..2 of a slot) at `row` for onset `o`.
   double measurementInput(const Onset& o, int direction, std::int64_t time_ns) const;
-  int directions() const { return glr::kImuDirections + glr::kSatDirections * slots_used_; }
+  int propagatedColumns() const { return glr::kImuDirections + 2 * slots_used_; }
 
   GlrConfig config_;
   std::vector<Onset> onsets_;  ///< ring buffer, capacity window
@@ -215,13 +233,20 @@ class GlrMonitor {
   glr::HMatrix h_, prev_h_;
   glr::KMatrix prev_k_;
   glr::RowMatrix v_inv_;
-  glr::RowVector w_;                                      ///< V^-1 eps
-  Eigen::Matrix<double, glr::kMaxRows, glr::kStates> u_;  ///< V^-1 H (first rows_ rows)
-  Matrix17 s_;                                            ///< H^T V^-1 H
-  Eigen::Matrix<double, glr::kStates, 1> a_;              ///< H^T V^-1 eps
-  Matrix17 b_;                                            ///< Phi_k (I - K_{k-1} H_{k-1})
-  glr::KMatrix g_;                                        ///< Phi_k K_{k-1}
+  glr::RowVector w_;  ///< V^-1 eps
+  using SupportMatrix =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kStates, glr::kStates>;
+  std::array<int, glr::kStates> support_{};  ///< states some row of H measures
+  int support_size_{0};
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kMaxRows, glr::kStates> h_support_,
+      u_;                            ///< H and V^-1 H on the support
+  SupportMatrix s_;                  ///< H^T V^-1 H on the support
+  SupportVector a_;                  ///< H^T V^-1 eps on the support
+  glr::SignatureMatrix mu_support_;  ///< an onset's mu on the support
+  Matrix17 b_;                       ///< Phi_k (I - K_{k-1} H_{k-1})
+  glr::KMatrix g_;                   ///< Phi_k K_{k-1}
   glr::SignatureMatrix scratch_;
+  RampSums ramp_sums_;
 
   GlrResult result_;
   std::uint64_t epochs_{0};
