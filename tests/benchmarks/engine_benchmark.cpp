@@ -9,26 +9,11 @@
 #include <new>
 #include <vector>
 
+#include "allocation_counter.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/navigation_engine.hpp"
 #include "navbus/sim/scenario_source.hpp"
 #include "scenario_config.hpp"
-
-namespace {
-std::atomic<std::uint64_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace {
 
@@ -79,7 +64,7 @@ Result run(core::EngineConfig cfg, const std::vector<Input>& inputs, bool aid) {
   auto t0 = std::chrono::steady_clock::now();
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     if (i == warmup) {
-      alloc0 = g_allocations.load();
+      alloc0 = navbus::bench::g_allocations.load();
       t0 = std::chrono::steady_clock::now();
     }
     const Input& in = inputs[i];
@@ -92,7 +77,8 @@ Result run(core::EngineConfig cfg, const std::vector<Input>& inputs, bool aid) {
   }
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double cycles = static_cast<double>(inputs.size() - warmup);
-  return {1e6 * s / cycles, static_cast<double>(g_allocations.load() - alloc0) / cycles};
+  return {1e6 * s / cycles,
+          static_cast<double>(navbus::bench::g_allocations.load() - alloc0) / cycles};
 }
 
 }  // namespace

@@ -12,31 +12,12 @@
 #include <string>
 #include <vector>
 
+#include "allocation_counter.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/glr.hpp"
 #include "navbus/core/navigation_engine.hpp"
 #include "navbus/sim/scenario_source.hpp"
 #include "scenario_config.hpp"
-
-namespace {
-std::atomic<std::uint64_t> g_allocations{0};
-}  // namespace
-
-// Counting replacements of the global operator new/delete (malloc/free underneath); GCC 12
-// sees the inlined pair as a mismatch.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace {
 
@@ -111,7 +92,7 @@ Figures run(const navbus::sim::ScenarioConfig& scenario, int seconds, int window
     const double update_time = us(Clock::now() - t0);
     if (!fused) continue;
     toGlrEpoch(engine.lastEpoch(), engine.state().time_ns, epoch);
-    const std::uint64_t a0 = g_allocations.load();
+    const std::uint64_t a0 = navbus::bench::g_allocations.load();
     t0 = Clock::now();
     glr.update(epoch);
     const double glr_time = us(Clock::now() - t0);
@@ -119,7 +100,7 @@ Figures run(const navbus::sim::ScenarioConfig& scenario, int seconds, int window
     if (static_cast<int>(obs.size()) < scenario.gnss.max_satellites &&
         scenario.gnss.fixed_satellites == 0)
       continue;  // the 12-satellite case: full epochs only
-    allocs += g_allocations.load() - a0;
+    allocs += navbus::bench::g_allocations.load() - a0;
     update.push_back(update_time);
     glr_us.push_back(glr_time);
     sats += obs.size();

@@ -139,21 +139,26 @@ void GlrMonitor::reset() {
   result_ = GlrResult{};
 }
 
+void GlrMonitor::claimSlot(int slot, int sv_id) {
+  slots_[static_cast<std::size_t>(slot)] = Slot{};
+  slots_[static_cast<std::size_t>(slot)].sv_id = sv_id;
+  slots_[static_cast<std::size_t>(slot)].last_seen = epochs_;
+  slot_of_sv_[static_cast<std::size_t>(sv_id)] = slot + 1;
+  // A new satellite has no signature yet at any onset.
+  for (Onset& o : onsets_) {
+    o.mu.middleCols<2>(muColumn(slot, 0)).setZero();
+    o.f.segment<kSatDirections>(satColumn(slot, 0)).setZero();
+    o.r_sat[static_cast<std::size_t>(slot)].setZero();
+  }
+}
+
 void GlrMonitor::setQuarantined(int sv_id, bool quarantined) {
   if (sv_id < 1 || sv_id > 32) return;
   int slot = slot_of_sv_[static_cast<std::size_t>(sv_id)] - 1;
   if (slot < 0) {
     if (!quarantined || slots_used_ >= kMaxSatellites) return;
     slot = slots_used_++;
-    slots_[static_cast<std::size_t>(slot)] = Slot{};
-    slots_[static_cast<std::size_t>(slot)].sv_id = sv_id;
-    slots_[static_cast<std::size_t>(slot)].last_seen = epochs_;
-    slot_of_sv_[static_cast<std::size_t>(sv_id)] = slot + 1;
-    for (Onset& o : onsets_) {
-      o.mu.middleCols<2>(muColumn(slot, 0)).setZero();
-      o.f.segment<kSatDirections>(satColumn(slot, 0)).setZero();
-      o.r_sat[static_cast<std::size_t>(slot)].setZero();
-    }
+    claimSlot(slot, sv_id);
   }
   slots_[static_cast<std::size_t>(slot)].quarantined = quarantined;
 }
@@ -202,14 +207,7 @@ void GlrMonitor::assignSlots(const GlrEpoch& e) {
       } else {
         slot_of_sv_[static_cast<std::size_t>(slots_[static_cast<std::size_t>(slot)].sv_id)] = 0;
       }
-      slots_[static_cast<std::size_t>(slot)] = Slot{};
-      slots_[static_cast<std::size_t>(slot)].sv_id = sv;
-      slot_of_sv_[static_cast<std::size_t>(sv)] = slot + 1;
-      for (Onset& o : onsets_) {
-        o.mu.middleCols<2>(muColumn(slot, 0)).setZero();
-        o.f.segment<kSatDirections>(satColumn(slot, 0)).setZero();
-        o.r_sat[static_cast<std::size_t>(slot)].setZero();
-      }
+      claimSlot(slot, sv);
     }
     Slot& s = slots_[static_cast<std::size_t>(slot)];
     s.last_seen = epochs_;

@@ -188,6 +188,7 @@ class GlrMonitor {
 
   bool validate(const GlrEpoch& e) const;
   void assignSlots(const GlrEpoch& e);
+  void claimSlot(int slot, int sv_id);
   void prepareEpoch(const GlrEpoch& e);
   void propagate(Onset& o);
   void startOnset(const GlrEpoch& e);
