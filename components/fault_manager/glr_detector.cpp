@@ -103,10 +103,11 @@ void GlrDetector::report(const core::GlrResult& r, FaultOutput& out) {
   navbus::FaultDecision d;
   d.time_gps_ns(static_cast<std::uint64_t>(epoch_.time_ns));
   d.event(navbus::EVENT_FAULT_DETECTED);
-  d.source(toSource(best.hypothesis.fault));
-  d.sv_id(static_cast<std::uint16_t>(best.hypothesis.sv_id));
-  d.axis(static_cast<std::uint16_t>(best.hypothesis.isImu() ? best.hypothesis.axis : 0));
-  d.shape(toShape(best.hypothesis.fault));
+  const navbus::FaultCandidate isolated = toIdl(best);  // the decision names candidate 0
+  d.source(isolated.source());
+  d.sv_id(isolated.sv_id());
+  d.axis(isolated.axis());
+  d.shape(isolated.shape());
   d.test_statistic(r.statistic);
   d.threshold(r.threshold);
   d.magnitude(best.magnitude);

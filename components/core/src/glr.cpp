@@ -15,6 +15,9 @@ namespace {
 
 constexpr int kRangeStep = 0;
 constexpr int kRangeRamp = 1;
+/// D of a measurement step per unit magnitude: innovations are predicted minus measured, so a
+/// measurement reading long by nu lowers them (doc: inputs table).
+constexpr double kStepInput = -1.0;
 constexpr int kRateStep = 2;
 
 /// Index of a satellite slot's direction in f (three per slot).
@@ -112,11 +115,11 @@ void GlrMonitor::configure(const GlrConfig& config) {
   config_.window = std::clamp(config.window, 1, kMaxWindow);
   onsets_.assign(static_cast<std::size_t>(config_.window), Onset{});
   for (Onset& o : onsets_) {
-    o.mu.resize(kStates, kMaxDirections);
+    o.mu.resize(kStates, kMaxPropagated);
     o.f.resize(kMaxDirections);
   }
-  scratch_.resize(kStates, kMaxDirections);
-  mu_support_.resize(kStates, kMaxDirections);
+  scratch_.resize(kStates, kMaxPropagated);
+  mu_support_.resize(kStates, kMaxPropagated);
   reset();
 }
 
@@ -226,11 +229,8 @@ void GlrMonitor::prepareEpoch(const GlrEpoch& e) {
   }
   prev_time_ns_ = time_ns_;
   time_ns_ = e.time_ns;
-  rows_ = m;
-  h_ = e.h;
-  const Eigen::LLT<RowMatrix> llt(e.innovation_cov);
   v_inv_.setIdentity(m, m);
-  llt.solveInPlace(v_inv_);
+  llt_.solveInPlace(v_inv_);
   w_.noalias() = v_inv_ * e.innovation;
   // The statistics see the state only through H: everything below lives on H's support (the
   // states some row measures: position, velocity and clock in tightly coupled mode), which
@@ -250,12 +250,6 @@ void GlrMonitor::prepareEpoch(const GlrEpoch& e) {
   a_.noalias() = h_support_.transpose() * w_;
 }
 
-double GlrMonitor::measurementInput(const Onset& o, int direction, std::int64_t time_ns) const {
-  // Innovations are predicted minus measured: a measurement reading long by nu lowers them.
-  if (direction == kRangeRamp) return -1e-9 * static_cast<double>(time_ns - o.ramp_start_ns);
-  return -1.0;
-}
-
 void GlrMonitor::propagate(Onset& o) {
   // mu_k = Phi_k (mu_{k-1} - K_{k-1} rho_{k-1}) = B mu_{k-1} - G D_{k-1}  (doc eq. C3).
   const int n = propagatedColumns();
@@ -265,11 +259,9 @@ void GlrMonitor::propagate(Onset& o) {
   for (int s = 0; s < slots_used_; ++s) {
     const Slot& slot = slots_[static_cast<std::size_t>(s)];
     if (slot.prev_range_row >= 0 && range)
-      o.mu.col(muColumn(s, kRangeStep)) -=
-          g_.col(slot.prev_range_row) * measurementInput(o, kRangeStep, prev_time_ns_);
+      o.mu.col(muColumn(s, kRangeStep)) -= g_.col(slot.prev_range_row) * kStepInput;
     if (slot.prev_rate_row >= 0 && config_.rate_steps)
-      o.mu.col(muColumn(s, kRateStep)) -=
-          g_.col(slot.prev_rate_row) * measurementInput(o, kRateStep, prev_time_ns_);
+      o.mu.col(muColumn(s, kRateStep)) -= g_.col(slot.prev_rate_row) * kStepInput;
   }
 }
 
@@ -317,11 +309,11 @@ void GlrMonitor::accumulate(Onset& o, RampSums& ramp) {
     zc[kRangeStep] = z.col(muColumn(s, kRangeStep));
     zc[kRateStep] = z.col(muColumn(s, kRateStep));
     if (slot.range_row >= 0) {
-      d[kRangeStep] = measurementInput(o, kRangeStep, time_ns_);
+      d[kRangeStep] = kStepInput;
       zc[kRangeStep] += d[kRangeStep] * u_.row(slot.range_row).transpose();
     }
     if (slot.rate_row >= 0 && config_.rate_steps) {
-      d[kRateStep] = measurementInput(o, kRateStep, time_ns_);
+      d[kRateStep] = kStepInput;
       zc[kRateStep] += d[kRateStep] * u_.row(slot.rate_row).transpose();
     }
     RampSums::Slot& r = ramp.slots[static_cast<std::size_t>(s)];
@@ -360,8 +352,8 @@ const GlrResult& GlrMonitor::update(const GlrEpoch& e) {
     result_ = GlrResult{};
     return result_;
   }
-  const Eigen::LLT<RowMatrix> check(e.innovation_cov);
-  if (check.info() != Eigen::Success) {
+  llt_.compute(e.innovation_cov);  // used again for V^-1 in prepareEpoch
+  if (llt_.info() != Eigen::Success) {
     ++refused_;
     result_ = GlrResult{};
     return result_;

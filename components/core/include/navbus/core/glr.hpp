@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "navbus/core/gnss_measurement.hpp"
@@ -43,13 +44,16 @@ inline constexpr int kMaxRows = 2 * kMaxSatellites;
 inline constexpr int kImuDirections = 6;  ///< accelerometer x y z, gyro x y z
 inline constexpr int kSatDirections = 3;  ///< pseudorange step, pseudorange ramp, rate step
 inline constexpr int kMaxDirections = kImuDirections + kSatDirections * kMaxSatellites;
+/// Signature columns propagated: the IMU steps and each satellite's pseudorange and rate steps
+/// (ramps are sums of steps, see glr.cpp).
+inline constexpr int kMaxPropagated = kImuDirections + 2 * kMaxSatellites;
 inline constexpr int kMaxWindow = 100;  ///< largest configurable window M [epochs]
 
 using RowVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRows, 1>;
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, kMaxRows>;
 using HMatrix = Eigen::Matrix<double, Eigen::Dynamic, kStates, Eigen::RowMajor, kMaxRows, kStates>;
 using KMatrix = Eigen::Matrix<double, kStates, Eigen::Dynamic, 0, kStates, kMaxRows>;
-using SignatureMatrix = Eigen::Matrix<double, kStates, Eigen::Dynamic, 0, kStates, kMaxDirections>;
+using SignatureMatrix = Eigen::Matrix<double, kStates, Eigen::Dynamic, 0, kStates, kMaxPropagated>;
 using DirectionVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDirections, 1>;
 }  // namespace glr
 
@@ -215,8 +219,6 @@ class GlrMonitor {
   const Onset& onset(int age) const;
   void isolate(const Onset& o, int onset_age, GlrResult& r) const;
   double onsetStatistic(const Onset& o) const;
-  /// Measurement-fault input D of `direction` (0..2 of a slot) at `row` for onset `o`.
-  double measurementInput(const Onset& o, int direction, std::int64_t time_ns) const;
   int propagatedColumns() const { return glr::kImuDirections + 2 * slots_used_; }
 
   GlrConfig config_;
@@ -230,8 +232,8 @@ class GlrMonitor {
   // Per-epoch quantities (current epoch k) and what the recursion keeps of epoch k-1.
   bool have_previous_{false};
   std::int64_t time_ns_{0}, prev_time_ns_{0};
-  int rows_{0};
-  glr::HMatrix h_, prev_h_;
+  glr::HMatrix prev_h_;
+  Eigen::LLT<glr::RowMatrix> llt_;  ///< Cholesky factor of this epoch's V
   glr::KMatrix prev_k_;
   glr::RowMatrix v_inv_;
   glr::RowVector w_;  ///< V^-1 eps
