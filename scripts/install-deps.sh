@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libbenchmark-dev                            # tests and benchmarks
   cyclonedds-dev cyclonedds-tools                          # second DDS vendor for the interop test
   iproute2                                                 # network namespaces for the topology test
+  rtklib                                                   # rnx2rtkp: independent GPS fixes for the real-data test
 )
 missing=()
 for p in "${packages[@]}"; do

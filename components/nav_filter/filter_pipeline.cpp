@@ -181,33 +181,8 @@ void FilterPipeline::process(std::int64_t time_ns, const FilterInput& input) {
 
 void FilterPipeline::publishDiagnostics() {
   if (!sinks_.diagnostics) return;
-  const core::EpochDiagnostics& d = engine_.lastEpoch();
-  navbus::FilterDiagnostics msg;
-  msg.vehicle_id(config_.vehicle_id);
-  msg.seq(++diagnostics_seq_);
-  msg.time_gps_ns(static_cast<std::uint64_t>(engine_.state().time_ns));
-  const auto m = static_cast<std::uint16_t>(d.h.rows());
-  bus::fillTc17Layout(msg);
-  msg.m(m);
-  for (std::size_t r = 0; r < m; ++r) {
-    navbus::MeasurementRow row;
-    row.kind(d.is_rate[r] ? navbus::MEAS_PSEUDORANGE_RATE : navbus::MEAS_PSEUDORANGE);
-    row.sv_id(static_cast<std::uint16_t>(d.sv_ids[r]));
-    row.used(d.used[r]);
-    msg.rows().push_back(row);
-    msg.innovation().push_back(d.innovation[static_cast<Eigen::Index>(r)]);
-    msg.test_ratio().push_back(d.test_ratio[r]);
-  }
-  // Row-major matrices.
-  auto append = [](const auto& M, auto& out) {
-    for (Eigen::Index i = 0; i < M.rows(); ++i)
-      for (Eigen::Index j = 0; j < M.cols(); ++j) out.push_back(M(i, j));
-  };
-  append(d.innovation_cov, msg.innovation_cov());
-  append(d.h, msg.h());
-  append(d.k, msg.k());
-  append(d.phi, msg.phi());
-  sinks_.diagnostics(msg);
+  sinks_.diagnostics(bus::toIdl(engine_.lastEpoch(), config_.vehicle_id, ++diagnostics_seq_,
+                                engine_.state().time_ns));
 }
 
 void FilterPipeline::publishSolution() {

@@ -13,6 +13,7 @@
 #include "evaluation.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
+#include "real_data.hpp"
 #include "topic_registry.hpp"
 
 namespace nb = navbus;
@@ -248,9 +249,37 @@ int main(int argc, char** argv) {
                    "the error must stay below the threshold this long [s]")
       ->check(CLI::Range(0.0, 1e6));
 
+  nb::tool::RealDataOptions real;
+  auto* rinex_cmd = app.add_subcommand(
+      "rinex",
+      "real GPS data: RINEX 2 observation + navigation files -> single point fixes and the static "
+      "receiver filter, optionally monitored by the fault manager's GLR");
+  rinex_cmd->add_option("--obs", real.obs, "RINEX 2 observation file (.yyo)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  rinex_cmd->add_option("--nav", real.nav, "RINEX 2 GPS navigation file (.yyn)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  rinex_cmd->add_option("-o,--out", real.out_dir, "output directory (created)")->required();
+  rinex_cmd
+      ->add_option("--fault-manager", real.fault_manager,
+                   "navbus-fault-manager YAML (e.g. config/fault_manager_static.yaml): run the "
+                   "GLR on the filter; writes decisions.csv and commands.csv")
+      ->check(CLI::ExistingFile);
+  rinex_cmd
+      ->add_option("--reference", real.reference,
+                   "reference position x,y,z ECEF [m] (default: the header's APPROX POSITION)")
+      ->delimiter(',');
+  rinex_cmd
+      ->add_option("--inject-ramp", real.ramp,
+                   "sv,rate_mps,onset_s: add rate * (t - onset) to one satellite's pseudoranges "
+                   "from onset_s after the first epoch")
+      ->delimiter(',');
+
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) -> int {
     // Offline work: no DDS participant at all.
     if (*offline_cmd) return nb::tool::runOfflineCommand(offline);
+    if (*rinex_cmd) return nb::tool::runRealDataCommand(real);
     if (*mc_cmd) {
       mc.perturb_initial = !mc_no_perturb;
       return nb::tool::runMonteCarloCommand(mc);

@@ -101,6 +101,35 @@ void fillTc17Layout(navbus::FilterDiagnostics& msg) {
   }
 }
 
+navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t vehicle_id,
+                                std::uint64_t seq, std::int64_t time_ns) {
+  navbus::FilterDiagnostics msg;
+  msg.vehicle_id(vehicle_id);
+  msg.seq(seq);
+  msg.time_gps_ns(static_cast<std::uint64_t>(time_ns));
+  const auto m = static_cast<std::uint16_t>(d.h.rows());
+  fillTc17Layout(msg);
+  msg.m(m);
+  for (std::size_t r = 0; r < m; ++r) {
+    navbus::MeasurementRow row;
+    row.kind(d.is_rate[r] ? navbus::MEAS_PSEUDORANGE_RATE : navbus::MEAS_PSEUDORANGE);
+    row.sv_id(static_cast<std::uint16_t>(d.sv_ids[r]));
+    row.used(d.used[r]);
+    msg.rows().push_back(row);
+    msg.innovation().push_back(d.innovation[static_cast<Eigen::Index>(r)]);
+    msg.test_ratio().push_back(d.test_ratio[r]);
+  }
+  auto append = [](const auto& M, auto& out) {
+    for (Eigen::Index i = 0; i < M.rows(); ++i)
+      for (Eigen::Index j = 0; j < M.cols(); ++j) out.push_back(M(i, j));
+  };
+  append(d.innovation_cov, msg.innovation_cov());
+  append(d.h, msg.h());
+  append(d.k, msg.k());
+  append(d.phi, msg.phi());
+  return msg;
+}
+
 std::optional<Rejection> toGlrEpoch(const navbus::FilterDiagnostics& msg, core::GlrEpoch& out) {
   constexpr std::size_t n = core::tc17::kSize;
   if (msg.n() != n)

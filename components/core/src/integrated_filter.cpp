@@ -169,29 +169,9 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
     reports.push_back({d.sv_ids[static_cast<std::size_t>(row)],
                        d.is_rate[static_cast<std::size_t>(row)], fuse, res});
   }
-  appliedGain();
+  applied_gain_.compute(last_epoch_, prior_P_);
   closeUpdate();
   return reports_;
-}
-
-void IntegratedFilter::appliedGain() {
-  // The gain the sequential updates applied in total: for the accepted rows a (diagonal R),
-  // K_a = P- H_a^T V_aa^-1, the batch gain over those rows; 0 for the others. Decoupling the
-  // other rows in V (identity block) gives it in one solve.
-  EpochDiagnostics& d = last_epoch_;
-  const Eigen::Index m = d.h.rows();
-  applied_cov_ = d.innovation_cov;
-  for (Eigen::Index i = 0; i < m; ++i) {
-    if (d.used[static_cast<std::size_t>(i)]) continue;
-    applied_cov_.row(i).setZero();
-    applied_cov_.col(i).setZero();
-    applied_cov_(i, i) = 1.0;
-  }
-  applied_llt_.compute(applied_cov_);
-  d.k = applied_llt_.solve(d.h * prior_P_).transpose();
-  for (Eigen::Index i = 0; i < m; ++i) {
-    if (!d.used[static_cast<std::size_t>(i)]) d.k.col(i).setZero();
-  }
 }
 
 void IntegratedFilter::closeUpdate() {

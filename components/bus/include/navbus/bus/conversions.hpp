@@ -11,6 +11,7 @@
 #include <navbus_idl/StarTracker.h>
 
 #include "navbus/bus/validation.hpp"
+#include "navbus/core/epoch_diagnostics.hpp"
 #include "navbus/core/glr.hpp"
 #include "navbus/core/gnss_measurement.hpp"
 #include "navbus/core/navigation_engine.hpp"
@@ -38,6 +39,10 @@ std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoc
 
 /// The tightly coupled filter's state layout (core::tc17) as the diagnostics declare it.
 void fillTc17Layout(navbus::FilterDiagnostics& msg);
+
+/// A GNSS epoch's diagnostics over the tc17 layout as the message (matrices row-major).
+navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t vehicle_id,
+                                std::uint64_t seq, std::int64_t time_ns);
 
 /// A validated diagnostics sample (validate() passed) as the GLR's epoch; a rejection when
 /// its state layout is not core::tc17's or it has more rows than the GLR supports.

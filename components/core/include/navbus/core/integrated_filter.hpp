@@ -18,6 +18,7 @@
 #include <Eigen/Cholesky>
 
 #include "navbus/core/aiding_measurements.hpp"
+#include "navbus/core/epoch_diagnostics.hpp"
 #include "navbus/core/error_state.hpp"
 #include "navbus/core/gnss_measurement.hpp"
 #include "navbus/core/innovation_window.hpp"
@@ -64,20 +65,6 @@ struct MeasurementReport {
   bool rate;   ///< false: pseudorange row, true: pseudorange-rate row
   bool fused;  ///< offered to the update (false: excluded, monitored only)
   ScalarUpdateResult result;
-};
-
-/// Everything the GLR detector (seed 000 eqs. 6-16) needs from one GNSS epoch, in batch form
-/// from the prior covariance: rows are (pseudorange, rate) per satellite, in order.
-struct EpochDiagnostics {
-  std::vector<int> sv_ids;         ///< per row
-  std::vector<bool> is_rate;       ///< per row
-  std::vector<bool> used;          ///< per row: fused (false: gated, or monitored only)
-  Eigen::VectorXd innovation;      ///< predicted minus measured, m rows
-  Eigen::MatrixXd innovation_cov;  ///< V = H P- H^T + R, m x m
-  Eigen::MatrixXd h;               ///< m x 17
-  Eigen::MatrixXd k;  ///< 17 x m: the gain applied, P- H_u^T V_uu^-1 on the used rows, 0 elsewhere
-  Matrix17 phi{Matrix17::Identity()};  ///< transition accumulated since the previous epoch
-  std::vector<double> test_ratio;      ///< per row, from the sequential gated update
 };
 
 class IntegratedFilter {
@@ -134,8 +121,6 @@ class IntegratedFilter {
   /// Applies the estimate after an update: centralized feedback, or master fusion + feedback.
   void closeUpdate();
   void feedback(const Vector17& dx);
-  /// Sets the diagnostics' K to the gain the epoch's sequential updates applied.
-  void appliedGain();
   InnovationWindow<3>* window(AidingKind kind);
 
   FilterTuning tuning_;
@@ -147,8 +132,7 @@ class IntegratedFilter {
   Matrix17 phi_since_update_{Matrix17::Identity()};
   EpochDiagnostics last_epoch_;
   Matrix17 prior_P_{Matrix17::Zero()};  ///< P- of the latest GNSS epoch
-  Eigen::MatrixXd applied_cov_;         ///< V with the unused rows decoupled (reused storage)
-  Eigen::LLT<Eigen::MatrixXd> applied_llt_;
+  AppliedGain applied_gain_;            ///< the diagnostics' K from the sequential updates
   std::vector<MeasurementReport> reports_;
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
