@@ -20,6 +20,12 @@ constexpr int kRangeRamp = 1;
 constexpr double kStepInput = -1.0;
 constexpr int kRateStep = 2;
 
+/// The accelerometer and gyro bias states, adjacent in tc17.
+constexpr int kBiasIndex = tc17::kAccelBias.index;
+constexpr int kBiasStates = tc17::kAccelBias.dof + tc17::kGyroBias.dof;
+static_assert(tc17::kGyroBias.index == tc17::kAccelBias.end() && tc17::kAtt.end() == kBiasIndex &&
+              tc17::kGyroBias.end() == kSupportTail.index);
+
 /// Index of a satellite slot's direction in f (three per slot).
 constexpr int satColumn(int slot, int direction) {
   return kImuDirections + kSatDirections * slot + direction;
@@ -47,43 +53,90 @@ struct GroupFit {
 /// information not explained by those already chosen is taken; directions whose remaining
 /// share falls below `tolerance` depend on the chosen ones and are dropped (f lies in the range
 /// of R, so the statistic over the chosen basis equals f^T R^+ f).
+/// The same statistic without pivoting, when no direction can be dropped: scaled to unit
+/// diagonal (A), each direction's smallest unexplained share is det(A) / cofactor_ii(A) >=
+/// det(A) (a principal minor of a unit-diagonal correlation matrix is at most 1), so
+/// det(A) = prod(LDL^T pivots) / prod(R_ii) > tolerance means full rank, and the order of
+/// elimination does not change f^T R^-1 f. Returns false when that cannot be shown.
+template <int N>
+bool fitFullRank(const Eigen::Matrix<double, N, N>& R, const Eigen::Matrix<double, N, 1>& f,
+                 double tolerance, GroupFit& out) {
+  Eigen::Matrix<double, N, N> A = R;
+  Eigen::Matrix<double, N, 1> b = f;
+  double det_ratio = 1.0;
+  out = GroupFit{};
+  for (int k = 0; k < N; ++k) {
+    const double d = A(k, k);
+    if (!(d > 0.0) || !(R(k, k) > 0.0)) return false;
+    det_ratio *= d / R(k, k);
+    out.statistic += 0.5 * b[k] * b[k] / d;
+    for (int i = k + 1; i < N; ++i) {
+      const double factor = A(i, k) / d;
+      b[i] -= factor * b[k];
+      for (int j = k + 1; j <= i; ++j) A(i, j) -= factor * A(j, k);
+    }
+  }
+  out.rank = N;
+  return det_ratio > tolerance;
+}
+
 template <int N>
 GroupFit fitGroup(const Eigen::Matrix<double, N, N>& R, const Eigen::Matrix<double, N, 1>& f,
                   double tolerance) {
+  GroupFit fast;
+  if (fitFullRank<N>(R, f, tolerance, fast)) return fast;
   Eigen::Matrix<double, N, 1> scale;
   for (int i = 0; i < N; ++i) scale[i] = R(i, i) > 0.0 ? 1.0 / std::sqrt(R(i, i)) : 0.0;
   Eigen::Matrix<double, N, N> A = scale.asDiagonal() * R * scale.asDiagonal();
   Eigen::Matrix<double, N, 1> b = scale.cwiseProduct(f);
-  std::array<int, N> idx;
-  for (int i = 0; i < N; ++i) idx[static_cast<std::size_t>(i)] = i;
   GroupFit out;
   for (int k = 0; k < N; ++k) {
+    // Pivot: the remaining direction with the largest unexplained share, moved to position k.
     int best = -1;
     double best_d = tolerance;
     for (int i = k; i < N; ++i) {
-      const double d = A(idx[static_cast<std::size_t>(i)], idx[static_cast<std::size_t>(i)]);
-      if (d > best_d) {
-        best_d = d;
+      if (A(i, i) > best_d) {
+        best_d = A(i, i);
         best = i;
       }
     }
     if (best < 0) break;
-    std::swap(idx[static_cast<std::size_t>(k)], idx[static_cast<std::size_t>(best)]);
-    const int p = idx[static_cast<std::size_t>(k)];
-    const double d = A(p, p);
-    out.statistic += 0.5 * b[p] * b[p] / d;
+    if (best != k) {
+      A.row(k).swap(A.row(best));
+      A.col(k).swap(A.col(best));
+      std::swap(b[k], b[best]);
+    }
+    const double d = A(k, k);
+    out.statistic += 0.5 * b[k] * b[k] / d;
     for (int i = k + 1; i < N; ++i) {
-      const int r = idx[static_cast<std::size_t>(i)];
-      const double factor = A(r, p) / d;
-      b[r] -= factor * b[p];
-      for (int j = k + 1; j < N; ++j) {
-        const int c = idx[static_cast<std::size_t>(j)];
-        A(r, c) -= factor * A(p, c);
-      }
+      const double factor = A(i, k) / d;
+      b[i] -= factor * b[k];
+      for (int j = k + 1; j < N; ++j) A(i, j) -= factor * A(k, j);
     }
     ++out.rank;
   }
   return out;
+}
+
+/// The statistic of a satellite's group (three directions), as fitGroup<3> gives it, in closed
+/// form when no direction can be dropped: with R scaled to unit diagonal (A), each direction's
+/// smallest unexplained share is det(A) / cofactor_ii(A) >= det(A), so det(A) > tolerance
+/// means full rank, and l = 1/2 f^T adj(R) f / det(R). Otherwise (the newest onset, where a
+/// step and a ramp coincide) the pivoted factorization decides.
+double satelliteGroupStatistic(const Eigen::Matrix3d& R, const Eigen::Vector3d& f,
+                               double tolerance) {
+  const double c00 = R(1, 1) * R(2, 2) - R(1, 2) * R(1, 2);
+  const double c11 = R(0, 0) * R(2, 2) - R(0, 2) * R(0, 2);
+  const double c22 = R(0, 0) * R(1, 1) - R(0, 1) * R(0, 1);
+  const double c01 = R(0, 2) * R(1, 2) - R(0, 1) * R(2, 2);
+  const double c02 = R(0, 1) * R(1, 2) - R(0, 2) * R(1, 1);
+  const double c12 = R(0, 1) * R(0, 2) - R(0, 0) * R(1, 2);
+  const double det = R(0, 0) * c00 + R(0, 1) * c01 + R(0, 2) * c02;
+  const double diag = R(0, 0) * R(1, 1) * R(2, 2);
+  if (!(diag > 0.0) || !(det > tolerance * diag)) return fitGroup<3>(R, f, tolerance).statistic;
+  const double q = c00 * f[0] * f[0] + c11 * f[1] * f[1] + c22 * f[2] * f[2] +
+                   2.0 * (c01 * f[0] * f[1] + c02 * f[0] * f[2] + c12 * f[1] * f[2]);
+  return 0.5 * q / det;
 }
 
 }  // namespace
@@ -114,12 +167,15 @@ void GlrMonitor::configure(const GlrConfig& config) {
   config_ = config;
   config_.window = std::clamp(config.window, 1, kMaxWindow);
   onsets_.assign(static_cast<std::size_t>(config_.window), Onset{});
-  for (Onset& o : onsets_) {
-    o.mu.resize(kStates, kMaxPropagated);
-    o.f.resize(kMaxDirections);
-  }
-  scratch_.resize(kStates, kMaxPropagated);
-  mu_support_.resize(kStates, kMaxPropagated);
+  f_.resize(kMaxDirections, config_.window);
+  r_imu_.resize(kImuDirections * kImuDirections, config_.window);
+  r_sat_.resize(kSatDirections * kSatDirections * kMaxSatellites, config_.window);
+  const int columns = kMaxPropagated * config_.window;
+  mu_.resize(kStates, columns);
+  mu_next_.resize(kStates, columns);
+  ms_.resize(kSupport, columns);
+  z_.resize(kSupport, columns);
+  spacing_s_.resize(config_.window);
   reset();
 }
 
@@ -136,6 +192,8 @@ void GlrMonitor::reset() {
   slots_ = {};
   slots_used_ = 0;
   slot_of_sv_ = {};
+  mu_.setZero();
+  spacing_s_.setZero();
   for (int sv = 1; sv <= 32; ++sv) {
     if (quarantined[static_cast<std::size_t>(sv)]) setQuarantined(sv, true);
   }
@@ -147,12 +205,12 @@ void GlrMonitor::claimSlot(int slot, int sv_id) {
   slots_[static_cast<std::size_t>(slot)].sv_id = sv_id;
   slots_[static_cast<std::size_t>(slot)].last_seen = epochs_;
   slot_of_sv_[static_cast<std::size_t>(sv_id)] = slot + 1;
-  // A new satellite has no signature yet at any onset.
-  for (Onset& o : onsets_) {
-    o.mu.middleCols<2>(muColumn(slot, 0)).setZero();
-    o.f.segment<kSatDirections>(satColumn(slot, 0)).setZero();
-    o.r_sat[static_cast<std::size_t>(slot)].setZero();
-  }
+  // A new satellite has no signature yet at any onset (its two propagated columns are
+  // adjacent, so their blocks are too).
+  mu_.middleCols(firstColumn(muColumn(slot, 0)), 2 * config_.window).setZero();
+  f_.middleRows<kSatDirections>(satColumn(slot, 0)).setZero();
+  r_sat_.middleRows<kSatDirections * kSatDirections>(kSatDirections * kSatDirections * slot)
+      .setZero();
 }
 
 void GlrMonitor::setQuarantined(int sv_id, bool quarantined) {
@@ -181,6 +239,9 @@ bool GlrMonitor::validate(const GlrEpoch& e) const {
     const int sv = e.sv_id[static_cast<std::size_t>(r)];
     if (sv < 1 || sv > 32) return false;
   }
+  // H must stay on the support (the pseudorange and rate model of the tc17 layout).
+  if (!e.h.middleCols<kSupportTail.index - kSupportHead.end()>(kSupportHead.end()).isZero(0.0))
+    return false;
   return e.innovation.allFinite() && e.innovation_cov.allFinite() && e.h.allFinite() &&
          e.k.allFinite() && e.phi.allFinite() && (!have_previous_ || e.time_ns > time_ns_);
 }
@@ -224,44 +285,83 @@ void GlrMonitor::prepareEpoch(const GlrEpoch& e) {
     // Closed-loop transition from the previous epoch's prior to this one's (doc eq. C3).
     g_.resize(kStates, prev_k_.cols());
     g_.noalias() = e.phi * prev_k_;
+    // H is zero outside the support (validate), so G H only touches the support's columns.
     b_ = e.phi;
-    b_.noalias() -= g_ * prev_h_;
+    b_.middleCols<kSupportHead.dof>(kSupportHead.index).noalias() -=
+        g_ * prev_h_support_.leftCols<kSupportHead.dof>();
+    b_.middleCols<kSupportTail.dof>(kSupportTail.index).noalias() -=
+        g_ * prev_h_support_.rightCols<kSupportTail.dof>();
   }
   prev_time_ns_ = time_ns_;
   time_ns_ = e.time_ns;
-  v_inv_.setIdentity(m, m);
-  llt_.solveInPlace(v_inv_);
-  w_.noalias() = v_inv_ * e.innovation;
-  // The statistics see the state only through H: everything below lives on H's support (the
-  // states some row measures: position, velocity and clock in tightly coupled mode), which
-  // makes S mu an 8 x 8 product instead of 17 x 17.
-  support_size_ = 0;
-  for (int j = 0; j < kStates; ++j) {
-    if (!e.h.col(j).isZero(0.0)) support_[static_cast<std::size_t>(support_size_++)] = j;
-  }
-  const int k = support_size_;
-  h_support_.resize(m, k);
-  for (int c = 0; c < k; ++c) h_support_.col(c) = e.h.col(support_[static_cast<std::size_t>(c)]);
-  u_.resize(m, k);
-  u_.noalias() = v_inv_ * h_support_;
-  s_.resize(k, k);
+  // V = L L^T: V^-1 eps and V^-1 H by two triangular solves; the few entries of V^-1 the
+  // direct inputs need (vInv) from the columns of L^-1.
+  l_inv_.setIdentity(m, m);
+  llt_.matrixL().solveInPlace(l_inv_);
+  w_ = llt_.solve(e.innovation);
+  // The statistics see the state only through H: everything below lives on H's support
+  // (position, velocity and clock), which makes S mu an 8 x 8 product instead of 17 x 17.
+  h_support_.resize(m, kSupport);
+  h_support_.leftCols<kSupportHead.dof>() = e.h.middleCols<kSupportHead.dof>(kSupportHead.index);
+  h_support_.rightCols<kSupportTail.dof>() = e.h.middleCols<kSupportTail.dof>(kSupportTail.index);
+  u_.resize(m, kSupport);
+  u_ = llt_.solve(h_support_);
   s_.noalias() = h_support_.transpose() * u_;
-  a_.resize(k);
   a_.noalias() = h_support_.transpose() * w_;
 }
 
-void GlrMonitor::propagate(Onset& o) {
-  // mu_k = Phi_k (mu_{k-1} - K_{k-1} rho_{k-1}) = B mu_{k-1} - G D_{k-1}  (doc eq. C3).
-  const int n = propagatedColumns();
-  scratch_.leftCols(n).noalias() = b_ * o.mu.leftCols(n);
-  o.mu.leftCols(n) = scratch_.leftCols(n);
+double GlrMonitor::vInv(int i, int j) const {
+  // (V^-1)_ij = sum_k (L^-1)_ki (L^-1)_kj, over the rows where both columns can be nonzero.
+  const int first = std::max(i, j);
+  const int n = static_cast<int>(l_inv_.rows()) - first;
+  return l_inv_.col(i).tail(n).dot(l_inv_.col(j).tail(n));
+}
+
+bool GlrMonitor::biasAndClockRowsSparse() const {
+  // Random-constant biases and a clock that only the clock drives (the tc17 error model)
+  // make the bias and clock rows of Phi [0 I 0] and [0 0 Phi_clock] exactly, and G H only
+  // adds support columns.
+  constexpr int kNav = tc17::kAtt.end();
+  return b_.block<kStates - kNav, tc17::kAtt.dof>(kNav, tc17::kAtt.index).isZero(0.0) &&
+         b_.block<kBiasStates, kBiasStates>(kBiasIndex, kBiasIndex).isIdentity(0.0) &&
+         b_.block<kSupportTail.dof, kBiasStates>(kSupportTail.index, kBiasIndex).isZero(0.0);
+}
+
+void GlrMonitor::propagate() {
+  // mu_k = Phi_k (mu_{k-1} - K_{k-1} rho_{k-1}) = B mu_{k-1} - G D_{k-1}  (doc eq. C3), for
+  // every onset and column in one product.
+  const int columns = propagatedColumns() * config_.window;
+  const auto in = mu_.leftCols(columns);
+  auto out = mu_next_.leftCols(columns);
+  if (biasAndClockRowsSparse()) {
+    // Bias and clock rows: B = [0 I 0] + B(:, support): 8 x 8 per column instead of 8 x 17.
+    constexpr int kNav = tc17::kAtt.end();  // position, velocity, attitude rows
+    constexpr int kLower = kStates - kNav;  // bias and clock rows
+    // (Eigen's kernels work on blocks of 4 rows: 8 rows as a product, the 9th alone.)
+    out.topRows<kNav - 1>().noalias() = b_.topRows<kNav - 1>() * in;
+    out.row(kNav - 1).noalias() = b_.row(kNav - 1) * in;
+    out.bottomRows<kLower>().noalias() =
+        b_.block<kLower, kSupportHead.dof>(kNav, kSupportHead.index) *
+        in.middleRows<kSupportHead.dof>(kSupportHead.index);
+    out.bottomRows<kLower>().noalias() +=
+        b_.block<kLower, kSupportTail.dof>(kNav, kSupportTail.index) *
+        in.middleRows<kSupportTail.dof>(kSupportTail.index);
+    out.middleRows<kBiasStates>(kBiasIndex) += in.middleRows<kBiasStates>(kBiasIndex);
+  } else {
+    out.noalias() = b_ * in;
+  }
+  mu_.swap(mu_next_);
   const bool range = config_.range_steps || config_.range_ramps;
   for (int s = 0; s < slots_used_; ++s) {
     const Slot& slot = slots_[static_cast<std::size_t>(s)];
-    if (slot.prev_range_row >= 0 && range)
-      o.mu.col(muColumn(s, kRangeStep)) -= g_.col(slot.prev_range_row) * kStepInput;
-    if (slot.prev_rate_row >= 0 && config_.rate_steps)
-      o.mu.col(muColumn(s, kRateStep)) -= g_.col(slot.prev_rate_row) * kStepInput;
+    if (slot.prev_range_row >= 0 && range) {
+      mu_.middleCols(firstColumn(muColumn(s, kRangeStep)), config_.window).colwise() -=
+          g_.col(slot.prev_range_row) * kStepInput;
+    }
+    if (slot.prev_rate_row >= 0 && config_.rate_steps) {
+      mu_.middleCols(firstColumn(muColumn(s, kRateStep)), config_.window).colwise() -=
+          g_.col(slot.prev_rate_row) * kStepInput;
+    }
   }
 }
 
@@ -270,79 +370,120 @@ void GlrMonitor::startOnset(const GlrEpoch& e) {
     onset_head_ = (onset_head_ + 1) % config_.window;  // the oldest onset leaves the window
     --onset_count_;
   }
-  Onset& o = onsets_[static_cast<std::size_t>((onset_head_ + onset_count_) % config_.window)];
+  const int ring = (onset_head_ + onset_count_) % config_.window;
+  Onset& o = onsets_[static_cast<std::size_t>(ring)];
   ++onset_count_;
+  f_.col(ring).setZero();
+  r_imu_.col(ring).setZero();
+  r_sat_.col(ring).setZero();
   o.time_ns = e.time_ns;
   o.ramp_start_ns = prev_time_ns_;
-  o.mu.setZero();
-  o.f.setZero();
-  o.r_imu.setZero();
-  for (auto& r : o.r_sat) r.setZero();
+  spacing_s_[ring] = 1e-9 * static_cast<double>(o.time_ns - o.ramp_start_ns);
+  for (int c = 0; c < propagatedColumns(); ++c) mu_.col(firstColumn(c) + ring).setZero();
   if (config_.imu_steps) {
     // A bias step at the start of the interval: the bias error (estimate minus truth) drops by
     // the step, and Phi_k carries it to this epoch (doc eq. C4).
-    for (int j = 0; j < kImuDirections; ++j) o.mu.col(j) = -e.phi.col(imuState(j));
+    for (int j = 0; j < kImuDirections; ++j)
+      mu_.col(firstColumn(j) + ring) = -e.phi.col(imuState(j));
   }
 }
 
-void GlrMonitor::accumulate(Onset& o, RampSums& ramp) {
+void GlrMonitor::accumulate() {
   // rho_c = H mu_c + d_c e_{row_c}; f_c += rho_c^T V^-1 eps; R_cd += rho_c^T V^-1 rho_d
-  // (eqs. 9-10), with z_c = H^T V^-1 rho_c = S mu_c + d_c U_{row_c}^T, all on H's support.
-  const int n = propagatedColumns();
-  const int k = support_size_;
-  auto ms = mu_support_.topLeftCorner(k, n);
-  for (int r = 0; r < k; ++r) ms.row(r) = o.mu.row(support_[static_cast<std::size_t>(r)]).head(n);
-  auto z = scratch_.topLeftCorner(k, n);
-  z.noalias() = s_ * ms;
-  o.f.head<kImuDirections>().noalias() += ms.leftCols<kImuDirections>().transpose() * a_;
-  o.r_imu.noalias() += ms.leftCols<kImuDirections>().transpose() * z.leftCols<kImuDirections>();
-  // The onset's share of the ramps: a step from this epoch on, weighted by its spacing.
-  const double spacing_s = 1e-9 * static_cast<double>(o.time_ns - o.ramp_start_ns);
-  for (int s = 0; s < slots_used_; ++s) {
-    const Slot& slot = slots_[static_cast<std::size_t>(s)];
-    // Directions (range step, ramp, rate step): signature mu, z (on the support), input d, row.
-    std::array<SupportVector, kSatDirections> mu, zc;
-    std::array<double, kSatDirections> d{};
-    const std::array<int, kSatDirections> row{slot.range_row, slot.range_row, slot.rate_row};
-    mu[kRangeStep] = ms.col(muColumn(s, kRangeStep));
-    mu[kRateStep] = ms.col(muColumn(s, kRateStep));
-    zc[kRangeStep] = z.col(muColumn(s, kRangeStep));
-    zc[kRateStep] = z.col(muColumn(s, kRateStep));
-    if (slot.range_row >= 0) {
-      d[kRangeStep] = kStepInput;
-      zc[kRangeStep] += d[kRangeStep] * u_.row(slot.range_row).transpose();
+  // (eqs. 9-10), with z_c = H^T V^-1 rho_c = S mu_c + d_c U_{row_c}^T, all on H's support,
+  // for every onset at once (one block of `window` columns per direction).
+  const int columns = propagatedColumns() * config_.window;
+  ms_.topLeftCorner<kSupportHead.dof, Eigen::Dynamic>(kSupportHead.dof, columns) =
+      mu_.block(kSupportHead.index, 0, kSupportHead.dof, columns);
+  ms_.bottomLeftCorner<kSupportTail.dof, Eigen::Dynamic>(kSupportTail.dof, columns) =
+      mu_.block(kSupportTail.index, 0, kSupportTail.dof, columns);
+  z_.leftCols(columns).noalias() = s_ * ms_.leftCols(columns);
+  if (config_.imu_steps) accumulateImu();
+  for (int s = 0; s < slots_used_; ++s) accumulateSatellite(s);
+}
+
+// The sums are added to every ring position, active or not: a position that is not (yet) an
+// onset is cleared when it becomes one (startOnset), and only active ones are read.
+void GlrMonitor::accumulateImu() {
+  const int window = config_.window;
+  for (int c = 0; c < kImuDirections; ++c) {
+    const auto mu_c = ms_.middleCols(firstColumn(c), window);
+    addPerOnset(f_, c, (a_.transpose() * mu_c).array());
+    for (int d = c; d < kImuDirections; ++d) {
+      const OnsetArray r =
+          mu_c.cwiseProduct(z_.middleCols(firstColumn(d), window)).colwise().sum().array();
+      addPerOnset(r_imu_, c + kImuDirections * d, r);
+      if (d != c) addPerOnset(r_imu_, d + kImuDirections * c, r);
     }
-    if (slot.rate_row >= 0 && config_.rate_steps) {
-      d[kRateStep] = kStepInput;
-      zc[kRateStep] += d[kRateStep] * u_.row(slot.rate_row).transpose();
-    }
-    RampSums::Slot& r = ramp.slots[static_cast<std::size_t>(s)];
-    r.mu += spacing_s * mu[kRangeStep];
-    r.z += spacing_s * zc[kRangeStep];
-    r.d += spacing_s * d[kRangeStep];
-    mu[kRangeRamp] = r.mu;
-    zc[kRangeRamp] = r.z;
-    d[kRangeRamp] = r.d;
-    std::array<bool, kSatDirections> on{config_.range_steps, config_.range_ramps,
-                                        config_.rate_steps};
-    Eigen::Matrix3d& R = o.r_sat[static_cast<std::size_t>(s)];
-    for (int i = 0; i < kSatDirections; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      if (!on[ui]) continue;
-      o.f[satColumn(s, i)] += mu[ui].dot(a_) + (row[ui] >= 0 ? d[ui] * w_[row[ui]] : 0.0);
-      for (int j = 0; j < kSatDirections; ++j) {
-        const auto uj = static_cast<std::size_t>(j);
-        if (!on[uj]) continue;
-        // rho_i^T V^-1 rho_j = mu_i^T z_j + d_i e_ri^T V^-1 (H mu_j + d_j e_rj)
-        double v = mu[ui].dot(zc[uj]);
-        if (row[ui] >= 0 && d[ui] != 0.0) {
-          double t = u_.row(row[ui]).dot(mu[uj]);
-          if (row[uj] >= 0) t += d[uj] * v_inv_(row[ui], row[uj]);
-          v += d[ui] * t;
-        }
-        R(i, j) += v;
-      }
-    }
+  }
+}
+
+void GlrMonitor::accumulateSatellite(int s) {
+  const Slot& slot = slots_[static_cast<std::size_t>(s)];
+  using Vector = Eigen::Matrix<double, kSupport, 1>;
+  using ConstColumn = Eigen::Map<const Vector>;
+  const int window = config_.window;
+  // Direct inputs d (doc: inputs table) and the rows they enter; an absent row has d = 0.
+  const int rr = slot.range_row, tr = slot.rate_row;
+  const double d_step = rr >= 0 ? kStepInput : 0.0;
+  const double d_rate = tr >= 0 && config_.rate_steps ? kStepInput : 0.0;
+  const Vector u_range = rr >= 0 ? Vector(u_.row(rr).transpose()) : Vector::Zero();
+  const Vector u_rate = tr >= 0 ? Vector(u_.row(tr).transpose()) : Vector::Zero();
+  const double w_range = rr >= 0 ? w_[rr] : 0.0, w_rate = tr >= 0 ? w_[tr] : 0.0;
+  const double v_rr = rr >= 0 ? vInv(rr, rr) : 0.0;
+  const double v_rt = rr >= 0 && tr >= 0 ? vInv(rr, tr) : 0.0;
+  const double v_tt = tr >= 0 ? vInv(tr, tr) : 0.0;
+  // Disabled hypotheses add nothing (their columns may still carry a ramp's steps).
+  const double on_step = config_.range_steps ? 1.0 : 0.0;
+  const double on_ramp = config_.range_ramps ? 1.0 : 0.0;
+  const double on_rate = config_.rate_steps ? 1.0 : 0.0;
+  const int step_first = firstColumn(muColumn(s, kRangeStep));
+  const int rate_first = firstColumn(muColumn(s, kRateStep));
+  const int r_first = kSatDirections * kSatDirections * s;
+  // Newest onset to oldest: a ramp from onset theta is the sum of the steps from the onsets
+  // theta and newer, each weighted by its epoch spacing (doc: ramps from steps).
+  Vector ramp_mu = Vector::Zero(), ramp_z = Vector::Zero();
+  double ramp_d = 0.0;
+  int ring = (onset_head_ + onset_count_ - 1) % window;
+  for (int age = 0; age < onset_count_; ++age, ring = ring == 0 ? window - 1 : ring - 1) {
+    const ConstColumn mu_step(ms_.col(step_first + ring).data());
+    const ConstColumn z_step(z_.col(step_first + ring).data());
+    const ConstColumn mu_rate(ms_.col(rate_first + ring).data());
+    const ConstColumn z_rate(z_.col(rate_first + ring).data());
+    const double c = spacing_s_[ring];
+    ramp_mu += c * mu_step;
+    ramp_z += c * z_step;
+    ramp_d += c * d_step;
+    // f_c = mu_c^T a + d_c w(r_c)
+    double* f = f_.col(ring).data() + satColumn(s, 0);
+    f[kRangeStep] += on_step * (mu_step.dot(a_) + d_step * w_range);
+    f[kRangeRamp] += on_ramp * (ramp_mu.dot(a_) + ramp_d * w_range);
+    f[kRateStep] += on_rate * (mu_rate.dot(a_) + d_rate * w_rate);
+    // R_ij = mu_i^T S mu_j + d_j U(r_j,:) mu_i + d_i U(r_i,:) mu_j + d_i d_j V^-1(r_i, r_j);
+    // the range step and ramp enter the range row, the rate step the rate row.
+    const double ur_step = u_range.dot(mu_step), ur_ramp = u_range.dot(ramp_mu);
+    const double ur_rate = u_range.dot(mu_rate);
+    const double ut_step = u_rate.dot(mu_step), ut_ramp = u_rate.dot(ramp_mu);
+    const double ut_rate = u_rate.dot(mu_rate);
+    const double ss = mu_step.dot(z_step) + 2.0 * d_step * ur_step + d_step * d_step * v_rr;
+    const double pp = ramp_mu.dot(ramp_z) + 2.0 * ramp_d * ur_ramp + ramp_d * ramp_d * v_rr;
+    const double tt = mu_rate.dot(z_rate) + 2.0 * d_rate * ut_rate + d_rate * d_rate * v_tt;
+    const double sp =
+        mu_step.dot(ramp_z) + ramp_d * ur_step + d_step * ur_ramp + d_step * ramp_d * v_rr;
+    const double st =
+        mu_step.dot(z_rate) + d_rate * ut_step + d_step * ur_rate + d_step * d_rate * v_rt;
+    const double pt =
+        ramp_mu.dot(z_rate) + d_rate * ut_ramp + ramp_d * ur_rate + ramp_d * d_rate * v_rt;
+    Eigen::Map<Eigen::Matrix3d> R(r_sat_.col(ring).data() + r_first);
+    R(kRangeStep, kRangeStep) += on_step * ss;
+    R(kRangeRamp, kRangeRamp) += on_ramp * pp;
+    R(kRateStep, kRateStep) += on_rate * tt;
+    R(kRangeStep, kRangeRamp) += on_step * on_ramp * sp;
+    R(kRangeStep, kRateStep) += on_step * on_rate * st;
+    R(kRangeRamp, kRateStep) += on_ramp * on_rate * pt;
+    R(kRangeRamp, kRangeStep) = R(kRangeStep, kRangeRamp);
+    R(kRateStep, kRangeStep) = R(kRangeStep, kRateStep);
+    R(kRateStep, kRangeRamp) = R(kRangeRamp, kRateStep);
   }
 }
 
@@ -363,14 +504,11 @@ const GlrResult& GlrMonitor::update(const GlrEpoch& e) {
   const bool had_previous = have_previous_;
   prepareEpoch(e);
   if (had_previous) {
-    for (int i = 0; i < onset_count_; ++i)
-      propagate(onsets_[static_cast<std::size_t>((onset_head_ + i) % config_.window)]);
+    propagate();
     startOnset(e);
   }
-  // Newest onset first: the ramp of an onset sums the steps of the newer ones.
-  ramp_sums_.clear(slots_used_, support_size_);
-  for (int age = 0; age < onset_count_; ++age) accumulate(onsetAt(age), ramp_sums_);
-  prev_h_ = e.h;
+  accumulate();
+  prev_h_support_ = h_support_;
   prev_k_ = e.k;
   have_previous_ = true;
   evaluate();
@@ -382,17 +520,18 @@ int GlrMonitor::onsetIndex(int age) const {
   return (onset_head_ + i) % config_.window;
 }
 
-GlrMonitor::Onset& GlrMonitor::onsetAt(int age) {
-  return onsets_[static_cast<std::size_t>(onsetIndex(age))];
-}
-
-const GlrMonitor::Onset& GlrMonitor::onset(int age) const {
-  return onsets_[static_cast<std::size_t>(onsetIndex(age))];
+GlrMonitor::OnsetView GlrMonitor::onset(int age) const {
+  const int ring = onsetIndex(age);
+  return {onsets_[static_cast<std::size_t>(ring)].ramp_start_ns,
+          Eigen::Map<const Eigen::Matrix<double, kMaxDirections, 1>>(f_.col(ring).data()),
+          Eigen::Map<const Eigen::Matrix<double, kImuDirections, kImuDirections>>(
+              r_imu_.col(ring).data()),
+          r_sat_.col(ring).data()};
 }
 
 GlrMonitor::DirectionSums GlrMonitor::directionSums(int age, const GlrHypothesis& h) const {
   if (age < 0 || age >= onset_count_) return {};
-  const Onset& o = onset(age);
+  const OnsetView o = onset(age);
   if (h.isImu()) {
     const int j = (h.fault == GlrFault::kAccelStep ? 0 : 3) + std::clamp(h.axis, 0, 2);
     return {o.f[j], o.r_imu(j, j)};
@@ -403,12 +542,12 @@ GlrMonitor::DirectionSums GlrMonitor::directionSums(int age, const GlrHypothesis
   const int j = h.fault == GlrFault::kRangeStep   ? kRangeStep
                 : h.fault == GlrFault::kRangeRamp ? kRangeRamp
                                                   : kRateStep;
-  return {o.f[satColumn(slot, j)], o.r_sat[static_cast<std::size_t>(slot)](j, j)};
+  return {o.f[satColumn(slot, j)], o.rSat(slot)(j, j)};
 }
 
 double GlrMonitor::imuStatistic(int age) const {
   if (age < 0 || age >= onset_count_) return 0.0;
-  const Onset& o = onset(age);
+  const OnsetView o = onset(age);
   return fitGroup<kImuDirections>(o.r_imu, o.f.head<kImuDirections>(), config_.rank_tolerance)
       .statistic;
 }
@@ -417,14 +556,12 @@ double GlrMonitor::satelliteStatistic(int age, int sv_id) const {
   if (age < 0 || age >= onset_count_ || sv_id < 1 || sv_id > 32) return 0.0;
   const int slot = slot_of_sv_[static_cast<std::size_t>(sv_id)] - 1;
   if (slot < 0) return 0.0;
-  const Onset& o = onset(age);
+  const OnsetView o = onset(age);
   const Eigen::Vector3d f = o.f.segment<kSatDirections>(satColumn(slot, 0));
-  return fitGroup<kSatDirections>(o.r_sat[static_cast<std::size_t>(slot)], f,
-                                  config_.rank_tolerance)
-      .statistic;
+  return fitGroup<kSatDirections>(o.rSat(slot), f, config_.rank_tolerance).statistic;
 }
 
-double GlrMonitor::onsetStatistic(const Onset& o) const {
+double GlrMonitor::onsetStatistic(const OnsetView& o) const {
   double l = 0.0;
   if (config_.imu_steps) {
     l = fitGroup<kImuDirections>(o.r_imu, o.f.head<kImuDirections>(), config_.rank_tolerance)
@@ -433,9 +570,7 @@ double GlrMonitor::onsetStatistic(const Onset& o) const {
   for (int s = 0; s < slots_used_; ++s) {
     if (slots_[static_cast<std::size_t>(s)].quarantined) continue;
     const Eigen::Vector3d f = o.f.segment<kSatDirections>(satColumn(s, 0));
-    l = std::max(
-        l, fitGroup<kSatDirections>(o.r_sat[static_cast<std::size_t>(s)], f, config_.rank_tolerance)
-               .statistic);
+    l = std::max(l, satelliteGroupStatistic(o.rSat(s), f, config_.rank_tolerance));
   }
   return l;
 }
@@ -454,9 +589,15 @@ void GlrMonitor::evaluate() {
     }
   }
   if (best_age < 0) return;
-  isolate(onset(best_age), best_age, result_);
   result_.statistic = best;
   result_.detected = best >= config_.threshold;
+  const OnsetView o = onset(best_age);
+  if (result_.detected) {
+    isolate(o, best_age, result_);  // eqs. 14-16 at detection time
+  } else {
+    result_.onset_epochs_ago = best_age;
+    result_.onset_time_ns = o.ramp_start_ns;
+  }
 }
 
 GlrResult GlrMonitor::isolationAt(int onset_age) const {
@@ -464,7 +605,7 @@ GlrResult GlrMonitor::isolationAt(int onset_age) const {
   if (onset_age < 0 || onset_age >= onset_count_) return r;
   r.valid = true;
   r.threshold = config_.threshold;
-  const Onset& o = onset(onset_age);
+  const OnsetView o = onset(onset_age);
   isolate(o, onset_age, r);
   r.statistic = onsetStatistic(o);
   r.detected = r.statistic >= config_.threshold;
@@ -478,7 +619,7 @@ int GlrMonitor::onsetAge(std::int64_t onset_time_ns) const {
   return -1;
 }
 
-void GlrMonitor::isolate(const Onset& o, int onset_age, GlrResult& r) const {
+void GlrMonitor::isolate(const OnsetView& o, int onset_age, GlrResult& r) const {
   r.onset_epochs_ago = onset_age;
   r.onset_time_ns = o.ramp_start_ns;
   r.onset_censored = onset_count_ == config_.window && onset_age == onset_count_ - 1;
@@ -495,8 +636,7 @@ void GlrMonitor::isolate(const Onset& o, int onset_age, GlrResult& r) const {
   for (int s = 0; s < slots_used_; ++s) {
     if (slots_[static_cast<std::size_t>(s)].quarantined) continue;
     const Eigen::Vector3d f = o.f.segment<kSatDirections>(satColumn(s, 0));
-    const GroupFit g =
-        fitGroup<kSatDirections>(o.r_sat[static_cast<std::size_t>(s)], f, config_.rank_tolerance);
+    const GroupFit g = fitGroup<kSatDirections>(o.rSat(s), f, config_.rank_tolerance);
     const double sig = chiSquareSignificance(2.0 * g.statistic, g.rank);
     if (best_slot < 0 || sig > r.satellite_significance) {
       best_slot = s;
@@ -537,7 +677,7 @@ void GlrMonitor::isolate(const Onset& o, int onset_age, GlrResult& r) const {
                         : j == kRangeRamp ? GlrFault::kRangeRamp
                                           : GlrFault::kRateStep,
                         0, slot.sv_id};
-        scalar(o.f[satColumn(s, j)], o.r_sat[static_cast<std::size_t>(s)](j, j), c);
+        scalar(o.f[satColumn(s, j)], o.rSat(s)(j, j), c);
         if (c.statistic > best.statistic || j == 0) best = c;
       }
       all[static_cast<std::size_t>(count++)] = best;

@@ -48,6 +48,17 @@ inline constexpr int kMaxDirections = kImuDirections + kSatDirections * kMaxSate
 /// (ramps are sums of steps, see glr.cpp).
 inline constexpr int kMaxPropagated = kImuDirections + 2 * kMaxSatellites;
 inline constexpr int kMaxWindow = 100;  ///< largest configurable window M [epochs]
+/// The states pseudorange and rate rows measure: position and velocity (the first six) and the
+/// clock bias and drift (the last two). f and R see a signature only through H, so they are
+/// accumulated on these eight states; an epoch whose H reaches others is refused.
+inline constexpr StateBlock kSupportHead{tc17::kPos.index, tc17::kPos.dof + tc17::kVel.dof};
+inline constexpr StateBlock kSupportTail{tc17::kClockBias.index,
+                                         tc17::kClockBias.dof + tc17::kClockDrift.dof};
+inline constexpr int kSupport = kSupportHead.dof + kSupportTail.dof;
+static_assert(kSupportHead.index == 0 && tc17::kVel.index == tc17::kPos.end() &&
+                  tc17::kClockDrift.index == tc17::kClockBias.end() &&
+                  kSupportTail.end() == kStates,
+              "the GLR's support is position, velocity (leading) and clock (trailing)");
 
 using RowVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRows, 1>;
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, kMaxRows>;
@@ -142,8 +153,10 @@ class GlrMonitor {
   /// the filter was reconfigured so that old signatures no longer describe it).
   void reset();
 
-  /// Processes one epoch; refuses (valid = false, counted) an epoch with more rows than
-  /// supported, non-finite values or an innovation covariance that is not positive definite.
+  /// Processes one epoch: the largest statistic and its onset, and, when it reaches h, the
+  /// isolation at that onset (eqs. 14-16; isolationAt() gives it for any onset). Refuses (valid =
+  /// false, counted) an epoch with more rows than supported, non-finite values or an innovation
+  /// covariance that is not positive definite.
   const GlrResult& update(const GlrEpoch& epoch);
 
   /// A quarantined satellite is still monitored but cannot trigger a detection.
@@ -174,13 +187,21 @@ class GlrMonitor {
   std::uint64_t refused() const { return refused_; }
 
  private:
+  /// The times of an onset; its signatures and sums live in mu_, f_, r_imu_ and r_sat_.
   struct Onset {
     std::int64_t time_ns{0};        ///< epoch theta
     std::int64_t ramp_start_ns{0};  ///< epoch theta - 1: where the hypothesised ramp is 0
-    glr::SignatureMatrix mu;        ///< state signatures before this epoch's update
-    glr::DirectionVector f;         ///< eq. 9, per direction
-    Eigen::Matrix<double, glr::kImuDirections, glr::kImuDirections> r_imu;  ///< eq. 10
-    std::array<Eigen::Matrix3d, glr::kMaxSatellites> r_sat;
+  };
+  /// f (eq. 9) and R (eq. 10) of one onset, read from the per-onset columns.
+  struct OnsetView {
+    std::int64_t ramp_start_ns;
+    Eigen::Map<const Eigen::Matrix<double, glr::kMaxDirections, 1>> f;
+    Eigen::Map<const Eigen::Matrix<double, glr::kImuDirections, glr::kImuDirections>> r_imu;
+    const double* r_sat;
+    Eigen::Map<const Eigen::Matrix3d> rSat(int slot) const {
+      return Eigen::Map<const Eigen::Matrix3d>(r_sat +
+                                               glr::kSatDirections * glr::kSatDirections * slot);
+    }
   };
   struct Slot {
     int sv_id{0};
@@ -189,36 +210,31 @@ class GlrMonitor {
     int prev_range_row{-1}, prev_rate_row{-1};  ///< rows at the previous epoch
     bool quarantined{false};
   };
+  /// Per-onset values of one quantity, indexed by ring position (not age).
+  using OnsetArray = Eigen::Array<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, glr::kMaxWindow>;
+  /// A block of mu_ / ms_ / z_: one signature column c for every ring position.
+  int firstColumn(int c) const { return c * config_.window; }
 
   bool validate(const GlrEpoch& e) const;
   void assignSlots(const GlrEpoch& e);
   void claimSlot(int slot, int sv_id);
   void prepareEpoch(const GlrEpoch& e);
-  void propagate(Onset& o);
+  bool biasAndClockRowsSparse() const;
+  void propagate();
   void startOnset(const GlrEpoch& e);
-  /// Running sums over the onsets newer than the one being accumulated: the ramp signature.
-  using SupportVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, glr::kStates, 1>;
-  struct RampSums {
-    struct Slot {
-      SupportVector mu, z;
-      double d{0.0};
-    };
-    std::array<Slot, glr::kMaxSatellites> slots;
-    void clear(int n, int support) {
-      for (int s = 0; s < n; ++s) {
-        slots[static_cast<std::size_t>(s)].mu.setZero(support);
-        slots[static_cast<std::size_t>(s)].z.setZero(support);
-        slots[static_cast<std::size_t>(s)].d = 0.0;
-      }
-    }
-  };
-  void accumulate(Onset& o, RampSums& ramp);
-  Onset& onsetAt(int age);
+  void accumulate();
+  void accumulateImu();
+  void accumulateSatellite(int slot);
+  /// Adds one value per ring position to row `row` of a per-onset sum.
+  template <typename Sums, typename Values>
+  static void addPerOnset(Sums& sums, int row, const Values& values) {
+    sums.row(row) += values.matrix();
+  }
   int onsetIndex(int age) const;
   void evaluate();
-  const Onset& onset(int age) const;
-  void isolate(const Onset& o, int onset_age, GlrResult& r) const;
-  double onsetStatistic(const Onset& o) const;
+  OnsetView onset(int age) const;
+  void isolate(const OnsetView& o, int onset_age, GlrResult& r) const;
+  double onsetStatistic(const OnsetView& o) const;
   int propagatedColumns() const { return glr::kImuDirections + 2 * slots_used_; }
 
   GlrConfig config_;
@@ -229,27 +245,38 @@ class GlrMonitor {
   int slots_used_{0};
   std::array<int, 33> slot_of_sv_{};  ///< PRN 1..32 -> slot + 1 (0: none)
 
+  // Signatures of every onset in one matrix, so that one product propagates them all: column
+  // c (an IMU step or a satellite's range or rate step, see muColumn) of the onset at ring
+  // position i is column c * window + i. Sized once in configure(), swapped after each product.
+  Eigen::Matrix<double, glr::kStates, Eigen::Dynamic> mu_, mu_next_;
+  /// mu_ on H's support (ms_) and S ms_ (z_), same column order.
+  Eigen::Matrix<double, glr::kSupport, Eigen::Dynamic> ms_, z_;
+  OnsetArray spacing_s_;  ///< t_theta - t_{theta-1} of each ring position [s]
+  // Sums of eqs. 9-10, one column per ring position: f per direction, the IMU group's R (6 x 6,
+  // column-major) and each satellite slot's R (3 x 3, column-major, slot after slot).
+  Eigen::Matrix<double, glr::kMaxDirections, Eigen::Dynamic> f_;
+  Eigen::Matrix<double, glr::kImuDirections * glr::kImuDirections, Eigen::Dynamic> r_imu_;
+  Eigen::Matrix<double, glr::kSatDirections * glr::kSatDirections * glr::kMaxSatellites,
+                Eigen::Dynamic>
+      r_sat_;
+
   // Per-epoch quantities (current epoch k) and what the recursion keeps of epoch k-1.
   bool have_previous_{false};
   std::int64_t time_ns_{0}, prev_time_ns_{0};
-  glr::HMatrix prev_h_;
   Eigen::LLT<glr::RowMatrix> llt_;  ///< Cholesky factor of this epoch's V
   glr::KMatrix prev_k_;
-  glr::RowMatrix v_inv_;
+  glr::RowMatrix l_inv_;  ///< L^-1 of this epoch's V = L L^T (lower triangular)
+  double vInv(int i, int j) const;
   glr::RowVector w_;  ///< V^-1 eps
-  using SupportMatrix =
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kStates, glr::kStates>;
-  std::array<int, glr::kStates> support_{};  ///< states some row of H measures
-  int support_size_{0};
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kMaxRows, glr::kStates> h_support_,
-      u_;                            ///< H and V^-1 H on the support
-  SupportMatrix s_;                  ///< H^T V^-1 H on the support
-  SupportVector a_;                  ///< H^T V^-1 eps on the support
-  glr::SignatureMatrix mu_support_;  ///< an onset's mu on the support
-  Matrix17 b_;                       ///< Phi_k (I - K_{k-1} H_{k-1})
-  glr::KMatrix g_;                   ///< Phi_k K_{k-1}
-  glr::SignatureMatrix scratch_;
-  RampSums ramp_sums_;
+  using SupportVector = Eigen::Matrix<double, glr::kSupport, 1>;
+  using SupportMatrix = Eigen::Matrix<double, glr::kSupport, glr::kSupport>;
+  Eigen::Matrix<double, Eigen::Dynamic, glr::kSupport, 0, glr::kMaxRows, glr::kSupport> h_support_,
+      u_,               ///< H and V^-1 H on the support
+      prev_h_support_;  ///< the previous epoch's H on the support
+  SupportMatrix s_;     ///< H^T V^-1 H on the support
+  SupportVector a_;     ///< H^T V^-1 eps on the support
+  Matrix17 b_;          ///< Phi_k (I - K_{k-1} H_{k-1})
+  glr::KMatrix g_;      ///< Phi_k K_{k-1}
 
   GlrResult result_;
   std::uint64_t epochs_{0};
