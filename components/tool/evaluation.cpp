@@ -204,13 +204,9 @@ int runOfflineCommand(const OfflineOptions& o) {
                setup.sim.scenario.name, setup.sim.scenario.seed, r.solutions,
                r.solutions_without_truth, r.summary);
   if (setup.fault_manager) {
-    std::ofstream dec_f(o.out_dir + "/decisions.csv"), cmd_f(o.out_dir + "/commands.csv");
-    dec_f << csvHeader<navbus::FaultDecision>() << "\n";
-    for (const auto& d : r.decisions)
-      for (const auto& row : csvRows(d)) dec_f << row << "\n";
-    cmd_f << csvHeader<navbus::FilterCommand>() << "\n";
-    for (const auto& c : r.commands)
-      for (const auto& row : csvRows(c)) cmd_f << row << "\n";
+    if (!writeCsvFile(o.out_dir + "/decisions.csv", r.decisions) ||
+        !writeCsvFile(o.out_dir + "/commands.csv", r.commands))
+      spdlog::error("could not write decisions.csv / commands.csv in {}", o.out_dir);
     spdlog::info("fault manager: {}", r.fault_summary);
     spdlog::info("wrote {}/solution.csv, truth.csv, error.csv, decisions.csv, commands.csv",
                  o.out_dir);

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -98,6 +99,17 @@ std::vector<std::string> csvRows(const T& msg) {
   std::vector<std::string> out;
   for (const auto& r : c.rowsOut()) out.push_back(joinCsv(r));
   return out;
+}
+
+/// Writes messages of one type as a CSV file (header, then their rows); false if the file
+/// could not be written.
+template <class T>
+bool writeCsvFile(const std::string& path, const std::vector<T>& messages) {
+  std::ofstream f(path);
+  f << csvHeader<T>() << "\n";
+  for (const auto& m : messages)
+    for (const auto& row : csvRows(m)) f << row << "\n";
+  return static_cast<bool>(f);
 }
 
 /// "name: value" lines, sequences of structs indexed.

@@ -260,13 +260,9 @@ void writeFixes(const std::string& path, const RealDataResult& r) {
 }
 
 void writeFaultCsv(const std::string& dir, const RealDataResult& r) {
-  std::ofstream dec_f(dir + "/decisions.csv"), cmd_f(dir + "/commands.csv");
-  dec_f << csvHeader<navbus::FaultDecision>() << "\n";
-  for (const auto& d : r.decisions)
-    for (const auto& row : csvRows(d)) dec_f << row << "\n";
-  cmd_f << csvHeader<navbus::FilterCommand>() << "\n";
-  for (const auto& c : r.commands)
-    for (const auto& row : csvRows(c)) cmd_f << row << "\n";
+  if (!writeCsvFile(dir + "/decisions.csv", r.decisions) ||
+      !writeCsvFile(dir + "/commands.csv", r.commands))
+    spdlog::error("could not write decisions.csv / commands.csv in {}", dir);
 }
 
 void printSummary(const RealDataSetup& s, const RealDataResult& r) {
