@@ -128,6 +128,8 @@ struct GlrResult {
   double threshold{0.0};          ///< h
   int onset_epochs_ago{0};        ///< theta of the largest statistic: 0 = this epoch
   std::int64_t onset_time_ns{0};  ///< the fault began after this time (epoch theta - 1)
+  // Isolation (eqs. 14-16), from here on: filled by update() only when detected (it is what
+  // the paper does at detection time); GlrMonitor::isolationAt() gives it for any onset.
   GlrSourceClass source{GlrSourceClass::kNone};
   double imu_statistic{0.0};        ///< IMU group l at the onset
   double satellite_statistic{0.0};  ///< best satellite group l at the onset
