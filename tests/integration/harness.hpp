@@ -25,14 +25,17 @@
 
 namespace navbus::test {
 
-/// A navbus executable run as a child process, its output in a log file. Killed if still
-/// running when destroyed.
+/// A navbus executable run as a child process, its output in a log file. It leads its own
+/// process group, so that signals reach what it starts too (`fastdds discovery` is a launcher
+/// that starts fast-discovery-server as its child: killing the launcher alone left the server
+/// running after the test). Killed, with its group, if still running when destroyed.
 class ChildProcess {
  public:
   ChildProcess(const std::string& exe, const std::vector<std::string>& args,
                const std::string& log) {
     pid_ = fork();
     if (pid_ == 0) {
+      setpgid(0, 0);
       // The test process blocks SIGINT/SIGTERM (ShutdownSignal); the child must not inherit it.
       sigset_t none;
       sigemptyset(&none);
@@ -47,17 +50,17 @@ class ChildProcess {
       execv(exe.c_str(), argv.data());
       _exit(127);
     }
+    setpgid(pid_, pid_);  // also here: whichever of parent and child runs first
   }
   ~ChildProcess() {
-    if (running()) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
+    const bool was_running = running();
+    kill(-pid_, SIGKILL);  // the group: children the process left behind too
+    if (was_running) waitpid(pid_, nullptr, 0);
   }
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
 
-  void signal(int sig) { kill(pid_, sig); }
+  void signal(int sig) { kill(-pid_, sig); }
   bool running() {
     if (exited_) return false;
     int status = 0;
