@@ -48,11 +48,6 @@ struct GroupFit {
   int rank{0};
 };
 
-/// l = 1/2 f^T R^+ f of one group of directions (eq. 12), by a Cholesky factorization with
-/// diagonal pivoting of R scaled to unit diagonal: at each step the direction with the most
-/// information not explained by those already chosen is taken; directions whose remaining
-/// share falls below `tolerance` depend on the chosen ones and are dropped (f lies in the range
-/// of R, so the statistic over the chosen basis equals f^T R^+ f).
 /// The same statistic without pivoting, when no direction can be dropped: scaled to unit
 /// diagonal (A), each direction's smallest unexplained share is det(A) / cofactor_ii(A) >=
 /// det(A) (a principal minor of a unit-diagonal correlation matrix is at most 1), so
@@ -80,6 +75,12 @@ bool fitFullRank(const Eigen::Matrix<double, N, N>& R, const Eigen::Matrix<doubl
   return det_ratio > tolerance;
 }
 
+/// l = 1/2 f^T R^+ f of one group of directions (eq. 12), by a Cholesky factorization with
+/// diagonal pivoting of R scaled to unit diagonal: at each step the direction with the most
+/// information not explained by those already chosen is taken; directions whose remaining
+/// share falls below `tolerance` depend on the chosen ones and are dropped (f lies in the range
+/// of R, so the statistic over the chosen basis equals f^T R^+ f).
+/// fitFullRank first: most groups are well conditioned.
 template <int N>
 GroupFit fitGroup(const Eigen::Matrix<double, N, N>& R, const Eigen::Matrix<double, N, 1>& f,
                   double tolerance) {
@@ -118,11 +119,12 @@ GroupFit fitGroup(const Eigen::Matrix<double, N, N>& R, const Eigen::Matrix<doub
   return out;
 }
 
-/// The statistic of a satellite's group (three directions), as fitGroup<3> gives it, in closed
-/// form when no direction can be dropped: with R scaled to unit diagonal (A), each direction's
-/// smallest unexplained share is det(A) / cofactor_ii(A) >= det(A), so det(A) > tolerance
-/// means full rank, and l = 1/2 f^T adj(R) f / det(R). Otherwise (the newest onset, where a
-/// step and a ramp coincide) the pivoted factorization decides.
+/// The statistic of a satellite's group (three directions), as fitGroup<3> gives it: the
+/// full-rank case of fitFullRank (same test, det(A) > tolerance) in closed form,
+/// l = 1/2 f^T adj(R) f / det(R), with one division. It runs for every satellite and onset of
+/// every epoch (240 times with 12 satellites), and saves about 3 % of the filter update's time
+/// in glr_benchmark over fitGroup<3>. Otherwise (the newest onset, where a step and a ramp
+/// coincide) the pivoted factorization decides.
 double satelliteGroupStatistic(const Eigen::Matrix3d& R, const Eigen::Vector3d& f,
                                double tolerance) {
   const double c00 = R(1, 1) * R(2, 2) - R(1, 2) * R(1, 2);
@@ -390,8 +392,9 @@ void GlrMonitor::startOnset(const GlrEpoch& e) {
 
 void GlrMonitor::accumulate() {
   // rho_c = H mu_c + d_c e_{row_c}; f_c += rho_c^T V^-1 eps; R_cd += rho_c^T V^-1 rho_d
-  // (eqs. 9-10), with z_c = H^T V^-1 rho_c = S mu_c + d_c U_{row_c}^T, all on H's support,
-  // for every onset at once (one block of `window` columns per direction).
+  // (eqs. 9-10), on H's support: ms_ = mu's support rows and z_ = S ms_ for every onset at once
+  // (one block of `window` columns per direction); the direct inputs d enter in
+  // accumulateSatellite.
   const int columns = propagatedColumns() * config_.window;
   ms_.topLeftCorner<kSupportHead.dof, Eigen::Dynamic>(kSupportHead.dof, columns) =
       mu_.block(kSupportHead.index, 0, kSupportHead.dof, columns);
@@ -408,27 +411,28 @@ void GlrMonitor::accumulateImu() {
   const int window = config_.window;
   for (int c = 0; c < kImuDirections; ++c) {
     const auto mu_c = ms_.middleCols(firstColumn(c), window);
-    addPerOnset(f_, c, (a_.transpose() * mu_c).array());
+    f_.row(c).noalias() += a_.transpose() * mu_c;
     for (int d = c; d < kImuDirections; ++d) {
       const OnsetArray r =
           mu_c.cwiseProduct(z_.middleCols(firstColumn(d), window)).colwise().sum().array();
-      addPerOnset(r_imu_, c + kImuDirections * d, r);
-      if (d != c) addPerOnset(r_imu_, d + kImuDirections * c, r);
+      r_imu_.row(c + kImuDirections * d) += r.matrix();
+      if (d != c) r_imu_.row(d + kImuDirections * c) += r.matrix();
     }
   }
 }
 
 void GlrMonitor::accumulateSatellite(int s) {
   const Slot& slot = slots_[static_cast<std::size_t>(s)];
-  using Vector = Eigen::Matrix<double, kSupport, 1>;
-  using ConstColumn = Eigen::Map<const Vector>;
+  using ConstColumn = Eigen::Map<const SupportVector>;
   const int window = config_.window;
   // Direct inputs d (doc: inputs table) and the rows they enter; an absent row has d = 0.
   const int rr = slot.range_row, tr = slot.rate_row;
   const double d_step = rr >= 0 ? kStepInput : 0.0;
   const double d_rate = tr >= 0 && config_.rate_steps ? kStepInput : 0.0;
-  const Vector u_range = rr >= 0 ? Vector(u_.row(rr).transpose()) : Vector::Zero();
-  const Vector u_rate = tr >= 0 ? Vector(u_.row(tr).transpose()) : Vector::Zero();
+  const SupportVector u_range =
+      rr >= 0 ? SupportVector(u_.row(rr).transpose()) : SupportVector::Zero();
+  const SupportVector u_rate =
+      tr >= 0 ? SupportVector(u_.row(tr).transpose()) : SupportVector::Zero();
   const double w_range = rr >= 0 ? w_[rr] : 0.0, w_rate = tr >= 0 ? w_[tr] : 0.0;
   const double v_rr = rr >= 0 ? vInv(rr, rr) : 0.0;
   const double v_rt = rr >= 0 && tr >= 0 ? vInv(rr, tr) : 0.0;
@@ -442,7 +446,7 @@ void GlrMonitor::accumulateSatellite(int s) {
   const int r_first = kSatDirections * kSatDirections * s;
   // Newest onset to oldest: a ramp from onset theta is the sum of the steps from the onsets
   // theta and newer, each weighted by its epoch spacing (doc: ramps from steps).
-  Vector ramp_mu = Vector::Zero(), ramp_z = Vector::Zero();
+  SupportVector ramp_mu = SupportVector::Zero(), ramp_z = SupportVector::Zero();
   double ramp_d = 0.0;
   int ring = (onset_head_ + onset_count_ - 1) % window;
   for (int age = 0; age < onset_count_; ++age, ring = ring == 0 ? window - 1 : ring - 1) {

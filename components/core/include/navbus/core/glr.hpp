@@ -64,7 +64,6 @@ using RowVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRows, 1>;
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, kMaxRows>;
 using HMatrix = Eigen::Matrix<double, Eigen::Dynamic, kStates, Eigen::RowMajor, kMaxRows, kStates>;
 using KMatrix = Eigen::Matrix<double, kStates, Eigen::Dynamic, 0, kStates, kMaxRows>;
-using SignatureMatrix = Eigen::Matrix<double, kStates, Eigen::Dynamic, 0, kStates, kMaxPropagated>;
 using DirectionVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDirections, 1>;
 }  // namespace glr
 
@@ -221,17 +220,13 @@ class GlrMonitor {
   void assignSlots(const GlrEpoch& e);
   void claimSlot(int slot, int sv_id);
   void prepareEpoch(const GlrEpoch& e);
+  double vInv(int i, int j) const;  ///< (V^-1)_ij of this epoch, from l_inv_
   bool biasAndClockRowsSparse() const;
   void propagate();
   void startOnset(const GlrEpoch& e);
   void accumulate();
   void accumulateImu();
   void accumulateSatellite(int slot);
-  /// Adds one value per ring position to row `row` of a per-onset sum.
-  template <typename Sums, typename Values>
-  static void addPerOnset(Sums& sums, int row, const Values& values) {
-    sums.row(row) += values.matrix();
-  }
   int onsetIndex(int age) const;
   void evaluate();
   OnsetView onset(int age) const;
@@ -268,8 +263,7 @@ class GlrMonitor {
   Eigen::LLT<glr::RowMatrix> llt_;  ///< Cholesky factor of this epoch's V
   glr::KMatrix prev_k_;
   glr::RowMatrix l_inv_;  ///< L^-1 of this epoch's V = L L^T (lower triangular)
-  double vInv(int i, int j) const;
-  glr::RowVector w_;  ///< V^-1 eps
+  glr::RowVector w_;      ///< V^-1 eps
   using SupportVector = Eigen::Matrix<double, glr::kSupport, 1>;
   using SupportMatrix = Eigen::Matrix<double, glr::kSupport, glr::kSupport>;
   Eigen::Matrix<double, Eigen::Dynamic, glr::kSupport, 0, glr::kMaxRows, glr::kSupport> h_support_,
