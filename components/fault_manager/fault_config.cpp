@@ -4,10 +4,14 @@
 #include <string>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/core/units.hpp"
 
 namespace navbus::fault_manager {
 
 namespace {
+
+using units::kDeg;
+using units::kMilliG;
 
 void checkKeys(const YAML::Node& node, const std::string& where,
                const std::set<std::string>& allowed) {
@@ -17,6 +21,76 @@ void checkKeys(const YAML::Node& node, const std::string& where,
     const auto key = kv.first.as<std::string>();
     if (allowed.count(key) == 0)
       throw bus::ConfigError("configuration " + where + "." + key + ": unknown key");
+  }
+}
+
+/// A [low, high] pair in Hz.
+void band(const YAML::Node& node, const std::string& where, double& low, double& high) {
+  const YAML::Node b = node ? node["band_hz"] : YAML::Node();
+  if (!b) return;
+  if (!b.IsSequence() || b.size() != 2)
+    throw bus::ConfigError("configuration " + where + ".band_hz must be [low, high] in Hz");
+  low = bus::checkRange(b[0].as<double>(), 0.0, 1e6, where + ".band_hz[0]");
+  high = bus::checkRange(b[1].as<double>(), low + 1e-3, 1e6, where + ".band_hz[1]");
+}
+
+void parseDither(const YAML::Node& n, DitherDetectorConfig& d) {
+  const std::string w = "dither";
+  checkKeys(n, w,
+            {"enabled", "imu_id", "sample_rate_hz", "frequencies_hz", "tolerance_hz",
+             "window_samples", "hop_samples", "windows_to_fail", "windows_to_clear",
+             "accelerometer", "gyro", "stillness", "actions"});
+  core::DitherMonitorConfig& m = d.monitor;
+  d.enabled = bus::get<bool>(n, w, "enabled", d.enabled);
+  d.imu_id = bus::get<std::uint32_t>(n, w, "imu_id", d.imu_id);
+  m.sample_rate_hz = bus::checkRange(bus::get<double>(n, w, "sample_rate_hz", m.sample_rate_hz),
+                                     1.0, 1e6, "dither.sample_rate_hz");
+  if (n && n["frequencies_hz"]) {
+    const YAML::Node f = n["frequencies_hz"];
+    if (!f.IsSequence() || f.size() != 3)
+      throw bus::ConfigError("configuration dither.frequencies_hz must be [x, y, z] in Hz");
+    for (std::size_t i = 0; i < 3; ++i) {
+      m.dither_frequency_hz[i] =
+          bus::checkRange(f[i].as<double>(), 1.0, m.sample_rate_hz / 2,
+                          "dither.frequencies_hz[" + std::to_string(i) + "]");
+    }
+  }
+  m.tolerance_hz = bus::checkRange(bus::get<double>(n, w, "tolerance_hz", m.tolerance_hz), 0.01,
+                                   1e3, "dither.tolerance_hz");
+  m.window_samples = bus::get<int>(n, w, "window_samples", m.window_samples);
+  m.hop_samples = bus::get<int>(n, w, "hop_samples", m.hop_samples);
+  m.windows_to_fail = bus::get<int>(n, w, "windows_to_fail", m.windows_to_fail);
+  m.windows_to_clear = bus::get<int>(n, w, "windows_to_clear", m.windows_to_clear);
+  const YAML::Node a = n ? n["accelerometer"] : YAML::Node();
+  checkKeys(a, "dither.accelerometer", {"band_hz", "min_amplitude_mg"});
+  band(a, "dither.accelerometer", m.accel_band_low_hz, m.accel_band_high_hz);
+  m.accel_min_amplitude_mps2 = bus::get<double>(a, "dither.accelerometer", "min_amplitude_mg",
+                                                m.accel_min_amplitude_mps2 / kMilliG) *
+                               kMilliG;
+  const YAML::Node g = n ? n["gyro"] : YAML::Node();
+  checkKeys(g, "dither.gyro", {"check", "band_hz", "min_amplitude_dps"});
+  m.check_gyros = bus::get<bool>(g, "dither.gyro", "check", m.check_gyros);
+  band(g, "dither.gyro", m.gyro_band_low_hz, m.gyro_band_high_hz);
+  m.gyro_min_amplitude_radps =
+      bus::get<double>(g, "dither.gyro", "min_amplitude_dps", m.gyro_min_amplitude_radps / kDeg) *
+      kDeg;
+  const YAML::Node s = n ? n["stillness"] : YAML::Node();
+  checkKeys(s, "dither.stillness", {"band_hz", "max_rms_mg"});
+  band(s, "dither.stillness", m.motion_band_low_hz, m.motion_band_high_hz);
+  m.still_max_rms_mps2 =
+      bus::get<double>(s, "dither.stillness", "max_rms_mg", m.still_max_rms_mps2 / kMilliG) *
+      kMilliG;
+  const YAML::Node act = n ? n["actions"] : YAML::Node();
+  checkKeys(act, "dither.actions", {"axis"});
+  const auto axis = bus::get<std::string>(act, "dither.actions", "axis", "fail");
+  if (axis != "fail" && axis != "none")
+    throw bus::ConfigError("configuration dither.actions.axis: '" + axis +
+                           "' is not one of fail, none");
+  d.fail_axes = axis == "fail";
+  try {
+    core::DitherMonitor check(m);  // the monitor's own consistency rules, naming the field
+  } catch (const std::invalid_argument& e) {
+    throw bus::ConfigError(std::string("configuration ") + e.what());
   }
 }
 
@@ -71,6 +145,7 @@ FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
                                     100.0, "glr.readmission.pass_sigma");
   d.readmit_after_s = bus::checkRange(bus::get<double>(r, "glr.readmission", "pass_time_s", 30.0),
                                       0.0, 86400.0, "glr.readmission.pass_time_s");
+  parseDither(root["dither"], c.dither);
   return c;
 }
 

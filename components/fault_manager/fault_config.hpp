@@ -6,6 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "navbus/core/dither_monitor.hpp"
 #include "navbus/core/glr.hpp"
 
 namespace navbus::fault_manager {
@@ -25,9 +26,17 @@ struct GlrDetectorConfig {
   double readmit_after_s{30.0};
 };
 
+struct DitherDetectorConfig {
+  bool enabled{false};
+  std::uint32_t imu_id{1};  ///< the raw stream monitored (ImuRawBlock.sensor_id)
+  core::DitherMonitorConfig monitor;
+  bool fail_axes{true};  ///< command CMD_FAIL_SENSOR_AXIS for a failed axis
+};
+
 struct FaultManagerConfig {
   std::uint32_t vehicle_id{1};  ///< the filter monitored and commanded
   GlrDetectorConfig glr;
+  DitherDetectorConfig dither;
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid or unknown entry.

@@ -1,6 +1,7 @@
 #include "fault_manager_node.hpp"
 
 #include <chrono>
+#include <type_traits>
 
 #include <navbus_idl/GnssPubSubTypes.h>
 #include <navbus_idl/ImuPubSubTypes.h>
@@ -33,7 +34,7 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
       topic::kImuIncrement, profile::kSensorWatchdogReader, StreamKind::kImu,
       [](const auto& m) { return m.sensor_id(); }, [](const auto& m) { return m.time_gps_ns(); });
   watch<navbus::ImuRawBlockPubSubType>(
-      topic::kImuRaw, profile::kSensorWatchdogReader, StreamKind::kImuRaw,
+      topic::kImuRaw, profile::kRawImuMonitorReader, StreamKind::kImuRaw,
       [](const auto& m) { return m.sensor_id(); },
       [](const auto& m) { return m.first_sample_time_gps_ns(); });
   watch<navbus::GnssObservationEpochPubSubType>(
@@ -72,6 +73,9 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
                              const eprosima::fastdds::dds::SampleInfo& info) {
         instances_[{kind, info.instance_handle}] = id(m);
         pipeline_.onStreamSample(kind, id(m), m.seq(), time(m), steadyNowNs());
+        if constexpr (std::is_same_v<typename PubSubType::type, navbus::ImuRawBlock>) {
+          pipeline_.onRawBlock(m);
+        }
       },
       callbacks);
   // The decisions quote the reader's own requested deadline (from the QoS profile) as threshold.

@@ -65,7 +65,13 @@ FaultPipeline::FaultPipeline(const FaultManagerConfig& config, bus::HealthCounte
       sinks_(std::move(sinks)),
       glr_(config.glr),
       diagnostics_gate_(bus::topic::kFilterDiagnostics,
-                        health.stream(bus::topic::kFilterDiagnostics)) {}
+                        health.stream(bus::topic::kFilterDiagnostics)) {
+  if (config.dither.enabled) dither_.emplace(config.dither);
+}
+
+void FaultPipeline::onRawBlock(const navbus::ImuRawBlock& block) {
+  if (dither_) dither_->onRawBlock(block, *this);
+}
 
 void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
                                    std::uint64_t time_gps_ns, std::int64_t wall_now_ns) {
@@ -142,6 +148,7 @@ std::string FaultPipeline::summary() const {
   std::ostringstream out;
   out << "decisions published " << decisions() << " (stream lost " << lost_ << ", restored "
       << restored_ << "), commands published " << commands() << "; " << glr_.summary();
+  if (dither_) out << "; " << dither_->summary();
   if (other_vehicles_ > 0) out << "; diagnostics of other vehicles ignored " << other_vehicles_;
   return out.str();
 }

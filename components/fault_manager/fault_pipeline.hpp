@@ -1,18 +1,21 @@
 // navbus-fault-manager's processing without DDS, the shape of navbus-filter's FilterPipeline:
 // stream events and the filter's diagnostics in; decisions (facts) and commands (requests)
 // out through sinks. One detector per file beside it: stream_watchdog (silence), glr_detector
-// (seed 000). The participant (fault_manager_node.hpp) owns the readers and writers and feeds
-// it; `navbus offline` runs it in the same process as the filter pipeline.
+// (seed 000), dither_detector (seed 003, the raw IMU stream). The participant
+// (fault_manager_node.hpp) owns the readers and writers and feeds it; `navbus offline` runs it in
+// the same process as the filter pipeline.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 
 #include <navbus_idl/Fault.h>
 #include <navbus_idl/Navigation.h>
 
+#include "dither_detector.hpp"
 #include "fault_config.hpp"
 #include "fault_output.hpp"
 #include "glr_detector.hpp"
@@ -42,8 +45,13 @@ class FaultPipeline : private FaultOutput {
 
   /// The monitored filter's diagnostics (validated here; other vehicles are ignored).
   void onDiagnostics(const navbus::FilterDiagnostics& msg);
+  /// A raw IMU block, for the dither monitor (watchdog bookkeeping goes through
+  /// onStreamSample as for every stream).
+  void onRawBlock(const navbus::ImuRawBlock& block);
 
   const GlrDetector& glr() const { return glr_; }
+  /// The dither detector, when configured.
+  const std::optional<DitherDetector>& dither() const { return dither_; }
   std::uint64_t decisions() const { return next_decision_id_ - 1; }
   std::uint64_t commands() const { return next_command_id_ - 1; }
   std::string summary() const;
@@ -58,6 +66,7 @@ class FaultPipeline : private FaultOutput {
   Sinks sinks_;
   StreamWatchdog watchdog_;
   GlrDetector glr_;
+  std::optional<DitherDetector> dither_;
   bus::StreamGate diagnostics_gate_;
   std::map<StreamKind, bus::SequenceTracker> trackers_;
   std::map<StreamKind, double> deadline_s_;

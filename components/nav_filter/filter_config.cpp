@@ -4,6 +4,7 @@
 
 #include "navbus/bus/config.hpp"
 #include "navbus/core/rotation.hpp"
+#include "navbus/core/units.hpp"
 
 namespace navbus::nav_filter {
 
@@ -65,11 +66,11 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   c.max_accel_compensation_mps2 =
       bus::checkRange(bus::get<double>(rec, "recovery", "max_accel_compensation_mg", 50.0), 0.0,
                       1e4, "recovery.max_accel_compensation_mg") *
-      9.80665e-3;
+      units::kMilliG;
   c.max_gyro_compensation_radps =
       bus::checkRange(bus::get<double>(rec, "recovery", "max_gyro_compensation_deg_per_h", 200.0),
                       0.0, 1e6, "recovery.max_gyro_compensation_deg_per_h") *
-      M_PI / 180.0 / 3600.0;
+      units::kDegPerHour;
   c.solution_writer_profile =
       bus::get<std::string>(root, "", "solution_writer_profile", c.solution_writer_profile);
   const YAML::Node init = root["initial_state"];
@@ -127,9 +128,9 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
 
   // EKF parameters, in the units of the papers' error budgets.
   const YAML::Node tc = root["ekf"];
-  constexpr double kDeg = M_PI / 180.0;
-  constexpr double kMicroG = 9.80665e-6;
-  constexpr double kArcsec = kDeg / 3600.0;
+  using units::kArcsec;
+  using units::kDeg;
+  using units::kMicroG;
   auto& t = e.tuning;
   const std::string w = "ekf";
   t.gravity =
@@ -171,6 +172,32 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   }
   e.initial_clock_bias_m = bus::get<double>(tc, w, "initial_clock_bias_m", 0.0);
   e.initial_clock_drift_mps = bus::get<double>(tc, w, "initial_clock_drift_mps", 0.0);
+
+  // A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its error is a random-walk bias.
+  const YAML::Node fa = root["failed_axis"];
+  const std::string wf = "failed_axis";
+  auto positive = [](double v, const std::string& key) {
+    return bus::checkRange(v, 1e-12, 1e12, "failed_axis." + key);
+  };
+  t.failed_accel_bias_sigma_mps2 =
+      positive(bus::get<double>(fa, wf, "accel_bias_sigma_mg",
+                                t.failed_accel_bias_sigma_mps2 / units::kMilliG),
+               "accel_bias_sigma_mg") *
+      units::kMilliG;
+  t.failed_accel_bias_rw_mps2_per_sqrts =
+      positive(bus::get<double>(fa, wf, "accel_bias_rw_mg_per_sqrts",
+                                t.failed_accel_bias_rw_mps2_per_sqrts / units::kMilliG),
+               "accel_bias_rw_mg_per_sqrts") *
+      units::kMilliG;
+  t.failed_gyro_bias_sigma_radps = positive(bus::get<double>(fa, wf, "gyro_bias_sigma_dps",
+                                                             t.failed_gyro_bias_sigma_radps / kDeg),
+                                            "gyro_bias_sigma_dps") *
+                                   kDeg;
+  t.failed_gyro_bias_rw_radps_per_sqrts =
+      positive(bus::get<double>(fa, wf, "gyro_bias_rw_dps_per_sqrts",
+                                t.failed_gyro_bias_rw_radps_per_sqrts / kDeg),
+               "gyro_bias_rw_dps_per_sqrts") *
+      kDeg;
 
   const YAML::Node ad = root["adaptive"];
   const std::string wa = "adaptive";

@@ -34,6 +34,7 @@ std::uint32_t faultFlags(std::uint32_t engine_status) {
   if (engine_status & core::kStatusImuGap) f |= navbus::FAULT_IMU_GAP;
   if (engine_status & core::kStatusSatelliteExcluded) f |= navbus::FAULT_SATELLITE_EXCLUDED;
   if (engine_status & core::kStatusBiasCompensated) f |= navbus::FAULT_SENSOR_AXIS;
+  if (engine_status & core::kStatusAxisFailed) f |= navbus::FAULT_IMU_AXIS_FAILED;
   return f;
 }
 
@@ -59,6 +60,8 @@ navbus::FilterMode toIdl(core::EngineMode mode) {
       return navbus::MODE_MDF_F3_RECOVERY;
     case core::EngineMode::kMdfF4:
       return navbus::MODE_MDF_F4_CIF;
+    case core::EngineMode::kAidedAxisFailed:
+      return navbus::MODE_AIDED_AXIS_FAILED;
   }
   return navbus::MODE_INITIALIZING;
 }
@@ -352,7 +355,7 @@ std::int64_t FilterPipeline::restorePoint(const navbus::FilterCommand& c) const 
 bool FilterPipeline::recoversFromOnset(const navbus::FilterCommand& c) const {
   return history_.enabled() && c.onset_time_gps_ns() > 0 &&
          (c.kind() == navbus::CMD_EXCLUDE_SATELLITE || c.kind() == navbus::CMD_COMPENSATE_BIAS ||
-          c.kind() == navbus::CMD_RELEARN_BIAS);
+          c.kind() == navbus::CMD_RELEARN_BIAS || c.kind() == navbus::CMD_FAIL_SENSOR_AXIS);
 }
 
 std::optional<std::string> FilterPipeline::checkCommand(const navbus::FilterCommand& c) const {
@@ -360,6 +363,13 @@ std::optional<std::string> FilterPipeline::checkCommand(const navbus::FilterComm
     case navbus::CMD_EXCLUDE_SATELLITE:
     case navbus::CMD_READMIT_SATELLITE:
       if (c.sv_id() < 1 || c.sv_id() > 32) return fmt::format("sv_id {} outside 1..32", c.sv_id());
+      return std::nullopt;
+    case navbus::CMD_FAIL_SENSOR_AXIS:
+    case navbus::CMD_RESTORE_SENSOR_AXIS:
+      if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
+        return fmt::format("sensor {} is not an accelerometer or gyro",
+                           static_cast<int>(c.sensor()));
+      if (c.axis() > 2) return fmt::format("axis {} outside 0..2", c.axis());
       return std::nullopt;
     case navbus::CMD_COMPENSATE_BIAS:
     case navbus::CMD_RELEARN_BIAS: {
@@ -397,6 +407,12 @@ bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
     case navbus::CMD_COMPENSATE_BIAS:
       engine_.compensateBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias(),
                              c.bias_sigma());
+      return true;
+    case navbus::CMD_FAIL_SENSOR_AXIS:
+      engine_.failSensorAxis(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis());
+      return true;
+    case navbus::CMD_RESTORE_SENSOR_AXIS:
+      engine_.restoreSensorAxis(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis());
       return true;
     case navbus::CMD_SELECT_FUSION:
       switch (c.fusion()) {

@@ -3,15 +3,16 @@
 #include <cmath>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/core/units.hpp"
 
 namespace navbus::sensor_sim {
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
-constexpr double kG = 9.80665;
-constexpr double kMicroG = 1e-6 * kG;          // m/s^2
-constexpr double kDegPerHour = kDeg / 3600.0;  // rad/s
-constexpr double kArcsec = kDeg / 3600.0;      // rad
+using units::kArcsec;
+using units::kDeg;
+using units::kDegPerHour;
+using units::kMicroG;
+constexpr double kG = units::kStandardGravity;
 using bus::checkRange;
 using bus::ConfigError;
 using bus::get;
@@ -338,6 +339,26 @@ SimConfig parseSimConfig(const YAML::Node& root) {
       get<double>(dither, "dither", "accel_own_axis_mg", 1.0) * 1e-3 * kG;
   s.dither_spec.trapping_rate_radps =
       get<double>(dither, "dither", "trapping_rate_dps", 0.5) * kDeg;
+
+  const YAML::Node vib = root["vibration"];
+  s.vibration.enabled = get<bool>(vib, "vibration", "enabled", false);
+  s.vibration.accel_rms_mps2 = checkRange(get<double>(vib, "vibration", "accel_rms_mg",
+                                                      s.vibration.accel_rms_mps2 / units::kMilliG),
+                                          0.0, 1e4, "vibration.accel_rms_mg") *
+                               units::kMilliG;
+  s.vibration.gyro_rms_radps =
+      checkRange(get<double>(vib, "vibration", "gyro_rms_dps", s.vibration.gyro_rms_radps / kDeg),
+                 0.0, 1e3, "vibration.gyro_rms_dps") *
+      kDeg;
+  s.vibration.isolator_corner_hz =
+      get<double>(vib, "vibration", "isolator_corner_hz", s.vibration.isolator_corner_hz);
+  if (s.vibration.enabled) {  // the corner must lie below the raw stream's Nyquist frequency
+    checkRange(s.vibration.isolator_corner_hz, 0.1, raw_hz / 2.0 * 0.9,
+               "vibration.isolator_corner_hz");
+  }
+  s.vibration.moving_speed_mps =
+      checkRange(get<double>(vib, "vibration", "moving_speed_mps", s.vibration.moving_speed_mps),
+                 0.0, 1e3, "vibration.moving_speed_mps");
 
   const YAML::Node gnss = root["gnss"];
   s.constellation.planes =

@@ -22,6 +22,8 @@ const char* enumName(navbus::FilterMode v) {
       return "MDF_F4_CIF";
     case navbus::MODE_INERTIAL_LOST:
       return "INERTIAL_LOST";
+    case navbus::MODE_AIDED_AXIS_FAILED:
+      return "AIDED_AXIS_FAILED";
   }
   return "UNKNOWN";
 }
@@ -116,6 +118,10 @@ const char* enumName(navbus::CommandKind v) {
       return "READMIT_STREAM";
     case navbus::CMD_RELEARN_BIAS:
       return "RELEARN_BIAS";
+    case navbus::CMD_FAIL_SENSOR_AXIS:
+      return "FAIL_SENSOR_AXIS";
+    case navbus::CMD_RESTORE_SENSOR_AXIS:
+      return "RESTORE_SENSOR_AXIS";
   }
   return "UNKNOWN";
 }

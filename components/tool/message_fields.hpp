@@ -176,6 +176,12 @@ void visitFields(const navbus::FaultDecision& m, V& v) {
   }
   v.text("candidates", candidates.str());
   v("detector", m.detector());
+  v("dither_peak_frequency_hz", m.dither().peak_frequency_hz());
+  v("dither_peak_amplitude", m.dither().peak_amplitude());
+  v("dither_min_amplitude", m.dither().min_amplitude());
+  v("dither_expected_frequency_hz", m.dither().expected_frequency_hz());
+  v("dither_tolerance_hz", m.dither().tolerance_hz());
+  v("dither_window_s", m.dither().window_s());
 }
 template <class V>
 void visitFields(const navbus::FilterCommand& m, V& v) {

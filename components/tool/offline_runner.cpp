@@ -100,17 +100,19 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   const auto total = static_cast<std::int64_t>(
       std::llround(setup.duration_s * 1e9 / static_cast<double>(period_ns)));
   sensor_sim::FrameSequence seq;
-  auto feed = [&pipeline](const auto& sample) {
+  auto feed = [&pipeline, &faults](const auto& sample) {
     using T = std::decay_t<decltype(sample)>;
     if constexpr (std::is_same_v<T, navbus::ImuIncrement>) pipeline.onImu(sample);
     if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
       pipeline.onGnssObservations(sample);
     if constexpr (std::is_same_v<T, navbus::GnssFix>) pipeline.onGnssFix(sample);
     if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) pipeline.onStarTracker(sample);
-    return true;  // raw blocks: for the fault manager's dither monitor (not offline yet)
+    if constexpr (std::is_same_v<T, navbus::ImuRawBlock>) faults->onRawBlock(sample);
+    return true;
   };
   sensor_sim::SimConfig emitted = sim;
-  emitted.publish_raw = false;  // nothing offline reads them
+  // Raw blocks only feed the fault manager's dither monitor.
+  emitted.publish_raw = sim.publish_raw && faults && faults->dither().has_value();
   while (source.index() < total) {
     const sim::SensorFrame f = source.next();
     truths.push_back(f.truth);

@@ -29,6 +29,9 @@ ScenarioSource::ScenarioSource(const ScenarioConfig& c)
         d.seed = c.seed * 4 + 2;
         return d;
       }()),
+      vibration_(c.vibration,
+                 1e9 * c.raw_samples_per_increment / static_cast<double>(c.imu_period_ns),
+                 c.seed * 4 + 5),
       constellation_(c.constellation),
       receiver_(c.gnss, constellation_),
       star_(c.star_tracker, c.seed * 4 + 3),
@@ -71,6 +74,12 @@ SensorFrame ScenarioSource::next() {
     PerfectIncrement sensed = imu_.apply(perfect, trajectory_->specificForceBody(), dt);
     sensed.delta_vel_b_mps += config_.faults.accelBias(t) * dt;
     sensed.delta_angle_b_rad += config_.faults.gyroBias(t) * dt;
+    if (config_.vibration.enabled) {
+      const auto [f_vib, w_vib] =
+          vibration_.next(trajectory_->state().vel_ned_mps.head<2>().norm());
+      sensed.delta_vel_b_mps += f_vib * dt;
+      sensed.delta_angle_b_rad += w_vib * dt;
+    }
     // Mean rates over the sample; a stuck axis outputs its frozen value (no dither either:
     // the loss of the dither is how seed 003 detects it).
     const Eigen::Vector3d accel =

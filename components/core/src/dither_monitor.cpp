@@ -110,7 +110,10 @@ void DitherMonitor::analyse() {
         window_.motion_rms_mps2, bandRms(config_.motion_band_low_hz, config_.motion_band_high_hz));
     updateState(a);
   }
-  window_.still = window_.motion_rms_mps2 < config_.still_max_rms_mps2;
+  // A failed accelerometer cannot vouch for stillness (a stuck output is perfectly quiet).
+  bool accels_healthy = true;
+  for (int a = 0; a < 3; ++a) accels_healthy = accels_healthy && !failed(a);
+  window_.still = accels_healthy && window_.motion_rms_mps2 < config_.still_max_rms_mps2;
   for (int g = kFirstGyroChannel; g < kDitherChannels; ++g) {
     if (config_.check_gyros && window_.still) {
       window_.check[static_cast<std::size_t>(g)] =

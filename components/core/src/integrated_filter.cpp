@@ -86,6 +86,14 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   Q(kClockBias.index, kClockBias.index) = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
   Q(kClockDrift.index, kClockDrift.index) =
       std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
+  for (int a = 0; a < 3; ++a) {
+    if (axis_failed_[static_cast<std::size_t>(a)])
+      Q(kAccelBias.index + a, kAccelBias.index + a) =
+          std::pow(tuning_.failed_accel_bias_rw_mps2_per_sqrts, 2) * dt;
+    if (axis_failed_[static_cast<std::size_t>(3 + a)])
+      Q(kGyroBias.index + a, kGyroBias.index + a) =
+          std::pow(tuning_.failed_gyro_bias_rw_radps_per_sqrts, 2) * dt;
+  }
   if (structure_ == FusionStructure::kFederated) {
     for (ErrorState& l : local_) l.predict(Phi, Q * tuning_.federated_share);
   }
@@ -220,6 +228,16 @@ void IntegratedFilter::setActive(const StateMask& active) {
 void IntegratedFilter::zeroOffDiagonal() {
   central_.zeroOffDiagonal();
   for (ErrorState& l : local_) l.zeroOffDiagonal();
+}
+
+void IntegratedFilter::setAxisFailed(bool accelerometer, int axis, bool failed) {
+  bool& flag = axis_failed_[static_cast<std::size_t>((accelerometer ? 0 : 3) + axis)];
+  if (failed && !flag) {
+    const double sigma =
+        accelerometer ? tuning_.failed_accel_bias_sigma_mps2 : tuning_.failed_gyro_bias_sigma_radps;
+    addVariance((accelerometer ? kAccelBias.index : kGyroBias.index) + axis, sigma * sigma);
+  }
+  flag = failed;
 }
 
 void IntegratedFilter::addVariance(int state, double variance) {

@@ -31,6 +31,7 @@ void NavigationEngine::reset() {
   filter_ = IntegratedFilter();
   mode_ = EngineMode::kInitializing;
   status_ = 0;
+  failed_axes_ = 0;
   excluded_.clear();
   accel_compensation_.setZero();
   gyro_compensation_.setZero();
@@ -68,6 +69,9 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
     s.time_ns = start_ns;
     filter_.initialize(s, config_.initial_clock_bias_m, config_.initial_clock_drift_mps,
                        config_.tuning, baseMask(), config_.fusion);
+    for (int i = 0; i < 6; ++i) {
+      if (failed_axes_ & (1u << i)) filter_.setAxisFailed(i < 3, i % 3, true);
+    }
     next_output_ns_ = (start_ns / period + 1) * period;
     next_constraint_ns_ = start_ns;
   } else if (start_ns - filter_.state().time_ns > interval_ns / 2) {
@@ -170,6 +174,7 @@ void NavigationEngine::countGated(const ScalarUpdateResult* results, int n) {
 }
 
 EngineMode NavigationEngine::aidedMode() const {
+  if (failed_axes_ != 0) return EngineMode::kAidedAxisFailed;
   return config_.aiding == AidingMode::kTightlyCoupled ? EngineMode::kTightlyCoupled
                                                        : EngineMode::kLooselyCoupled;
 }
@@ -261,6 +266,23 @@ void NavigationEngine::compensateBias(bool accelerometer, int axis, double bias,
     filter_.addVariance(state, bias_sigma * bias_sigma);
   }
   status_ |= kStatusBiasCompensated;
+}
+
+void NavigationEngine::failSensorAxis(bool accelerometer, int axis) {
+  failed_axes_ |= static_cast<std::uint8_t>(1u << ((accelerometer ? 0 : 3) + axis));
+  if (filter_.initialized()) filter_.setAxisFailed(accelerometer, axis, true);
+  status_ |= kStatusAxisFailed;
+  if (mode_ == EngineMode::kTightlyCoupled || mode_ == EngineMode::kLooselyCoupled)
+    mode_ = aidedMode();
+}
+
+void NavigationEngine::restoreSensorAxis(bool accelerometer, int axis) {
+  failed_axes_ &= static_cast<std::uint8_t>(~(1u << ((accelerometer ? 0 : 3) + axis)));
+  if (filter_.initialized()) filter_.setAxisFailed(accelerometer, axis, false);
+  if (failed_axes_ == 0) {
+    status_ &= ~static_cast<std::uint32_t>(kStatusAxisFailed);
+    if (mode_ == EngineMode::kAidedAxisFailed) mode_ = aidedMode();
+  }
 }
 
 bool NavigationEngine::selectFusion(FusionStructure s) {

@@ -11,6 +11,7 @@
 
 #include "navbus/sim/constellation.hpp"
 #include "navbus/sim/dither.hpp"
+#include "navbus/sim/vibration.hpp"
 #include "navbus/sim/faults.hpp"
 #include "navbus/sim/gnss_receiver.hpp"
 #include "navbus/sim/imu_model.hpp"
@@ -35,6 +36,7 @@ struct ScenarioConfig {
   ImuSpec imu;
   bool dither{false};
   DitherSpec dither_spec;
+  VibrationSpec vibration;
   ConstellationConfig constellation;
   GnssReceiverConfig gnss;
   StarTrackerSpec star_tracker;
@@ -58,6 +60,7 @@ class ScenarioSource {
   std::unique_ptr<Trajectory> trajectory_;
   ImuErrorModel imu_;
   DitherModel dither_;
+  VehicleVibration vibration_;
   Constellation constellation_;
   GnssReceiverModel receiver_;
   StarTrackerModel star_;

@@ -24,6 +24,7 @@ inline constexpr const char* kParticipantLoopback = "navbus_participant_udp_loop
 inline constexpr const char* kSensorWriter = "navbus_sensor_writer";
 inline constexpr const char* kSensorReader = "navbus_sensor_reader";
 inline constexpr const char* kSensorWatchdogReader = "navbus_sensor_watchdog_reader";
+inline constexpr const char* kRawImuMonitorReader = "navbus_raw_imu_monitor_reader";
 inline constexpr const char* kMeasurementWriter = "navbus_measurement_writer";
 inline constexpr const char* kMeasurementReader = "navbus_measurement_reader";
 inline constexpr const char* kMeasurementWatchdogReader = "navbus_measurement_watchdog_reader";

@@ -10,7 +10,7 @@
 // Gyros are checked on the difference frequencies, and only while the vehicle is still: the
 // difference lines (30-70 Hz) collide with vehicle motion (seed 003, vehicle test). Stillness is
 // taken from the same spectra: the accelerometers' RMS in the vehicle-motion band below a
-// threshold.
+// threshold, with every accelerometer healthy (a stuck one is quiet whatever the vehicle does).
 //
 // A peak also has to reach a minimum amplitude: a stuck (constant) output has no lines at all,
 // and the largest "peak" of its numerical noise could fall on a dither frequency by chance.

@@ -55,6 +55,13 @@ struct FilterTuning {
   double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]
   double adaptive_floor_velocity_mps{0.01};
   double adaptive_floor_attitude_rad{1e-6};
+  // A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its output error (a stuck value minus the true
+  // specific force or rate) is modelled as a bias with this random walk, and its variance grows
+  // by the sigma at the failure. The walk must cover the vehicle's manoeuvres on that axis.
+  double failed_accel_bias_sigma_mps2{1.0};
+  double failed_accel_bias_rw_mps2_per_sqrts{1.0};
+  double failed_gyro_bias_sigma_radps{0.02};
+  double failed_gyro_bias_rw_radps_per_sqrts{0.005};
   // Federated structure: each local filter starts from, and is driven by, share times the
   // covariance and process noise (information sharing 1/share, Carlson's no-reset mode).
   double federated_share{2.0};
@@ -99,6 +106,9 @@ class IntegratedFilter {
   void resetVariances(const StateBlock& block, double sigma);
   /// Adds `variance` to one state's variance (a correction of uncertain size was applied).
   void addVariance(int state, double variance);
+  /// Marks an IMU axis failed (or trusted again): while failed, its bias state is a random
+  /// walk of the tuning's failed_* density, so the aiding carries that axis.
+  void setAxisFailed(bool accelerometer, int axis, bool failed);
   const StateMask& active() const { return central_.active(); }
 
   const NavState& state() const { return ins_.state(); }
@@ -124,6 +134,7 @@ class IntegratedFilter {
   InnovationWindow<3>* window(AidingKind kind);
 
   FilterTuning tuning_;
+  std::array<bool, 6> axis_failed_{};  ///< accelerometers x y z, gyros x y z
   FusionStructure structure_{FusionStructure::kCentralized};
   StrapdownNed ins_;
   ErrorState central_;               ///< centralized/adaptive filter; master result (federated)

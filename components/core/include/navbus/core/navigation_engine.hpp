@@ -30,7 +30,8 @@ enum class EngineMode {
   kMdfF1,
   kMdfF2,
   kMdfF3,
-  kMdfF4
+  kMdfF4,
+  kAidedAxisFailed  ///< tightly or loosely coupled with a failed IMU axis
 };
 
 /// Engine status bits (the participant maps them to the solution's fault flags).
@@ -38,6 +39,7 @@ enum EngineStatus : std::uint32_t {
   kStatusImuGap = 1u << 0,
   kStatusSatelliteExcluded = 1u << 1,
   kStatusBiasCompensated = 1u << 2,
+  kStatusAxisFailed = 1u << 3,
 };
 
 /// Which measurements of a satellite an exclusion concerns (bit mask).
@@ -105,6 +107,12 @@ class NavigationEngine {
   void relearnBias(bool accelerometer, int axis, double sigma) {
     compensateBias(accelerometer, axis, 0.0, sigma);
   }
+  /// An IMU axis has failed: its error becomes a random-walk bias (IntegratedFilter::
+  /// setAxisFailed) and an aided solution reports kAidedAxisFailed. Free inertial navigation
+  /// keeps its mode and shows the failure in the status (its sigmas grow with the bias walk).
+  void failSensorAxis(bool accelerometer, int axis);
+  void restoreSensorAxis(bool accelerometer, int axis);
+  bool anyAxisFailed() const { return failed_axes_ != 0; }
   /// False when the structure does not apply to the aiding mode (see the .cpp).
   bool selectFusion(FusionStructure s);
   void markInertialLost();
@@ -143,6 +151,7 @@ class NavigationEngine {
   std::vector<SatelliteObservation> used_;  ///< reused buffer of the satellites fused
   Eigen::Vector3d accel_compensation_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_compensation_{Eigen::Vector3d::Zero()};
+  std::uint8_t failed_axes_{0};  ///< bit i: accelerometer i (0-2), gyro i - 3 (3-5)
   std::int64_t next_output_ns_{0};
   std::int64_t last_fix_ns_{-1};
   std::int64_t next_constraint_ns_{0};
