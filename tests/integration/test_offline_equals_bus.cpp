@@ -296,3 +296,91 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }
+
+TEST(FaultLoop, StuckAccelerometerFlaggedByTheDitherMonitorOverTheBus) {
+  constexpr int kDomain = 90;
+  test::cleanSharedMemory();
+  const auto dir = test::scratchDir("dither-loop");
+  const std::string src = NAVBUS_SOURCE_DIR;
+  const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
+  // Seed 003: the static laser INS, accelerometer x stuck at 40 s (y and z later, cut off).
+  const std::string sim_cfg = test::writeFile(
+      dir / "sim.yaml", "extends: " + src + "/sim/scenarios/seed003_laser_ins.yaml\n" + domain +
+                            "timing: {duration_s: 45, pacing: fast}\n");
+  const std::string filter_cfg = test::writeFile(
+      dir / "filter.yaml", "extends: " + src + "/config/filter.yaml\n" + domain +
+                               "initial_state: {latitude_deg: 36.4, longitude_deg: 127.4, "
+                               "height_m: 60.0}\n");
+  const std::string fm_cfg =
+      test::writeFile(dir / "fm.yaml", "extends: " + src + "/config/fault_manager.yaml\n" + domain);
+
+  bus::ShutdownSignal shutdown;
+  bus::Participant me(test::testParticipant(kDomain, "dither-loop-test"), shutdown);
+  std::vector<NavigationSolution> solutions;
+  std::vector<FaultDecision> decisions;
+  std::vector<FilterCommand> commands;
+  me.subscribe<NavigationSolutionPubSubType>(
+      bus::topic::kNavSolution, bus::profile::kSolutionReader,
+      [&](const NavigationSolution& s, const auto&) { solutions.push_back(s); });
+  me.subscribe<FaultDecisionPubSubType>(
+      bus::topic::kFaultDecision, bus::profile::kDecisionReader,
+      [&](const FaultDecision& d, const auto&) { decisions.push_back(d); });
+  me.subscribe<FilterCommandPubSubType>(
+      bus::topic::kFilterCommand, bus::profile::kDecisionReader,
+      [&](const FilterCommand& c, const auto&) { commands.push_back(c); });
+  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
+  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
+  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg}, (dir / "sim.log").string());
+  while (sim.running()) me.spinOnce(50ms);
+  EXPECT_EQ(sim.wait(1s), 0) << test::readFile(dir / "sim.log");
+  test::spinUntil(me, 20s, [&] {
+    return !solutions.empty() && solutions.back().time_gps_ns() >= 1'400'000'045'000'000'000ULL;
+  });
+  me.spinOnce(500ms);
+  filter.signal(SIGTERM);
+  fm.signal(SIGTERM);
+  EXPECT_EQ(filter.wait(10s), 0);
+  EXPECT_EQ(fm.wait(10s), 0);
+
+  // The decision: dither-fft, accelerometer x, within 0.5 s of the fault, with its evidence.
+  const double start_s = 1.4e9;
+  std::vector<FaultDecision> dither;
+  std::copy_if(decisions.begin(), decisions.end(), std::back_inserter(dither),
+               [](const FaultDecision& d) { return d.detector() == "dither-fft"; });
+  ASSERT_EQ(dither.size(), 1u) << test::readFile(dir / "fm.log");
+  const FaultDecision& d = dither.front();
+  EXPECT_EQ(d.event(), EVENT_FAULT_DETECTED);
+  EXPECT_EQ(d.source(), SOURCE_ACCELEROMETER);
+  EXPECT_EQ(d.axis(), 0);
+  const double decided_s = 1e-9 * static_cast<double>(d.time_gps_ns()) - start_s;
+  EXPECT_GT(decided_s, 40.0);
+  EXPECT_LE(decided_s, 40.5);
+  EXPECT_LE(1e-9 * static_cast<double>(d.onset_time_gps_ns()) - start_s, 40.0);
+  EXPECT_GT(d.test_statistic(), d.threshold());  // the peak is off every line (or absent)
+  EXPECT_EQ(d.dither().expected_frequency_hz()[0], 373.0);
+  // The command, and the filter acting on it: solutions flagged from the decision on, not before.
+  const auto fail = std::find_if(commands.begin(), commands.end(), [&](const FilterCommand& c) {
+    return c.kind() == CMD_FAIL_SENSOR_AXIS && c.decision_id() == d.decision_id();
+  });
+  ASSERT_NE(fail, commands.end());
+  EXPECT_EQ(fail->sensor(), SOURCE_ACCELEROMETER);
+  EXPECT_EQ(fail->axis(), 0);
+  int flagged_before = 0, flagged_after = 0, after = 0;
+  for (const auto& s : solutions) {
+    const double t = 1e-9 * static_cast<double>(s.time_gps_ns()) - start_s;
+    const bool flagged = (s.active_fault_flags() & FAULT_IMU_AXIS_FAILED) != 0;
+    if (t < 39.0) flagged_before += flagged ? 1 : 0;
+    if (t > decided_s + 0.1 && s.mode() != MODE_INERTIAL_LOST) {
+      ++after;
+      flagged_after += flagged ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(flagged_before, 0);
+  EXPECT_GT(after, 10);
+  EXPECT_EQ(flagged_after, after);
+  std::printf("dither loop: accelerometer x stuck at 40 s, decided at %.3f s, %d of %d later "
+              "solutions flagged\n",
+              decided_s, flagged_after, after);
+  test::cleanSharedMemory();
+  std::filesystem::remove_all(dir);
+}
