@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the default demo: navbus-filter,
-# navbus-fault-manager and navbus-sensor-sim as separate processes on loopback, with a
-# `navbus record` observer. The simulator publishes 20 s of data and stops; the fault manager
-# declares its streams lost; everything then stops and a summary is printed.
+# Installs what is missing, builds (reusing an existing build), and runs the main demo: the
+# fault-tolerant loop. navbus-sensor-sim, navbus-filter (tightly coupled) and
+# navbus-fault-manager run as separate processes on loopback with a `navbus record` observer;
+# the scenario (sim/scenarios/demo_fault_loop.yaml) injects a pseudorange ramp and a stuck
+# accelerometer. The summary shows, per fault, the error before it, the decision, the
+# reconfiguration and the error after it; the figures go next to the CSV files.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -11,40 +13,45 @@ bash scripts/build.sh > build/demo-build.log 2>&1 || { tail -50 build/demo-build
 bin=build/bin
 domain=${NAVBUS_DEMO_DOMAIN:-0}
 out=build/demo
+scenario=sim/scenarios/demo_fault_loop.yaml
+filter_cfg=config/filter_demo.yaml
+fm_cfg=config/fault_manager.yaml
 rm -rf "$out" && mkdir -p "$out"
 pids=()
 trap 'kill -TERM "${pids[@]}" 2>/dev/null || true' EXIT
 
-"$bin/navbus-filter" -c config/filter.yaml -d "$domain" > "$out/filter.log" 2>&1 &
-pids+=($!)
-"$bin/navbus-fault-manager" -c config/fault_manager.yaml -d "$domain" > "$out/fault_manager.log" 2>&1 &
-pids+=($!)
-"$bin/navbus" -d "$domain" record navbus/nav/solution navbus/fault/decision navbus/health -o "$out/record" \
-  > "$out/record.log" 2>&1 &
+"$bin/navbus-filter" -c "$filter_cfg" -d "$domain" > "$out/filter.log" 2>&1 &
+filter=$!
+"$bin/navbus-fault-manager" -c "$fm_cfg" -d "$domain" > "$out/fault_manager.log" 2>&1 &
+fm=$!
+"$bin/navbus" -d "$domain" record navbus/nav/solution navbus/fault/decision navbus/filter/command \
+  -o "$out/record" > "$out/record.log" 2>&1 &
 rec=$!
-pids+=($rec)
-echo "demo: filter, fault manager and recorder started on domain $domain; simulator publishing 20 s of data"
-"$bin/navbus-sensor-sim" -c sim/scenarios/default.yaml -d "$domain" 2>&1 | tee "$out/sensor_sim.log" | grep -E "summary|warn|error" || true
-sleep 3   # the watchdogs see the streams stop
-kill -TERM "${pids[@]}"
-wait "${pids[@]}" 2>/dev/null || true
+pids=($filter $fm $rec)
+echo "demo: filter, fault manager and recorder started on domain $domain; the simulator publishes"
+echo "      120 s of data as fast as they take it (pseudorange ramp at 30 s, stuck accelerometer at 65 s)"
+"$bin/navbus-sensor-sim" -c "$scenario" -d "$domain" > "$out/sensor_sim.log" 2>&1
+sleep 1   # the filter releases its last inputs
+kill -TERM $filter $fm
+wait $filter $fm 2>/dev/null || true
+sleep 0.5
+kill -TERM $rec
+wait $rec 2>/dev/null || true
 trap - EXIT
+
+# The same scenario without DDS: its truth (the simulator is deterministic), and the same data
+# without the fault manager, to show what the loop saves.
+"$bin/navbus" offline --scenario "$scenario" --filter "$filter_cfg" --fault-manager "$fm_cfg" \
+  -o "$out/offline" > "$out/offline.log" 2>&1
+"$bin/navbus" offline --scenario "$scenario" --filter "$filter_cfg" \
+  -o "$out/offline_without_fault_manager" > "$out/offline_without_fault_manager.log" 2>&1
 
 echo
 echo "================ navbus demo summary ================"
 grep -h "summary" "$out/sensor_sim.log" | sed 's/.*summary: /sensor-sim:    /'
-grep -h -A7 "summary" "$out/filter.log" | sed 's/.*summary: /filter:        /'
-grep -h -A6 "summary" "$out/fault_manager.log" | sed 's/.*summary: /fault-manager: /'
-solutions=$(($(wc -l < "$out/record/navbus_nav_solution.csv") - 1))
-decisions=$(($(wc -l < "$out/record/navbus_fault_decision.csv") - 1))
-echo "recorder:      $solutions solutions and $decisions fault decisions recorded in $out/record"
-# CSV columns are read by their header names (see the README's CSV section).
-awk -F, 'NR==1 {for (i = 1; i <= NF; ++i) c[$i] = i; next}
-  NR==2 {lat0=$c["latitude_rad"]; lon0=$c["longitude_rad"]; h0=$c["height_m"]}
-  $c["mode"]=="INERTIAL_ONLY" {lat=$c["latitude_rad"]; lon=$c["longitude_rad"]; h=$c["height_m"]; t=1}
-  END { if (t) printf("last inertial solution: drift north %.3f m, east %.3f m, up %.3f m from the first solution\n",
-        (lat-lat0)*6.3567e6, (lon-lon0)*6.3567e6*cos(lat0), h-h0) }' "$out/record/navbus_nav_solution.csv"
-awk -F, 'NR==1 {for (i = 1; i <= NF; ++i) c[$i] = i; next}
-  {print "decision:      " $c["detector"] " " $c["event"] " " $c["source"]}' \
-  "$out/record/navbus_fault_decision.csv" | sort | uniq -c
-echo "logs and CSV files: $out"
+grep -h "summary" "$out/filter.log" | sed 's/.*summary: /filter:        /'
+grep -h "summary" "$out/fault_manager.log" | sed 's/.*summary: /fault-manager: /'
+/usr/bin/python3 scripts/demo_summary.py "$scenario" "$out/record" "$out/offline" \
+  "$out/offline_without_fault_manager"
+/usr/bin/python3 scripts/plot_navbus.py demo "$scenario" "$out" -o "$out/figures"
+echo "logs and CSV files: $out; figures: $out/figures"

@@ -10,6 +10,7 @@ packages=(
   cyclonedds-dev cyclonedds-tools                          # second DDS vendor for the interop test
   iproute2                                                 # network namespaces for the topology test
   rtklib                                                   # rnx2rtkp: independent GPS fixes for the real-data test
+  python3-matplotlib python3-yaml                          # demo summary and figures (scripts/*.py)
 )
 missing=()
 for p in "${packages[@]}"; do

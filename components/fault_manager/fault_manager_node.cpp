@@ -62,6 +62,10 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
     auto it = instances_.find({kind, st.last_instance_handle});
     if (it != instances_.end()) pipeline_.onDeadlineMissed(kind, it->second, steadyNowNs());
   };
+  callbacks.on_disposed = [this, kind](const eprosima::fastrtps::rtps::InstanceHandle_t& h) {
+    auto it = instances_.find({kind, h});
+    if (it != instances_.end()) pipeline_.onStreamEnded(kind, it->second);
+  };
   callbacks.on_liveliness = [this,
                              kind](const eprosima::fastdds::dds::LivelinessChangedStatus& st) {
     if (st.alive_count == 0 && st.alive_count_change < 0)

@@ -98,6 +98,17 @@ void FaultPipeline::onWritersGone(StreamKind kind, std::int64_t wall_now_ns) {
   for (const auto& e : watchdog_.onWritersGone(kind, wall_now_ns)) onWatchdogEvent(e);
 }
 
+void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id) {
+  // An IMU's raw stream ends with its increment stream (the same sensor; the raw reader does
+  // not see the raw writer's dispose with Fast DDS 2.9, see the README).
+  if (kind == StreamKind::kImu) onStreamEnded(StreamKind::kImuRaw, sensor_id);
+  if (!watchdog_.onEnded({kind, sensor_id})) return;
+  trackers_[kind].reset(sensor_id);
+  ++ended_;
+  spdlog::info("{} stream {} ended (its writer disposed it): not a loss", kindName(kind),
+               sensor_id);
+}
+
 void FaultPipeline::onWatchdogEvent(const WatchdogEvent& e) {
   navbus::FaultDecision d;
   d.time_gps_ns(e.last_time_gps_ns);
@@ -147,7 +158,8 @@ void FaultPipeline::command(navbus::FilterCommand& c) {
 std::string FaultPipeline::summary() const {
   std::ostringstream out;
   out << "decisions published " << decisions() << " (stream lost " << lost_ << ", restored "
-      << restored_ << "), commands published " << commands() << "; " << glr_.summary();
+      << restored_ << "), streams ended as announced " << ended_ << ", commands published "
+      << commands() << "; " << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
   if (other_vehicles_ > 0) out << "; diagnostics of other vehicles ignored " << other_vehicles_;
   return out.str();

@@ -40,6 +40,8 @@ class FaultPipeline : private FaultOutput {
                       std::uint64_t time_gps_ns, std::int64_t wall_now_ns);
   void onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id, std::int64_t wall_now_ns);
   void onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
+  /// The stream's writer announced its end (disposed the instance): no loss, counted.
+  void onStreamEnded(StreamKind kind, std::uint32_t sensor_id);
   /// The watchdog deadline of a stream kind [s], quoted as the decisions' threshold.
   void setDeadline(StreamKind kind, double deadline_s) { deadline_s_[kind] = deadline_s; }
 
@@ -72,7 +74,7 @@ class FaultPipeline : private FaultOutput {
   std::map<StreamKind, double> deadline_s_;
   std::uint32_t next_decision_id_{1};
   std::uint64_t next_command_id_{1};
-  std::uint64_t lost_{0}, restored_{0}, other_vehicles_{0};
+  std::uint64_t lost_{0}, restored_{0}, ended_{0}, other_vehicles_{0};
 };
 
 /// The IDL source of a watched stream kind, and its name for logs.

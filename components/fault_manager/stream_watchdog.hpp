@@ -40,6 +40,10 @@ class StreamWatchdog {
   /// Every writer of a topic lost liveliness: all its streams that are alive are lost.
   std::vector<WatchdogEvent> onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
 
+  /// The stream's writer disposed it (an announced end): forgotten, so that its silence is no
+  /// loss. Returns false if the stream was not known. A new sample starts it again.
+  bool onEnded(const StreamKey& key) { return states_.erase(key) > 0; }
+
   bool isLost(const StreamKey& key) const;
 
  private:

@@ -146,4 +146,32 @@ void FramePublisher::flush() {
   }
 }
 
+void FramePublisher::endStreams() {
+  if (counts_.imu > 0) {
+    navbus::ImuIncrement k;
+    k.sensor_id(config_.imu_sensor_id);
+    imu_.dispose(k);
+  }
+  if (counts_.raw > 0) {
+    navbus::ImuRawBlock k;
+    k.sensor_id(config_.imu_sensor_id);
+    raw_.dispose(k);
+  }
+  if (counts_.gnss_epochs > 0) {
+    navbus::GnssObservationEpoch k;
+    k.receiver_id(config_.gnss_receiver_id);
+    gnss_.dispose(k);
+  }
+  if (counts_.gnss_fixes > 0) {
+    navbus::GnssFix k;
+    k.receiver_id(config_.gnss_receiver_id);
+    fix_.dispose(k);
+  }
+  if (counts_.star_tracker > 0) {
+    navbus::StarTrackerAttitude k;
+    k.tracker_id(config_.star_tracker_id);
+    star_.dispose(k);
+  }
+}
+
 }  // namespace navbus::sensor_sim

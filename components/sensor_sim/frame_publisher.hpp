@@ -68,6 +68,10 @@ class FramePublisher {
   bool readersMatched() const;
   /// Waits (bounded) until every written sample is acknowledged by the reliable readers.
   void flush();
+  /// Disposes every stream instance written: readers see the streams end as announced (the
+  /// fault manager's watchdog reports no loss). A crashed simulator cannot do this: its
+  /// streams are lost.
+  void endStreams();
 
   /// Samples written per stream, and writes retried because a reliable reader was behind.
   const FrameSequence& counts() const { return counts_; }

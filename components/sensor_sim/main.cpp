@@ -117,6 +117,7 @@ int main(int argc, char** argv) {
         participant.spinOnce(std::chrono::nanoseconds(0));
       }
     }
+    publisher.endStreams();  // a clean stop (end of data or SIGTERM) is announced, not a loss
     publisher.flush();
     participant.finish();
     const auto& n = publisher.counts();

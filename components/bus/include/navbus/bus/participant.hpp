@@ -44,6 +44,18 @@ class Writer {
     health_->countPublished();
     return true;
   }
+  /// Disposes the instance whose key `key_holder` carries: readers learn that the stream
+  /// ended as announced (not lost). Returns false (and logs) on failure.
+  bool dispose(const Sample& key_holder) {
+    if (writer_ == nullptr) return false;
+    if (writer_->dispose(const_cast<Sample*>(&key_holder),
+                         eprosima::fastrtps::rtps::c_InstanceHandle_Unknown) !=
+        ReturnCode_t::RETCODE_OK) {
+      spdlog::error("dispose on '{}' failed", writer_->get_topic()->get_name());
+      return false;
+    }
+    return true;
+  }
   eprosima::fastdds::dds::DataWriter* raw() { return writer_; }
   std::size_t matchedReaders() const;
 
@@ -55,6 +67,8 @@ class Writer {
 struct ReaderCallbacks {
   std::function<void(const eprosima::fastdds::dds::RequestedDeadlineMissedStatus&)> on_deadline;
   std::function<void(const eprosima::fastdds::dds::LivelinessChangedStatus&)> on_liveliness;
+  /// An instance was disposed by its writer (the stream ended as announced).
+  std::function<void(const eprosima::fastrtps::rtps::InstanceHandle_t&)> on_disposed;
 };
 
 class Participant {
@@ -94,13 +108,17 @@ class Participant {
     auto* topic = dds_.topic<PubSubType>(topic_name);
     auto* reader = dds_.createReader(topic, profile);
     StreamCounters* counters = &health_.stream(topic_name);
-    auto take_all = [reader, counters, on_sample]() {
+    auto take_all = [reader, counters, on_sample, on_disposed = callbacks.on_disposed]() {
       Sample sample;
       eprosima::fastdds::dds::SampleInfo info;
       while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
         if (info.valid_data) {
           ++counters->received;
           on_sample(sample, info);
+        } else if (info.instance_state ==
+                       eprosima::fastdds::dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE &&
+                   on_disposed) {
+          on_disposed(info.instance_handle);
         }
       }
     };

@@ -1,0 +1,195 @@
+#!/usr/bin/python3
+"""Figures from navbus CSV files (matplotlib, Debian's python3-matplotlib).
+
+  plot_navbus.py errors OFFLINE_DIR -o OUT_DIR
+      position, velocity and attitude error with the filter's 3-sigma envelope (error.csv of
+      `navbus offline`), decisions marked when decisions.csv is there -> errors.png
+  plot_navbus.py compare WITH_DIR WITHOUT_DIR -o OUT_DIR
+      3-D position error with and without the fault manager (two `navbus offline` runs of the
+      same scenario) -> with_without_fault_manager.png
+  plot_navbus.py spectrum RAW_CSV --before T0 --after T1 --axis x -o OUT_DIR [--lines F F F]
+      amplitude spectrum of one accelerometer from a `navbus-sensor-sim --files` imu_raw.csv
+      over 0.5 s before T0 and after T1 [s from the first sample], dither lines marked
+      -> spectrum_<axis>.png
+  plot_navbus.py demo SCENARIO DEMO_DIR -o OUT_DIR
+      the main demo's figures (errors, with/without the fault manager) from scripts/demo.sh's
+      output directory
+"""
+import argparse
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(__file__))
+from navbus_py.navcsv import load_scenario, read_csv, vector  # noqa: E402
+
+AXES = ("north", "east", "down")
+
+
+def _time_s(rows, start_ns):
+    return np.array([(int(r["time_gps_ns"]) - start_ns) * 1e-9 for r in rows])
+
+
+def _mark_decisions(ax, decisions, start_ns):
+    for d in decisions:
+        if d["event"] != "FAULT_DETECTED":
+            continue
+        t = (int(d["time_gps_ns"]) - start_ns) * 1e-9
+        ax.axvline(t, color="tab:red", lw=0.8, ls="--")
+
+
+def errors(offline_dir, out_dir, start_ns=None, title=""):
+    rows = read_csv(os.path.join(offline_dir, "error.csv"))
+    start_ns = start_ns if start_ns is not None else int(rows[0]["time_gps_ns"])
+    t = _time_s(rows, start_ns)
+    decisions_path = os.path.join(offline_dir, "decisions.csv")
+    decisions = read_csv(decisions_path) if os.path.exists(decisions_path) else []
+    fig, axes = plt.subplots(3, 3, figsize=(13, 8), sharex=True)
+    blocks = (("pos_err_ned_m", "pos_sigma_ned_m", "position error [m]", 1.0),
+              ("vel_err_ned_mps", "vel_sigma_ned_mps", "velocity error [m/s]", 1.0),
+              ("att_err_ned_rad", "att_sigma_ned_rad", "attitude error [mrad]", 1e3))
+    for row_i, (err, sig, label, scale) in enumerate(blocks):
+        e = np.array([vector(r, err) for r in rows]) * scale
+        s = np.array([vector(r, sig) for r in rows]) * scale
+        for k in range(3):
+            ax = axes[row_i][k]
+            ax.fill_between(t, -3 * s[:, k], 3 * s[:, k], color="tab:blue", alpha=0.2,
+                            label="filter 3-sigma")
+            ax.plot(t, e[:, k], color="black", lw=0.8, label="error")
+            _mark_decisions(ax, decisions, start_ns)
+            ax.set_ylabel(f"{AXES[k]} {label}", fontsize=8)
+            ax.grid(alpha=0.3)
+            if row_i == 2:
+                ax.set_xlabel("time [s]")
+    axes[0][0].legend(fontsize=8, loc="upper left")
+    fig.suptitle(title or f"navigation error and 3-sigma envelope ({offline_dir}); "
+                 "dashed: fault decisions", fontsize=10)
+    fig.tight_layout()
+    os.makedirs(out_dir, exist_ok=True)
+    path = os.path.join(out_dir, "errors.png")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def compare(with_dir, without_dir, out_dir, start_ns=None):
+    fig, ax = plt.subplots(figsize=(10, 5))
+    for d, label, color in ((without_dir, "without the fault manager", "tab:red"),
+                            (with_dir, "with the fault manager (decisions -> commands)",
+                             "tab:green")):
+        rows = read_csv(os.path.join(d, "error.csv"))
+        s0 = start_ns if start_ns is not None else int(rows[0]["time_gps_ns"])
+        t = _time_s(rows, s0)
+        e = np.linalg.norm(np.array([vector(r, "pos_err_ned_m") for r in rows]), axis=1)
+        ax.semilogy(t, np.maximum(e, 1e-3), color=color, lw=1.0, label=label)
+        if d == with_dir:
+            s = np.linalg.norm(np.array([vector(r, "pos_sigma_ned_m") for r in rows]), axis=1)
+            ax.semilogy(t, 3 * s, color="tab:blue", lw=0.8, ls=":", label="3-sigma (3-D), with")
+            decisions_path = os.path.join(d, "decisions.csv")
+            if os.path.exists(decisions_path):
+                _mark_decisions(ax, read_csv(decisions_path), s0)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("3-D position error [m]")
+    ax.set_title("the same data with and without fault exclusion / reconfiguration "
+                 "(dashed: decisions)", fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    os.makedirs(out_dir, exist_ok=True)
+    path = os.path.join(out_dir, "with_without_fault_manager.png")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def _amplitude(x, rate):
+    n = len(x)
+    w = np.hanning(n + 1)[:-1]
+    spec = np.abs(np.fft.rfft((x - x.mean()) * w)) * 2 / w.sum()
+    return np.fft.rfftfreq(n, 1 / rate), spec
+
+
+def spectrum(raw_csv, before, after, axis, out_dir, lines=(373, 441, 409)):
+    rows = read_csv(raw_csv)
+    t0 = int(rows[0]["time_gps_ns"])
+    t = np.array([(int(r["time_gps_ns"]) - t0) * 1e-9 for r in rows])
+    x = np.array([float(r[f"specific_force_{axis}_mps2"]) for r in rows])
+    rate = 1.0 / np.median(np.diff(t))
+    fig, ax = plt.subplots(figsize=(10, 5))
+    for t_start, label, color in ((before - 0.5, f"{before - 0.5:.1f}-{before:.1f} s (healthy)",
+                                   "tab:blue"),
+                                  (after, f"{after:.1f}-{after + 0.5:.1f} s (stuck)", "tab:red")):
+        sel = (t >= t_start) & (t < t_start + 0.5)
+        if sel.sum() < 16:
+            continue
+        f, a = _amplitude(x[sel], rate)
+        # A stuck output has no spectrum at all: drawn at 1e-5 mg, the floor of the plot.
+        ax.semilogy(f, np.maximum(a / 9.80665e-3, 1e-5), color=color, lw=0.8, label=label)
+    for line in lines:
+        ax.axvline(line, color="gray", ls="--", lw=0.8)
+    ax.axvspan(300, 1200, color="tab:green", alpha=0.06, label="search band 300-1200 Hz")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(f"accelerometer {axis} amplitude [mg]")
+    ax.set_title(f"raw accelerometer {axis} spectrum before and after a stuck fault "
+                 f"(dashed: dither lines {', '.join(str(int(v)) for v in lines)} Hz)", fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    os.makedirs(out_dir, exist_ok=True)
+    path = os.path.join(out_dir, f"spectrum_{axis}.png")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def demo(scenario_path, demo_dir, out_dir):
+    start_ns = int(load_scenario(scenario_path)["timing"]["start"])
+    paths = [errors(os.path.join(demo_dir, "offline"), out_dir, start_ns,
+                    "demo: navigation error and 3-sigma envelope; dashed: fault decisions"),
+             compare(os.path.join(demo_dir, "offline"),
+                     os.path.join(demo_dir, "offline_without_fault_manager"), out_dir, start_ns)]
+    return paths
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    sub = p.add_subparsers(dest="cmd", required=True)
+    a = sub.add_parser("errors")
+    a.add_argument("offline_dir")
+    a.add_argument("-o", "--out", required=True)
+    a = sub.add_parser("compare")
+    a.add_argument("with_dir")
+    a.add_argument("without_dir")
+    a.add_argument("-o", "--out", required=True)
+    a = sub.add_parser("spectrum")
+    a.add_argument("raw_csv")
+    a.add_argument("--before", type=float, required=True)
+    a.add_argument("--after", type=float, required=True)
+    a.add_argument("--axis", choices=("x", "y", "z"), default="x")
+    a.add_argument("--lines", type=float, nargs=3, default=(373, 441, 409))
+    a.add_argument("-o", "--out", required=True)
+    a = sub.add_parser("demo")
+    a.add_argument("scenario")
+    a.add_argument("demo_dir")
+    a.add_argument("-o", "--out", required=True)
+    args = p.parse_args()
+    if args.cmd == "errors":
+        paths = [errors(args.offline_dir, args.out)]
+    elif args.cmd == "compare":
+        paths = [compare(args.with_dir, args.without_dir, args.out)]
+    elif args.cmd == "spectrum":
+        paths = [spectrum(args.raw_csv, args.before, args.after, args.axis, args.out, args.lines)]
+    else:
+        paths = demo(args.scenario, args.demo_dir, args.out)
+    for path in paths:
+        print(f"figure: {path}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# The figure commands (scripts/plot_navbus.py) on small data: each writes a non-trivial PNG.
+# usage: run.sh NAVBUS_EXE SENSOR_SIM_EXE
+set -euo pipefail
+navbus=$1
+sim=$2
+src=$(cd "$(dirname "$0")/../.." && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+scenario=$src/sim/scenarios/demo_fault_loop.yaml
+"$navbus" offline --scenario "$scenario" --filter "$src/config/filter_demo.yaml" \
+  --fault-manager "$src/config/fault_manager.yaml" --duration 45 -o "$work/with" > "$work/with.log" 2>&1
+"$navbus" offline --scenario "$scenario" --filter "$src/config/filter_demo.yaml" --duration 45 \
+  -o "$work/without" > "$work/without.log" 2>&1
+"$sim" -c "$src/sim/scenarios/seed003_laser_ins.yaml" --files "$work/raw" --duration 41 \
+  > "$work/raw.log" 2>&1
+py=/usr/bin/python3
+$py "$src/scripts/plot_navbus.py" errors "$work/with" -o "$work/fig"
+$py "$src/scripts/plot_navbus.py" compare "$work/with" "$work/without" -o "$work/fig"
+$py "$src/scripts/plot_navbus.py" spectrum "$work/raw/imu_raw.csv" --before 40 --after 40.2 \
+  --axis x -o "$work/fig"
+for f in errors with_without_fault_manager spectrum_x; do
+  size=$(stat -c %s "$work/fig/$f.png" 2>/dev/null || echo 0)
+  echo "figure $f.png: $size bytes"
+  [ "$size" -gt 20000 ] || { echo "figure $f.png missing or trivial"; exit 1; }
+done
+echo "figures: passed"
