@@ -117,7 +117,9 @@ int main(int argc, char** argv) {
         participant.spinOnce(std::chrono::nanoseconds(0));
       }
     }
-    publisher.endStreams();  // a clean stop (end of data or SIGTERM) is announced, not a loss
+    // The end of the data is announced (not a loss). Not on SIGTERM: a reader that stopped
+    // taking (a full KEEP_ALL history) would hold the dispose's acknowledgment up.
+    if (!participant.stopping()) publisher.endStreams();
     publisher.flush();
     participant.finish();
     const auto& n = publisher.counts();
