@@ -32,6 +32,15 @@ from navbus_py.navcsv import load_scenario, read_csv, vector  # noqa: E402
 AXES = ("north", "east", "down")
 
 
+def _save(fig, out_dir, name):
+    fig.tight_layout()
+    os.makedirs(out_dir, exist_ok=True)
+    path = os.path.join(out_dir, name)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def _time_s(rows, start_ns):
     return np.array([(int(r["time_gps_ns"]) - start_ns) * 1e-9 for r in rows])
 
@@ -70,12 +79,7 @@ def errors(offline_dir, out_dir, start_ns=None, title=""):
     axes[0][0].legend(fontsize=8, loc="upper left")
     fig.suptitle(title or f"navigation error and 3-sigma envelope ({offline_dir}); "
                  "dashed: fault decisions", fontsize=10)
-    fig.tight_layout()
-    os.makedirs(out_dir, exist_ok=True)
-    path = os.path.join(out_dir, "errors.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, out_dir, "errors.png")
 
 
 def compare(with_dir, without_dir, out_dir, start_ns=None):
@@ -100,12 +104,7 @@ def compare(with_dir, without_dir, out_dir, start_ns=None):
                  "(dashed: decisions)", fontsize=10)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    os.makedirs(out_dir, exist_ok=True)
-    path = os.path.join(out_dir, "with_without_fault_manager.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, out_dir, "with_without_fault_manager.png")
 
 
 def _amplitude(x, rate):
@@ -140,12 +139,7 @@ def spectrum(raw_csv, before, after, axis, out_dir, lines=(373, 441, 409)):
                  f"(dashed: dither lines {', '.join(str(int(v)) for v in lines)} Hz)", fontsize=10)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    os.makedirs(out_dir, exist_ok=True)
-    path = os.path.join(out_dir, f"spectrum_{axis}.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, out_dir, f"spectrum_{axis}.png")
 
 
 def demo(scenario_path, demo_dir, out_dir):

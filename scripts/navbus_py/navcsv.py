@@ -6,8 +6,6 @@ import math
 
 import yaml
 
-GPS_START_NS = None  # set by load_scenario: the scenario's start (GPS ns)
-
 # WGS84
 _A = 6378137.0
 _E2 = 6.69437999014e-3
@@ -19,17 +17,14 @@ def read_csv(path):
         return list(csv.DictReader(f))
 
 
-def column(rows, name, convert=float):
-    return [convert(r[name]) for r in rows]
-
-
 def vector(row, name, n=3):
     """The n elements name[0] ... name[n-1] of a row."""
     return [float(row[f"{name}[{i}]"]) for i in range(n)]
 
 
 def load_scenario(path):
-    """The scenario YAML, with `extends` resolved one level (as the tools do)."""
+    """The scenario YAML with `extends` resolved; top-level keys replace the base's (shallow:
+    the tools merge nested maps, which the summary and figures do not need)."""
     import os
     with open(path) as f:
         s = yaml.safe_load(f)

@@ -5,7 +5,7 @@
 namespace navbus::sim {
 
 VehicleVibration::Coefficients VehicleVibration::butterworth(double corner_hz, double rate_hz,
-                                                            bool high_pass) {
+                                                             bool high_pass) {
   // Second-order Butterworth by the bilinear transform with pre-warping.
   const double k = std::tan(M_PI * corner_hz / rate_hz);
   const double q = 1.0 / std::sqrt(2.0);

@@ -378,9 +378,10 @@ TEST(FaultLoop, StuckAccelerometerFlaggedByTheDitherMonitorOverTheBus) {
   EXPECT_EQ(flagged_before, 0);
   EXPECT_GT(after, 10);
   EXPECT_EQ(flagged_after, after);
-  std::printf("dither loop: accelerometer x stuck at 40 s, decided at %.3f s, %d of %d later "
-              "solutions flagged\n",
-              decided_s, flagged_after, after);
+  std::printf(
+      "dither loop: accelerometer x stuck at 40 s, decided at %.3f s, %d of %d later "
+      "solutions flagged\n",
+      decided_s, flagged_after, after);
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }

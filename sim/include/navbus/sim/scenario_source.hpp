@@ -11,13 +11,13 @@
 
 #include "navbus/sim/constellation.hpp"
 #include "navbus/sim/dither.hpp"
-#include "navbus/sim/vibration.hpp"
 #include "navbus/sim/faults.hpp"
 #include "navbus/sim/gnss_receiver.hpp"
 #include "navbus/sim/imu_model.hpp"
 #include "navbus/sim/samples.hpp"
 #include "navbus/sim/star_tracker_model.hpp"
 #include "navbus/sim/trajectory.hpp"
+#include "navbus/sim/vibration.hpp"
 
 namespace navbus::sim {
 
