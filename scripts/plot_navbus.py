@@ -1,19 +1,28 @@
 #!/usr/bin/python3
 """Figures from navbus CSV files (matplotlib, Debian's python3-matplotlib).
 
-  plot_navbus.py errors OFFLINE_DIR -o OUT_DIR
+  plot_navbus.py errors OFFLINE_DIR -o OUT_DIR [--scenario YAML]
       position, velocity and attitude error with the filter's 3-sigma envelope (error.csv of
       `navbus offline`), decisions marked when decisions.csv is there -> errors.png
-  plot_navbus.py compare WITH_DIR WITHOUT_DIR -o OUT_DIR
+  plot_navbus.py compare WITH_DIR WITHOUT_DIR -o OUT_DIR [--scenario YAML]
       3-D position error with and without the fault manager (two `navbus offline` runs of the
       same scenario) -> with_without_fault_manager.png
   plot_navbus.py spectrum RAW_CSV --before T0 --after T1 --axis x -o OUT_DIR [--lines F F F]
       amplitude spectrum of one accelerometer from a `navbus-sensor-sim --files` imu_raw.csv
       over 0.5 s before T0 and after T1 [s from the first sample], dither lines marked
       -> spectrum_<axis>.png
+  plot_navbus.py glr OFFLINE_DIR -o OUT_DIR [--scenario YAML]
+      the GLR's largest statistic per epoch against its threshold h (glr.csv of `navbus offline`
+      or `navbus rinex` with --fault-manager), detections marked -> glr.png
+  plot_navbus.py montecarlo CSV_DIR -o OUT_DIR
+      from `navbus montecarlo --csv CSV_DIR`: average NEES per epoch of each configuration with
+      its 95 % band -> nees.png; with --fault-manager, the detection delays after the injected
+      fault, one histogram per configuration -> detection_delay.png
+  With --scenario, times are seconds from the scenario's start (timing.start); without, from
+  the first row of the file.
   plot_navbus.py demo SCENARIO DEMO_DIR -o OUT_DIR
-      the main demo's figures (errors, with/without the fault manager) from scripts/demo.sh's
-      output directory
+      the main demo's figures (errors, with/without the fault manager, GLR statistic) from
+      scripts/demo.sh's output directory
 """
 import argparse
 import math
@@ -142,12 +151,110 @@ def spectrum(raw_csv, before, after, axis, out_dir, lines=(373, 441, 409)):
     return _save(fig, out_dir, f"spectrum_{axis}.png")
 
 
+def glr(offline_dir, out_dir, start_ns=None, title=""):
+    rows = read_csv(os.path.join(offline_dir, "glr.csv"))
+    if not rows:
+        raise SystemExit(f"{offline_dir}/glr.csv has no epochs (was the GLR enabled?)")
+    start_ns = start_ns if start_ns is not None else int(rows[0]["time_gps_ns"])
+    t = _time_s(rows, start_ns)
+    stat = np.array([float(r["statistic"]) for r in rows])
+    h = np.array([float(r["threshold"]) for r in rows])
+    hit = np.array([r["detected"] == "1" for r in rows])
+    fig, ax = plt.subplots(figsize=(10, 5))
+    # The statistic is >= 0 and spans decades: a log axis with a floor keeps the quiet part
+    # visible next to a detection.
+    floor = 0.1
+    ax.semilogy(t, np.maximum(stat, floor), color="black", lw=0.8, label="GLR statistic l")
+    ax.semilogy(t, h, color="tab:red", lw=1.0, ls="--", label="threshold h")
+    if hit.any():
+        ax.semilogy(t[hit], stat[hit], "v", color="tab:red", ms=8, label="detection (l >= h)")
+        ago = np.array([int(r["onset_epochs_ago"]) for r in rows])
+        for n, i in enumerate(np.flatnonzero(hit)):
+            ax.annotate(f"{t[i]:.1f} s", (t[i], stat[i]), textcoords="offset points",
+                        xytext=(4, 8), fontsize=8, color="tab:red")
+            # The fault began after epoch theta - 1 (seed 000's onset estimate).
+            j = i - ago[i] - 1
+            if j >= 0:
+                ax.axvline(t[j], color="tab:orange", ls=":", lw=1.2,
+                           label="estimated onset (after)" if n == 0 else None)
+    ax.set_xlabel("time [s]")
+    ax.set_ylim(bottom=floor, top=max(stat.max(), h.max()) * 3)
+    ax.set_ylabel("largest GLR statistic over onsets and hypotheses")
+    ax.set_title(title or f"GLR fault detection ({offline_dir})", fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8, loc="upper right")
+    return _save(fig, out_dir, "glr.png")
+
+
+def _by_configuration(rows):
+    out = {}
+    for r in rows:
+        out.setdefault(r["configuration"], []).append(r)
+    return out
+
+
+def montecarlo(csv_dir, out_dir):
+    paths = []
+    groups = _by_configuration(read_csv(os.path.join(csv_dir, "nees.csv")))
+    fig, ax = plt.subplots(figsize=(10, 5))
+    spread = [float(r["nees9_mean"]) for rows in groups.values() for r in rows]
+    if spread and max(spread) > 20 * max(min(spread), 1e-9):
+        ax.set_yscale("log")  # inconsistent configurations reach decades above the band
+    for k, (label, rows) in enumerate(groups.items()):
+        t = np.array([float(r["time_s"]) for r in rows])
+        nees = np.array([float(r["nees9_mean"]) for r in rows])
+        lo, hi = float(rows[0]["band_low"]), float(rows[0]["band_high"])
+        runs = rows[0]["runs"]
+        color = f"C{k}"
+        inside = np.mean((nees >= lo) & (nees <= hi)) * 100
+        ax.plot(t, nees, color=color, lw=0.8,
+                label=f"{label}: mean {nees.mean():.2f}, {inside:.0f} % of epochs in band")
+        ax.axhspan(lo, hi, color=color, alpha=0.12,
+                   label=f"95 % band of the average over {runs} runs [{lo:.2f}, {hi:.2f}]")
+    ax.axhline(9, color="gray", lw=0.8, ls=":", label="expected value 9")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("average NEES (position, velocity, attitude; 9 dof)")
+    ax.set_title(f"Monte Carlo consistency ({csv_dir}/nees.csv)", fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    paths.append(_save(fig, out_dir, "nees.png"))
+    faults_path = os.path.join(csv_dir, "faults.csv")
+    if not os.path.exists(faults_path):
+        return paths
+    groups = _by_configuration(read_csv(faults_path))
+    fig, axes = plt.subplots(1, len(groups), figsize=(5 * len(groups), 4.5), squeeze=False)
+    for ax, (label, rows) in zip(axes[0], groups.items()):
+        delays = np.array([float(r["delay_s"]) for r in rows if r["detected"] == "1"])
+        missed = sum(1 for r in rows if r["detected"] != "1")
+        fault_s = float(rows[0]["fault_s"])
+        if len(delays):
+            # Detections happen at measurement epochs: one bin per epoch spacing.
+            u = np.unique(delays)
+            step = np.min(np.diff(u)) if len(u) > 1 else 1.0
+            if (u[-1] - u[0]) / step > 60:
+                step = (u[-1] - u[0]) / 30
+            ax.hist(delays, bins=np.arange(u[0] - step / 2, u[-1] + step, step),
+                    color="tab:blue", edgecolor="black")
+            ax.axvline(np.median(delays), color="tab:red", ls="--",
+                       label=f"median {np.median(delays):.1f} s")
+            ax.legend(fontsize=8)
+        ax.set_xlabel(f"detection time after the fault at {fault_s:.0f} s [s]")
+        ax.set_ylabel("runs")
+        ax.set_title(f"{label}\n{len(delays)} detected, {missed} missed of {len(rows)}",
+                     fontsize=9)
+        ax.grid(alpha=0.3)
+    paths.append(_save(fig, out_dir, "detection_delay.png"))
+    return paths
+
+
 def demo(scenario_path, demo_dir, out_dir):
     start_ns = int(load_scenario(scenario_path)["timing"]["start"])
     paths = [errors(os.path.join(demo_dir, "offline"), out_dir, start_ns,
                     "demo: navigation error and 3-sigma envelope; dashed: fault decisions"),
              compare(os.path.join(demo_dir, "offline"),
-                     os.path.join(demo_dir, "offline_without_fault_manager"), out_dir, start_ns)]
+                     os.path.join(demo_dir, "offline_without_fault_manager"), out_dir, start_ns),
+             glr(os.path.join(demo_dir, "offline"), out_dir, start_ns,
+                 "demo: GLR statistic on the filter's diagnostics against its threshold")]
     return paths
 
 
@@ -168,17 +275,31 @@ def main():
     a.add_argument("--axis", choices=("x", "y", "z"), default="x")
     a.add_argument("--lines", type=float, nargs=3, default=(373, 441, 409))
     a.add_argument("-o", "--out", required=True)
+    a = sub.add_parser("glr")
+    a.add_argument("offline_dir")
+    a.add_argument("-o", "--out", required=True)
+    a = sub.add_parser("montecarlo")
+    a.add_argument("csv_dir")
+    a.add_argument("-o", "--out", required=True)
     a = sub.add_parser("demo")
     a.add_argument("scenario")
     a.add_argument("demo_dir")
     a.add_argument("-o", "--out", required=True)
+    for name in ("errors", "compare", "glr"):
+        sub.choices[name].add_argument("--scenario", help="times from this scenario's start")
     args = p.parse_args()
+    start_ns = (int(load_scenario(args.scenario)["timing"]["start"])
+                if getattr(args, "scenario", None) and args.cmd != "demo" else None)
     if args.cmd == "errors":
-        paths = [errors(args.offline_dir, args.out)]
+        paths = [errors(args.offline_dir, args.out, start_ns)]
     elif args.cmd == "compare":
-        paths = [compare(args.with_dir, args.without_dir, args.out)]
+        paths = [compare(args.with_dir, args.without_dir, args.out, start_ns)]
     elif args.cmd == "spectrum":
         paths = [spectrum(args.raw_csv, args.before, args.after, args.axis, args.out, args.lines)]
+    elif args.cmd == "glr":
+        paths = [glr(args.offline_dir, args.out, start_ns)]
+    elif args.cmd == "montecarlo":
+        paths = montecarlo(args.csv_dir, args.out)
     else:
         paths = demo(args.scenario, args.demo_dir, args.out)
     for path in paths:

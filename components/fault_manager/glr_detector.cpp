@@ -88,6 +88,7 @@ bool GlrDetector::onDiagnostics(const navbus::FilterDiagnostics& msg, FaultOutpu
     return false;
   }
   ++counters_.epochs;
+  latest_ = {epoch_.time_ns, r.statistic, r.threshold, r.onset_epochs_ago, r.detected};
   counters_.max_statistic = std::max(counters_.max_statistic, r.statistic);
   if (pending_.active) {
     refine(out);  // a detected IMU fault is being sized: no new decision meanwhile

@@ -19,6 +19,15 @@
 
 namespace navbus::fault_manager {
 
+/// The GLR's largest statistic at one accepted epoch (seed 000, eq. 13) against its threshold h.
+struct GlrEpochStatistic {
+  std::int64_t time_ns{0};
+  double statistic{0.0};
+  double threshold{0.0};
+  int onset_epochs_ago{0};  ///< of the largest statistic
+  bool detected{false};
+};
+
 class GlrDetector {
  public:
   explicit GlrDetector(const GlrDetectorConfig& config);
@@ -37,6 +46,8 @@ class GlrDetector {
   };
   const Counters& counters() const { return counters_; }
   const core::GlrMonitor& monitor() const { return glr_; }
+  /// The statistic of the latest accepted epoch (kept: a detection resets the monitor).
+  const GlrEpochStatistic& latest() const { return latest_; }
   std::string summary() const;
 
  private:
@@ -67,6 +78,7 @@ class GlrDetector {
   std::uint64_t last_seq_{0};
   std::vector<Quarantine> quarantine_;
   Counters counters_;
+  GlrEpochStatistic latest_;
 };
 
 }  // namespace navbus::fault_manager

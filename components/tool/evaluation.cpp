@@ -68,7 +68,8 @@ struct Stats {
   // NEES: per epoch index, summed over runs.
   std::vector<double> nees_sum;
   std::vector<int> nees_runs;
-  std::vector<double> recovery_s;  ///< per run and instant; NaN when not converged
+  std::vector<double> nees_time_s;  ///< of epoch index k, from the start (the first run's)
+  std::vector<double> recovery_s;   ///< per run and instant; NaN when not converged
 };
 
 void accumulate(Stats& st, const OfflineResult& r, std::int64_t from_ns, const MonteCarloOptions& o,
@@ -87,6 +88,7 @@ void accumulate(Stats& st, const OfflineResult& r, std::int64_t from_ns, const M
     if (st.nees_sum.size() <= k) {
       st.nees_sum.resize(k + 1, 0.0);
       st.nees_runs.resize(k + 1, 0);
+      st.nees_time_s.push_back(1e-9 * static_cast<double>(e.time_ns - start_ns));
     }
     st.nees_sum[k] += e.nees9;
     ++st.nees_runs[k];
@@ -108,6 +110,30 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t m = v.size() / 2;
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+/// Average NEES over the runs at every epoch all of them reached, with the 95 % band.
+void writeNeesCsv(std::ofstream& f, const std::string& label, const Stats& s, int runs, double lo,
+                  double hi) {
+  for (std::size_t k = 0; k < s.nees_sum.size(); ++k) {
+    if (s.nees_runs[k] != runs) continue;
+    f << csvQuote(label) << "," << fmt(s.nees_time_s[k]) << "," << fmt(s.nees_sum[k] / runs) << ","
+      << fmt(lo) << "," << fmt(hi) << "," << runs << "\n";
+  }
+}
+
+void writeFaultRunsCsv(std::ofstream& f, const std::string& label,
+                       const std::optional<sim::Fault>& fault,
+                       const std::vector<FaultRunOutcome>& runs) {
+  const double fault_s = fault ? fault->start_s : std::nan("");
+  for (const FaultRunOutcome& r : runs) {
+    f << csvQuote(label) << "," << r.seed << "," << fmt(fault_s) << "," << (r.detected ? 1 : 0)
+      << "," << (r.detected ? fmt(r.detection_s) : "") << ","
+      << (r.detected && fault ? fmt(r.detection_s - fault_s) : "") << ","
+      << (r.detected ? fmt(r.onset_s) : "") << "," << r.class_correct << "," << r.source_correct
+      << "," << r.ambiguous << "," << r.false_alarms << ","
+      << (std::isnan(r.recovery_s) ? "" : fmt(r.recovery_s)) << "," << csvQuote(r.decided) << "\n";
+  }
 }
 
 }  // namespace
@@ -205,11 +231,13 @@ int runOfflineCommand(const OfflineOptions& o) {
                r.solutions_without_truth, r.summary);
   if (setup.fault_manager) {
     if (!writeCsvFile(o.out_dir + "/decisions.csv", r.decisions) ||
-        !writeCsvFile(o.out_dir + "/commands.csv", r.commands))
-      spdlog::error("could not write decisions.csv / commands.csv in {}", o.out_dir);
+        !writeCsvFile(o.out_dir + "/commands.csv", r.commands) ||
+        !writeGlrCsv(o.out_dir + "/glr.csv", r.glr_trace))
+      spdlog::error("could not write decisions.csv / commands.csv / glr.csv in {}", o.out_dir);
     spdlog::info("fault manager: {}", r.fault_summary);
-    spdlog::info("wrote {}/solution.csv, truth.csv, error.csv, decisions.csv, commands.csv",
-                 o.out_dir);
+    spdlog::info(
+        "wrote {}/solution.csv, truth.csv, error.csv, decisions.csv, commands.csv, glr.csv",
+        o.out_dir);
   } else {
     spdlog::info("wrote {}/solution.csv, truth.csv, error.csv", o.out_dir);
   }
@@ -337,6 +365,24 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
                 nees_mean, lo, hi, 100.0 * in_band / std::max(epochs, 1));
   }
   for (const FaultTable& t : fault_tables) printFaultTable(t.label, t.fault, t.runs, t.hours);
+  if (!o.csv_dir.empty()) {
+    std::filesystem::create_directories(o.csv_dir);
+    std::ofstream nees(o.csv_dir + "/nees.csv");
+    nees << "configuration,time_s,nees9_mean,band_low,band_high,runs\n";
+    for (const Row& r : rows) writeNeesCsv(nees, r.label, r.st, o.runs, lo, hi);
+    std::string written = o.csv_dir + "/nees.csv";
+    bool ok = static_cast<bool>(nees);
+    if (!fault_tables.empty()) {
+      std::ofstream faults(o.csv_dir + "/faults.csv");
+      faults << "configuration,seed,fault_s,detected,detection_s,delay_s,onset_s,class_correct,"
+                "source_correct,ambiguous,false_alarms,recovery_s,decided\n";
+      for (const FaultTable& t : fault_tables) writeFaultRunsCsv(faults, t.label, t.fault, t.runs);
+      ok = ok && static_cast<bool>(faults);
+      written += ", faults.csv";
+    }
+    if (!ok) throw bus::ConfigError("cannot write the CSV files into --csv " + o.csv_dir);
+    std::printf("\nwrote %s\n", written.c_str());
+  }
   if (!o.recovery_after_s.empty()) {
     std::printf(
         "\nconvergence after each instant: median over runs of the time until the "

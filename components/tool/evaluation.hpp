@@ -37,6 +37,9 @@ struct MonteCarloOptions {
   double recovery_window_s{15.0};        ///< ... and must stay below it this long
   std::string fault_manager;  ///< navbus-fault-manager YAML: run and evaluate the fault pipeline
   int threads{0};             ///< parallel runs (0: one per core)
+  /// Directory for nees.csv (average NEES per epoch and its band, per configuration) and,
+  /// with a fault manager, faults.csv (one row per run); empty: tables only.
+  std::string csv_dir;
 };
 
 int runMonteCarloCommand(const MonteCarloOptions& o);

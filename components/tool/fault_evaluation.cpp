@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
+
+#include "formatters.hpp"
 
 namespace navbus::tool {
 
@@ -79,6 +82,17 @@ double recoveryTime(const std::vector<EpochError>& errors, std::int64_t decision
 }
 
 }  // namespace
+
+bool writeGlrCsv(const std::string& path,
+                 const std::vector<fault_manager::GlrEpochStatistic>& trace) {
+  std::ofstream f(path);
+  f << "time_gps_ns,statistic,threshold,onset_epochs_ago,detected\n";
+  for (const fault_manager::GlrEpochStatistic& e : trace) {
+    f << e.time_ns << "," << formatNumber(e.statistic) << "," << formatNumber(e.threshold) << ","
+      << e.onset_epochs_ago << "," << (e.detected ? 1 : 0) << "\n";
+  }
+  return static_cast<bool>(f);
+}
 
 std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule) {
   for (const sim::Fault& f : schedule.faults()) {

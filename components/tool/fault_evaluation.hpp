@@ -35,6 +35,11 @@ struct FaultRunOutcome {
   std::string decided;  ///< text of the first detection after the fault
 };
 
+/// Writes the GLR's statistic per accepted epoch (time_gps_ns, statistic, threshold,
+/// onset_epochs_ago, detected) as CSV; false if the file could not be written.
+bool writeGlrCsv(const std::string& path,
+                 const std::vector<fault_manager::GlrEpochStatistic>& trace);
+
 /// The first fault of the schedule that a GLR can detect (IMU bias step or pseudorange ramp).
 std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule);
 

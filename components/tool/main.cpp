@@ -225,6 +225,9 @@ int main(int argc, char** argv) {
                    "navbus-fault-manager YAML: run the fault pipeline and report detection time, "
                    "isolation, magnitude error and false alarms per configuration")
       ->check(CLI::ExistingFile);
+  mc_cmd->add_option("--csv", mc.csv_dir,
+                     "directory for nees.csv (average NEES per epoch, 95 % band) and, with "
+                     "--fault-manager, faults.csv (one row per run)");
   mc_cmd->add_option("--threads", mc.threads, "parallel runs (0: one per core)")
       ->check(CLI::Range(0, 256));
   mc_cmd->add_option("--first-seed", mc.first_seed, "seed of the first run (then +1 per run)")

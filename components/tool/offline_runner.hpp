@@ -15,6 +15,7 @@
 
 #include "fault_config.hpp"
 #include "filter_config.hpp"
+#include "glr_detector.hpp"
 #include "navbus/core/strapdown.hpp"
 #include "scenario_config.hpp"
 
@@ -51,6 +52,8 @@ struct OfflineResult {
   std::vector<navbus::FaultDecision> decisions;
   std::vector<navbus::FilterCommand> commands;
   double max_glr_statistic{0.0};
+  std::vector<fault_manager::GlrEpochStatistic>
+      glr_trace;  ///< every epoch the GLR accepted, in order
 };
 
 using SolutionHook = std::function<void(const navbus::NavigationSolution&,

@@ -8,6 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "fault_evaluation.hpp"
 #include "fault_pipeline.hpp"
 #include "formatters.hpp"
 #include "navbus/bus/app.hpp"
@@ -162,8 +163,11 @@ class RealDataRun {
     }
     const core::EpochDiagnostics& d = filter_.update(input.time_s, input.sats);
     if (monitor && faults_) {
+      const std::uint64_t before = faults_->glr().counters().epochs;
       faults_->onDiagnostics(
           bus::toIdl(d, setup_.fault_manager->vehicle_id, ++diagnostics_seq_, toNs(input.time_s)));
+      if (faults_->glr().counters().epochs != before)
+        result_.glr_trace.push_back(faults_->glr().latest());
     }
   }
 
@@ -261,8 +265,9 @@ void writeFixes(const std::string& path, const RealDataResult& r) {
 
 void writeFaultCsv(const std::string& dir, const RealDataResult& r) {
   if (!writeCsvFile(dir + "/decisions.csv", r.decisions) ||
-      !writeCsvFile(dir + "/commands.csv", r.commands))
-    spdlog::error("could not write decisions.csv / commands.csv in {}", dir);
+      !writeCsvFile(dir + "/commands.csv", r.commands) ||
+      !writeGlrCsv(dir + "/glr.csv", r.glr_trace))
+    spdlog::error("could not write decisions.csv / commands.csv / glr.csv in {}", dir);
 }
 
 void printSummary(const RealDataSetup& s, const RealDataResult& r) {
@@ -373,7 +378,7 @@ int runRealDataCommand(const RealDataOptions& o) {
   writeFixes(o.out_dir + "/fixes.csv", r);
   if (s.fault_manager) writeFaultCsv(o.out_dir, r);
   spdlog::info("wrote {}/fixes.csv{}", o.out_dir,
-               s.fault_manager ? ", decisions.csv, commands.csv" : "");
+               s.fault_manager ? ", decisions.csv, commands.csv, glr.csv" : "");
   return bus::kExitOk;
 }
 

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "fault_config.hpp"
+#include "glr_detector.hpp"
 #include "navbus/core/single_point_positioning.hpp"
 #include "navbus/core/static_receiver_filter.hpp"
 #include "rinex2.hpp"
@@ -66,6 +67,7 @@ struct RealDataResult {
   std::uint64_t injected_epochs{0};          ///< pseudoranges the ramp injection changed
   std::string fault_summary;
   double max_glr_statistic{0.0};
+  std::vector<fault_manager::GlrEpochStatistic> glr_trace;  ///< every epoch the GLR accepted
 };
 
 RealDataResult runRealData(const RealDataSetup& setup);
