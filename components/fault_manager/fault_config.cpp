@@ -1,6 +1,5 @@
 #include "fault_config.hpp"
 
-#include <set>
 #include <string>
 
 #include "navbus/bus/config.hpp"
@@ -13,16 +12,7 @@ namespace {
 using units::kDeg;
 using units::kMilliG;
 
-void checkKeys(const YAML::Node& node, const std::string& where,
-               const std::set<std::string>& allowed) {
-  if (!node || node.IsNull()) return;  // absent or empty: every default
-  if (!node.IsMap()) throw bus::ConfigError("configuration " + where + " must be a map");
-  for (const auto& kv : node) {
-    const auto key = kv.first.as<std::string>();
-    if (allowed.count(key) == 0)
-      throw bus::ConfigError("configuration " + where + "." + key + ": unknown key");
-  }
-}
+using bus::checkKeys;
 
 /// A [low, high] pair in Hz.
 void band(const YAML::Node& node, const std::string& where, double& low, double& high) {
@@ -98,6 +88,7 @@ void parseDither(const YAML::Node& n, DitherDetectorConfig& d) {
 
 FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
   FaultManagerConfig c;
+  checkKeys(root, "", {"vehicle_id", "glr", "dither"}, bus::kParticipantKeys);
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", c.vehicle_id);
   const YAML::Node g = root["glr"];
   checkKeys(g, "glr",

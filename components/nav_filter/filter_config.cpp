@@ -20,6 +20,7 @@ std::optional<InputConfig> input(const YAML::Node& inputs, const std::string& ke
     return std::nullopt;
   }
   const std::string where = "inputs." + key;
+  bus::checkKeys(n, where, {"id", "period_s"});
   InputConfig c;
   c.id = bus::require<std::uint32_t>(n, where, "id");
   c.period_ns = seconds(
@@ -45,6 +46,12 @@ Enum choice(const YAML::Node& node, const std::string& where, const std::string&
 
 FilterConfig parseFilterConfig(const YAML::Node& root) {
   FilterConfig c;
+  bus::checkKeys(
+      root, "",
+      {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
+       "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
+       "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional"},
+      bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
   const double rate = bus::checkRange(bus::get<double>(root, "", "solution_rate_hz", 10.0), 1.0,
@@ -55,6 +62,9 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                               "sequencer_max_wait_s"));
 
   const YAML::Node rec = root["recovery"];
+  bus::checkKeys(rec, "recovery",
+                 {"history_s", "snapshot_period_s", "exclusion_margin_s",
+                  "max_accel_compensation_mg", "max_gyro_compensation_deg_per_h"});
   c.recovery_history_ns = seconds(bus::checkRange(
       bus::get<double>(rec, "recovery", "history_s", 40.0), 0.0, 600.0, "recovery.history_s"));
   c.recovery_snapshot_period_ns =
@@ -75,6 +85,9 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       bus::get<std::string>(root, "", "solution_writer_profile", c.solution_writer_profile);
   const YAML::Node init = root["initial_state"];
   if (!init) throw bus::ConfigError("configuration initial_state is missing");
+  bus::checkKeys(init, "initial_state",
+                 {"latitude_deg", "longitude_deg", "height_m", "vel_ned_mps", "roll_deg",
+                  "pitch_deg", "yaw_deg"});
   auto& s = e.initial_state;
   s.position = bus::getGeodeticDeg(init, "initial_state", nullptr);
   s.vel_ned_mps = bus::getVector3(init, "initial_state", "vel_ned_mps", 1.0);
@@ -83,6 +96,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
 
   const YAML::Node inputs = root["inputs"];
   if (!inputs) throw bus::ConfigError("configuration inputs is missing");
+  bus::checkKeys(inputs, "inputs", {"imu", "gnss_observations", "gnss_fix", "star_tracker"});
   c.imu = *input(inputs, "imu", true);
   e.imu_period_s = 1e-9 * static_cast<double>(c.imu.period_ns);
   c.gnss_observations = input(inputs, "gnss_observations", false);
@@ -128,6 +142,14 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
 
   // EKF parameters, in the units of the papers' error budgets.
   const YAML::Node tc = root["ekf"];
+  bus::checkKeys(
+      tc, "ekf",
+      {"gravity", "accel_noise_ug_per_sqrthz", "gyro_arw_deg_per_sqrth",
+       "clock_bias_noise_m_per_sqrts", "clock_drift_noise_mps_per_sqrts",
+       "initial_position_sigma_m", "initial_velocity_sigma_mps", "initial_level_sigma_mrad",
+       "initial_heading_sigma_mrad", "accel_bias_sigma_ug", "gyro_bias_sigma_deg_per_h",
+       "initial_clock_bias_sigma_m", "initial_clock_drift_sigma_mps", "gate_sigma",
+       "initial_clock_bias_m", "initial_clock_drift_mps"});
   using units::kArcsec;
   using units::kDeg;
   using units::kMicroG;
@@ -175,6 +197,9 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
 
   // A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its error is a random-walk bias.
   const YAML::Node fa = root["failed_axis"];
+  bus::checkKeys(fa, "failed_axis",
+                 {"accel_bias_sigma_mg", "accel_bias_rw_mg_per_sqrts", "gyro_bias_sigma_dps",
+                  "gyro_bias_rw_dps_per_sqrts"});
   const std::string wf = "failed_axis";
   auto positive = [](double v, const std::string& key) {
     return bus::checkRange(v, 1e-12, 1e12, "failed_axis." + key);
@@ -200,6 +225,9 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       kDeg;
 
   const YAML::Node ad = root["adaptive"];
+  bus::checkKeys(ad, "adaptive",
+                 {"window", "floor_position_m", "floor_velocity_mps", "floor_attitude_arcsec"});
+  bus::checkKeys(root["federated"], "federated", {"share"});
   const std::string wa = "adaptive";
   t.adaptive_window =
       static_cast<int>(bus::checkRange(bus::get<double>(ad, wa, "window", 50), 2,
@@ -212,6 +240,9 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                       "federated.share");
 
   const YAML::Node md = root["multi_dimensional"];
+  bus::checkKeys(md, "multi_dimensional",
+                 {"policy", "recovery_s", "gnss_timeout_s", "constraint_rate_hz", "zupt_sigma_mps",
+                  "nhc_sigma_mps", "stationary"});
   const std::string wm = "multi_dimensional";
   auto& m = e.mdf;
   m.policy = choice<core::MdfPolicy>(md, wm, "policy", "mdf",
@@ -231,6 +262,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                                     "multi_dimensional.nhc_sigma_mps");
   const YAML::Node st = md ? md["stationary"] : YAML::Node();
   const std::string ws = "multi_dimensional.stationary";
+  bus::checkKeys(st, ws, {"window_s", "accel_std_mps2", "gyro_std_dps", "speed_mps"});
   m.stationarity.window_s =
       bus::checkRange(bus::get<double>(st, ws, "window_s", 1.0), 0.05, 10.0, ws + ".window_s");
   m.stationarity.accel_std_mps2 = bus::get<double>(st, ws, "accel_std_mps2", 0.03);

@@ -13,6 +13,7 @@ using units::kDeg;
 using units::kDegPerHour;
 using units::kMicroG;
 constexpr double kG = units::kStandardGravity;
+using bus::checkKeys;
 using bus::checkRange;
 using bus::ConfigError;
 using bus::get;
@@ -57,6 +58,15 @@ std::vector<sim::Segment> parseSegments(const YAML::Node& list) {
     const YAML::Node n = list[i];
     const std::string where = "vehicle.segments[" + std::to_string(i) + "]";
     const std::string type = bus::require<std::string>(n, where, "type");
+    if (type == "accelerate") checkKeys(n, where, {"type", "duration_s", "accel_mps2"});
+    if (type == "turn") checkKeys(n, where, {"type", "duration_s", "turn_rate_dps"});
+    if (type == "climb") checkKeys(n, where, {"type", "duration_s", "climb_rate_dps"});
+    if (type == "coordinated_turn")
+      checkKeys(n, where, {"type", "duration_s", "turn_rate_dps", "speed_mps", "roll_time_s"});
+    if (type == "attitude")
+      checkKeys(n, where,
+                {"type", "duration_s", "roll_rate_dps", "pitch_rate_dps", "yaw_rate_dps"});
+    if (type == "stationary" || type == "cruise") checkKeys(n, where, {"type", "duration_s"});
     sim::Segment s;
     s.duration_s =
         checkRange(bus::require<double>(n, where, "duration_s"), 1e-3, 1e7, where + ".duration_s");
@@ -112,6 +122,36 @@ std::vector<sim::Segment> parseSegments(const YAML::Node& list) {
   return out;
 }
 
+void checkImuKeys(const YAML::Node& imu) {
+  checkKeys(
+      imu, "imu",
+      {"accel_bias_ug", "accel_bias_sigma_ug", "accel_bias_instability_ug",
+       "accel_noise_ug_per_sqrthz", "accel_vrw_ug_per_sqrth", "accel_scale_factor_ppm",
+       "accel_misalignment_urad", "accel_quantum_mps", "gyro_bias_deg_per_h",
+       "gyro_bias_sigma_deg_per_h", "gyro_bias_instability_deg_per_h", "gyro_arw_deg_per_sqrth",
+       "gyro_noise_dps_per_sqrthz", "gyro_scale_factor_ppm", "gyro_misalignment_urad",
+       "gyro_quantum_urad", "gyro_g_sensitivity_deg_per_h_per_g", "bias_correlation_time_s"});
+}
+
+/// The keys of one fault: the common ones and those of its type.
+void checkFaultKeys(const YAML::Node& n, const std::string& where, const std::string& type) {
+  if (type == "imu_bias_step")
+    checkKeys(n, where, {"sensor", "axis", "magnitude_mg", "magnitude_deg_per_h"},
+              {"type", "start_s", "end_s", "duration_s"});
+  else if (type == "pseudorange_ramp")
+    checkKeys(n, where, {"sv_id", "slope_mps", "saturation_m"},
+              {"type", "start_s", "end_s", "duration_s"});
+  else if (type == "gnss_position_pulse")
+    checkKeys(n, where, {"north_m", "east_m", "down_m"},
+              {"type", "start_s", "end_s", "duration_s"});
+  else if (type == "sensor_stuck")
+    checkKeys(n, where, {"sensor", "axis"}, {"type", "start_s", "end_s", "duration_s"});
+  else if (type == "star_tracker_bias")
+    checkKeys(n, where, {"bias_arcsec"}, {"type", "start_s", "end_s", "duration_s"});
+  else
+    checkKeys(n, where, {"type", "start_s", "end_s", "duration_s"});
+}
+
 void parseTriad(const YAML::Node& imu, const std::string& prefix, double bias_unit, double bi_unit,
                 double rw_unit, const std::string& rw_key, sim::TriadErrors& t) {
   const std::string w = "imu";
@@ -145,6 +185,7 @@ sim::FaultSchedule parseFaults(const YAML::Node& list) {
     const YAML::Node n = list[i];
     const std::string where = "faults[" + std::to_string(i) + "]";
     const std::string type = bus::require<std::string>(n, where, "type");
+    checkFaultKeys(n, where, type);
     sim::Fault f;
     f.start_s = checkRange(bus::require<double>(n, where, "start_s"), 0, 1e7, where + ".start_s");
     if (n["end_s"])
@@ -194,6 +235,10 @@ sim::FaultSchedule parseFaults(const YAML::Node& list) {
 SimConfig parseSimConfig(const YAML::Node& root) {
   SimConfig c;
   auto& s = c.scenario;
+  checkKeys(root, "",
+            {"name", "seed", "vehicle", "orbit", "gravity", "timing", "imu", "dither", "vibration",
+             "gnss", "star_tracker", "faults", "ids", "publish"},
+            bus::kParticipantKeys);
   s.name = get<std::string>(root, "", "name", "default");
   s.seed = get<std::uint64_t>(root, "", "seed", 1);
 
@@ -201,6 +246,7 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   const YAML::Node orbit = root["orbit"];
   if (veh && orbit) throw ConfigError("configuration has both vehicle and orbit; choose one");
   if (orbit) {
+    checkKeys(orbit, "orbit", {"altitude_km", "inclination_deg", "latitude_deg", "longitude_deg"});
     s.orbit = true;
     s.orbit_start.altitude_m = checkRange(bus::require<double>(orbit, "orbit", "altitude_km"), 100,
                                           50000, "orbit.altitude_km") *
@@ -220,6 +266,9 @@ SimConfig parseSimConfig(const YAML::Node& root) {
     }
     s.gravity = core::earth::GravityModel::kPointMass;  // seed 001: spherical Earth
   } else {
+    checkKeys(veh, "vehicle",
+              {"latitude_deg", "longitude_deg", "height_m", "roll_deg", "pitch_deg", "yaw_deg",
+               "speed_mps", "heading_deg", "flight_path_deg", "segments"});
     const core::earth::Geodetic default_site{36.5 * kDeg, 127.5 * kDeg, 100.0};  // seed 000
     s.vehicle.position = bus::getGeodeticDeg(veh, "vehicle", &default_site);
     s.vehicle.roll_pitch_yaw_rad = bus::getRollPitchYawDeg(veh, "vehicle");
@@ -240,6 +289,9 @@ SimConfig parseSimConfig(const YAML::Node& root) {
     throw ConfigError("configuration gravity = '" + gravity + "' is not wgs84 or point_mass");
 
   const YAML::Node timing = root["timing"];
+  checkKeys(timing, "timing",
+            {"start", "duration_s", "pacing", "wait_for_readers_s", "min_readers", "imu_rate_hz",
+             "raw_rate_hz", "gnss_rate_hz", "star_tracker_rate_hz"});
   const std::string start = get<std::string>(timing, "timing", "start", "now");
   if (start == "now") {
     c.start_now = true;
@@ -264,6 +316,7 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   c.wait_for_readers_s = checkRange(get<double>(timing, "timing", "wait_for_readers_s", 10.0), 0,
                                     3600, "timing.wait_for_readers_s");
   const YAML::Node wait = child(timing, "min_readers");
+  checkKeys(wait, "timing.min_readers", {"imu", "raw_imu", "gnss", "star_tracker"});
   auto readers = [&](const char* key, int fallback) {
     return static_cast<int>(checkRange(get<int>(wait, "timing.min_readers", key, fallback), 0, 64,
                                        std::string("timing.min_readers.") + key));
@@ -298,6 +351,7 @@ SimConfig parseSimConfig(const YAML::Node& root) {
       st_hz > 0 ? ratio(imu_hz, st_hz, "timing.star_tracker_rate_hz") : 0;
 
   const YAML::Node imu = root["imu"];
+  checkImuKeys(imu);
   parseTriad(imu, "accel_", kMicroG, kMicroG, kMicroG, "accel_noise_ug_per_sqrthz", s.imu.accel);
   parseTriad(imu, "gyro_", kDegPerHour, kDegPerHour, kDeg / 60.0, "gyro_arw_deg_per_sqrth",
              s.imu.gyro);
@@ -316,6 +370,9 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   s.imu.gyro.quantum = get<double>(imu, "imu", "gyro_quantum_urad", 0.0) * 1e-6;
 
   const YAML::Node dither = root["dither"];
+  checkKeys(dither, "dither",
+            {"enabled", "frequencies_hz", "peak_rate_min_dps", "peak_rate_max_dps",
+             "accel_cross_axis_mg", "accel_own_axis_mg", "trapping_rate_dps"});
   s.dither = get<bool>(dither, "dither", "enabled", false);
   s.dither_spec.frequency_hz =
       bus::getVector3(dither, "dither", "frequencies_hz", 1.0, s.dither_spec.frequency_hz);
@@ -341,6 +398,8 @@ SimConfig parseSimConfig(const YAML::Node& root) {
       get<double>(dither, "dither", "trapping_rate_dps", 0.5) * kDeg;
 
   const YAML::Node vib = root["vibration"];
+  checkKeys(vib, "vibration",
+            {"enabled", "accel_rms_mg", "gyro_rms_dps", "isolator_corner_hz", "moving_speed_mps"});
   s.vibration.enabled = get<bool>(vib, "vibration", "enabled", false);
   s.vibration.accel_rms_mps2 = checkRange(get<double>(vib, "vibration", "accel_rms_mg",
                                                       s.vibration.accel_rms_mps2 / units::kMilliG),
@@ -361,6 +420,12 @@ SimConfig parseSimConfig(const YAML::Node& root) {
                  0.0, 1e3, "vibration.moving_speed_mps");
 
   const YAML::Node gnss = root["gnss"];
+  checkKeys(
+      gnss, "gnss",
+      {"planes", "satellites_per_plane", "eccentricity", "elevation_mask_deg", "max_satellites",
+       "fixed_satellites", "clock_bias_m", "clock_drift_mps", "clock_bias_noise_m_per_sqrts",
+       "clock_drift_noise_mps_per_sqrts", "pseudorange_sigma_m", "pseudorange_rate_sigma_mps",
+       "fix", "fix_position_sigma_m", "fix_velocity_sigma_mps"});
   s.constellation.planes =
       static_cast<int>(checkRange(get<int>(gnss, "gnss", "planes", 6), 1, 8, "gnss.planes"));
   s.constellation.satellites_per_plane = static_cast<int>(checkRange(
@@ -398,6 +463,8 @@ SimConfig parseSimConfig(const YAML::Node& root) {
                                         1e-4, 100, "gnss.fix_velocity_sigma_mps");
 
   const YAML::Node st = root["star_tracker"];
+  checkKeys(st, "star_tracker",
+            {"sigma_arcsec", "bias_arcsec", "bias_correlation_time_s", "dropout_probability"});
   s.star_tracker.noise_rad = checkRange(get<double>(st, "star_tracker", "sigma_arcsec", 0.3), 0,
                                         3600, "star_tracker.sigma_arcsec") *
                              kArcsec;
@@ -414,10 +481,12 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   s.faults = parseFaults(root["faults"]);
 
   const YAML::Node ids = root["ids"];
+  checkKeys(ids, "ids", {"imu", "gnss_receiver", "star_tracker"});
   c.imu_sensor_id = get<std::uint32_t>(ids, "ids", "imu", 1);
   c.gnss_receiver_id = get<std::uint32_t>(ids, "ids", "gnss_receiver", 1);
   c.star_tracker_id = get<std::uint32_t>(ids, "ids", "star_tracker", 1);
   const YAML::Node pub = root["publish"];
+  checkKeys(pub, "publish", {"raw_imu", "gnss", "star_tracker"});
   c.publish_raw = get<bool>(pub, "publish", "raw_imu", true);
   c.publish_gnss = get<bool>(pub, "publish", "gnss", s.gnss_every_n_increments > 0);
   c.publish_star_tracker =

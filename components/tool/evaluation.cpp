@@ -26,15 +26,21 @@ namespace {
 
 constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
 
+/// `filter_yaml` is the filter file's content (the Monte Carlo overrides some keys);
+/// `filter_path` names it in errors.
 OfflineSetup loadSetup(const std::string& scenario, const YAML::Node& filter_yaml,
-                       std::uint64_t seed, double duration_s,
+                       const std::string& filter_path, std::uint64_t seed, double duration_s,
                        const std::string& fault_manager = "") {
   OfflineSetup s;
   if (!fault_manager.empty())
-    s.fault_manager = fault_manager::parseFaultManagerConfig(bus::loadYamlFile(fault_manager));
-  s.sim = sensor_sim::parseSimConfig(bus::loadYamlFile(scenario));
+    s.fault_manager = bus::parseFile(fault_manager, fault_manager::parseFaultManagerConfig);
+  s.sim = bus::parseFile(scenario, sensor_sim::parseSimConfig);
   if (seed != 0) s.sim.scenario.seed = seed;
-  s.filter = nav_filter::parseFilterConfig(filter_yaml);
+  try {
+    s.filter = nav_filter::parseFilterConfig(filter_yaml);
+  } catch (const bus::ConfigError& e) {
+    bus::rethrowNamingFile(filter_path, e);
+  }
   s.duration_s = duration_s > 0.0 ? duration_s : s.sim.duration_s;
   if (!(s.duration_s > 0.0)) {
     throw bus::ConfigError("scenario " + scenario +
@@ -187,8 +193,8 @@ double chiSquareQuantile(double p, double dof) {
 }
 
 int runOfflineCommand(const OfflineOptions& o) {
-  const OfflineSetup setup =
-      loadSetup(o.scenario, bus::loadYamlFile(o.filter), o.seed, o.duration_s, o.fault_manager);
+  const OfflineSetup setup = loadSetup(o.scenario, bus::loadYamlFile(o.filter), o.filter, o.seed,
+                                       o.duration_s, o.fault_manager);
   std::filesystem::create_directories(o.out_dir);
   std::ofstream sol_f(o.out_dir + "/solution.csv"), truth_f(o.out_dir + "/truth.csv"),
       err_f(o.out_dir + "/error.csv");
@@ -248,6 +254,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
   struct Variant {
     std::string label;
     YAML::Node yaml;
+    std::string path;
   };
   std::vector<Variant> variants;
   for (const std::string& file : o.filters) {
@@ -267,7 +274,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
           y["multi_dimensional"]["policy"] = po;
           label += " " + po;
         }
-        variants.push_back({label, y});
+        variants.push_back({label, y, file});
       }
     }
   }
@@ -296,7 +303,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
     for (int i = 0; i < o.runs; ++i) {
       const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
       OfflineSetup& setup = setups[static_cast<std::size_t>(i)];
-      setup = loadSetup(o.scenario, v.yaml, seed, o.duration_s, o.fault_manager);
+      setup = loadSetup(o.scenario, v.yaml, v.path, seed, o.duration_s, o.fault_manager);
       const core::NavState truth0 = initialTruth(setup.sim.scenario);
       setup.filter.engine.initial_state =
           o.perturb_initial

@@ -351,7 +351,7 @@ int runRealDataCommand(const RealDataOptions& o) {
     s.ramp = RampInjection{static_cast<int>(o.ramp[0]), o.ramp[1], o.ramp[2]};
   }
   if (!o.fault_manager.empty()) {
-    s.fault_manager = fault_manager::parseFaultManagerConfig(bus::loadYamlFile(o.fault_manager));
+    s.fault_manager = bus::parseFile(o.fault_manager, fault_manager::parseFaultManagerConfig);
   }
   const RealDataResult r = runRealData(s);
   if (s.ramp && r.injected_epochs == 0) {

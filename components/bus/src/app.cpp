@@ -54,7 +54,12 @@ int runMain(CLI::App& app, int argc, char** argv, CommonOptions& options,
   try {
     const YAML::Node config = options.config_file.empty() ? YAML::Node(YAML::NodeType::Map)
                                                           : loadYamlFile(options.config_file);
-    return body(config);
+    try {
+      return body(config);
+    } catch (const ConfigError& e) {
+      if (options.config_file.empty()) throw;
+      rethrowNamingFile(options.config_file, e);
+    }
   } catch (const ConfigError& e) {
     spdlog::error("{}", e.what());
     return kExitConfigError;

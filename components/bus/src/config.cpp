@@ -1,5 +1,6 @@
 #include "navbus/bus/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,64 @@ YAML::Node loadWithExtends(const std::filesystem::path& path, int depth) {
 
 YAML::Node loadYamlFile(const std::string& path) {
   return loadWithExtends(path, 0);
+}
+
+void checkKeys(const YAML::Node& node, const std::string& where,
+               std::initializer_list<const char*> allowed,
+               std::initializer_list<const char*> also) {
+  if (!node || node.IsNull()) return;  // absent or empty: every default
+  if (!node.IsMap())
+    throw ConfigError("configuration " + (where.empty() ? "file" : where) + " must be a map");
+  for (const auto& kv : node) {
+    const auto key = kv.first.as<std::string>();
+    auto is_key = [&key](const char* k) { return key == k; };
+    const bool known = std::any_of(allowed.begin(), allowed.end(), is_key) ||
+                       std::any_of(also.begin(), also.end(), is_key);
+    if (!known) throw UnknownKeyError(where.empty() ? key : where + "." + key);
+  }
+}
+
+namespace {
+/// The node at a dotted key path with [i] list indices; an undefined node when absent.
+YAML::Node nodeAt(YAML::Node node, const std::string& key_path) {
+  std::stringstream parts(key_path);
+  std::string part;
+  while (std::getline(parts, part, '.')) {
+    const std::size_t bracket = part.find('[');
+    const std::string key = part.substr(0, bracket);
+    if (!node.IsMap() || !node[key]) return YAML::Node(YAML::NodeType::Undefined);
+    node = node[key];
+    if (bracket != std::string::npos) {
+      const std::size_t i = std::stoul(part.substr(bracket + 1));
+      if (!node.IsSequence() || i >= node.size()) return YAML::Node(YAML::NodeType::Undefined);
+      node = node[i];
+    }
+  }
+  return node;
+}
+}  // namespace
+
+std::string fileDefiningKey(const std::string& path, const std::string& key_path) {
+  std::filesystem::path file = path;
+  for (int depth = 0; depth <= 8; ++depth) {
+    YAML::Node own;
+    try {
+      own = YAML::LoadFile(file.string());
+    } catch (const YAML::Exception&) {
+      break;
+    }
+    if (nodeAt(own, key_path).IsDefined()) return file.string();
+    if (!own.IsMap() || !own["extends"]) break;
+    file = file.parent_path() / own["extends"].as<std::string>();
+  }
+  return path;
+}
+
+void rethrowNamingFile(const std::string& path, const ConfigError& e) {
+  if (std::string(e.what()).rfind("configuration file '", 0) == 0) throw e;  // named already
+  const auto* unknown = dynamic_cast<const UnknownKeyError*>(&e);
+  const std::string file = unknown ? fileDefiningKey(path, unknown->keyPath()) : path;
+  throw ConfigError("configuration file '" + file + "': " + e.what());
 }
 
 double checkRange(double value, double lo, double hi, const std::string& name) {

@@ -1,6 +1,7 @@
 // YAML configuration helpers: every error names the key and the offending value.
 #pragma once
 
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +16,50 @@ class ConfigError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+YAML::Node loadYamlFile(const std::string& path);
+
+/// A key no parser reads: a typo that would otherwise be silently ignored.
+class UnknownKeyError : public ConfigError {
+ public:
+  explicit UnknownKeyError(const std::string& key_path)
+      : ConfigError("configuration " + key_path + ": unknown key"), key_path_(key_path) {}
+  /// Dotted path of the key, list elements as [i] ("glr.actions.imu", "faults[2].slope").
+  const std::string& keyPath() const { return key_path_; }
+
+ private:
+  std::string key_path_;
+};
+
+/// Throws UnknownKeyError for the first key of the map `node` (at `where`, "" for the top
+/// level) that is in neither `allowed` nor `also`; ConfigError if `node` is present but not a
+/// map.
+void checkKeys(const YAML::Node& node, const std::string& where,
+               std::initializer_list<const char*> allowed,
+               std::initializer_list<const char*> also = {});
+
+/// The top-level keys every participant's configuration may carry (participantOptions()).
+inline constexpr std::initializer_list<const char*> kParticipantKeys = {
+    "domain_id", "qos_file", "participant_profile", "health_period_s"};
+
+/// The file of `path`'s extends chain that spells `key_path` (the most derived one; `path`
+/// itself when none does).
+std::string fileDefiningKey(const std::string& path, const std::string& key_path);
+
+/// A ConfigError from parsing the configuration file `path`, re-thrown with the file named
+/// (for an unknown key, the file of the extends chain that holds it).
+[[noreturn]] void rethrowNamingFile(const std::string& path, const ConfigError& e);
+
+/// Loads `path` (with extends) and parses it; errors name the file.
+template <class Parse>
+auto parseFile(const std::string& path, Parse&& parse) -> decltype(parse(YAML::Node())) {
+  const YAML::Node node = loadYamlFile(path);
+  try {
+    return parse(node);
+  } catch (const ConfigError& e) {
+    rethrowNamingFile(path, e);
+  }
+}
 
 /// Loads a YAML file; throws ConfigError naming the file on failure. A top-level
 /// `extends: other.yaml` (relative path) loads that file first; this file's keys override its

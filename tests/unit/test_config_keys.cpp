@@ -1,0 +1,133 @@
+// Configuration files are strict: a key no parser reads (a typo) is an error naming the key and
+// the file that spells it, for every parser and at every level; every shipped file passes.
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "fault_config.hpp"
+#include "filter_config.hpp"
+#include "navbus/bus/config.hpp"
+#include "scenario_config.hpp"
+
+namespace fs = std::filesystem;
+using navbus::bus::ConfigError;
+
+namespace {
+
+class ConfigKeys : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("navbus-config-keys-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+
+  /// The message of the ConfigError parsing `path` throws ("" when it does not throw).
+  template <class Parse>
+  static std::string errorOf(const std::string& path, Parse parse) {
+    try {
+      navbus::bus::parseFile(path, parse);
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  }
+
+  fs::path dir_;
+};
+
+const std::string kSrc = NAVBUS_CONFIG_DIR;
+const std::string kScenarios = NAVBUS_SCENARIO_DIR;
+
+auto filter = [](const YAML::Node& n) { return navbus::nav_filter::parseFilterConfig(n); };
+auto faults = [](const YAML::Node& n) { return navbus::fault_manager::parseFaultManagerConfig(n); };
+auto scenario = [](const YAML::Node& n) { return navbus::sensor_sim::parseSimConfig(n); };
+
+::testing::AssertionResult names(const std::string& message, const std::string& key,
+                                 const std::string& file) {
+  if (message.find(key + ": unknown key") == std::string::npos)
+    return ::testing::AssertionFailure() << "'" << message << "' does not name key " << key;
+  if (message.find("'" + file + "'") == std::string::npos)
+    return ::testing::AssertionFailure() << "'" << message << "' does not name file " << file;
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace
+
+TEST_F(ConfigKeys, FilterTypoAtEveryLevelNamesKeyAndFile) {
+  for (const auto& [text, key] : std::vector<std::pair<std::string, std::string>>{
+           {"mdoe: tightly_coupled\n", "mdoe"},
+           {"ekf: {gate_sigmaa: 3}\n", "ekf.gate_sigmaa"},
+           {"inputs: {imu: {id: 1, period_s: 0.01, rate_hz: 100}}\n", "inputs.imu.rate_hz"},
+           {"initial_state: {latitude_deg: 1, longitude_deg: 2, height_m: 3, heading_deg: 4}\n",
+            "initial_state.heading_deg"},
+           {"multi_dimensional: {stationary: {speed: 1}}\n", "multi_dimensional.stationary.speed"},
+           {"recovery: {history: 10}\n", "recovery.history"}}) {
+    const std::string path = write("filter.yaml", "extends: " + kSrc + "/filter.yaml\n" + text);
+    EXPECT_TRUE(names(errorOf(path, filter), key, path)) << text;
+  }
+}
+
+TEST_F(ConfigKeys, TypoInAnExtendedFileNamesThatFile) {
+  const std::string base =
+      write("base.yaml", "extends: " + kSrc + "/fault_manager.yaml\nglr: {thresold: 40}\n");
+  const std::string top = write("top.yaml", "extends: base.yaml\nvehicle_id: 2\n");
+  EXPECT_TRUE(names(errorOf(top, faults), "glr.thresold", base));
+  // The same typo in the derived file: that file is named.
+  const std::string top2 = write(
+      "top2.yaml", "extends: " + kSrc + "/fault_manager.yaml\ndither: {windw_samples: 256}\n");
+  EXPECT_TRUE(names(errorOf(top2, faults), "dither.windw_samples", top2));
+}
+
+TEST_F(ConfigKeys, ScenarioTypoInListsAndSections) {
+  const std::string base = kScenarios + "/seed000_aircraft.yaml";
+  for (const auto& [text, key] : std::vector<std::pair<std::string, std::string>>{
+           {"faults:\n  - {type: pseudorange_ramp, start_s: 10, sv_id: 3, slope: 2}\n",
+            "faults[0].slope"},
+           {"faults:\n  - {type: sensor_stuck, start_s: 10, axis: x, magnitude_mg: 2}\n",
+            "faults[0].magnitude_mg"},
+           {"timing: {imu_rate: 100}\n", "timing.imu_rate"},
+           {"gnss: {pseudorange_sigma: 3}\n", "gnss.pseudorange_sigma"},
+           {"vehicle: {segments: [{type: turn, duration_s: 5, turn_rate_dps: 1, accel_mps2: 1}]}\n",
+            "vehicle.segments[0].accel_mps2"},
+           {"imu: {accel_bias_sigma_mg: 1}\n", "imu.accel_bias_sigma_mg"},
+           {"seeed: 3\n", "seeed"}}) {
+    const std::string path = write("scenario.yaml", "extends: " + base + "\n" + text);
+    EXPECT_TRUE(names(errorOf(path, scenario), key, path)) << text;
+  }
+}
+
+TEST_F(ConfigKeys, EveryShippedConfigurationPasses) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(kSrc)) {
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() != ".yaml") continue;
+    const std::string path = e.path().string();
+    if (name.rfind("filter", 0) == 0) {
+      EXPECT_EQ(errorOf(path, filter), "") << path;
+    } else if (name.rfind("fault_manager", 0) == 0) {
+      EXPECT_EQ(errorOf(path, faults), "") << path;
+    } else {
+      ADD_FAILURE() << path << ": no parser known for this file in the test";
+    }
+    ++n;
+  }
+  for (const auto& e : fs::directory_iterator(kScenarios)) {
+    if (e.path().extension() != ".yaml") continue;
+    EXPECT_EQ(errorOf(e.path().string(), scenario), "") << e.path();
+    ++n;
+  }
+  EXPECT_GE(n, 30);
+}
