@@ -103,10 +103,19 @@ def main(scenario_path, record_dir, truth_dir, without_dir):
                 what = f"sv {c['sv_id']} ({c['scope']})" if "SATELLITE" in c["kind"] else \
                     f"{c['sensor']} axis {'xyz'[int(c['axis'])]}"
                 print(f"  command {c['command_id']}: {c['kind']} {what}")
-        after = [e for e in bus if seconds(e[0], start_ns) > t_decided + 0.5]
+        after = [e for e in bus if t_decided <= seconds(e[0], start_ns) < t_next]
         if after:
-            print(f"  filter    mode {after[0][3]}, fault flags 0x{after[0][4]:04x} after the "
-                  f"decision")
+            # The mode and flags the filter settles in, and the first solution of the run of
+            # solutions carrying them up to the next fault: with fast pacing the filter may be
+            # ahead of the fault manager in data time when the command arrives (its state is
+            # restored from the onset; solutions already published stay as they were).
+            mode, flags = after[-1][3], after[-1][4]
+            since = len(after)
+            while since > 0 and (after[since - 1][3], after[since - 1][4]) == (mode, flags):
+                since -= 1
+            t_since = seconds(after[since][0], start_ns)
+            print(f"  filter    mode {mode}, fault flags 0x{flags:04x} from {t_since:.2f} s on "
+                  f"({t_since - t_decided:.2f} s of data after the decision time)")
         print(f"  after     ({t_decided + 1:5.1f}-{t_next:5.1f} s): "
               f"{window(bus, start_ns, t_decided + 1, t_next)}")
         print(f"  no fault manager, same data: {window(without, start_ns, t_decided + 1, t_next)}")
