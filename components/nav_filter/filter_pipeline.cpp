@@ -128,8 +128,13 @@ void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
 
 void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
   if (!admit(gnss_obs_gate_, m, m.receiver_id(), config_.gnss_observations)) return;
+  // A bad satellite costs that satellite only (counted per reason); the others are used.
+  const std::vector<bus::SatelliteRejection> dropped =
+      bus::screenSatellites(m, gnss_obs_gate_.limits());
+  for (const bus::SatelliteRejection& d : dropped)
+    gnss_obs_gate_.rejectElement(d.rejection, m.receiver_id());
   queue(gnss_obs_gate_, {kRankGnssObs, m.receiver_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
-        GnssEpochInput{static_cast<std::int64_t>(m.time_gps_ns()), bus::toCore(m)});
+        GnssEpochInput{static_cast<std::int64_t>(m.time_gps_ns()), bus::toCore(m, dropped)});
 }
 
 void FilterPipeline::onGnssFix(const navbus::GnssFix& m) {

@@ -212,6 +212,10 @@ void visitFields(const navbus::StreamHealth& m, V& v) {
   std::ostringstream rejected;
   for (const auto& r : m.rejected()) rejected << enumName(r.reason()) << "=" << r.count() << " ";
   v.text("rejected", rejected.str());
+  std::ostringstream elements;
+  for (const auto& r : m.elements_rejected())
+    elements << enumName(r.reason()) << "=" << r.count() << " ";
+  v.text("elements_rejected", elements.str());
 }
 template <class V>
 void visitFields(const navbus::Health& m, V& v) {

@@ -1,9 +1,12 @@
 // A publisher sends NaN, infinite, out-of-order, duplicate, out-of-range and otherwise invalid
 // samples among good ones: each is rejected and counted by reason in the filter's health, and
-// the solution stays finite.
+// the solution stays finite. A GNSS epoch with bad satellites (unknown id, one id twice, an
+// implausible sigma) loses those satellites only: the good ones are fused (diagnostics rows).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <navbus_idl/HealthPubSubTypes.h>
@@ -26,7 +29,8 @@ using Counts = std::map<std::string, std::map<RejectReason, std::uint64_t>>;
 TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("bad-input");
-  const std::string cfg = test::writeFile(dir / "filter.yaml", test::filterConfig(kDomain));
+  const std::string cfg =
+      test::writeFile(dir / "filter.yaml", test::filterConfig(kDomain) + "mode: tightly_coupled\n");
   test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
 
   bus::ShutdownSignal shutdown;
@@ -35,6 +39,10 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
   me.subscribe<NavigationSolutionPubSubType>(
       bus::topic::kNavSolution, bus::profile::kSolutionReader,
       [&](const NavigationSolution& s, const auto&) { solutions.push_back(s); });
+  std::vector<FilterDiagnostics> diagnostics;
+  me.subscribe<FilterDiagnosticsPubSubType>(
+      bus::topic::kFilterDiagnostics, bus::profile::kDiagnosticsReader,
+      [&](const FilterDiagnostics& d, const auto&) { diagnostics.push_back(d); });
   Health filter_health;
   me.subscribe<HealthPubSubType>(bus::topic::kHealth, bus::profile::kHealthReader,
                                  [&](const Health& h, const auto&) {
@@ -51,6 +59,8 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   std::uint64_t seq = 0, n_obs = 0, n_fix = 0, n_star = 0;
+  std::vector<int> good_svs;  // of the epoch with bad satellites added
+  std::uint64_t screened_epoch_ns = 0;
   ImuIncrement last;
   for (int k = 0; k < 300; ++k) {
     const sim::SensorFrame f = src.next();
@@ -90,12 +100,27 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
     w.imu.write(good);
     last = good;
     if (f.has_gnss) {
-      w.obs.write(sensor_sim::toIdl(f.gnss, 1, ++n_obs));
+      auto e = sensor_sim::toIdl(f.gnss, 1, ++n_obs);
+      if (n_obs == 2) {
+        // Bad satellites beside the good ones: an unknown id, the last satellite twice (both
+        // copies go: which is right cannot be told), a sigma of 1e-300 m on a copy of the first.
+        auto& sats = e.satellites();
+        ASSERT_GE(sats.size(), 5u);
+        for (std::size_t i = 0; i + 1 < sats.size(); ++i) good_svs.push_back(sats[i].sv_id());
+        good_svs.erase(good_svs.begin());  // the first gets an implausible twin below
+        auto unknown = sats[1];
+        unknown.sv_id(40);
+        auto twin = sats.back();
+        twin.pseudorange_m(twin.pseudorange_m() + 100.0);
+        sats.push_back(twin);
+        sats.push_back(unknown);
+        sats[0].pseudorange_sigma_m(1e-300);
+        screened_epoch_ns = e.time_gps_ns();
+      }
+      w.obs.write(e);
       w.fix.write(sensor_sim::toIdl(f.fix, 1, ++n_fix));
       if (n_obs == 1) {
-        auto e = sensor_sim::toIdl(f.gnss, 1, n_obs + 1);
-        e.satellites().at(0).sv_id(40);
-        w.obs.write(e);
+        w.obs.write(e);  // the same epoch again: a duplicate sample
         auto x = sensor_sim::toIdl(f.fix, 1, n_fix + 1);
         x.latitude_rad(nan);
         w.fix.write(x);
@@ -132,7 +157,7 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
         {REJECT_TIME_NOT_MONOTONIC, 1},
         {REJECT_DUPLICATE, 1},
         {REJECT_UNEXPECTED_SOURCE, 1}}},
-      {bus::topic::kGnssObservations, {{REJECT_UNKNOWN_SATELLITE, 1}}},
+      {bus::topic::kGnssObservations, {{REJECT_DUPLICATE, 1}}},
       {bus::topic::kGnssFix, {{REJECT_NOT_FINITE, 1}}},
       {bus::topic::kStarTracker, {{REJECT_BAD_QUATERNION, 1}}},
   };
@@ -148,13 +173,35 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
       std::printf("rejected on %s: %s x%llu\n", topic.c_str(), bus::rejectReasonName(reason),
                   static_cast<unsigned long long>(n));
   }
+  // The screened epoch: accepted, its bad satellites counted by reason, the good ones fused.
+  const auto* obs = stream(bus::topic::kGnssObservations);
+  ASSERT_NE(obs, nullptr);
+  std::map<RejectReason, std::uint64_t> dropped;
+  for (const auto& r : obs->elements_rejected()) dropped[r.reason()] = r.count();
+  const std::map<RejectReason, std::uint64_t> expected_dropped = {
+      {REJECT_OUT_OF_RANGE, 1}, {REJECT_DUPLICATE_SATELLITE, 2}, {REJECT_UNKNOWN_SATELLITE, 1}};
+  EXPECT_EQ(dropped, expected_dropped);
+  EXPECT_EQ(obs->accepted(), n_obs);
+  const auto diag = std::find_if(diagnostics.begin(), diagnostics.end(), [&](const auto& d) {
+    return d.time_gps_ns() == screened_epoch_ns;
+  });
+  ASSERT_NE(diag, diagnostics.end()) << "no diagnostics for the screened epoch";
+  std::set<int> fused;
+  for (const auto& row : diag->rows())
+    if (row.sv_id() != 0) fused.insert(row.sv_id());
+  EXPECT_EQ(fused, std::set<int>(good_svs.begin(), good_svs.end()));
+  std::printf(
+      "screened epoch: %zu satellites kept, dropped: unknown id 1, duplicate id 2, "
+      "implausible sigma 1\n",
+      fused.size());
   EXPECT_EQ(solutions.size(), 30u);
   for (const auto& sol : solutions) {
     EXPECT_TRUE(std::isfinite(sol.latitude_rad()) && std::isfinite(sol.longitude_rad()) &&
                 std::isfinite(sol.height_m()) && std::isfinite(sol.roll_rad()) &&
                 std::isfinite(sol.yaw_rad()));
     for (double v : sol.vel_ned_mps()) EXPECT_TRUE(std::isfinite(v));
-    EXPECT_LT(std::abs(sol.height_m() - 100.0), 1.0);
+    // Tightly coupled on a handful of 3 m pseudoranges: the height is the GNSS one, metres off.
+    EXPECT_LT(std::abs(sol.height_m() - 100.0), 15.0);
   }
   filter.signal(SIGTERM);
   EXPECT_EQ(filter.wait(10s), 0);

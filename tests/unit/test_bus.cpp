@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/bus/conversions.hpp"
 #include "navbus/bus/dds_context.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/participant.hpp"
@@ -72,20 +73,50 @@ TEST(Validation, RejectsOutOfRangeAndBadIntervals) {
   EXPECT_EQ(r->value, 0.0);
 }
 
-TEST(Validation, GnssEpochRules) {
-  EXPECT_FALSE(validate(goodEpoch(), ValidationLimits{}));
+TEST(Validation, GnssSatellitesScreenedOneByOne) {
+  using navbus::bus::screenSatellites;
+  EXPECT_TRUE(screenSatellites(goodEpoch(), ValidationLimits{}).empty());
   auto e = goodEpoch();
   e.satellites()[0].sv_id(40);
-  auto r = validate(e, ValidationLimits{});
-  EXPECT_EQ(r->reason, navbus::REJECT_UNKNOWN_SATELLITE);
-  EXPECT_EQ(r->field, "satellites[0].sv_id");
-  EXPECT_EQ(r->value, 40.0);
+  auto r = screenSatellites(e, ValidationLimits{});
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0].rejection.reason, navbus::REJECT_UNKNOWN_SATELLITE);
+  EXPECT_EQ(r[0].rejection.field, "satellites[0].sv_id");
+  EXPECT_EQ(r[0].rejection.value, 40.0);
+  EXPECT_FALSE(validate(e, ValidationLimits{}));  // the epoch itself stands
   e = goodEpoch();
   e.satellites()[0].pseudorange_m(1.0e3);
-  EXPECT_EQ(validate(e, ValidationLimits{})->reason, navbus::REJECT_OUT_OF_RANGE);
+  EXPECT_EQ(screenSatellites(e, ValidationLimits{})[0].rejection.reason,
+            navbus::REJECT_OUT_OF_RANGE);
   e = goodEpoch();
   e.satellites()[0].sat_pos_ecef_m()[1] = std::nan("");
-  EXPECT_EQ(validate(e, ValidationLimits{})->field, "satellites[0].sat_pos_ecef_m[1]");
+  EXPECT_EQ(screenSatellites(e, ValidationLimits{})[0].rejection.field,
+            "satellites[0].sat_pos_ecef_m[1]");
+  // Implausible sigmas, both ways.
+  for (double sigma : {1e-300, 1e-3, 5e3}) {
+    e = goodEpoch();
+    e.satellites()[0].pseudorange_sigma_m(sigma);
+    r = screenSatellites(e, ValidationLimits{});
+    ASSERT_EQ(r.size(), 1u) << sigma;
+    EXPECT_EQ(r[0].rejection.field, "satellites[0].pseudorange_sigma_m");
+  }
+  e = goodEpoch();
+  e.satellites()[0].pseudorange_rate_sigma_mps(0.0);
+  EXPECT_EQ(screenSatellites(e, ValidationLimits{})[0].rejection.field,
+            "satellites[0].pseudorange_rate_sigma_mps");
+  // The same id twice: both copies go, a third satellite stays.
+  e = goodEpoch();
+  e.satellites().push_back(e.satellites()[0]);
+  e.satellites().push_back(e.satellites()[0]);
+  e.satellites()[2].sv_id(7);
+  r = screenSatellites(e, ValidationLimits{});
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[0].index, 0u);
+  EXPECT_EQ(r[1].index, 1u);
+  EXPECT_EQ(r[1].rejection.reason, navbus::REJECT_DUPLICATE_SATELLITE);
+  const auto kept = navbus::bus::toCore(e, r);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].sv_id, 7);
 }
 
 TEST(Validation, StarTrackerQuaternionMustBeUnit) {

@@ -1,5 +1,7 @@
 #include "navbus/bus/conversions.hpp"
 
+#include <algorithm>
+
 #include "navbus/core/rotation.hpp"
 
 namespace navbus::bus {
@@ -33,10 +35,18 @@ core::StarAttitudeMeasurement toCore(const navbus::StarTrackerAttitude& msg) {
 }
 
 std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& m) {
+  return toCore(m, {});
+}
+
+std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& m,
+                                               const std::vector<SatelliteRejection>& dropped) {
   std::vector<core::SatelliteObservation> out;
   out.reserve(m.satellites().size());
-  for (const auto& s : m.satellites()) {
-    if (!s.valid()) continue;
+  for (std::size_t i = 0; i < m.satellites().size(); ++i) {
+    const auto& s = m.satellites()[i];
+    const bool is_dropped = std::any_of(dropped.begin(), dropped.end(),
+                                        [i](const SatelliteRejection& d) { return d.index == i; });
+    if (!s.valid() || is_dropped) continue;
     out.push_back({s.sv_id(), toVector(s.sat_pos_ecef_m()), toVector(s.sat_vel_ecef_mps()),
                    s.pseudorange_m() + s.sat_clock_correction_m(),
                    s.pseudorange_rate_mps() + s.sat_clock_drift_mps(), s.pseudorange_sigma_m(),

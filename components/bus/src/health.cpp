@@ -51,6 +51,12 @@ navbus::Health HealthCounters::report(navbus::ParticipantState state, std::uint6
       rc.count(count);
       s.rejected().push_back(rc);
     }
+    for (const auto& [reason, count] : c.elements_rejected) {
+      navbus::RejectCount rc;
+      rc.reason(reason);
+      rc.count(count);
+      s.elements_rejected().push_back(rc);
+    }
     h.inputs().push_back(s);
   }
   return h;
@@ -63,6 +69,9 @@ std::string HealthCounters::summary() const {
         << ", rejected " << c.rejectedTotal();
     for (const auto& [reason, count] : c.rejected) {
       out << " [" << rejectReasonName(reason) << " " << count << "]";
+    }
+    for (const auto& [reason, count] : c.elements_rejected) {
+      out << " [element " << rejectReasonName(reason) << " " << count << "]";
     }
     out << ", sequence gaps " << c.sequence_gaps << ", deadline misses " << c.deadline_misses
         << "\n";
@@ -93,6 +102,8 @@ const char* rejectReasonName(navbus::RejectReason reason) {
       return "unexpected_source";
     case navbus::REJECT_INCONSISTENT:
       return "inconsistent";
+    case navbus::REJECT_DUPLICATE_SATELLITE:
+      return "duplicate_satellite";
   }
   return "unknown";
 }

@@ -1,5 +1,7 @@
 #include "navbus/bus/validation.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <sstream>
 
@@ -101,39 +103,64 @@ std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const Validation
   return std::nullopt;
 }
 
-std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s,
-                                  const ValidationLimits& l) {
-  for (std::size_t i = 0; i < s.satellites().size(); ++i) {
-    const auto& m = s.satellites()[i];
-    const std::string p = indexed("satellites", i) + ".";
-    if (m.sv_id() < 1 || m.sv_id() > 32) {
-      return Rejection{navbus::REJECT_UNKNOWN_SATELLITE, p + "sv_id",
-                       static_cast<double>(m.sv_id())};
-    }
-    if (auto r = finite(m.pseudorange_m(), p + "pseudorange_m")) return r;
-    if (auto r = finite(m.pseudorange_rate_mps(), p + "pseudorange_rate_mps")) return r;
-    if (auto r = finiteArray(m.sat_pos_ecef_m(), p + "sat_pos_ecef_m")) return r;
-    if (auto r = finiteArray(m.sat_vel_ecef_mps(), p + "sat_vel_ecef_mps")) return r;
-    if (auto r = finite(m.sat_clock_correction_m(), p + "sat_clock_correction_m")) return r;
-    if (auto r = finite(m.sat_clock_drift_mps(), p + "sat_clock_drift_mps")) return r;
-    if (auto r = finite(m.cn0_dbhz(), p + "cn0_dbhz")) return r;
-    if (auto r = finite(m.pseudorange_sigma_m(), p + "pseudorange_sigma_m")) return r;
-    if (auto r = finite(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps")) return r;
-    if (auto r =
-            range(m.pseudorange_m(), l.min_pseudorange_m, l.max_pseudorange_m, p + "pseudorange_m"))
-      return r;
-    if (auto r = range(std::abs(m.pseudorange_rate_mps()), 0.0, l.max_pseudorange_rate_mps,
-                       p + "pseudorange_rate_mps"))
-      return r;
-    if (auto r = range(norm(m.sat_pos_ecef_m()), l.min_sat_radius_m, l.max_sat_radius_m,
-                       p + "|sat_pos_ecef_m|"))
-      return r;
-    if (auto r = range(m.cn0_dbhz(), 0.0, 70.0, p + "cn0_dbhz")) return r;
-    if (auto r = positive(m.pseudorange_sigma_m(), p + "pseudorange_sigma_m")) return r;
-    if (auto r = positive(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps"))
-      return r;
-  }
+std::optional<Rejection> validate(const navbus::GnssObservationEpoch&, const ValidationLimits&) {
   return std::nullopt;
+}
+
+namespace {
+std::optional<Rejection> screenSatellite(const navbus::GnssSatelliteMeasurement& m,
+                                         const std::string& p, const ValidationLimits& l) {
+  if (m.sv_id() < 1 || m.sv_id() > 32) {
+    return Rejection{navbus::REJECT_UNKNOWN_SATELLITE, p + "sv_id", static_cast<double>(m.sv_id())};
+  }
+  if (auto r = finite(m.pseudorange_m(), p + "pseudorange_m")) return r;
+  if (auto r = finite(m.pseudorange_rate_mps(), p + "pseudorange_rate_mps")) return r;
+  if (auto r = finiteArray(m.sat_pos_ecef_m(), p + "sat_pos_ecef_m")) return r;
+  if (auto r = finiteArray(m.sat_vel_ecef_mps(), p + "sat_vel_ecef_mps")) return r;
+  if (auto r = finite(m.sat_clock_correction_m(), p + "sat_clock_correction_m")) return r;
+  if (auto r = finite(m.sat_clock_drift_mps(), p + "sat_clock_drift_mps")) return r;
+  if (auto r = finite(m.cn0_dbhz(), p + "cn0_dbhz")) return r;
+  if (auto r = finite(m.pseudorange_sigma_m(), p + "pseudorange_sigma_m")) return r;
+  if (auto r = finite(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps")) return r;
+  if (auto r =
+          range(m.pseudorange_m(), l.min_pseudorange_m, l.max_pseudorange_m, p + "pseudorange_m"))
+    return r;
+  if (auto r = range(std::abs(m.pseudorange_rate_mps()), 0.0, l.max_pseudorange_rate_mps,
+                     p + "pseudorange_rate_mps"))
+    return r;
+  if (auto r = range(norm(m.sat_pos_ecef_m()), l.min_sat_radius_m, l.max_sat_radius_m,
+                     p + "|sat_pos_ecef_m|"))
+    return r;
+  if (auto r = range(m.cn0_dbhz(), 0.0, 70.0, p + "cn0_dbhz")) return r;
+  if (auto r = range(m.pseudorange_sigma_m(), l.min_pseudorange_sigma_m, l.max_pseudorange_sigma_m,
+                     p + "pseudorange_sigma_m"))
+    return r;
+  if (auto r = range(m.pseudorange_rate_sigma_mps(), l.min_pseudorange_rate_sigma_mps,
+                     l.max_pseudorange_rate_sigma_mps, p + "pseudorange_rate_sigma_mps"))
+    return r;
+  return std::nullopt;
+}
+}  // namespace
+
+std::vector<SatelliteRejection> screenSatellites(const navbus::GnssObservationEpoch& s,
+                                                 const ValidationLimits& l) {
+  std::vector<SatelliteRejection> out;
+  const auto& sats = s.satellites();
+  for (std::size_t i = 0; i < sats.size(); ++i) {
+    const std::string p = indexed("satellites", i) + ".";
+    if (auto r = screenSatellite(sats[i], p, l)) {
+      out.push_back({i, *r});
+      continue;
+    }
+    const auto same_id = [&](const navbus::GnssSatelliteMeasurement& o) {
+      return o.sv_id() == sats[i].sv_id();
+    };
+    if (std::count_if(sats.begin(), sats.end(), same_id) > 1) {
+      out.push_back({i, Rejection{navbus::REJECT_DUPLICATE_SATELLITE, p + "sv_id",
+                                  static_cast<double>(sats[i].sv_id())}});
+    }
+  }
+  return out;
 }
 
 std::optional<Rejection> validate(const navbus::GnssFix& s, const ValidationLimits& l) {
@@ -247,6 +274,14 @@ void StreamGate::reject(const Rejection& r, std::uint32_t sensor_id) {
   const std::uint64_t n = ++counters_.rejected[r.reason];
   if (n == 1 || n % 1000 == 0) {
     spdlog::warn("{}: rejected sample of sensor {} ({}; {} rejected for this reason so far)",
+                 topic_, sensor_id, r.describe(), n);
+  }
+}
+
+void StreamGate::rejectElement(const Rejection& r, std::uint32_t sensor_id) {
+  const std::uint64_t n = ++counters_.elements_rejected[r.reason];
+  if (n == 1 || n % 1000 == 0) {
+    spdlog::warn("{}: dropped an element of sensor {}'s sample, the rest kept ({}; {} so far)",
                  topic_, sensor_id, r.describe(), n);
   }
 }

@@ -36,6 +36,9 @@ core::StarAttitudeMeasurement toCore(const navbus::StarTrackerAttitude& msg);
 /// The valid satellites of an epoch with the satellite clock corrections applied, so that the
 /// core sees corrected pseudoranges and rates.
 std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& msg);
+/// The same without the satellites screenSatellites() dropped.
+std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& msg,
+                                               const std::vector<SatelliteRejection>& dropped);
 
 /// The tightly coupled filter's state layout (core::tc17) as the diagnostics declare it.
 void fillTc17Layout(navbus::FilterDiagnostics& msg);

@@ -16,6 +16,8 @@ struct StreamCounters {
   std::uint64_t sequence_gaps{0};
   std::uint64_t deadline_misses{0};
   std::map<navbus::RejectReason, std::uint64_t> rejected;
+  /// Elements dropped from accepted samples (satellites of an epoch), by reason.
+  std::map<navbus::RejectReason, std::uint64_t> elements_rejected;
 
   std::uint64_t rejectedTotal() const;
 };

@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <navbus_idl/Gnss.h>
 #include <navbus_idl/Imu.h>
@@ -35,11 +36,30 @@ struct ValidationLimits {
   double min_height_m{-1.0e3};
   double quaternion_norm_tolerance{1e-6};
   double max_star_tracker_sigma_rad{0.1};
+  /// Plausible 1-sigma of a pseudorange and its rate: a receiver claiming less than a
+  /// centimetre (a millimetre per second) or more than a kilometre (100 m/s) is not believed.
+  double min_pseudorange_sigma_m{0.01};
+  double max_pseudorange_sigma_m{1.0e3};
+  double min_pseudorange_rate_sigma_mps{1.0e-3};
+  double max_pseudorange_rate_sigma_mps{100.0};
 };
 
 std::optional<Rejection> validate(const navbus::ImuIncrement& s, const ValidationLimits& l);
 std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const ValidationLimits& l);
+/// Epoch-level checks only (none today beyond the IDL bounds): a bad satellite costs that
+/// satellite, not the epoch; see screenSatellites.
 std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s, const ValidationLimits& l);
+
+/// A satellite of an epoch that cannot be used, and why.
+struct SatelliteRejection {
+  std::size_t index;  ///< in satellites()
+  Rejection rejection;
+};
+/// Per-satellite checks: id 1..32, finite values, physical ranges, plausible sigmas, and an id
+/// that appears more than once (every copy: which one is right cannot be told). The others
+/// stay usable. No allocation when every satellite passes.
+std::vector<SatelliteRejection> screenSatellites(const navbus::GnssObservationEpoch& s,
+                                                 const ValidationLimits& l);
 std::optional<Rejection> validate(const navbus::GnssFix& s, const ValidationLimits& l);
 std::optional<Rejection> validate(const navbus::StarTrackerAttitude& s, const ValidationLimits& l);
 /// Sizes consistent with n and m, finite values, satellite ids 1..32 on ranging rows,
@@ -99,9 +119,12 @@ class StreamGate {
 
   /// Counts a rejection decided after admission (e.g. late for the sequencer).
   void reject(const Rejection& r, std::uint32_t sensor_id);
+  /// Counts an element dropped from an accepted sample (a satellite of an epoch).
+  void rejectElement(const Rejection& r, std::uint32_t sensor_id);
   /// Undoes the accepted count of a sample rejected after admission.
   void unaccept();
   const std::string& topic() const { return topic_; }
+  const ValidationLimits& limits() const { return limits_; }
   SequenceTracker& tracker() { return tracker_; }
 
  private:
