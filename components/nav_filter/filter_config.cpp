@@ -46,12 +46,12 @@ Enum choice(const YAML::Node& node, const std::string& where, const std::string&
 
 FilterConfig parseFilterConfig(const YAML::Node& root) {
   FilterConfig c;
-  bus::checkKeys(
-      root, "",
-      {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
-       "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
-       "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional"},
-      bus::kParticipantKeys);
+  bus::checkKeys(root, "",
+                 {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
+                  "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
+                  "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated",
+                  "multi_dimensional", "command_issuers"},
+                 bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
   const double rate = bus::checkRange(bus::get<double>(root, "", "solution_rate_hz", 10.0), 1.0,
@@ -83,6 +83,13 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       units::kDegPerHour;
   c.solution_writer_profile =
       bus::get<std::string>(root, "", "solution_writer_profile", c.solution_writer_profile);
+  c.command_issuers =
+      bus::get<std::vector<std::string>>(root, "", "command_issuers", c.command_issuers);
+  for (const std::string& issuer : c.command_issuers) {
+    if (issuer.empty() || issuer.size() > 64)
+      throw bus::ConfigError("configuration command_issuers: '" + issuer +
+                             "' must have 1 to 64 characters (FilterCommand.issuer)");
+  }
   const YAML::Node init = root["initial_state"];
   if (!init) throw bus::ConfigError("configuration initial_state is missing");
   bus::checkKeys(init, "initial_state",

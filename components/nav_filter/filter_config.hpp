@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -37,6 +38,10 @@ struct FilterConfig {
   /// QoS profile of the solution writer (qos/navbus_qos.xml): navbus_solution_writer, or
   /// navbus_solution_writer_lossless for recording fast-paced runs.
   std::string solution_writer_profile{bus::profile::kSolutionWriter};
+  /// Issuers whose commands the filter accepts (FilterCommand.issuer); others are refused and
+  /// counted. Without DDS Security the issuer is what the sender claims: this stops a
+  /// misconfigured or stray tool, not an attacker (see the README).
+  std::vector<std::string> command_issuers{"fault-manager", "operator"};
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid entry.

@@ -1,5 +1,7 @@
 #include "filter_pipeline.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <sstream>
 #include <type_traits>
@@ -284,6 +286,17 @@ bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c) {
   if (c.vehicle_id() != config_.vehicle_id) return;  // for another vehicle: not ours
+  const std::string issuer = c.issuer().to_string();
+  if (std::find(config_.command_issuers.begin(), config_.command_issuers.end(), issuer) ==
+      config_.command_issuers.end()) {
+    ++commands_refused_;
+    ++commands_unauthorized_;
+    spdlog::warn(
+        "command {} (kind {}) from '{}' refused: not a configured issuer "
+        "(command_issuers); {} refused so far",
+        c.command_id(), static_cast<int>(c.kind()), issuer, commands_unauthorized_);
+    return;
+  }
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM || c.kind() == navbus::CMD_READMIT_STREAM) {
     // About the merge itself (a lost stream must stop holding it): at once.
     const bool applied = applyStreamCommand(c);
@@ -450,10 +463,11 @@ std::string FilterPipeline::summary() const {
       << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
       << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
       << ", stage switches " << n.stage_switches << ", decisions seen " << decisions_seen_
-      << ", commands applied " << commands_applied_ << " refused " << commands_refused_ << " late "
-      << commands_late_ << ", sequencer timeouts " << sequencer_.timeouts() << ", pending "
-      << sequencer_.pending() << ", recoveries from onset " << history_.rollbacks()
-      << " (onset beyond history " << history_.outOfReach() << ")";
+      << ", commands applied " << commands_applied_ << " refused " << commands_refused_
+      << " (unauthorized issuer " << commands_unauthorized_ << ") late " << commands_late_
+      << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending()
+      << ", recoveries from onset " << history_.rollbacks() << " (onset beyond history "
+      << history_.outOfReach() << ")";
   return out.str();
 }
 

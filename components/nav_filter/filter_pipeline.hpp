@@ -124,6 +124,7 @@ class FilterPipeline {
   std::uint64_t decisions_seen_{0};
   std::uint64_t commands_applied_{0};
   std::uint64_t commands_refused_{0};
+  std::uint64_t commands_unauthorized_{0};  ///< of those refused: not from a configured issuer
   std::uint64_t commands_late_{0};
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
 };

@@ -150,13 +150,13 @@ TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
       << test::readFile(dir / "filter.log");
   EXPECT_EQ(seen.back(), FUSION_CENTRALIZED);
   std::uint64_t id = 0;
-  auto select = [&](FusionStructure f) {
+  auto select = [&](FusionStructure f, const char* issuer = "operator") {
     FilterCommand c;
     c.command_id(++id);
     c.vehicle_id(1);
     c.kind(CMD_SELECT_FUSION);
     c.fusion(f);
-    c.issuer("fusion-switch-test");
+    c.issuer(issuer);
     ASSERT_TRUE(commands.write(c));
   };
   for (FusionStructure f : {FUSION_FEDERATED, FUSION_ADAPTIVE}) {
@@ -165,6 +165,8 @@ TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
         << "structure " << static_cast<int>(f) << " not reached";
   }
   select(FUSION_NONE);  // not a structure of a loosely coupled filter: refused
+  // A valid request from an issuer the filter is not configured to obey: refused.
+  select(FUSION_CENTRALIZED, "intruder");
   const std::size_t before = seen.size();
   test::spinUntil(me, 10s, [&] { return seen.size() >= before + 10; });
   EXPECT_EQ(seen.back(), FUSION_ADAPTIVE);
@@ -174,7 +176,8 @@ TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
   EXPECT_EQ(filter.wait(10s), 0);
   const std::string log = test::readFile(dir / "filter.log");
   EXPECT_NE(log.find("refused"), std::string::npos) << log;
-  EXPECT_NE(log.find("commands applied 2 refused 1"), std::string::npos) << log;
+  EXPECT_NE(log.find("commands applied 2 refused 2 (unauthorized issuer 1)"), std::string::npos)
+      << log;
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }
