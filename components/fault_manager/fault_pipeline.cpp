@@ -98,11 +98,14 @@ void FaultPipeline::onWritersGone(StreamKind kind, std::int64_t wall_now_ns) {
   for (const auto& e : watchdog_.onWritersGone(kind, wall_now_ns)) onWatchdogEvent(e);
 }
 
-void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id) {
-  // An IMU's raw stream ends with its increment stream (the same sensor; the raw reader does
-  // not see the raw writer's dispose with Fast DDS 2.9, see the README).
-  if (kind == StreamKind::kImu) onStreamEnded(StreamKind::kImuRaw, sensor_id);
-  if (!watchdog_.onEnded({kind, sensor_id})) return;
+void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id,
+                                  std::uint64_t end_time_gps_ns) {
+  // An IMU's raw stream ends with its increment stream, at the same data time (the same
+  // sensor; the raw reader does not see the raw writer's dispose with Fast DDS 2.9, see the
+  // README). Raw blocks up to that time may still arrive after it: they are no new run.
+  if (kind == StreamKind::kImu)
+    onStreamEnded(StreamKind::kImuRaw, sensor_id, watchdog_.lastTime({kind, sensor_id}));
+  if (!watchdog_.onEnded({kind, sensor_id}, end_time_gps_ns)) return;
   trackers_[kind].reset(sensor_id);
   ++ended_;
   spdlog::info("{} stream {} ended (its writer disposed it): not a loss", kindName(kind),

@@ -41,7 +41,7 @@ class FaultPipeline : private FaultOutput {
   void onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id, std::int64_t wall_now_ns);
   void onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
   /// The stream's writer announced its end (disposed the instance): no loss, counted.
-  void onStreamEnded(StreamKind kind, std::uint32_t sensor_id);
+  void onStreamEnded(StreamKind kind, std::uint32_t sensor_id, std::uint64_t end_time_gps_ns = 0);
   /// The watchdog deadline of a stream kind [s], quoted as the decisions' threshold.
   void setDeadline(StreamKind kind, double deadline_s) { deadline_s_[kind] = deadline_s; }
 

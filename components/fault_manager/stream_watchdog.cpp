@@ -1,10 +1,17 @@
 #include "stream_watchdog.hpp"
 
+#include <algorithm>
+
 namespace navbus::fault_manager {
 
 std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
                                                       std::uint64_t time_gps_ns,
                                                       std::int64_t wall_now_ns) {
+  const auto ended = ended_at_.find(key);
+  if (ended != ended_at_.end()) {
+    if (time_gps_ns <= ended->second) return std::nullopt;  // in flight before the end
+    ended_at_.erase(ended);                                 // a new run of the stream
+  }
   auto [it, inserted] = states_.try_emplace(key);
   State& s = it->second;
   std::optional<WatchdogEvent> event;
@@ -42,6 +49,19 @@ std::vector<WatchdogEvent> StreamWatchdog::onWritersGone(StreamKind kind,
     if (auto e = markLost(key, s, wall_now_ns)) out.push_back(*e);
   }
   return out;
+}
+
+bool StreamWatchdog::onEnded(const StreamKey& key, std::uint64_t end_time_gps_ns) {
+  const auto it = states_.find(key);
+  if (it == states_.end()) return false;
+  ended_at_[key] = std::max(end_time_gps_ns, it->second.last_time_gps_ns);
+  states_.erase(it);
+  return true;
+}
+
+std::uint64_t StreamWatchdog::lastTime(const StreamKey& key) const {
+  const auto it = states_.find(key);
+  return it == states_.end() ? 0 : it->second.last_time_gps_ns;
 }
 
 bool StreamWatchdog::isLost(const StreamKey& key) const {

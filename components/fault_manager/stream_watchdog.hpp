@@ -40,9 +40,14 @@ class StreamWatchdog {
   /// Every writer of a topic lost liveliness: all its streams that are alive are lost.
   std::vector<WatchdogEvent> onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
 
-  /// The stream's writer disposed it (an announced end): forgotten, so that its silence is no
-  /// loss. Returns false if the stream was not known. A new sample starts it again.
-  bool onEnded(const StreamKey& key) { return states_.erase(key) > 0; }
+  /// The stream's writer disposed it (an announced end) after data up to `end_time_gps_ns`
+  /// (or its latest sample seen, if later): forgotten, so that its silence is no loss. Samples
+  /// not later than the end still in flight (another reader of the same topic may deliver
+  /// them after the dispose) are ignored; a later one starts the stream again. Returns false
+  /// if the stream was not known.
+  bool onEnded(const StreamKey& key, std::uint64_t end_time_gps_ns = 0);
+  /// Sensor time of the stream's latest sample (0: not known).
+  std::uint64_t lastTime(const StreamKey& key) const;
 
   bool isLost(const StreamKey& key) const;
 
@@ -54,6 +59,7 @@ class StreamWatchdog {
   };
   std::optional<WatchdogEvent> markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns);
   std::map<StreamKey, State> states_;
+  std::map<StreamKey, std::uint64_t> ended_at_;  ///< announced ends, data time
 };
 
 }  // namespace navbus::fault_manager

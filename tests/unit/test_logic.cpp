@@ -107,6 +107,24 @@ TEST(StreamWatchdog, OneDecisionPerTransition) {
   EXPECT_EQ(w.onWritersGone(StreamKind::kImu, 2100 * kMs).size(), 2u);
 }
 
+TEST(StreamWatchdog, SamplesInFlightAfterAnAnnouncedEndAreNoNewRun) {
+  // The raw stream ends with the IMU's dispose at data time 1000; a reliable reader may still
+  // deliver raw blocks up to that time afterwards: they must not start a run that then
+  // "falls silent" (the demo's end-of-data false alarm).
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey raw{StreamKind::kImuRaw, 1};
+  EXPECT_FALSE(w.onSample(raw, 900, 1 * kMs));
+  EXPECT_TRUE(w.onEnded(raw, 1000));
+  EXPECT_FALSE(w.onSample(raw, 950, 2 * kMs));
+  EXPECT_FALSE(w.onSample(raw, 1000, 3 * kMs));
+  EXPECT_FALSE(w.onDeadlineMissed(raw, 300 * kMs));
+  EXPECT_FALSE(w.onEnded(raw));  // nothing running
+  // A later sample is a new run of the stream, watched again.
+  EXPECT_FALSE(w.onSample(raw, 5000, 400 * kMs));
+  EXPECT_EQ(w.lastTime(raw), 5000u);
+  EXPECT_TRUE(w.onDeadlineMissed(raw, 700 * kMs));
+}
+
 TEST(Formatters, CsvHasOneRowPerSatelliteAndRoundTripsDoubles) {
   navbus::GnssObservationEpoch e;
   e.receiver_id(3);
