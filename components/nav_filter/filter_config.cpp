@@ -50,7 +50,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                  {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
                   "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
                   "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated",
-                  "multi_dimensional", "command_issuers"},
+                  "multi_dimensional", "command_issuers", "time_jump"},
                  bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
@@ -85,6 +85,13 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       bus::get<std::string>(root, "", "solution_writer_profile", c.solution_writer_profile);
   c.command_issuers =
       bus::get<std::vector<std::string>>(root, "", "command_issuers", c.command_issuers);
+  const YAML::Node jump = root["time_jump"];
+  bus::checkKeys(jump, "time_jump", {"tolerance_s", "confirmations"});
+  c.time_jump.tolerance_ns = static_cast<std::uint64_t>(
+      seconds(bus::checkRange(bus::get<double>(jump, "time_jump", "tolerance_s", 2.0), 0.0, 86400.0,
+                              "time_jump.tolerance_s")));
+  c.time_jump.confirmations = static_cast<int>(bus::checkRange(
+      bus::get<int>(jump, "time_jump", "confirmations", 3), 1, 1000, "time_jump.confirmations"));
   for (const std::string& issuer : c.command_issuers) {
     if (issuer.empty() || issuer.size() > 64)
       throw bus::ConfigError("configuration command_issuers: '" + issuer +

@@ -9,6 +9,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "navbus/bus/topics.hpp"
+#include "navbus/bus/validation.hpp"
 #include "navbus/core/navigation_engine.hpp"
 
 namespace navbus::nav_filter {
@@ -42,6 +43,9 @@ struct FilterConfig {
   /// counted. Without DDS Security the issuer is what the sender claims: this stops a
   /// misconfigured or stray tool, not an attacker (see the README).
   std::vector<std::string> command_issuers{"fault-manager", "operator"};
+  /// A sample more than this ahead of every input's latest data is not believed until the
+  /// samples after it confirm it (bus::TimeJumpRule).
+  bus::TimeJumpRule time_jump{2'000'000'000, 3};
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid entry.

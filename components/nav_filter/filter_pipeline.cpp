@@ -87,10 +87,14 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
       sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
       history_(config.recovery_history_ns, config.recovery_snapshot_period_ns),
       engine_(config.engine),
-      imu_gate_(bus::topic::kImuIncrement, health.stream(bus::topic::kImuIncrement)),
-      gnss_obs_gate_(bus::topic::kGnssObservations, health.stream(bus::topic::kGnssObservations)),
-      gnss_fix_gate_(bus::topic::kGnssFix, health.stream(bus::topic::kGnssFix)),
-      star_gate_(bus::topic::kStarTracker, health.stream(bus::topic::kStarTracker)) {}
+      imu_gate_(bus::topic::kImuIncrement, health.stream(bus::topic::kImuIncrement),
+                config.time_jump, &time_reference_),
+      gnss_obs_gate_(bus::topic::kGnssObservations, health.stream(bus::topic::kGnssObservations),
+                     config.time_jump, &time_reference_),
+      gnss_fix_gate_(bus::topic::kGnssFix, health.stream(bus::topic::kGnssFix), config.time_jump,
+                     &time_reference_),
+      star_gate_(bus::topic::kStarTracker, health.stream(bus::topic::kStarTracker),
+                 config.time_jump, &time_reference_) {}
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
                            FilterInput input) {

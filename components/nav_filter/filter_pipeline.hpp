@@ -114,6 +114,8 @@ class FilterPipeline {
   std::deque<FilterInput> replay_;
   bool replaying_{false};
   core::NavigationEngine engine_;
+  bus::TimeReference
+      time_reference_;  ///< latest data time accepted on any input (before the gates)
   bus::StreamGate imu_gate_;
   bus::StreamGate gnss_obs_gate_;
   bus::StreamGate gnss_fix_gate_;

@@ -94,6 +94,10 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
         bad.sensor_id(9);
         w.imu.write(bad);
         break;  // not configured
+      case 160:
+        bad.time_gps_ns(good.time_gps_ns() + 3'600'000'000'000ULL);
+        w.imu.write(bad);
+        break;  // an hour in the future: not adopted, the genuine samples after it go on
       default:
         break;
     }
@@ -156,14 +160,15 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
         {REJECT_BAD_INTERVAL, 1},
         {REJECT_TIME_NOT_MONOTONIC, 1},
         {REJECT_DUPLICATE, 1},
-        {REJECT_UNEXPECTED_SOURCE, 1}}},
+        {REJECT_UNEXPECTED_SOURCE, 1},
+        {REJECT_TIME_JUMP, 1}}},
       {bus::topic::kGnssObservations, {{REJECT_DUPLICATE, 1}}},
       {bus::topic::kGnssFix, {{REJECT_NOT_FINITE, 1}}},
       {bus::topic::kStarTracker, {{REJECT_BAD_QUATERNION, 1}}},
   };
   ASSERT_TRUE(test::spinUntil(me, 20s, [&] {
     const auto* s = stream(bus::topic::kImuIncrement);
-    return s != nullptr && s->received() == 307 && counts() == expected && solutions.size() >= 30;
+    return s != nullptr && s->received() == 308 && counts() == expected && solutions.size() >= 30;
   })) << test::readFile(dir / "filter.log");
   const auto* s = stream(bus::topic::kImuIncrement);
   EXPECT_EQ(s->accepted(), 300u);

@@ -119,6 +119,38 @@ TEST(Validation, GnssSatellitesScreenedOneByOne) {
   EXPECT_EQ(kept[0].sv_id, 7);
 }
 
+TEST(SequenceTracker, ForwardJumpRejectedUnlessTheSamplesAfterItConfirmIt) {
+  using navbus::bus::SequenceTracker;
+  navbus::bus::TimeReference reference;
+  SequenceTracker imu({2'000'000'000, 3}, &reference), gnss({2'000'000'000, 3}, &reference);
+  const std::uint64_t t0 = 1'000'000'000'000, dt = 10'000'000, hour = 3'600'000'000'000;
+  std::uint64_t seq = 0, t = t0;
+  auto next = [&] { return imu.check(1, ++seq, t += dt); };
+  for (int k = 0; k < 10; ++k) EXPECT_FALSE(next().rejection);
+  // One sample stamped an hour ahead: rejected and not adopted; the stream goes on.
+  auto o = imu.check(1, seq + 1, t + hour);
+  ASSERT_TRUE(o.rejection);
+  EXPECT_EQ(o.rejection->reason, navbus::REJECT_TIME_JUMP);
+  for (int k = 0; k < 5; ++k) EXPECT_FALSE(next().rejection) << k;
+  EXPECT_EQ(reference.latest_ns, t);
+  // Another stream is judged against the participant's reference too.
+  EXPECT_EQ(gnss.check(1, 1, t + hour).rejection->reason, navbus::REJECT_TIME_JUMP);
+  EXPECT_FALSE(gnss.check(1, 2, t).rejection);
+  // A real resumption after 60 s of silence: the first two samples are rejected, the third,
+  // continuing from them, is accepted and adopted.
+  t += 60'000'000'000;
+  EXPECT_EQ(next().rejection->reason, navbus::REJECT_TIME_JUMP);
+  EXPECT_EQ(next().rejection->reason, navbus::REJECT_TIME_JUMP);
+  o = next();
+  EXPECT_FALSE(o.rejection);
+  EXPECT_TRUE(o.jump_adopted);
+  EXPECT_FALSE(next().rejection);
+  // Without a rule nothing is judged (the fault manager's counters).
+  SequenceTracker plain;
+  EXPECT_FALSE(plain.check(1, 1, t0).rejection);
+  EXPECT_FALSE(plain.check(1, 2, t0 + hour).rejection);
+}
+
 TEST(Validation, StarTrackerQuaternionMustBeUnit) {
   navbus::StarTrackerAttitude s;
   s.q_b_to_i({1.0, 0.0, 0.0, 0.0});

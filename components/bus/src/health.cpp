@@ -104,6 +104,8 @@ const char* rejectReasonName(navbus::RejectReason reason) {
       return "inconsistent";
     case navbus::REJECT_DUPLICATE_SATELLITE:
       return "duplicate_satellite";
+    case navbus::REJECT_TIME_JUMP:
+      return "time_jump";
   }
   return "unknown";
 }

@@ -254,14 +254,48 @@ SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::ui
           Rejection{navbus::REJECT_TIME_NOT_MONOTONIC, "time_gps_ns", static_cast<double>(time_ns)};
       return out;
     }
-    if (seq > last.seq + 1) {
-      out.missing = seq - last.seq - 1;
-    } else if (seq <= last.seq) {
+  }
+  const std::uint64_t stream_latest = it != last_.end() ? it->second.time_ns : 0;
+  if (auto r = checkJump(sensor_id, seq, time_ns, stream_latest, out)) {
+    out.rejection = r;
+    return out;
+  }
+  if (it != last_.end() && !out.jump_adopted) {
+    if (seq > it->second.seq + 1) {
+      out.missing = seq - it->second.seq - 1;
+    } else if (seq <= it->second.seq) {
       out.restarted = true;
     }
   }
   last_[sensor_id] = Last{seq, time_ns};
+  if (reference_ != nullptr && time_ns > reference_->latest_ns) reference_->latest_ns = time_ns;
   return out;
+}
+
+std::optional<Rejection> SequenceTracker::checkJump(std::uint32_t sensor_id, std::uint64_t seq,
+                                                    std::uint64_t time_ns,
+                                                    std::uint64_t stream_latest_ns, Outcome& out) {
+  if (rule_.tolerance_ns == 0) return std::nullopt;
+  const std::uint64_t latest =
+      std::max(stream_latest_ns, reference_ != nullptr ? reference_->latest_ns : 0);
+  auto cand = candidate_.find(sensor_id);
+  if (latest == 0 || time_ns <= latest + rule_.tolerance_ns) {
+    if (cand != candidate_.end()) candidate_.erase(cand);  // the stream goes on: a one-off
+    return std::nullopt;
+  }
+  // Ahead of everything seen by more than the tolerance: a forward jump. It is adopted only
+  // when the samples after it continue from it.
+  const bool continues = cand != candidate_.end() && seq > cand->second.seq &&
+                         time_ns > cand->second.time_ns &&
+                         time_ns <= cand->second.time_ns + rule_.tolerance_ns;
+  const int count = continues ? cand->second.count + 1 : 1;
+  if (count >= rule_.confirmations) {
+    candidate_.erase(sensor_id);
+    out.jump_adopted = true;
+    return std::nullopt;
+  }
+  candidate_[sensor_id] = Candidate{seq, time_ns, count};
+  return Rejection{navbus::REJECT_TIME_JUMP, "time_gps_ns", static_cast<double>(time_ns)};
 }
 
 }  // namespace navbus::bus
@@ -295,6 +329,9 @@ void StreamGate::noteSequence(const SequenceTracker::Outcome& o) {
   counters_.sequence_gaps += o.missing;
   if (o.restarted) {
     spdlog::info("{}: sequence restarted (writer restart)", topic_);
+  }
+  if (o.jump_adopted) {
+    spdlog::warn("{}: a forward time jump confirmed by the samples after it: adopted", topic_);
   }
 }
 

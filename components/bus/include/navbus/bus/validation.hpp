@@ -66,6 +66,23 @@ std::optional<Rejection> validate(const navbus::StarTrackerAttitude& s, const Va
 /// positive innovation variances.
 std::optional<Rejection> validate(const navbus::FilterDiagnostics& s, const ValidationLimits& l);
 
+/// The latest data time accepted on any input of a participant [ns]: the reference a
+/// sample's time is judged against (0: nothing accepted yet).
+struct TimeReference {
+  std::uint64_t latest_ns{0};
+};
+
+/// Rules for a sample far ahead of the data seen so far.
+struct TimeJumpRule {
+  /// Later than max(the stream's latest, the participant's latest) by more than this: rejected
+  /// (REJECT_TIME_JUMP) and not adopted as the stream's time; 0: no check.
+  std::uint64_t tolerance_ns{0};
+  /// ... unless this many samples in a row continue from it (sequence and time increasing,
+  /// each within the tolerance of the previous): a real resumption after a long silence. The
+  /// last of them is accepted, the ones before stay rejected.
+  int confirmations{3};
+};
+
 /// Tracks time and sequence per sensor id of one stream.
 class SequenceTracker {
  public:
@@ -73,18 +90,38 @@ class SequenceTracker {
     std::optional<Rejection> rejection;
     std::uint64_t missing{0};  ///< samples skipped according to the sequence number
     bool restarted{false};     ///< sequence went back while time went forward (writer restart)
+    bool jump_adopted{false};  ///< a forward jump confirmed by the samples after it
   };
+  SequenceTracker() = default;
+  /// `reference` (optional, outliving the tracker) is shared by the participant's streams.
+  SequenceTracker(TimeJumpRule rule, TimeReference* reference)
+      : rule_(rule), reference_(reference) {}
   /// Checks a sample and, if accepted, records it.
   Outcome check(std::uint32_t sensor_id, std::uint64_t seq, std::uint64_t time_ns);
   /// Forgets a sensor (e.g. after the stream was declared lost).
-  void reset(std::uint32_t sensor_id) { last_.erase(sensor_id); }
+  void reset(std::uint32_t sensor_id) {
+    last_.erase(sensor_id);
+    candidate_.erase(sensor_id);
+  }
 
  private:
   struct Last {
     std::uint64_t seq;
     std::uint64_t time_ns;
   };
+  struct Candidate {
+    std::uint64_t seq;
+    std::uint64_t time_ns;
+    int count;
+  };
+  /// The forward-jump rule: nullopt to accept, or the rejection.
+  std::optional<Rejection> checkJump(std::uint32_t sensor_id, std::uint64_t seq,
+                                     std::uint64_t time_ns, std::uint64_t stream_latest_ns,
+                                     Outcome& out);
+  TimeJumpRule rule_;
+  TimeReference* reference_{nullptr};
   std::map<std::uint32_t, Last> last_;
+  std::map<std::uint32_t, Candidate> candidate_;
 };
 
 }  // namespace navbus::bus
@@ -100,6 +137,10 @@ class StreamGate {
  public:
   StreamGate(std::string topic, StreamCounters& counters, ValidationLimits limits = {})
       : topic_(std::move(topic)), counters_(counters), limits_(limits) {}
+  /// With the forward-jump rule, judged against the participant's shared time reference.
+  StreamGate(std::string topic, StreamCounters& counters, TimeJumpRule rule,
+             TimeReference* reference)
+      : topic_(std::move(topic)), counters_(counters), tracker_(rule, reference) {}
 
   template <class Sample>
   bool admit(const Sample& sample, std::uint32_t sensor_id, std::uint64_t seq,
