@@ -136,13 +136,15 @@ void FaultPipeline::onWatchdogEvent(const WatchdogEvent& e) {
   command(c);
 }
 
-void FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
+bool FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
   if (msg.vehicle_id() != config_.vehicle_id) {
     ++other_vehicles_;
-    return;
+    return false;
   }
-  if (!diagnostics_gate_.admit(msg, msg.vehicle_id(), msg.seq(), msg.time_gps_ns())) return;
+  if (!diagnostics_gate_.admit(msg, msg.vehicle_id(), msg.seq(), msg.time_gps_ns())) return false;
+  const std::uint64_t before = glr_.counters().epochs;
   glr_.onDiagnostics(msg, *this);
+  return glr_.counters().epochs != before;
 }
 
 std::uint32_t FaultPipeline::decide(navbus::FaultDecision& d) {

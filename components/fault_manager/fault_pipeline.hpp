@@ -45,8 +45,9 @@ class FaultPipeline : private FaultOutput {
   /// The watchdog deadline of a stream kind [s], quoted as the decisions' threshold.
   void setDeadline(StreamKind kind, double deadline_s) { deadline_s_[kind] = deadline_s; }
 
-  /// The monitored filter's diagnostics (validated here; other vehicles are ignored).
-  void onDiagnostics(const navbus::FilterDiagnostics& msg);
+  /// The monitored filter's diagnostics (validated here; other vehicles are ignored). True
+  /// when the GLR evaluated the epoch (its statistic is then glr().latest()).
+  bool onDiagnostics(const navbus::FilterDiagnostics& msg);
   /// A raw IMU block, for the dither monitor (watchdog bookkeeping goes through
   /// onStreamSample as for every stream).
   void onRawBlock(const navbus::ImuRawBlock& block);

@@ -146,32 +146,30 @@ void FramePublisher::flush() {
   }
 }
 
+namespace {
+/// Disposes the instance `key` names, if the stream published anything.
+template <class Sample>
+void disposeIfPublished(bus::Writer<Sample>& writer, std::uint64_t published, const Sample& key) {
+  if (published > 0) writer.dispose(key);
+}
+}  // namespace
+
 void FramePublisher::endStreams() {
-  if (counts_.imu > 0) {
-    navbus::ImuIncrement k;
-    k.sensor_id(config_.imu_sensor_id);
-    imu_.dispose(k);
-  }
-  if (counts_.raw > 0) {
-    navbus::ImuRawBlock k;
-    k.sensor_id(config_.imu_sensor_id);
-    raw_.dispose(k);
-  }
-  if (counts_.gnss_epochs > 0) {
-    navbus::GnssObservationEpoch k;
-    k.receiver_id(config_.gnss_receiver_id);
-    gnss_.dispose(k);
-  }
-  if (counts_.gnss_fixes > 0) {
-    navbus::GnssFix k;
-    k.receiver_id(config_.gnss_receiver_id);
-    fix_.dispose(k);
-  }
-  if (counts_.star_tracker > 0) {
-    navbus::StarTrackerAttitude k;
-    k.tracker_id(config_.star_tracker_id);
-    star_.dispose(k);
-  }
+  navbus::ImuIncrement imu;
+  imu.sensor_id(config_.imu_sensor_id);
+  disposeIfPublished(imu_, counts_.imu, imu);
+  navbus::ImuRawBlock raw;
+  raw.sensor_id(config_.imu_sensor_id);
+  disposeIfPublished(raw_, counts_.raw, raw);
+  navbus::GnssObservationEpoch gnss;
+  gnss.receiver_id(config_.gnss_receiver_id);
+  disposeIfPublished(gnss_, counts_.gnss_epochs, gnss);
+  navbus::GnssFix fix;
+  fix.receiver_id(config_.gnss_receiver_id);
+  disposeIfPublished(fix_, counts_.gnss_fixes, fix);
+  navbus::StarTrackerAttitude star;
+  star.tracker_id(config_.star_tracker_id);
+  disposeIfPublished(star_, counts_.star_tracker, star);
 }
 
 }  // namespace navbus::sensor_sim

@@ -133,23 +133,25 @@ void checkImuKeys(const YAML::Node& imu) {
        "gyro_quantum_urad", "gyro_g_sensitivity_deg_per_h_per_g", "bias_correlation_time_s"});
 }
 
+/// The keys every fault has.
+constexpr std::initializer_list<const char*> kFaultCommonKeys = {"type", "start_s", "end_s",
+                                                                 "duration_s"};
+
 /// The keys of one fault: the common ones and those of its type.
 void checkFaultKeys(const YAML::Node& n, const std::string& where, const std::string& type) {
   if (type == "imu_bias_step")
     checkKeys(n, where, {"sensor", "axis", "magnitude_mg", "magnitude_deg_per_h"},
-              {"type", "start_s", "end_s", "duration_s"});
+              kFaultCommonKeys);
   else if (type == "pseudorange_ramp")
-    checkKeys(n, where, {"sv_id", "slope_mps", "saturation_m"},
-              {"type", "start_s", "end_s", "duration_s"});
+    checkKeys(n, where, {"sv_id", "slope_mps", "saturation_m"}, kFaultCommonKeys);
   else if (type == "gnss_position_pulse")
-    checkKeys(n, where, {"north_m", "east_m", "down_m"},
-              {"type", "start_s", "end_s", "duration_s"});
+    checkKeys(n, where, {"north_m", "east_m", "down_m"}, kFaultCommonKeys);
   else if (type == "sensor_stuck")
-    checkKeys(n, where, {"sensor", "axis"}, {"type", "start_s", "end_s", "duration_s"});
+    checkKeys(n, where, {"sensor", "axis"}, kFaultCommonKeys);
   else if (type == "star_tracker_bias")
-    checkKeys(n, where, {"bias_arcsec"}, {"type", "start_s", "end_s", "duration_s"});
+    checkKeys(n, where, {"bias_arcsec"}, kFaultCommonKeys);
   else
-    checkKeys(n, where, {"type", "start_s", "end_s", "duration_s"});
+    checkKeys(n, where, kFaultCommonKeys);
 }
 
 void parseTriad(const YAML::Node& imu, const std::string& prefix, double bias_unit, double bi_unit,

@@ -92,10 +92,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   std::function<void(const navbus::FilterDiagnostics&)> on_diagnostics;
   if (faults) {
     on_diagnostics = [&](const navbus::FilterDiagnostics& d) {
-      const std::uint64_t before = faults->glr().counters().epochs;
-      faults->onDiagnostics(d);
-      if (faults->glr().counters().epochs == before) return;  // refused or GLR disabled
-      result.glr_trace.push_back(faults->glr().latest());
+      if (faults->onDiagnostics(d)) result.glr_trace.push_back(faults->glr().latest());
     };
   }
   nav_filter::FilterPipeline pipeline(setup.filter, health, {on_solution, on_diagnostics});

@@ -163,10 +163,8 @@ class RealDataRun {
     }
     const core::EpochDiagnostics& d = filter_.update(input.time_s, input.sats);
     if (monitor && faults_) {
-      const std::uint64_t before = faults_->glr().counters().epochs;
-      faults_->onDiagnostics(
-          bus::toIdl(d, setup_.fault_manager->vehicle_id, ++diagnostics_seq_, toNs(input.time_s)));
-      if (faults_->glr().counters().epochs != before)
+      if (faults_->onDiagnostics(bus::toIdl(d, setup_.fault_manager->vehicle_id, ++diagnostics_seq_,
+                                            toNs(input.time_s))))
         result_.glr_trace.push_back(faults_->glr().latest());
     }
   }

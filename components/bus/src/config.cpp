@@ -20,16 +20,15 @@ YAML::Node merge(YAML::Node base, const YAML::Node& over) {
 }
 
 YAML::Node loadWithExtends(const std::filesystem::path& path, int depth) {
-  if (depth > 8)
-    throw ConfigError("configuration file '" + path.string() + "': 'extends' nested too deeply");
+  if (depth > 8) throw ConfigFileError(path.string(), ": 'extends' nested too deeply");
   if (!std::ifstream(path).good()) {
-    throw ConfigError("configuration file '" + path.string() + "' cannot be read");
+    throw ConfigFileError(path.string(), " cannot be read");
   }
   YAML::Node node;
   try {
     node = YAML::LoadFile(path.string());
   } catch (const YAML::Exception& e) {
-    throw ConfigError("configuration file '" + path.string() + "': " + e.what());
+    throw ConfigFileError(path.string(), std::string(": ") + e.what());
   }
   if (!node.IsMap() || !node["extends"]) return node;
   // `extends: base.yaml` (relative to this file): this file's keys override the base's.
@@ -96,10 +95,10 @@ std::string fileDefiningKey(const std::string& path, const std::string& key_path
 }
 
 void rethrowNamingFile(const std::string& path, const ConfigError& e) {
-  if (std::string(e.what()).rfind("configuration file '", 0) == 0) throw e;  // named already
+  if (const auto* named = dynamic_cast<const ConfigFileError*>(&e)) throw *named;
   const auto* unknown = dynamic_cast<const UnknownKeyError*>(&e);
   const std::string file = unknown ? fileDefiningKey(path, unknown->keyPath()) : path;
-  throw ConfigError("configuration file '" + file + "': " + e.what());
+  throw ConfigFileError(file, std::string(": ") + e.what());
 }
 
 double checkRange(double value, double lo, double hi, const std::string& name) {

@@ -19,6 +19,13 @@ class ConfigError : public std::runtime_error {
 
 YAML::Node loadYamlFile(const std::string& path);
 
+/// A ConfigError whose message already names the configuration file.
+class ConfigFileError : public ConfigError {
+ public:
+  ConfigFileError(const std::string& file, const std::string& what)
+      : ConfigError("configuration file '" + file + "'" + what) {}
+};
+
 /// A key no parser reads: a typo that would otherwise be silently ignored.
 class UnknownKeyError : public ConfigError {
  public:
