@@ -19,6 +19,9 @@ void addCommonOptions(CLI::App& app, CommonOptions& o, bool config_required) {
   app.add_option(
       "--profile", o.participant_profile,
       "participant profile name in the QoS file (default: navbus_participant_udp_loopback)");
+  app.add_option("--identity", o.security_identity,
+                 "DDS Security credentials directory, for a *_secure profile "
+                 "(scripts/make_credentials.sh makes test ones)");
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
 }
@@ -34,6 +37,9 @@ Participant::Options participantOptions(const CommonOptions& o, const YAML::Node
       !o.participant_profile.empty()
           ? o.participant_profile
           : get<std::string>(cfg, "", "participant_profile", profile::kParticipantLoopback);
+  p.dds.security_identity = !o.security_identity.empty()
+                                ? o.security_identity
+                                : get<std::string>(cfg, "", "security_identity", "");
   const double health_s =
       checkRange(get<double>(cfg, "", "health_period_s", 1.0), 0.05, 60.0, "health_period_s");
   p.health_period = std::chrono::milliseconds(static_cast<long>(health_s * 1000.0));

@@ -7,6 +7,8 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
+#include "navbus/bus/security.hpp"
+
 #ifndef NAVBUS_QOS_FILE_DEFAULT
 #error "NAVBUS_QOS_FILE_DEFAULT must be defined by the build"
 #endif
@@ -48,14 +50,21 @@ DdsContext::DdsContext(const ParticipantOptions& options) : name_(options.name) 
     throw DdsError("participant profile '" + options.participant_profile +
                    "' is not defined in the QoS file");
   }
+  applySecurityIdentity(qos, options.participant_profile, options.security_identity);
   qos.name(options.name);
   participant_ = factory->create_participant(
       static_cast<dds::DomainId_t>(options.domain_id), qos, options.listener,
       options.listener ? dds::StatusMask::none() : dds::StatusMask::all());
   if (participant_ == nullptr) {
-    throw DdsError("cannot create participant '" + options.name + "' on domain " +
-                   std::to_string(options.domain_id) + " with profile '" +
-                   options.participant_profile + "'");
+    std::string why = "cannot create participant '" + options.name + "' on domain " +
+                      std::to_string(options.domain_id) + " with profile '" +
+                      options.participant_profile + "'";
+    if (securityEnabled(qos)) {
+      why += " and security identity '" + options.security_identity +
+             "' (its certificate must be signed by its identity_ca.pem, the documents by its "
+             "permissions_ca.pem, and permissions.p7s must grant its subject this domain)";
+    }
+    throw DdsError(why);
   }
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
@@ -94,7 +103,7 @@ dds::DataWriter* DdsContext::createWriter(dds::Topic* topic, const std::string& 
   dds::DataWriter* writer = publisher_->create_datawriter_with_profile(topic, profile);
   if (writer == nullptr) {
     throw DdsError("cannot create writer on '" + topic->get_name() + "' with profile '" + profile +
-                   "' (missing profile or inconsistent QoS)");
+                   "' (missing profile, inconsistent QoS, or not permitted to this identity)");
   }
   return writer;
 }
@@ -103,7 +112,7 @@ dds::DataReader* DdsContext::createReader(dds::Topic* topic, const std::string& 
   dds::DataReader* reader = subscriber_->create_datareader_with_profile(topic, profile);
   if (reader == nullptr) {
     throw DdsError("cannot create reader on '" + topic->get_name() + "' with profile '" + profile +
-                   "' (missing profile or inconsistent QoS)");
+                   "' (missing profile, inconsistent QoS, or not permitted to this identity)");
   }
   return reader;
 }

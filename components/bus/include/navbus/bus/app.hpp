@@ -24,14 +24,15 @@ struct CommonOptions {
   int domain_id{-1};                ///< -1: from the configuration (default 0)
   std::string qos_file;             ///< empty: configuration, environment or installed default
   std::string participant_profile;  ///< empty: configuration or the loopback profile
+  std::string security_identity;    ///< empty: configuration (none by default)
   std::string log_level{"info"};
 };
 
-/// Adds --config, --domain, --qos, --profile and --log-level.
+/// Adds --config, --domain, --qos, --profile, --identity and --log-level.
 void addCommonOptions(CLI::App& app, CommonOptions& options, bool config_required);
 
 /// Participant options: command line first, then the configuration's keys domain_id,
-/// qos_file, participant_profile and health_period_s, then defaults.
+/// qos_file, participant_profile, security_identity and health_period_s, then defaults.
 Participant::Options participantOptions(const CommonOptions& options, const YAML::Node& config,
                                         const std::string& name);
 

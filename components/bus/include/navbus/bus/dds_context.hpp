@@ -34,6 +34,9 @@ struct ParticipantOptions {
   std::string participant_profile;  ///< a <participant> profile name from the QoS file
   std::string qos_file;             ///< empty: environment variable or installed default
   std::string name;                 ///< participant name shown in discovery and health
+  /// DDS Security credentials directory (see security.hpp); required by a secure profile,
+  /// refused by any other.
+  std::string security_identity;
   /// Optional listener installed at creation, so that no discovery event is missed.
   eprosima::fastdds::dds::DomainParticipantListener* listener{nullptr};
 };
