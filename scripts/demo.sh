@@ -5,6 +5,8 @@
 # the scenario (sim/scenarios/demo_fault_loop.yaml) injects a pseudorange ramp and a stuck
 # accelerometer. The summary shows, per fault, the error before it, the decision, the
 # reconfiguration and the error after it; the figures go next to the CSV files.
+# NAVBUS_SECURE=1 runs the four participants under DDS Security (secure loopback profile, the
+# test credentials the build makes in build/security).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -17,20 +19,25 @@ scenario=sim/scenarios/demo_fault_loop.yaml
 filter_cfg=config/filter_demo.yaml
 fm_cfg=config/fault_manager.yaml
 rm -rf "$out" && mkdir -p "$out"
+# bus_args IDENTITY: the participant profile and, when secure, the credentials of IDENTITY.
+bus_args() { :; }
+if [ "${NAVBUS_SECURE:-0}" = 1 ]; then
+  bus_args() { echo "--profile navbus_participant_udp_loopback_secure --identity build/security/$1"; }
+fi
 pids=()
 trap 'kill -TERM "${pids[@]}" 2>/dev/null || true' EXIT
 
-"$bin/navbus-filter" -c "$filter_cfg" -d "$domain" > "$out/filter.log" 2>&1 &
+"$bin/navbus-filter" -c "$filter_cfg" -d "$domain" $(bus_args filter) > "$out/filter.log" 2>&1 &
 filter=$!
-"$bin/navbus-fault-manager" -c "$fm_cfg" -d "$domain" > "$out/fault_manager.log" 2>&1 &
+"$bin/navbus-fault-manager" -c "$fm_cfg" -d "$domain" $(bus_args fault-manager) > "$out/fault_manager.log" 2>&1 &
 fm=$!
-"$bin/navbus" -d "$domain" record navbus/nav/solution navbus/fault/decision navbus/filter/command \
+"$bin/navbus" -d "$domain" $(bus_args tool) record navbus/nav/solution navbus/fault/decision navbus/filter/command \
   -o "$out/record" > "$out/record.log" 2>&1 &
 rec=$!
 pids=($filter $fm $rec)
-echo "demo: filter, fault manager and recorder started on domain $domain; the simulator publishes"
+echo "demo: filter, fault manager and recorder started on domain $domain$([ "${NAVBUS_SECURE:-0}" = 1 ] && echo ' under DDS Security'); the simulator publishes"
 echo "      120 s of data as fast as they take it (pseudorange ramp at 30 s, stuck accelerometer at 65 s)"
-"$bin/navbus-sensor-sim" -c "$scenario" -d "$domain" > "$out/sensor_sim.log" 2>&1
+"$bin/navbus-sensor-sim" -c "$scenario" -d "$domain" $(bus_args simulator) > "$out/sensor_sim.log" 2>&1
 sleep 1   # the filter releases its last inputs
 kill -TERM $filter $fm
 wait $filter $fm 2>/dev/null || true

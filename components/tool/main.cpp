@@ -1,4 +1,4 @@
-// navbus: the user's tool for the bus: `topics`, `echo`, `record`.
+// navbus: the user's tool for the bus: `topics`, `echo`, `record`, `latency`; offline runs.
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +11,7 @@
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 
 #include "evaluation.hpp"
+#include "latency.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
 #include "real_data.hpp"
@@ -180,6 +181,27 @@ int main(int argc, char** argv) {
   record_cmd->add_option("--duration", duration_s,
                          "stop after this many seconds (0: until SIGINT)");
 
+  nb::tool::LatencyOptions latency;
+  auto* latency_cmd = app.add_subcommand(
+      "latency",
+      "round-trip latency with navbus's message type: run `pong` in one process, "
+      "`ping` in another (same domain, --profile, --qos)");
+  latency_cmd->add_option("role", latency.role, "ping or pong")
+      ->required()
+      ->check(CLI::IsMember({"ping", "pong"}));
+  latency_cmd->add_option("--samples", latency.samples, "pings timed after the warm-up")
+      ->check(CLI::Range(1, 10'000'000));
+  latency_cmd->add_option("--warmup", latency.warmup, "pings sent first, not timed")
+      ->check(CLI::Range(0, 1'000'000));
+  latency_cmd->add_option("--rate", latency.rate_hz, "ping rate [Hz]")
+      ->check(CLI::Range(0.1, 100000.0));
+  latency_cmd
+      ->add_option("--match-timeout", latency.match_timeout_s, "seconds to wait for the other side")
+      ->check(CLI::Range(0.1, 600.0));
+  latency_cmd->add_option("--duration", latency.pong_duration_s,
+                          "pong: stop after this many seconds (0: until SIGINT)");
+  latency_cmd->add_option("--csv", latency.csv, "ping: write every round trip [ns] to this file");
+
   nb::tool::OfflineOptions offline;
   auto* offline_cmd = app.add_subcommand(
       "offline", "run a scenario through the filter without DDS; write solution, truth, error CSV");
@@ -288,6 +310,10 @@ int main(int argc, char** argv) {
       return nb::tool::runMonteCarloCommand(mc);
     }
     auto options = nb::bus::participantOptions(common, yaml, "navbus");
+    if (*latency_cmd) {
+      options.dds.name = "navbus-latency-" + latency.role;
+      return nb::tool::runLatencyCommand(options, latency, shutdown);
+    }
     if (*topics_cmd) {
       DiscoveryListener listener;
       options.dds.listener = &listener;

@@ -15,6 +15,9 @@ inline constexpr const char* kFilterDiagnostics = "navbus/nav/diagnostics";
 inline constexpr const char* kFaultDecision = "navbus/fault/decision";
 inline constexpr const char* kFilterCommand = "navbus/filter/command";
 inline constexpr const char* kHealth = "navbus/health";
+// Latency probes of `navbus latency` (ImuIncrement samples, sensor stream profiles).
+inline constexpr const char* kLatencyPing = "navbus/latency/ping";
+inline constexpr const char* kLatencyPong = "navbus/latency/pong";
 }  // namespace topic
 
 namespace profile {

@@ -1,0 +1,38 @@
+// `navbus latency`: round-trip latency over the bus with navbus's own message type. One
+// process pings (writes navbus/latency/ping at a fixed rate, times the echo), another pongs
+// (echoes each ping on navbus/latency/pong at once). Both use the sensor stream profiles, so
+// the figure is what an IMU increment costs on the participant profile under test (UDP
+// loopback, shared memory, LAN, discovery server, DDS Security).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "navbus/bus/participant.hpp"
+
+namespace navbus::tool {
+
+struct LatencyOptions {
+  std::string role;              ///< "ping" or "pong"
+  int samples{2000};             ///< pings timed (after the warm-up)
+  int warmup{100};               ///< pings sent first and not timed
+  double rate_hz{200.0};         ///< ping rate [Hz] (the navigation IMU rate)
+  double match_timeout_s{20.0};  ///< wait this long for the other side
+  double pong_duration_s{0.0};   ///< pong: stop after this long (0: at SIGINT/SIGTERM)
+  std::string csv;               ///< ping: write each round trip [ns] here if not empty
+};
+
+/// Nearest-rank statistics of round-trip times [ns].
+struct LatencyStats {
+  std::size_t count{0};
+  double median_ns{0}, p90_ns{0}, p99_ns{0}, p999_ns{0}, max_ns{0};
+};
+LatencyStats latencyStats(std::vector<std::int64_t> round_trips_ns);
+
+/// Runs one side; returns an exit code (runtime error if the other side never matched or a
+/// ping was not echoed).
+int runLatencyCommand(const bus::Participant::Options& participant, const LatencyOptions& options,
+                      bus::ShutdownSignal& shutdown);
+
+}  // namespace navbus::tool
