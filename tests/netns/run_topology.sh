@@ -4,9 +4,14 @@
 # veth into a bridge that lives in its own "switch" namespace, so nothing touches the host's
 # interfaces. Participants use the navbus_participant_udp_lan profile (UDP, multicast
 # discovery, no shared memory): discovery and data must cross the bridge.
+# With `secure CREDENTIALS_DIR`, every participant runs navbus_participant_udp_lan_secure (DDS
+# Security) with its own identity from CREDENTIALS_DIR (scripts/make_credentials.sh), on
+# another domain and subnet, so both variants can run one after the other.
 # Exits 77 (skipped) where network namespaces cannot be created.
 set -euo pipefail
 bin=$1
+mode=${2:-plain}
+creds=${3:-}
 id=$$
 probe="nbprobe$id"
 if ! ip netns add "$probe" 2>/dev/null; then
@@ -16,6 +21,12 @@ fi
 ip netns del "$probe"
 
 hosts=(sim filter fm obs)
+subnet=77
+domain=76
+profile=navbus_participant_udp_lan
+if [ "$mode" = secure ]; then subnet=78; domain=78; profile=navbus_participant_udp_lan_secure; fi
+# identity NAME: the credentials option of a participant (none on the plain profile)
+identity() { [ "$mode" = secure ] && echo "--identity $creds/$1" || true; }
 sw="nbsw$id"
 work=$(mktemp -d)
 pids=()
@@ -41,17 +52,16 @@ for h in "${hosts[@]}"; do
   ip link set "s$h$id" netns "$sw"
   ip netns exec "$sw" ip link set "s$h$id" master br0 up
   ip netns exec "$ns" ip link set "v$h$id" name eth0
-  ip netns exec "$ns" ip addr add "10.254.77.$n/24" dev eth0
+  ip netns exec "$ns" ip addr add "10.254.$subnet.$n/24" dev eth0
   ip netns exec "$ns" ip link set eth0 up
   ip netns exec "$ns" ip link set lo up
   # Multicast (SPDP discovery) leaves through eth0; the bridge is the whole network.
   ip netns exec "$ns" ip route add 224.0.0.0/4 dev eth0
   n=$((n + 1))
 done
-echo "namespaces: ${hosts[*]} on bridge br0 (10.254.77.0/24)"
+echo "namespaces: ${hosts[*]} on bridge br0 (10.254.$subnet.0/24), profile $profile"
 
-domain=76
-common=(--domain $domain --profile navbus_participant_udp_lan)
+common=(--domain $domain --profile $profile)
 cat > "$work/filter.yaml" <<YAML
 initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}
 inputs:
@@ -65,16 +75,16 @@ timing: {start: now, duration_s: 60, pacing: realtime, wait_for_readers_s: 30,
          min_readers: {imu: 2, raw_imu: 1, gnss: 2, star_tracker: 2}}
 YAML
 
-ip netns exec "nbfilter$id" "$bin/navbus-filter" -c "$work/filter.yaml" "${common[@]}" > "$work/filter.log" 2>&1 &
+ip netns exec "nbfilter$id" "$bin/navbus-filter" -c "$work/filter.yaml" "${common[@]}" $(identity filter) > "$work/filter.log" 2>&1 &
 pids+=($!)
-ip netns exec "nbfm$id" "$bin/navbus-fault-manager" "${common[@]}" > "$work/fm.log" 2>&1 &
+ip netns exec "nbfm$id" "$bin/navbus-fault-manager" "${common[@]}" $(identity fault-manager) > "$work/fm.log" 2>&1 &
 pids+=($!)
-ip netns exec "nbobs$id" "$bin/navbus" "${common[@]}" record navbus/nav/solution navbus/fault/decision \
+ip netns exec "nbobs$id" "$bin/navbus" "${common[@]}" $(identity tool) record navbus/nav/solution navbus/fault/decision \
   -o "$work/rec" --duration 25 > "$work/rec.log" 2>&1 &
 rec_pid=$!
 pids+=($rec_pid)
 sleep 1
-ip netns exec "nbsim$id" "$bin/navbus-sensor-sim" -c "$work/sim.yaml" "${common[@]}" > "$work/sim.log" 2>&1 &
+ip netns exec "nbsim$id" "$bin/navbus-sensor-sim" -c "$work/sim.yaml" "${common[@]}" $(identity simulator) > "$work/sim.log" 2>&1 &
 sim_pid=$!
 # A clean end of data is announced (no loss); a crash is not: kill the simulator after 4 s of
 # data or more so that the watchdog's decision has to cross the namespaces.
