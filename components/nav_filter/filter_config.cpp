@@ -1,5 +1,7 @@
 #include "filter_config.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "navbus/bus/config.hpp"
@@ -50,7 +52,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                  {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
                   "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
                   "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated",
-                  "multi_dimensional", "command_issuers", "time_jump"},
+                  "multi_dimensional", "command_issuers", "issuer_identities", "time_jump"},
                  bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
@@ -96,6 +98,16 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
     if (issuer.empty() || issuer.size() > 64)
       throw bus::ConfigError("configuration command_issuers: '" + issuer +
                              "' must have 1 to 64 characters (FilterCommand.issuer)");
+  }
+  c.issuer_identities = bus::get<std::map<std::string, std::string>>(root, "", "issuer_identities",
+                                                                     c.issuer_identities);
+  for (const std::string& issuer : c.command_issuers)
+    c.issuer_identities.emplace(issuer, "navbus-" + issuer);
+  for (const auto& [issuer, name] : c.issuer_identities) {
+    if (std::find(c.command_issuers.begin(), c.command_issuers.end(), issuer) ==
+        c.command_issuers.end())
+      throw bus::ConfigError("configuration issuer_identities: '" + issuer +
+                             "' is not one of command_issuers");
   }
   const YAML::Node init = root["initial_state"];
   if (!init) throw bus::ConfigError("configuration initial_state is missing");

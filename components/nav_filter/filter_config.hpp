@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,10 @@ struct FilterConfig {
   /// counted. Without DDS Security the issuer is what the sender claims: this stops a
   /// misconfigured or stray tool, not an attacker (see the README).
   std::vector<std::string> command_issuers{"fault-manager", "operator"};
+  /// Under DDS Security: the certificate common name each issuer must be authenticated as
+  /// (a command whose issuer is not the identity that wrote it is refused and counted). An
+  /// issuer without an entry must be "navbus-<issuer>" (the test credentials' names).
+  std::map<std::string, std::string> issuer_identities;
   /// A sample more than this ahead of every input's latest data is not believed until the
   /// samples after it confirm it (bus::TimeJumpRule).
   bus::TimeJumpRule time_jump{2'000'000'000, 3};

@@ -60,8 +60,9 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
                                                  updateState();
                                                });
   p.subscribe<navbus::FilterCommandPubSubType>(
-      topic::kFilterCommand, profile::kDecisionReader,
-      [this](const auto& c, const auto&) { pipeline_.onCommand(c); });
+      topic::kFilterCommand, profile::kDecisionReader, [this](const auto& c, const auto& info) {
+        pipeline_.onCommand(c, participant_.dds().writerIdentity(info));
+      });
   // Bounded-wait release of inputs held for a silent stream, and the held solution while
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });

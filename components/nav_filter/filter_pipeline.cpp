@@ -288,8 +288,8 @@ bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
   return true;
 }
 
-void FilterPipeline::onCommand(const navbus::FilterCommand& c) {
-  if (c.vehicle_id() != config_.vehicle_id) return;  // for another vehicle: not ours
+bool FilterPipeline::issuerAuthorized(const navbus::FilterCommand& c,
+                                      const std::optional<std::string>& writer_identity) {
   const std::string issuer = c.issuer().to_string();
   if (std::find(config_.command_issuers.begin(), config_.command_issuers.end(), issuer) ==
       config_.command_issuers.end()) {
@@ -299,8 +299,25 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c) {
         "command {} (kind {}) from '{}' refused: not a configured issuer "
         "(command_issuers); {} refused so far",
         c.command_id(), static_cast<int>(c.kind()), issuer, commands_unauthorized_);
-    return;
+    return false;
   }
+  if (writer_identity && *writer_identity != config_.issuer_identities.at(issuer)) {
+    ++commands_refused_;
+    ++commands_impersonated_;
+    spdlog::warn(
+        "command {} (kind {}) claims issuer '{}' but was written by identity '{}' (expected "
+        "'{}', issuer_identities): refused; {} refused so far",
+        c.command_id(), static_cast<int>(c.kind()), issuer, *writer_identity,
+        config_.issuer_identities.at(issuer), commands_impersonated_);
+    return false;
+  }
+  return true;
+}
+
+void FilterPipeline::onCommand(const navbus::FilterCommand& c,
+                               const std::optional<std::string>& writer_identity) {
+  if (c.vehicle_id() != config_.vehicle_id) return;  // for another vehicle: not ours
+  if (!issuerAuthorized(c, writer_identity)) return;
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM || c.kind() == navbus::CMD_READMIT_STREAM) {
     // About the merge itself (a lost stream must stop holding it): at once.
     const bool applied = applyStreamCommand(c);
@@ -468,10 +485,10 @@ std::string FilterPipeline::summary() const {
       << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
       << ", stage switches " << n.stage_switches << ", decisions seen " << decisions_seen_
       << ", commands applied " << commands_applied_ << " refused " << commands_refused_
-      << " (unauthorized issuer " << commands_unauthorized_ << ") late " << commands_late_
-      << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending()
-      << ", recoveries from onset " << history_.rollbacks() << " (onset beyond history "
-      << history_.outOfReach() << ")";
+      << " (unauthorized issuer " << commands_unauthorized_ << ", issuer not the writer's identity "
+      << commands_impersonated_ << ") late " << commands_late_ << ", sequencer timeouts "
+      << sequencer_.timeouts() << ", pending " << sequencer_.pending() << ", recoveries from onset "
+      << history_.rollbacks() << " (onset beyond history " << history_.outOfReach() << ")";
   return out.str();
 }
 

@@ -74,7 +74,10 @@ class FilterPipeline {
   /// estimated onset restores the filter to before the onset and re-processes what followed
   /// (input_history.hpp), so the state afterwards is the same as if it had come in time. A
   /// refused one (wrong field, not available in this mode) is logged and counted.
-  void onCommand(const navbus::FilterCommand& c);
+  /// `writer_identity`: under DDS Security, the certificate common name of the participant
+  /// that wrote the command (empty: unknown); nullopt where nobody is authenticated.
+  void onCommand(const navbus::FilterCommand& c,
+                 const std::optional<std::string>& writer_identity = std::nullopt);
 
   /// Processes every input that can no longer be preceded by another; `now_ns` is the clock
   /// that bounds the wait for a silent stream (steady time on the bus, data time offline).
@@ -97,6 +100,10 @@ class FilterPipeline {
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
   void process(std::int64_t time_ns, const FilterInput& input);
   static std::int64_t timeOf(const FilterInput& input);
+  /// The issuer is configured and, under DDS Security, is the identity that wrote the command;
+  /// otherwise the command is refused, logged and counted.
+  bool issuerAuthorized(const navbus::FilterCommand& c,
+                        const std::optional<std::string>& writer_identity);
   /// Why a command cannot be applied (field and value), or nothing.
   std::optional<std::string> checkCommand(const navbus::FilterCommand& c) const;
   bool applyToEngine(const navbus::FilterCommand& c);
@@ -127,6 +134,7 @@ class FilterPipeline {
   std::uint64_t commands_applied_{0};
   std::uint64_t commands_refused_{0};
   std::uint64_t commands_unauthorized_{0};  ///< of those refused: not from a configured issuer
+  std::uint64_t commands_impersonated_{0};  ///< of those refused: issuer not the writer's identity
   std::uint64_t commands_late_{0};
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
 };

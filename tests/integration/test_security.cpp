@@ -6,6 +6,8 @@
 //    configured receiver id, and reads solutions;
 //  - an inertial unit (imu-sensor identity) and the simulator identity try to write what their
 //    grants do not allow: commands, decisions, pseudoranges, and to read solutions.
+//  - the operator identity sends a command claiming to come from the fault manager (refused:
+//    the issuer is not the identity that wrote it) and one as itself (applied).
 // Nothing of the intruder reaches the filter (no command, no decision, not one epoch more
 // than the simulator sent) and it reads nothing; the wrong roles cannot even create the
 // writers and readers (Fast DDS's access control refuses them locally, and remote
@@ -143,16 +145,23 @@ TEST(Security, ParticipantWithoutCredentialsGetsNothingAcceptedAndReadsNothing) 
   auto fake_obs = intruder.createWriter<GnssObservationEpochPubSubType>(
       bus::topic::kGnssObservations, bus::profile::kMeasurementWriter);
 
+  bus::Participant console(secureParticipant("console", "operator"), shutdown);
+  auto operator_command = console.createWriter<FilterCommandPubSubType>(
+      bus::topic::kFilterCommand, bus::profile::kDecisionWriter);
+
   test::SensorInputWriters w(sensors);
   auto spinAll = [&] {
     sensors.spinOnce(1ms);
     observer.spinOnce(1ms);
     intruder.spinOnce(1ms);
+    console.spinOnce(1ms);
   };
   const auto deadline = std::chrono::steady_clock::now() + 30s;
-  while (!(w.matched() && filter_health.inputs().size() > 0) &&
+  while (!(w.matched() && filter_health.inputs().size() > 0 &&
+           operator_command.matchedReaders() > 0) &&
          std::chrono::steady_clock::now() < deadline)
     spinAll();
+  ASSERT_GT(operator_command.matchedReaders(), 0u);
   ASSERT_TRUE(w.matched()) << "the secure filter did not match the simulator identity\n"
                            << test::readFile(dir / "filter.log");
   EXPECT_EQ(command.matchedReaders(), 0u);
@@ -182,6 +191,21 @@ TEST(Security, ParticipantWithoutCredentialsGetsNothingAcceptedAndReadsNothing) 
       d.decision_id(static_cast<std::uint32_t>(n_forged));
       d.time_gps_ns(e.time_gps_ns());
       decision.write(d);
+      if (n_obs == 2) {
+        auto impersonated = forgedCompensation();  // "fault-manager", written by the operator
+        impersonated.command_id(100);
+        impersonated.time_gps_ns(e.time_gps_ns());
+        operator_command.write(impersonated);
+        FilterCommand own;  // as itself: expect the IMU stream (a no-op while it flows)
+        own.command_id(101);
+        own.vehicle_id(1);
+        own.kind(CMD_READMIT_STREAM);
+        own.sensor(SOURCE_IMU_STREAM);
+        own.sensor_id(1);
+        own.time_gps_ns(e.time_gps_ns());
+        own.issuer("operator");
+        operator_command.write(own);
+      }
     }
     if (f.has_star_tracker) w.star.write(sensor_sim::toIdl(f.star_tracker, 1, ++n_star));
     spinAll();
@@ -216,8 +240,10 @@ TEST(Security, ParticipantWithoutCredentialsGetsNothingAcceptedAndReadsNothing) 
   ASSERT_EQ(filter.wait(10s), std::optional<int>(0));
   const std::string log = test::readFile(dir / "filter.log");
   EXPECT_EQ(summaryCount(log, "decisions seen"), 0) << log;
-  EXPECT_EQ(summaryCount(log, "commands applied"), 0) << log;
-  EXPECT_EQ(summaryCount(log, "refused"), 0) << log;
+  EXPECT_EQ(summaryCount(log, "commands applied"), 1) << log;  // the operator's own
+  EXPECT_EQ(summaryCount(log, "commands applied [0-9]+ refused"), 1) << log;
+  EXPECT_EQ(summaryCount(log, "issuer not the writer's identity"), 1) << log;
+  EXPECT_EQ(summaryCount(log, "unauthorized issuer"), 0) << log;
   std::printf(
       "intruder wrote %llu commands, %llu decisions, %llu pseudorange epochs: 0 accepted; "
       "filter fused %llu genuine epochs, %zu solutions, intruder read 0\n",

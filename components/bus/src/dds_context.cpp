@@ -51,15 +51,17 @@ DdsContext::DdsContext(const ParticipantOptions& options) : name_(options.name) 
                    "' is not defined in the QoS file");
   }
   applySecurityIdentity(qos, options.participant_profile, options.security_identity);
+  secure_ = securityEnabled(qos);
   qos.name(options.name);
+  // The listener hears discovery only (mask none): data and statuses go to the waitset.
   participant_ = factory->create_participant(
-      static_cast<dds::DomainId_t>(options.domain_id), qos, options.listener,
-      options.listener ? dds::StatusMask::none() : dds::StatusMask::all());
+      static_cast<dds::DomainId_t>(options.domain_id), qos,
+      options.listener != nullptr ? options.listener : &peers_, dds::StatusMask::none());
   if (participant_ == nullptr) {
     std::string why = "cannot create participant '" + options.name + "' on domain " +
                       std::to_string(options.domain_id) + " with profile '" +
                       options.participant_profile + "'";
-    if (securityEnabled(qos)) {
+    if (secure_) {
       why += " and security identity '" + options.security_identity +
              "' (its certificate must be signed by its identity_ca.pem, the documents by its "
              "permissions_ca.pem, and permissions.p7s must grant its subject this domain)";
@@ -78,6 +80,11 @@ DdsContext::~DdsContext() {
     participant_->delete_contained_entities();
     dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
   }
+}
+
+std::optional<std::string> DdsContext::writerIdentity(const dds::SampleInfo& info) const {
+  if (!secure_) return std::nullopt;
+  return peers_.commonName(info.sample_identity.writer_guid().guidPrefix).value_or("");
 }
 
 dds::Topic* DdsContext::topicForType(const std::string& name, dds::TypeSupport type) {

@@ -11,9 +11,12 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "navbus/bus/peer_identities.hpp"
 
 namespace navbus::bus {
 
@@ -62,12 +65,20 @@ class DdsContext {
 
   eprosima::fastdds::dds::DomainParticipant* participant() { return participant_; }
   const std::string& name() const { return name_; }
+  /// True if the participant runs DDS Security.
+  bool secure() const { return secure_; }
+  /// Under DDS Security, the certificate common name of the participant that wrote the sample
+  /// (empty if it is not known); nullopt on a plain profile, where nobody is authenticated.
+  /// Known only when no listener was passed in the options.
+  std::optional<std::string> writerIdentity(const eprosima::fastdds::dds::SampleInfo& info) const;
 
  private:
   eprosima::fastdds::dds::Topic* topicForType(const std::string& name,
                                               eprosima::fastdds::dds::TypeSupport type);
 
   std::string name_;
+  bool secure_{false};
+  PeerIdentities peers_;  ///< the participant's listener unless the options bring one
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
   eprosima::fastdds::dds::Publisher* publisher_{nullptr};
   eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};
