@@ -28,7 +28,8 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
           bus::topic::kFilterCommand, bus::profile::kDecisionWriter)),
       pipeline_(config, p.health(),
                 {[this](const navbus::FaultDecision& d) { decision_writer_.write(d); },
-                 [this](const navbus::FilterCommand& c) { command_writer_.write(c); }}) {
+                 [this](const navbus::FilterCommand& c) { command_writer_.write(c); }},
+                bus::wallTimeNowNs()) {
   using namespace bus;
   watch<navbus::ImuIncrementPubSubType>(
       topic::kImuIncrement, profile::kSensorWatchdogReader, StreamKind::kImu,
@@ -71,10 +72,21 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
     if (st.alive_count == 0 && st.alive_count_change < 0)
       pipeline_.onWritersGone(kind, steadyNowNs());
   };
+  bus::WriterGate& writers =
+      writers_.try_emplace(kind, topic, participant_.health().stream(topic)).first->second;
   auto* reader = participant_.subscribe<PubSubType>(
       topic, profile,
-      [this, kind, id, time](const typename PubSubType::type& m,
-                             const eprosima::fastdds::dds::SampleInfo& info) {
+      [this, kind, id, time, &writers](const typename PubSubType::type& m,
+                                       const eprosima::fastdds::dds::SampleInfo& info) {
+        switch (writers.check(id(m), info)) {
+          case bus::WriterPins::Verdict::kNewSecondWriter:
+            pipeline_.onSecondWriter(kind, id(m), time(m));
+            return;
+          case bus::WriterPins::Verdict::kSecondWriter:
+            return;
+          default:
+            break;
+        }
         instances_[{kind, info.instance_handle}] = id(m);
         pipeline_.onStreamSample(kind, id(m), m.seq(), time(m), steadyNowNs());
         if constexpr (std::is_same_v<typename PubSubType::type, navbus::ImuRawBlock>) {

@@ -12,6 +12,7 @@
 
 #include "fault_pipeline.hpp"
 #include "navbus/bus/participant.hpp"
+#include "navbus/bus/writer_gate.hpp"
 
 namespace navbus::fault_manager {
 
@@ -32,6 +33,8 @@ class FaultManagerNode {
   /// DDS instance handle -> sensor id, per stream kind (deadline statuses name the instance).
   std::map<std::pair<StreamKind, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>
       instances_;
+  /// One writer per sensor id on each watched stream (bus::WriterGate).
+  std::map<StreamKind, bus::WriterGate> writers_;
 };
 
 }  // namespace navbus::fault_manager

@@ -59,13 +59,14 @@ const char* topicOf(StreamKind k) {
 }  // namespace
 
 FaultPipeline::FaultPipeline(const FaultManagerConfig& config, bus::HealthCounters& health,
-                             Sinks sinks)
+                             Sinks sinks, std::uint64_t run_id)
     : config_(config),
       health_(health),
       sinks_(std::move(sinks)),
       glr_(config.glr),
       diagnostics_gate_(bus::topic::kFilterDiagnostics,
-                        health.stream(bus::topic::kFilterDiagnostics)) {
+                        health.stream(bus::topic::kFilterDiagnostics)),
+      run_id_(run_id) {
   if (config.dither.enabled) dither_.emplace(config.dither);
 }
 
@@ -136,6 +137,24 @@ void FaultPipeline::onWatchdogEvent(const WatchdogEvent& e) {
   command(c);
 }
 
+void FaultPipeline::onSecondWriter(StreamKind kind, std::uint32_t sensor_id,
+                                   std::uint64_t time_gps_ns) {
+  navbus::FaultDecision d;
+  d.time_gps_ns(time_gps_ns);
+  d.event(navbus::EVENT_FAULT_DETECTED);
+  d.source(toSource(kind));
+  d.sensor_id(sensor_id);
+  d.shape(navbus::SHAPE_NONE);
+  d.test_statistic(2.0);  // writers publishing the sensor id
+  d.threshold(1.0);       // writers allowed
+  d.onset_time_gps_ns(time_gps_ns);
+  d.detector("writer-identity");
+  const std::uint32_t id = decide(d);
+  ++second_writers_;
+  spdlog::warn("decision {}: a second writer publishes {} stream {} while its owner is alive", id,
+               kindName(kind), sensor_id);
+}
+
 bool FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
   if (msg.vehicle_id() != config_.vehicle_id) {
     ++other_vehicles_;
@@ -149,6 +168,7 @@ bool FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
 
 std::uint32_t FaultPipeline::decide(navbus::FaultDecision& d) {
   d.decision_id(next_decision_id_++);
+  d.run_id(run_id_);
   if (sinks_.decision) sinks_.decision(d);
   return d.decision_id();
 }
@@ -157,14 +177,15 @@ void FaultPipeline::command(navbus::FilterCommand& c) {
   c.command_id(next_command_id_++);
   c.vehicle_id(config_.vehicle_id);
   c.issuer("fault-manager");
+  c.run_id(run_id_);
   if (sinks_.command) sinks_.command(c);
 }
 
 std::string FaultPipeline::summary() const {
   std::ostringstream out;
   out << "decisions published " << decisions() << " (stream lost " << lost_ << ", restored "
-      << restored_ << "), streams ended as announced " << ended_ << ", commands published "
-      << commands() << "; " << glr_.summary();
+      << restored_ << ", second writers " << second_writers_ << "), streams ended as announced "
+      << ended_ << ", commands published " << commands() << "; " << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
   if (other_vehicles_ > 0) out << "; diagnostics of other vehicles ignored " << other_vehicles_;
   return out.str();

@@ -32,7 +32,10 @@ class FaultPipeline : private FaultOutput {
     std::function<void(const navbus::FilterCommand&)> command;
   };
 
-  FaultPipeline(const FaultManagerConfig& config, bus::HealthCounters& health, Sinks sinks);
+  /// `run_id` goes into every decision and command (the run's start time on the bus, 0
+  /// offline), so that ids are unique across restarts.
+  FaultPipeline(const FaultManagerConfig& config, bus::HealthCounters& health, Sinks sinks,
+                std::uint64_t run_id = 0);
 
   // Stream watchdogs (wall times from the participant's steady clock).
   /// A sample of a watched stream; `seq` counts samples a best-effort reader lost.
@@ -42,6 +45,10 @@ class FaultPipeline : private FaultOutput {
   void onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
   /// The stream's writer announced its end (disposed the instance): no loss, counted.
   void onStreamEnded(StreamKind kind, std::uint32_t sensor_id, std::uint64_t end_time_gps_ns = 0);
+  /// A second writer publishes a stream's sensor id while its owner is alive (bus::WriterGate):
+  /// a fault decision (detector "writer-identity"), once per intruding writer. No command: the
+  /// filter keeps that writer's samples out by itself.
+  void onSecondWriter(StreamKind kind, std::uint32_t sensor_id, std::uint64_t time_gps_ns);
   /// The watchdog deadline of a stream kind [s], quoted as the decisions' threshold.
   void setDeadline(StreamKind kind, double deadline_s) { deadline_s_[kind] = deadline_s; }
 
@@ -73,6 +80,8 @@ class FaultPipeline : private FaultOutput {
   bus::StreamGate diagnostics_gate_;
   std::map<StreamKind, bus::SequenceTracker> trackers_;
   std::map<StreamKind, double> deadline_s_;
+  std::uint64_t second_writers_{0};
+  std::uint64_t run_id_{0};
   std::uint32_t next_decision_id_{1};
   std::uint64_t next_command_id_{1};
   std::uint64_t lost_{0}, restored_{0}, ended_{0}, other_vehicles_{0};

@@ -1,5 +1,6 @@
 #include "filter_node.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include <navbus_idl/FaultPubSubTypes.h>
@@ -36,24 +37,40 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
               : bus::Writer<navbus::FilterDiagnostics>()),
       pipeline_(
           config, p.health(),
-          {[this](const navbus::NavigationSolution& s) { solution_writer_.write(s); },
+          {[this](const navbus::NavigationSolution& s) {
+             if (solution_writer_.write(s)) last_solution_ns_ = steadyNowNs();
+           },
            publishesDiagnostics(config)
                ? std::function<void(const navbus::FilterDiagnostics&)>(
                      [this](const navbus::FilterDiagnostics& d) { diagnostics_writer_.write(d); })
-               : nullptr}) {
+               : nullptr}),
+      not_producing_ns_(
+          std::max(kNotProducingMinNs, kNotProducingPeriods * config.engine.solution_period_ns)),
+      imu_writers_(bus::topic::kImuIncrement, p.health().stream(bus::topic::kImuIncrement)),
+      gnss_obs_writers_(bus::topic::kGnssObservations,
+                        p.health().stream(bus::topic::kGnssObservations)),
+      gnss_fix_writers_(bus::topic::kGnssFix, p.health().stream(bus::topic::kGnssFix)),
+      star_writers_(bus::topic::kStarTracker, p.health().stream(bus::topic::kStarTracker)) {
   using namespace bus;
-  p.subscribe<navbus::ImuIncrementPubSubType>(
-      topic::kImuIncrement, profile::kSensorReader,
-      [this](const auto& m, const auto&) { pipeline_.onImu(m); });
+  p.subscribe<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorReader,
+                                              [this](const auto& m, const auto& info) {
+                                                if (imu_writers_.admit(m.sensor_id(), info))
+                                                  pipeline_.onImu(m);
+                                              });
   p.subscribe<navbus::GnssObservationEpochPubSubType>(
       topic::kGnssObservations, profile::kMeasurementReader,
-      [this](const auto& m, const auto&) { pipeline_.onGnssObservations(m); });
-  p.subscribe<navbus::GnssFixPubSubType>(
-      topic::kGnssFix, profile::kMeasurementReader,
-      [this](const auto& m, const auto&) { pipeline_.onGnssFix(m); });
+      [this](const auto& m, const auto& info) {
+        if (gnss_obs_writers_.admit(m.receiver_id(), info)) pipeline_.onGnssObservations(m);
+      });
+  p.subscribe<navbus::GnssFixPubSubType>(topic::kGnssFix, profile::kMeasurementReader,
+                                         [this](const auto& m, const auto& info) {
+                                           if (gnss_fix_writers_.admit(m.receiver_id(), info))
+                                             pipeline_.onGnssFix(m);
+                                         });
   p.subscribe<navbus::StarTrackerAttitudePubSubType>(
-      topic::kStarTracker, profile::kMeasurementReader,
-      [this](const auto& m, const auto&) { pipeline_.onStarTracker(m); });
+      topic::kStarTracker, profile::kMeasurementReader, [this](const auto& m, const auto& info) {
+        if (star_writers_.admit(m.tracker_id(), info)) pipeline_.onStarTracker(m);
+      });
   p.subscribe<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader,
                                                [this](const auto& d, const auto&) {
                                                  pipeline_.onDecision(d);
@@ -66,7 +83,10 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   // Bounded-wait release of inputs held for a silent stream, and the held solution while
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });
-  p.addTimer(std::chrono::milliseconds(20), [this] { pump(); });
+  p.addTimer(std::chrono::milliseconds(20), [this] {
+    pump();
+    updateState();
+  });
   p.addTimer(std::chrono::nanoseconds(config.engine.solution_period_ns),
              [this] { pipeline_.publishHeldSolution(); });
   updateState();
@@ -77,7 +97,13 @@ void FilterNode::pump() {
 }
 
 void FilterNode::updateState() {
-  participant_.setState(pipeline_.degraded() ? navbus::STATE_DEGRADED : navbus::STATE_RUNNING);
+  if (last_solution_ns_ < 0) {
+    participant_.setState(navbus::STATE_STARTING);
+    return;
+  }
+  const bool producing = steadyNowNs() - last_solution_ns_ <= not_producing_ns_;
+  participant_.setState(pipeline_.degraded() || !producing ? navbus::STATE_DEGRADED
+                                                           : navbus::STATE_RUNNING);
 }
 
 }  // namespace navbus::nav_filter

@@ -10,6 +10,7 @@
 #include "filter_config.hpp"
 #include "filter_pipeline.hpp"
 #include "navbus/bus/participant.hpp"
+#include "navbus/bus/writer_gate.hpp"
 
 namespace navbus::nav_filter {
 
@@ -22,12 +23,21 @@ class FilterNode {
   std::string summary() const { return pipeline_.summary(); }
 
  private:
+  /// STARTING until the first solution; DEGRADED while a stream is lost or no solution has
+  /// been published for kNotProducingPeriods solution periods (at least kNotProducingMinNs):
+  /// health never says RUNNING while the filter is not producing.
   void updateState();
+  static constexpr int kNotProducingPeriods = 3;
+  static constexpr std::int64_t kNotProducingMinNs = 1'000'000'000;
 
   bus::Participant& participant_;
   bus::Writer<navbus::NavigationSolution> solution_writer_;
   bus::Writer<navbus::FilterDiagnostics> diagnostics_writer_;
   FilterPipeline pipeline_;
+  std::int64_t not_producing_ns_;      ///< silence of the solution output that is "not producing"
+  std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)
+  /// One writer per sensor id on each sensor stream (a second writer's samples are kept out).
+  bus::WriterGate imu_writers_, gnss_obs_writers_, gnss_fix_writers_, star_writers_;
 };
 
 }  // namespace navbus::nav_filter

@@ -180,6 +180,8 @@ void FilterPipeline::process(std::int64_t time_ns, const FilterInput& input) {
     return;
   }
   history_.record(time_ns, input, engine_);
+  if (first_input_ns_ < 0 && !std::holds_alternative<CommandInput>(input))
+    first_input_ns_ = time_ns;
   if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {
     if (engine_.addImu(*inc) && !replaying_) publishSolution();
   } else if (const auto* epoch = std::get_if<GnssEpochInput>(&input)) {
@@ -320,6 +322,7 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c,
   if (!issuerAuthorized(c, writer_identity)) return;
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM || c.kind() == navbus::CMD_READMIT_STREAM) {
     // About the merge itself (a lost stream must stop holding it): at once.
+    if (refuseIfStale(c)) return;
     const bool applied = applyStreamCommand(c);
     (applied ? commands_applied_ : commands_refused_)++;
     if (!applied)
@@ -338,7 +341,25 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c,
   executeCommand(c);
 }
 
+bool FilterPipeline::refuseIfStale(const navbus::FilterCommand& c) {
+  const auto time_ns = static_cast<std::int64_t>(c.time_gps_ns());
+  if (time_ns == 0 || (first_input_ns_ >= 0 && time_ns >= first_input_ns_)) return false;
+  ++commands_refused_;
+  ++commands_stale_;
+  spdlog::warn(
+      "command {} (kind {}, decision {}) from '{}' refused: stale, about data at {:.3f} s, "
+      "before this run's first input{}; {} stale so far",
+      c.command_id(), static_cast<int>(c.kind()), c.decision_id(), c.issuer(),
+      1e-9 * static_cast<double>(time_ns),
+      first_input_ns_ < 0
+          ? " (none yet)"
+          : fmt::format(" at {:.3f} s", 1e-9 * static_cast<double>(first_input_ns_)),
+      commands_stale_);
+  return true;
+}
+
 void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
+  if (refuseIfStale(c)) return;
   std::string why;
   bool applied = false;
   if (auto refusal = checkCommand(c)) {
@@ -486,9 +507,10 @@ std::string FilterPipeline::summary() const {
       << ", stage switches " << n.stage_switches << ", decisions seen " << decisions_seen_
       << ", commands applied " << commands_applied_ << " refused " << commands_refused_
       << " (unauthorized issuer " << commands_unauthorized_ << ", issuer not the writer's identity "
-      << commands_impersonated_ << ") late " << commands_late_ << ", sequencer timeouts "
-      << sequencer_.timeouts() << ", pending " << sequencer_.pending() << ", recoveries from onset "
-      << history_.rollbacks() << " (onset beyond history " << history_.outOfReach() << ")";
+      << commands_impersonated_ << ", stale " << commands_stale_ << ") late " << commands_late_
+      << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending()
+      << ", recoveries from onset " << history_.rollbacks() << " (onset beyond history "
+      << history_.outOfReach() << ")";
   return out.str();
 }
 

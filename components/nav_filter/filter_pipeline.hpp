@@ -74,6 +74,9 @@ class FilterPipeline {
   /// estimated onset restores the filter to before the onset and re-processes what followed
   /// (input_history.hpp), so the state afterwards is the same as if it had come in time. A
   /// refused one (wrong field, not available in this mode) is logged and counted.
+  /// A command about data before the first input this run processed (or arriving before any,
+  /// with a data time) is stale: the durable history of an earlier run, about data and a state
+  /// this run never had. It is refused and counted, never re-applied.
   /// `writer_identity`: under DDS Security, the certificate common name of the participant
   /// that wrote the command (empty: unknown); nullopt where nobody is authenticated.
   void onCommand(const navbus::FilterCommand& c,
@@ -104,6 +107,8 @@ class FilterPipeline {
   /// otherwise the command is refused, logged and counted.
   bool issuerAuthorized(const navbus::FilterCommand& c,
                         const std::optional<std::string>& writer_identity);
+  /// Refuses and counts a stale command (see onCommand); true if it was.
+  bool refuseIfStale(const navbus::FilterCommand& c);
   /// Why a command cannot be applied (field and value), or nothing.
   std::optional<std::string> checkCommand(const navbus::FilterCommand& c) const;
   bool applyToEngine(const navbus::FilterCommand& c);
@@ -135,6 +140,8 @@ class FilterPipeline {
   std::uint64_t commands_refused_{0};
   std::uint64_t commands_unauthorized_{0};  ///< of those refused: not from a configured issuer
   std::uint64_t commands_impersonated_{0};  ///< of those refused: issuer not the writer's identity
+  std::uint64_t commands_stale_{0};  ///< of those refused: about data before this run's first input
+  std::int64_t first_input_ns_{-1};  ///< data time of the first input processed (-1: none yet)
   std::uint64_t commands_late_{0};
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
 };

@@ -182,6 +182,7 @@ void visitFields(const navbus::FaultDecision& m, V& v) {
   v("dither_expected_frequency_hz", m.dither().expected_frequency_hz());
   v("dither_tolerance_hz", m.dither().tolerance_hz());
   v("dither_window_s", m.dither().window_s());
+  v("run_id", m.run_id());
 }
 template <class V>
 void visitFields(const navbus::FilterCommand& m, V& v) {
@@ -201,6 +202,7 @@ void visitFields(const navbus::FilterCommand& m, V& v) {
   v("fusion", m.fusion());
   v("mode", m.mode());
   v("issuer", m.issuer());
+  v("run_id", m.run_id());
 }
 template <class V>
 void visitFields(const navbus::StreamHealth& m, V& v) {

@@ -177,7 +177,7 @@ TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
   const std::string log = test::readFile(dir / "filter.log");
   EXPECT_NE(log.find("refused"), std::string::npos) << log;
   EXPECT_NE(log.find("commands applied 2 refused 2 (unauthorized issuer 1, issuer not the writer's "
-                     "identity 0)"),
+                     "identity 0, stale 0)"),
             std::string::npos)
       << log;
   test::cleanSharedMemory();

@@ -12,6 +12,7 @@
 // than the simulator sent) and it reads nothing; the wrong roles cannot even create the
 // writers and readers (Fast DDS's access control refuses them locally, and remote
 // participants check the same signed permissions).
+#include <algorithm>
 #include <cmath>
 #include <regex>
 
@@ -129,10 +130,12 @@ TEST(Security, ParticipantWithoutCredentialsGetsNothingAcceptedAndReadsNothing) 
       bus::topic::kNavSolution, bus::profile::kSolutionReader,
       [&](const NavigationSolution& s, const auto&) { solutions.push_back(s); });
   Health filter_health;
+  std::vector<ParticipantState> states;  // the filter's reported states, in order
   observer.subscribe<HealthPubSubType>(bus::topic::kHealth, bus::profile::kHealthReader,
                                        [&](const Health& h, const auto&) {
-                                         if (h.participant().to_string() == "navbus-filter")
-                                           filter_health = h;
+                                         if (h.participant().to_string() != "navbus-filter") return;
+                                         filter_health = h;
+                                         states.push_back(h.state());
                                        });
   std::size_t intruder_read = 0;
   intruder.subscribe<NavigationSolutionPubSubType>(
@@ -235,6 +238,15 @@ TEST(Security, ParticipantWithoutCredentialsGetsNothingAcceptedAndReadsNothing) 
   }
   EXPECT_EQ(solutions.back().mode(), MODE_TIGHTLY_COUPLED);
   EXPECT_EQ(intruder_read, 0u) << "a participant without credentials read solutions";
+  // Health: STARTING before the first solution, RUNNING while solutions flow, and no longer
+  // RUNNING once they stop (the data ended): DEGRADED within 1 s plus a health period.
+  ASSERT_FALSE(states.empty());
+  EXPECT_EQ(states.front(), STATE_STARTING);
+  EXPECT_NE(std::find(states.begin(), states.end(), STATE_RUNNING), states.end());
+  const auto stopped = std::chrono::steady_clock::now() + 4s;
+  while (states.back() != STATE_DEGRADED && std::chrono::steady_clock::now() < stopped) spinAll();
+  EXPECT_EQ(states.back(), STATE_DEGRADED)
+      << "health says " << states.back() << " while the filter produces nothing";
 
   filter.signal(SIGTERM);
   ASSERT_EQ(filter.wait(10s), std::optional<int>(0));

@@ -11,6 +11,7 @@
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/bus/validation.hpp"
+#include "navbus/bus/writer_gate.hpp"
 
 using navbus::bus::SequenceTracker;
 using navbus::bus::validate;
@@ -277,4 +278,22 @@ TEST(Skeleton, UnknownWriterProfileIsAClearErrorAndKnownOnesWork) {
   p.stop();
   p.run();
   EXPECT_EQ(p.state(), navbus::STATE_STOPPING);
+}
+
+// One writer per sensor id: the owner keeps it while alive, another writer is a second writer
+// (reported once, counted every time), a new writer takes over after the owner's silence.
+TEST(WriterPins, OwnerSecondWriterAndTakeover) {
+  using V = navbus::bus::WriterPins::Verdict;
+  navbus::bus::WriterPins pins(1'000'000'000);
+  const navbus::bus::WriterId a{1}, b{2}, c{3};
+  EXPECT_EQ(pins.check(7, a, 0), V::kOwner);
+  EXPECT_EQ(pins.check(7, a, 100'000'000), V::kOwner);
+  EXPECT_EQ(pins.check(7, b, 200'000'000), V::kNewSecondWriter);
+  EXPECT_EQ(pins.check(7, b, 300'000'000), V::kSecondWriter);
+  EXPECT_EQ(pins.check(8, b, 300'000'000), V::kOwner);              // another sensor id: b owns it
+  EXPECT_EQ(pins.check(7, a, 900'000'000), V::kOwner);              // the owner goes on
+  EXPECT_EQ(pins.check(7, c, 1'800'000'000), V::kNewSecondWriter);  // a silent 0.9 s: alive
+  EXPECT_EQ(pins.check(7, c, 1'900'000'000), V::kTakeover);         // silent 1.0 s: gone
+  EXPECT_EQ(pins.check(7, a, 2'000'000'000), V::kNewSecondWriter);  // the old owner is back
+  EXPECT_EQ(navbus::bus::toString(a).substr(0, 4), "0100");
 }

@@ -106,6 +106,8 @@ const char* rejectReasonName(navbus::RejectReason reason) {
       return "duplicate_satellite";
     case navbus::REJECT_TIME_JUMP:
       return "time_jump";
+    case navbus::REJECT_SECOND_WRITER:
+      return "second_writer";
   }
   return "unknown";
 }

@@ -77,7 +77,7 @@ void Participant::runDueTimers() {
 }
 
 void Participant::spinOnce(std::chrono::nanoseconds max_wait) {
-  if (state_ == navbus::STATE_STARTING) {
+  if (state_ == navbus::STATE_STARTING && !state_managed_) {
     state_ = navbus::STATE_RUNNING;
     publishHealth();
   }

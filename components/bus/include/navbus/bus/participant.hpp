@@ -85,7 +85,12 @@ class Participant {
 
   DdsContext& dds() { return dds_; }
   HealthCounters& health() { return health_; }
-  void setState(navbus::ParticipantState state) { state_ = state; }
+  /// Sets the reported state; from then on the participant manages it (the skeleton no longer
+  /// promotes STARTING to RUNNING on the first loop iteration by itself).
+  void setState(navbus::ParticipantState state) {
+    state_ = state;
+    state_managed_ = true;
+  }
   navbus::ParticipantState state() const { return state_; }
 
   template <class PubSubType>
@@ -169,6 +174,7 @@ class Participant {
   DdsContext dds_;
   HealthCounters health_;
   navbus::ParticipantState state_{navbus::STATE_STARTING};
+  bool state_managed_{false};
   eprosima::fastdds::dds::WaitSet waitset_;
   std::vector<std::unique_ptr<ReaderEntry>> readers_;
   std::vector<Timer> timers_;
