@@ -47,6 +47,9 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   watch<navbus::StarTrackerAttitudePubSubType>(
       topic::kStarTracker, profile::kMeasurementWatchdogReader, StreamKind::kStarTracker,
       [](const auto& m) { return m.tracker_id(); }, [](const auto& m) { return m.time_gps_ns(); });
+  // Confirms suspect streams (a DDS deadline event before the own silence reached it) within
+  // this period of their silence reaching the deadline.
+  p.addTimer(std::chrono::milliseconds(10), [this] { pipeline_.onWatchdogTick(steadyNowNs()); });
   if (config.glr.enabled) {
     p.subscribe<navbus::FilterDiagnosticsPubSubType>(
         topic::kFilterDiagnostics, profile::kDiagnosticsReader,

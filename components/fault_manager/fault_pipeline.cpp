@@ -92,7 +92,13 @@ void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std
 
 void FaultPipeline::onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id,
                                      std::int64_t wall_now_ns) {
-  if (auto e = watchdog_.onDeadlineMissed({kind, sensor_id}, wall_now_ns)) onWatchdogEvent(*e);
+  const auto deadline_ns = static_cast<std::int64_t>(deadline_s_[kind] * 1e9);
+  if (auto e = watchdog_.onDeadlineMissed({kind, sensor_id}, wall_now_ns, deadline_ns))
+    onWatchdogEvent(*e);
+}
+
+void FaultPipeline::onWatchdogTick(std::int64_t wall_now_ns) {
+  for (const auto& e : watchdog_.onTick(wall_now_ns)) onWatchdogEvent(e);
 }
 
 void FaultPipeline::onWritersGone(StreamKind kind, std::int64_t wall_now_ns) {
@@ -184,8 +190,10 @@ void FaultPipeline::command(navbus::FilterCommand& c) {
 std::string FaultPipeline::summary() const {
   std::ostringstream out;
   out << "decisions published " << decisions() << " (stream lost " << lost_ << ", restored "
-      << restored_ << ", second writers " << second_writers_ << "), streams ended as announced "
-      << ended_ << ", commands published " << commands() << "; " << glr_.summary();
+      << restored_ << ", second writers " << second_writers_
+      << ", deadline events not confirmed by the silence " << watchdog_.unconfirmedDeadlines()
+      << "), streams ended as announced " << ended_ << ", commands published " << commands() << "; "
+      << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
   if (other_vehicles_ > 0) out << "; diagnostics of other vehicles ignored " << other_vehicles_;
   return out.str();

@@ -43,6 +43,8 @@ class FaultPipeline : private FaultOutput {
                       std::uint64_t time_gps_ns, std::int64_t wall_now_ns);
   void onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id, std::int64_t wall_now_ns);
   void onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
+  /// Periodic: declares suspect streams whose own silence reached the deadline.
+  void onWatchdogTick(std::int64_t wall_now_ns);
   /// The stream's writer announced its end (disposed the instance): no loss, counted.
   void onStreamEnded(StreamKind kind, std::uint32_t sensor_id, std::uint64_t end_time_gps_ns = 0);
   /// A second writer publishes a stream's sensor id while its owner is alive (bus::WriterGate):

@@ -20,6 +20,7 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
                           1e-9 * static_cast<double>(wall_now_ns - s.last_arrival_wall_ns)};
   }
   s.lost = false;
+  s.suspect_deadline_ns = -1;
   s.last_time_gps_ns = time_gps_ns;
   s.last_arrival_wall_ns = wall_now_ns;
   return event;
@@ -29,16 +30,34 @@ std::optional<WatchdogEvent> StreamWatchdog::markLost(const StreamKey& key, Stat
                                                       std::int64_t wall_now_ns) {
   if (s.lost) return std::nullopt;
   s.lost = true;
+  s.suspect_deadline_ns = -1;
   return WatchdogEvent{key, true, s.last_time_gps_ns,
                        1e-9 * static_cast<double>(wall_now_ns - s.last_arrival_wall_ns)};
 }
 
 std::optional<WatchdogEvent> StreamWatchdog::onDeadlineMissed(const StreamKey& key,
-                                                              std::int64_t wall_now_ns) {
+                                                              std::int64_t wall_now_ns,
+                                                              std::int64_t deadline_ns) {
   auto it = states_.find(key);
   // A stream never seen cannot be lost: the deadline only counts for instances that exist.
   if (it == states_.end()) return std::nullopt;
-  return markLost(key, it->second, wall_now_ns);
+  State& st = it->second;
+  if (!st.lost && wall_now_ns - st.last_arrival_wall_ns < deadline_ns) {
+    ++unconfirmed_;
+    st.suspect_deadline_ns = deadline_ns;
+    return std::nullopt;
+  }
+  return markLost(key, st, wall_now_ns);
+}
+
+std::vector<WatchdogEvent> StreamWatchdog::onTick(std::int64_t wall_now_ns) {
+  std::vector<WatchdogEvent> out;
+  for (auto& [key, s] : states_) {
+    if (s.suspect_deadline_ns < 0 || wall_now_ns - s.last_arrival_wall_ns < s.suspect_deadline_ns)
+      continue;
+    if (auto e = markLost(key, s, wall_now_ns)) out.push_back(*e);
+  }
+  return out;
 }
 
 std::vector<WatchdogEvent> StreamWatchdog::onWritersGone(StreamKind kind,

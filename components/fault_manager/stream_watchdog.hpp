@@ -36,7 +36,17 @@ class StreamWatchdog {
   std::optional<WatchdogEvent> onSample(const StreamKey& key, std::uint64_t time_gps_ns,
                                         std::int64_t wall_now_ns);
   /// DDS reported a missed deadline for this stream's instance; returns a 'lost' event once.
-  std::optional<WatchdogEvent> onDeadlineMissed(const StreamKey& key, std::int64_t wall_now_ns);
+  /// The silence is confirmed on this participant's own clock first: if the latest sample was
+  /// handed over less than `deadline_ns` ago (DDS's timer runs from reception, ours from the
+  /// hand-over, which a loaded machine delays), the stream is only suspect (counted as an
+  /// unconfirmed deadline event); onTick() declares it once its own silence reaches the
+  /// deadline, and a sample before that clears it.
+  std::optional<WatchdogEvent> onDeadlineMissed(const StreamKey& key, std::int64_t wall_now_ns,
+                                                std::int64_t deadline_ns = 0);
+  /// Suspect streams whose own silence has reached their deadline: lost.
+  std::vector<WatchdogEvent> onTick(std::int64_t wall_now_ns);
+  /// Deadline events not confirmed at once by the participant's own clock.
+  std::uint64_t unconfirmedDeadlines() const { return unconfirmed_; }
   /// Every writer of a topic lost liveliness: all its streams that are alive are lost.
   std::vector<WatchdogEvent> onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
 
@@ -56,10 +66,12 @@ class StreamWatchdog {
     bool lost{false};
     std::uint64_t last_time_gps_ns{0};
     std::int64_t last_arrival_wall_ns{0};
+    std::int64_t suspect_deadline_ns{-1};  ///< a DDS deadline event awaits confirmation (-1: no)
   };
   std::optional<WatchdogEvent> markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns);
   std::map<StreamKey, State> states_;
   std::map<StreamKey, std::uint64_t> ended_at_;  ///< announced ends, data time
+  std::uint64_t unconfirmed_{0};
 };
 
 }  // namespace navbus::fault_manager

@@ -125,6 +125,31 @@ TEST(StreamWatchdog, SamplesInFlightAfterAnAnnouncedEndAreNoNewRun) {
   EXPECT_TRUE(w.onDeadlineMissed(raw, 700 * kMs));
 }
 
+TEST(StreamWatchdog, DeadlineEventIsConfirmedByTheOwnSilence) {
+  // Under CPU load DDS's deadline timer (from reception) can fire before this participant has
+  // been silent for the deadline by its own clock (from the hand-over): the stream is only
+  // suspect then; the tick declares it once the own silence reaches the deadline, and a sample
+  // before that clears it.
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1};
+  const std::int64_t deadline = 250 * kMs;
+  EXPECT_FALSE(w.onSample(imu, 100, 1000 * kMs));
+  EXPECT_FALSE(w.onDeadlineMissed(imu, 1247 * kMs, deadline));  // silent 0.247 s < 0.25 s
+  EXPECT_EQ(w.unconfirmedDeadlines(), 1u);
+  EXPECT_TRUE(w.onTick(1249 * kMs).empty());
+  const auto lost = w.onTick(1250 * kMs);
+  ASSERT_EQ(lost.size(), 1u);
+  EXPECT_TRUE(lost[0].lost);
+  EXPECT_NEAR(lost[0].silence_s, 0.25, 1e-9);
+  EXPECT_TRUE(w.onTick(1300 * kMs).empty());  // once
+  // A sample clears a suspect stream: the delayed hand-over was no silence.
+  EXPECT_TRUE(w.onSample(imu, 200, 1400 * kMs));  // restored
+  EXPECT_FALSE(w.onDeadlineMissed(imu, 1640 * kMs, deadline));
+  EXPECT_FALSE(w.onSample(imu, 300, 1645 * kMs));
+  EXPECT_TRUE(w.onTick(1900 * kMs).empty());
+  EXPECT_FALSE(w.isLost(imu));
+}
+
 TEST(Formatters, CsvHasOneRowPerSatelliteAndRoundTripsDoubles) {
   navbus::GnssObservationEpoch e;
   e.receiver_id(3);
