@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -22,6 +23,7 @@
 
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/topics.hpp"
+#include "navbus/sim/scenario_source.hpp"
 
 namespace navbus::test {
 
@@ -157,6 +159,15 @@ struct SensorInputWriters {
   bus::Writer<GnssFix> fix;
   bus::Writer<StarTrackerAttitude> star;
 };
+
+/// The simulator's default vehicle at the place and time filterConfig() starts the filter:
+/// 36.5 N, 127.5 E, 100 m, GPS time 1.4e18 ns.
+inline sim::ScenarioSource testScenarioSource() {
+  sim::ScenarioConfig c;
+  c.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
+  c.start_time_ns = 1'400'000'000'000'000'000;
+  return sim::ScenarioSource(c);
+}
 
 inline std::string filterConfig(int domain, std::uint32_t imu_id = 1, bool measurements = true) {
   std::string c = "domain_id: " + std::to_string(domain) +

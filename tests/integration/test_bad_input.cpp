@@ -52,10 +52,7 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
   test::SensorInputWriters w(me);
   ASSERT_TRUE(test::spinUntil(me, 20s, [&] { return w.matched(); }));
 
-  sim::ScenarioConfig src_cfg;
-  src_cfg.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
-  src_cfg.start_time_ns = 1'400'000'000'000'000'000;
-  sim::ScenarioSource src(src_cfg);
+  sim::ScenarioSource src = test::testScenarioSource();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   std::uint64_t seq = 0, n_obs = 0, n_fix = 0, n_star = 0;

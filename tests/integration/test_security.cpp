@@ -171,10 +171,7 @@ TEST(Security, ParticipantWithoutCredentialsGetsNothingAcceptedAndReadsNothing) 
   EXPECT_EQ(decision.matchedReaders(), 0u);
   EXPECT_EQ(fake_obs.matchedReaders(), 0u);
 
-  sim::ScenarioConfig src_cfg;
-  src_cfg.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
-  src_cfg.start_time_ns = 1'400'000'000'000'000'000;
-  sim::ScenarioSource src(src_cfg);
+  sim::ScenarioSource src = test::testScenarioSource();
   std::uint64_t seq = 0, n_obs = 0, n_fix = 0, n_star = 0, n_forged = 0;
   for (int k = 0; k < 500; ++k) {
     const sim::SensorFrame f = src.next();

@@ -64,10 +64,7 @@ TEST(WriterIdentity, SecondWriterOnASensorKeyIsKeptOutAndReported) {
   ASSERT_TRUE(w.matched());
   ASSERT_GE(second.matchedReaders(), 2u) << "filter and fault manager";
 
-  sim::ScenarioConfig src_cfg;
-  src_cfg.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
-  src_cfg.start_time_ns = 1'400'000'000'000'000'000;
-  sim::ScenarioSource src(src_cfg);
+  sim::ScenarioSource src = test::testScenarioSource();
   std::uint64_t seq = 0, n_obs = 0, n_fix = 0, n_star = 0, n_second = 0;
   for (int k = 0; k < 600; ++k) {
     const sim::SensorFrame f = src.next();
