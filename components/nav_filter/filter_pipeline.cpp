@@ -94,7 +94,18 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
       gnss_fix_gate_(bus::topic::kGnssFix, health.stream(bus::topic::kGnssFix), config.time_jump,
                      &time_reference_),
       star_gate_(bus::topic::kStarTracker, health.stream(bus::topic::kStarTracker),
-                 config.time_jump, &time_reference_) {}
+                 config.time_jump, &time_reference_),
+      command_counters_(health.stream(bus::topic::kFilterCommand)) {}
+
+void FilterPipeline::countCommand(bool applied, navbus::RejectReason reason) {
+  if (applied) {
+    ++commands_applied_;
+    ++command_counters_.accepted;
+  } else {
+    ++commands_refused_;
+    ++command_counters_.rejected[reason];
+  }
+}
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
                            FilterInput input) {
@@ -295,7 +306,7 @@ bool FilterPipeline::issuerAuthorized(const navbus::FilterCommand& c,
   const std::string issuer = c.issuer().to_string();
   if (std::find(config_.command_issuers.begin(), config_.command_issuers.end(), issuer) ==
       config_.command_issuers.end()) {
-    ++commands_refused_;
+    countCommand(false, navbus::REJECT_UNAUTHORIZED);
     ++commands_unauthorized_;
     spdlog::warn(
         "command {} (kind {}) from '{}' refused: not a configured issuer "
@@ -304,7 +315,7 @@ bool FilterPipeline::issuerAuthorized(const navbus::FilterCommand& c,
     return false;
   }
   if (writer_identity && *writer_identity != config_.issuer_identities.at(issuer)) {
-    ++commands_refused_;
+    countCommand(false, navbus::REJECT_UNAUTHORIZED);
     ++commands_impersonated_;
     spdlog::warn(
         "command {} (kind {}) claims issuer '{}' but was written by identity '{}' (expected "
@@ -324,7 +335,7 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c,
     // About the merge itself (a lost stream must stop holding it): at once.
     if (refuseIfStale(c)) return;
     const bool applied = applyStreamCommand(c);
-    (applied ? commands_applied_ : commands_refused_)++;
+    countCommand(applied, navbus::REJECT_UNEXPECTED_SOURCE);
     if (!applied)
       spdlog::warn(
           "command {} from '{}' refused: stream source {} id {} is not a stream of this "
@@ -344,7 +355,7 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c,
 bool FilterPipeline::refuseIfStale(const navbus::FilterCommand& c) {
   const auto time_ns = static_cast<std::int64_t>(c.time_gps_ns());
   if (time_ns == 0 || (first_input_ns_ >= 0 && time_ns >= first_input_ns_)) return false;
-  ++commands_refused_;
+  countCommand(false, navbus::REJECT_STALE);
   ++commands_stale_;
   spdlog::warn(
       "command {} (kind {}, decision {}) from '{}' refused: stale, about data at {:.3f} s, "
@@ -362,8 +373,10 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
   if (refuseIfStale(c)) return;
   std::string why;
   bool applied = false;
+  navbus::RejectReason reason = navbus::REJECT_NOT_APPLICABLE;
   if (auto refusal = checkCommand(c)) {
     why = *refusal;
+    reason = navbus::REJECT_OUT_OF_RANGE;
   } else if (recoversFromOnset(c) && history_.rollback(restorePoint(c), engine_, replay_)) {
     // Restored to before the onset: the command applies there, and what followed is
     // re-processed without the fault (nothing is published meanwhile: those solutions went out).
@@ -381,12 +394,11 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
     applied = applyToEngine(c);
     why = "not available in the configured mode";
   }
+  countCommand(applied, reason);
   if (applied) {
-    ++commands_applied_;
     spdlog::info("command {} from '{}' applied (kind {})", c.command_id(), c.issuer(),
                  static_cast<int>(c.kind()));
   } else {
-    ++commands_refused_;
     spdlog::warn("command {} from '{}' refused: kind {}: {}", c.command_id(), c.issuer(),
                  static_cast<int>(c.kind()), why);
   }

@@ -107,6 +107,8 @@ class FilterPipeline {
   /// otherwise the command is refused, logged and counted.
   bool issuerAuthorized(const navbus::FilterCommand& c,
                         const std::optional<std::string>& writer_identity);
+  /// Counts a command in the health of the command topic: accepted, or rejected for `reason`.
+  void countCommand(bool applied, navbus::RejectReason reason = navbus::REJECT_NOT_APPLICABLE);
   /// Refuses and counts a stale command (see onCommand); true if it was.
   bool refuseIfStale(const navbus::FilterCommand& c);
   /// Why a command cannot be applied (field and value), or nothing.
@@ -142,6 +144,7 @@ class FilterPipeline {
   std::uint64_t commands_impersonated_{0};  ///< of those refused: issuer not the writer's identity
   std::uint64_t commands_stale_{0};  ///< of those refused: about data before this run's first input
   std::int64_t first_input_ns_{-1};  ///< data time of the first input processed (-1: none yet)
+  bus::StreamCounters& command_counters_;  ///< health of the command topic
   std::uint64_t commands_late_{0};
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
 };

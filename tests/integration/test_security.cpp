@@ -235,6 +235,16 @@ TEST(Security, ParticipantWithoutCredentialsGetsNothingAcceptedAndReadsNothing) 
   }
   EXPECT_EQ(solutions.back().mode(), MODE_TIGHTLY_COUPLED);
   EXPECT_EQ(intruder_read, 0u) << "a participant without credentials read solutions";
+  // The operator's two commands in the filter's health: one accepted, one unauthorized.
+  const StreamHealth* cmd = nullptr;
+  for (const auto& in : filter_health.inputs())
+    if (in.topic().to_string() == bus::topic::kFilterCommand) cmd = &in;
+  ASSERT_NE(cmd, nullptr);
+  EXPECT_EQ(cmd->received(), 2u);
+  EXPECT_EQ(cmd->accepted(), 1u);
+  ASSERT_EQ(cmd->rejected().size(), 1u);
+  EXPECT_EQ(cmd->rejected()[0].reason(), REJECT_UNAUTHORIZED);
+  EXPECT_EQ(cmd->rejected()[0].count(), 1u);
   // Health: STARTING before the first solution, RUNNING while solutions flow, and no longer
   // RUNNING once they stop (the data ended): DEGRADED within 1 s plus a health period.
   ASSERT_FALSE(states.empty());

@@ -7,6 +7,7 @@
 #include "filter_pipeline.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
+#include "navbus/bus/topics.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
 using namespace navbus;
@@ -51,4 +52,9 @@ TEST(FilterPipelineCommands, StaleCommandOfAnEarlierRunIsRefused) {
   EXPECT_EQ(solutions.back().mode(), MODE_INERTIAL_LOST);
   EXPECT_NE(pipeline.summary().find("commands applied 1 refused 1"), std::string::npos)
       << pipeline.summary();
+  // ... and in the health of the command topic.
+  const bus::StreamCounters* commands = health.find(bus::topic::kFilterCommand);
+  ASSERT_NE(commands, nullptr);
+  EXPECT_EQ(commands->accepted, 1u);
+  EXPECT_EQ(commands->rejected.at(REJECT_STALE), 1u);
 }

@@ -108,6 +108,12 @@ const char* rejectReasonName(navbus::RejectReason reason) {
       return "time_jump";
     case navbus::REJECT_SECOND_WRITER:
       return "second_writer";
+    case navbus::REJECT_UNAUTHORIZED:
+      return "unauthorized";
+    case navbus::REJECT_STALE:
+      return "stale";
+    case navbus::REJECT_NOT_APPLICABLE:
+      return "not_applicable";
   }
   return "unknown";
 }
