@@ -23,9 +23,9 @@ namespace {
 fdds::DomainParticipantQos profileQos(const std::string& profile) {
   navbus::bus::loadQosProfiles("");
   fdds::DomainParticipantQos qos;
-  EXPECT_EQ(
-      fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(profile, qos),
-      ReturnCode_t::RETCODE_OK);
+  EXPECT_EQ(fdds::DomainParticipantFactory::get_instance()->get_participant_qos_from_profile(
+                profile, qos),
+            ReturnCode_t::RETCODE_OK);
   return qos;
 }
 
