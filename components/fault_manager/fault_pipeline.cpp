@@ -167,6 +167,11 @@ bool FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
     return false;
   }
   if (!diagnostics_gate_.admit(msg, msg.vehicle_id(), msg.seq(), msg.time_gps_ns())) return false;
+  if (diagnostics_gate_.sourceRestarted()) {
+    // The filter started a new run at an earlier time: its statistics start over too.
+    glr_ = GlrDetector(config_.glr);
+    ++filter_new_runs_;
+  }
   const std::uint64_t before = glr_.counters().epochs;
   glr_.onDiagnostics(msg, *this);
   return glr_.counters().epochs != before;
@@ -195,6 +200,7 @@ std::string FaultPipeline::summary() const {
       << "), streams ended as announced " << ended_ << ", commands published " << commands() << "; "
       << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
+  if (filter_new_runs_ > 0) out << "; GLR restarted with the filter's new runs " << filter_new_runs_;
   if (other_vehicles_ > 0) out << "; diagnostics of other vehicles ignored " << other_vehicles_;
   return out.str();
 }

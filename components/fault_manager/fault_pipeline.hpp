@@ -83,6 +83,7 @@ class FaultPipeline : private FaultOutput {
   std::map<StreamKind, bus::SequenceTracker> trackers_;
   std::map<StreamKind, double> deadline_s_;
   std::uint64_t second_writers_{0};
+  std::uint64_t filter_new_runs_{0};  ///< the diagnostics' source restarted at an earlier time
   std::uint64_t run_id_{0};
   std::uint32_t next_decision_id_{1};
   std::uint64_t next_command_id_{1};

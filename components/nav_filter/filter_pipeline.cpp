@@ -139,6 +139,7 @@ bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, std::uint32
 
 void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
   if (!imu_gate_.admit(msg, msg.sensor_id(), msg.seq(), msg.time_gps_ns())) return;
+  if (imu_gate_.sourceRestarted()) startNewRun();
   queue(imu_gate_, {kRankImu, msg.sensor_id()}, static_cast<std::int64_t>(msg.time_gps_ns()),
         bus::toCore(msg));
 }
@@ -166,7 +167,29 @@ void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
         bus::toCore(m));
 }
 
+void FilterPipeline::startNewRun() {
+  flush(last_pump_ns_);
+  const std::size_t dropped = sequencer_.newRun();
+  solutions_earlier_runs_ += solution_seq_;
+  increments_earlier_runs_ += engine_.counters().imu_used;
+  engine_ = core::NavigationEngine(config_.engine);
+  history_ = InputHistory<FilterInput>(config_.recovery_history_ns,
+                                       config_.recovery_snapshot_period_ns);
+  replay_.clear();
+  first_input_ns_ = -1;
+  solution_seq_ = 0;
+  diagnostics_seq_ = 0;
+  time_reference_.latest_ns = 0;
+  for (bus::StreamGate* g : {&gnss_obs_gate_, &gnss_fix_gate_, &star_gate_})
+    g->tracker().resetAll();
+  ++new_runs_;
+  spdlog::warn("the IMU source restarted at an earlier time: new run {} (the filter starts over; "
+               "{} held inputs of the previous run could not be released)",
+               new_runs_, dropped);
+}
+
 void FilterPipeline::pump(std::int64_t now_ns) {
+  last_pump_ns_ = now_ns;
   sequencer_.release(now_ns, [this](StreamId, std::int64_t time_ns, const FilterInput& in) {
     process(time_ns, in);
   });
@@ -523,6 +546,10 @@ std::string FilterPipeline::summary() const {
       << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending()
       << ", recoveries from onset " << history_.rollbacks() << " (onset beyond history "
       << history_.outOfReach() << ")";
+  if (new_runs_ > 0) {
+    out << ", new runs after a source restart " << new_runs_ << " (before the latest: solutions "
+        << solutions_earlier_runs_ << ", increments " << increments_earlier_runs_ << ")";
+  }
   return out.str();
 }
 

@@ -93,6 +93,8 @@ class FilterPipeline {
 
   /// Some stream is currently lost (the participant reports DEGRADED).
   bool degraded() const;
+  /// New runs started because the IMU source restarted at an earlier time.
+  std::uint64_t newRuns() const { return new_runs_; }
   const core::NavigationEngine& engine() const { return engine_; }
   std::string summary() const;
 
@@ -117,6 +119,12 @@ class FilterPipeline {
   void executeCommand(const navbus::FilterCommand& c);
   bool recoversFromOnset(const navbus::FilterCommand& c) const;
   std::int64_t restorePoint(const navbus::FilterCommand& c) const;
+  /// The IMU source restarted at an earlier time (a restarted simulator replaying its
+  /// scenario): what is held of the old run is processed, then the filter starts over as at
+  /// construction (engine, order, history, the other streams' time checks), so that the new
+  /// run's inputs are used rather than rejected as not monotonic. Solution and diagnostics
+  /// sequence numbers restart with it, which tells subscribers the same.
+  void startNewRun();
   void publishSolution();
   void publishDiagnostics();
   bool applyStreamCommand(const navbus::FilterCommand& c);
@@ -147,6 +155,10 @@ class FilterPipeline {
   bus::StreamCounters& command_counters_;  ///< health of the command topic
   std::uint64_t commands_late_{0};
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
+  std::uint64_t new_runs_{0};
+  std::uint64_t solutions_earlier_runs_{0};   ///< published before the latest new run
+  std::uint64_t increments_earlier_runs_{0};  ///< integrated before the latest new run
+  std::int64_t last_pump_ns_{0};              ///< the clock of the latest pump
 };
 
 core::SatelliteScope toCore(navbus::SatelliteScope s);

@@ -211,6 +211,7 @@ void visitFields(const navbus::StreamHealth& m, V& v) {
   v("accepted", m.accepted());
   v("sequence_gaps", m.sequence_gaps());
   v("deadline_misses", m.deadline_misses());
+  v("source_restarts", m.source_restarts());
   std::ostringstream rejected;
   for (const auto& r : m.rejected()) rejected << enumName(r.reason()) << "=" << r.count() << " ";
   v.text("rejected", rejected.str());

@@ -199,6 +199,27 @@ TEST(SequenceTracker, DuplicatesOrderAndGaps) {
   EXPECT_FALSE(t.check(2, 1, 50).rejection);  // sensors are independent
 }
 
+TEST(SequenceTracker, SourceRestartAtAnEarlierTimeIsConfirmedByTheSamplesAfterIt) {
+  SequenceTracker t(navbus::bus::TimeJumpRule{50, 3}, nullptr);
+  for (std::uint64_t k = 1; k <= 10; ++k) EXPECT_FALSE(t.check(1, 100 + k, 1000 + 10 * k).rejection);
+  // One stale sample (time and sequence behind) followed by the stream going on: rejected, and
+  // the candidate forgotten.
+  EXPECT_EQ(t.check(1, 50, 500).rejection->reason, navbus::REJECT_TIME_NOT_MONOTONIC);
+  EXPECT_FALSE(t.check(1, 111, 1110).rejection);
+  EXPECT_EQ(t.check(1, 51, 510).rejection->reason, navbus::REJECT_TIME_NOT_MONOTONIC);
+  // A restart: sequence and time back, and the samples after it continue from it.
+  EXPECT_EQ(t.check(1, 1, 200).rejection->reason, navbus::REJECT_TIME_NOT_MONOTONIC);
+  EXPECT_EQ(t.check(1, 2, 210).rejection->reason, navbus::REJECT_TIME_NOT_MONOTONIC);
+  const auto o = t.check(1, 3, 220);
+  EXPECT_FALSE(o.rejection);
+  EXPECT_TRUE(o.source_restarted);
+  EXPECT_FALSE(t.check(1, 4, 230).rejection);  // the stream goes on from the new run
+  EXPECT_EQ(t.check(1, 5, 1120).rejection->reason, navbus::REJECT_TIME_JUMP);
+  // Time back with the sequence going on is no restart, however many samples.
+  for (std::uint64_t k = 0; k < 5; ++k)
+    EXPECT_EQ(t.check(2, 10 + k, 1000 - k).rejection.has_value(), k > 0);
+}
+
 TEST(HealthCounters, ReportCarriesEveryStreamAndReason) {
   navbus::bus::HealthCounters h("p");
   auto& s = h.stream("a");

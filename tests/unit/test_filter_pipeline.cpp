@@ -58,3 +58,77 @@ TEST(FilterPipelineCommands, StaleCommandOfAnEarlierRunIsRefused) {
   EXPECT_EQ(commands->accepted, 1u);
   EXPECT_EQ(commands->rejected.at(REJECT_STALE), 1u);
 }
+
+namespace {
+
+nav_filter::FilterConfig imuOnlyConfig() {
+  return nav_filter::parseFilterConfig(
+      YAML::Load("initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
+                 "inputs: {imu: {id: 1, period_s: 0.01}}\n"));
+}
+
+sim::ScenarioConfig sourceConfig() {
+  sim::ScenarioConfig c;
+  c.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
+  c.start_time_ns = 1'400'000'000'000'000'000;
+  return c;
+}
+
+}  // namespace
+
+// A simulator restarted with its scenario starting at a fixed time sends the same times
+// again, with its sequence restarting. The filter recognises the restart once the samples
+// after the first continue from it, and starts over: its solutions go on, and from then on
+// they equal those of a filter that started with the new run.
+TEST(FilterPipelineRestart, SourceRestartingAtAnEarlierTimeStartsANewRun) {
+  const auto cfg = imuOnlyConfig();
+  bus::HealthCounters health("test");
+  std::vector<NavigationSolution> solutions;
+  nav_filter::FilterPipeline pipeline(
+      cfg, health, {[&](const NavigationSolution& s) { solutions.push_back(s); }, nullptr});
+  std::int64_t now = 0;
+  auto feed = [&](nav_filter::FilterPipeline& p, sim::ScenarioSource& src, std::uint64_t from_seq,
+                  int n, int skip = 0) {
+    for (int k = 0; k < n; ++k) {
+      const auto inc = bus::toIdl(src.next().increment, 1, from_seq + k);
+      if (k >= skip) p.onImu(inc);
+      p.pump(now += 10'000'000);
+    }
+  };
+  sim::ScenarioSource first(sourceConfig());
+  feed(pipeline, first, 1, 300);
+  const std::size_t first_run = solutions.size();
+  ASSERT_GT(first_run, 0u);
+
+  sim::ScenarioSource restarted(sourceConfig());
+  feed(pipeline, restarted, 1, 300);
+  const bus::StreamCounters& imu = *health.find(bus::topic::kImuIncrement);
+  EXPECT_EQ(imu.source_restarts, 1u);
+  const int confirmations = cfg.time_jump.confirmations;
+  EXPECT_EQ(imu.rejected.at(REJECT_TIME_NOT_MONOTONIC),
+            static_cast<std::uint64_t>(confirmations - 1));
+  EXPECT_EQ(pipeline.newRuns(), 1u);
+  ASSERT_GT(solutions.size(), first_run + 10);
+  const NavigationSolution& restart_first = solutions[first_run];
+  EXPECT_EQ(restart_first.seq(), 1u);  // a new run for the subscribers too
+  EXPECT_LT(restart_first.time_gps_ns(), solutions[first_run - 1].time_gps_ns());
+
+  // A filter that started with the new run's first accepted sample gives the same solutions.
+  bus::HealthCounters fresh_health("fresh");
+  std::vector<NavigationSolution> fresh;
+  nav_filter::FilterPipeline reference(
+      cfg, fresh_health, {[&](const NavigationSolution& s) { fresh.push_back(s); }, nullptr});
+  sim::ScenarioSource again(sourceConfig());
+  feed(reference, again, 1, 300, confirmations - 1);
+  ASSERT_EQ(fresh.size(), solutions.size() - first_run);
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    const auto& a = fresh[i];
+    const auto& b = solutions[first_run + i];
+    EXPECT_EQ(a.time_gps_ns(), b.time_gps_ns());
+    EXPECT_EQ(a.latitude_rad(), b.latitude_rad());
+    EXPECT_EQ(a.vel_ned_mps(), b.vel_ned_mps());
+    EXPECT_EQ(a.q_b_to_n(), b.q_b_to_n());
+  }
+  EXPECT_NE(pipeline.summary().find("new runs after a source restart 1"), std::string::npos)
+      << pipeline.summary();
+}

@@ -45,6 +45,7 @@ navbus::Health HealthCounters::report(navbus::ParticipantState state, std::uint6
     s.accepted(c.accepted);
     s.sequence_gaps(c.sequence_gaps);
     s.deadline_misses(c.deadline_misses);
+    s.source_restarts(c.source_restarts);
     for (const auto& [reason, count] : c.rejected) {
       navbus::RejectCount rc;
       rc.reason(reason);
@@ -73,8 +74,9 @@ std::string HealthCounters::summary() const {
     for (const auto& [reason, count] : c.elements_rejected) {
       out << " [element " << rejectReasonName(reason) << " " << count << "]";
     }
-    out << ", sequence gaps " << c.sequence_gaps << ", deadline misses " << c.deadline_misses
-        << "\n";
+    out << ", sequence gaps " << c.sequence_gaps << ", deadline misses " << c.deadline_misses;
+    if (c.source_restarts > 0) out << ", source restarts " << c.source_restarts;
+    out << "\n";
   }
   out << "  published: " << published_ << " samples\n";
   return out.str();

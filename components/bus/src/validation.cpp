@@ -250,10 +250,16 @@ SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::ui
       return out;
     }
     if (time_ns <= last.time_ns) {
+      if (seq < last.seq && confirmsRestart(sensor_id, seq, time_ns)) {
+        out.source_restarted = true;
+        last_[sensor_id] = Last{seq, time_ns};
+        return out;
+      }
       out.rejection =
           Rejection{navbus::REJECT_TIME_NOT_MONOTONIC, "time_gps_ns", static_cast<double>(time_ns)};
       return out;
     }
+    restart_candidate_.erase(sensor_id);  // the stream goes on: a stale sample, no restart
   }
   const std::uint64_t stream_latest = it != last_.end() ? it->second.time_ns : 0;
   if (auto r = checkJump(sensor_id, seq, time_ns, stream_latest, out)) {
@@ -272,6 +278,25 @@ SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::ui
   return out;
 }
 
+bool SequenceTracker::continues(const Candidate& c, std::uint64_t seq,
+                                std::uint64_t time_ns) const {
+  return seq > c.seq && time_ns > c.time_ns &&
+         (rule_.tolerance_ns == 0 || time_ns <= c.time_ns + rule_.tolerance_ns);
+}
+
+bool SequenceTracker::confirmsRestart(std::uint32_t sensor_id, std::uint64_t seq,
+                                      std::uint64_t time_ns) {
+  auto cand = restart_candidate_.find(sensor_id);
+  const bool more = cand != restart_candidate_.end() && continues(cand->second, seq, time_ns);
+  const int count = more ? cand->second.count + 1 : 1;
+  if (count >= rule_.confirmations) {
+    restart_candidate_.erase(sensor_id);
+    return true;
+  }
+  restart_candidate_[sensor_id] = Candidate{seq, time_ns, count};
+  return false;
+}
+
 std::optional<Rejection> SequenceTracker::checkJump(std::uint32_t sensor_id, std::uint64_t seq,
                                                     std::uint64_t time_ns,
                                                     std::uint64_t stream_latest_ns, Outcome& out) {
@@ -285,10 +310,8 @@ std::optional<Rejection> SequenceTracker::checkJump(std::uint32_t sensor_id, std
   }
   // Ahead of everything seen by more than the tolerance: a forward jump. It is adopted only
   // when the samples after it continue from it.
-  const bool continues = cand != candidate_.end() && seq > cand->second.seq &&
-                         time_ns > cand->second.time_ns &&
-                         time_ns <= cand->second.time_ns + rule_.tolerance_ns;
-  const int count = continues ? cand->second.count + 1 : 1;
+  const bool more = cand != candidate_.end() && continues(cand->second, seq, time_ns);
+  const int count = more ? cand->second.count + 1 : 1;
   if (count >= rule_.confirmations) {
     candidate_.erase(sensor_id);
     out.jump_adopted = true;
@@ -329,6 +352,12 @@ void StreamGate::noteSequence(const SequenceTracker::Outcome& o) {
   counters_.sequence_gaps += o.missing;
   if (o.restarted) {
     spdlog::info("{}: sequence restarted (writer restart)", topic_);
+  }
+  if (o.source_restarted) {
+    ++counters_.source_restarts;
+    spdlog::warn("{}: the source restarted (time and sequence went back, confirmed by the samples "
+                 "after it): a new run",
+                 topic_);
   }
   if (o.jump_adopted) {
     spdlog::warn("{}: a forward time jump confirmed by the samples after it: adopted", topic_);

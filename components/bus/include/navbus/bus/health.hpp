@@ -15,6 +15,7 @@ struct StreamCounters {
   std::uint64_t accepted{0};
   std::uint64_t sequence_gaps{0};
   std::uint64_t deadline_misses{0};
+  std::uint64_t source_restarts{0};  ///< new runs of the source (SequenceTracker::Outcome)
   std::map<navbus::RejectReason, std::uint64_t> rejected;
   /// Elements dropped from accepted samples (satellites of an epoch), by reason.
   std::map<navbus::RejectReason, std::uint64_t> elements_rejected;

@@ -80,6 +80,9 @@ struct TimeJumpRule {
   /// ... unless this many samples in a row continue from it (sequence and time increasing,
   /// each within the tolerance of the previous): a real resumption after a long silence. The
   /// last of them is accepted, the ones before stay rejected.
+  /// The same count confirms a source restart: a sample whose time and sequence number are
+  /// both behind the stream's latest is rejected as not monotonic, unless this many samples
+  /// in a row continue from it (a restarted writer replaying its scenario from the start).
   int confirmations{3};
 };
 
@@ -91,6 +94,9 @@ class SequenceTracker {
     std::uint64_t missing{0};  ///< samples skipped according to the sequence number
     bool restarted{false};     ///< sequence went back while time went forward (writer restart)
     bool jump_adopted{false};  ///< a forward jump confirmed by the samples after it
+    /// Time and sequence went back, confirmed by the samples after it: the source started a
+    /// new run, and the stream continues from this sample.
+    bool source_restarted{false};
   };
   SequenceTracker() = default;
   /// `reference` (optional, outliving the tracker) is shared by the participant's streams.
@@ -102,6 +108,13 @@ class SequenceTracker {
   void reset(std::uint32_t sensor_id) {
     last_.erase(sensor_id);
     candidate_.erase(sensor_id);
+    restart_candidate_.erase(sensor_id);
+  }
+  /// Forgets every sensor (the participant started a new run).
+  void resetAll() {
+    last_.clear();
+    candidate_.clear();
+    restart_candidate_.clear();
   }
 
  private:
@@ -118,10 +131,16 @@ class SequenceTracker {
   std::optional<Rejection> checkJump(std::uint32_t sensor_id, std::uint64_t seq,
                                      std::uint64_t time_ns, std::uint64_t stream_latest_ns,
                                      Outcome& out);
+  /// The restart rule for a sample behind the stream: true when it confirms a restart.
+  bool confirmsRestart(std::uint32_t sensor_id, std::uint64_t seq, std::uint64_t time_ns);
+  /// A candidate continues from the previous one: sequence and time increasing (time within
+  /// the jump tolerance, when there is one).
+  bool continues(const Candidate& c, std::uint64_t seq, std::uint64_t time_ns) const;
   TimeJumpRule rule_;
   TimeReference* reference_{nullptr};
   std::map<std::uint32_t, Last> last_;
   std::map<std::uint32_t, Candidate> candidate_;
+  std::map<std::uint32_t, Candidate> restart_candidate_;
 };
 
 }  // namespace navbus::bus
@@ -155,8 +174,12 @@ class StreamGate {
       return false;
     }
     noteSequence(o);
+    source_restarted_ = o.source_restarted;
     return true;
   }
+
+  /// The sample admitted last started a new run of its source (SequenceTracker::Outcome).
+  bool sourceRestarted() const { return source_restarted_; }
 
   /// Counts a rejection decided after admission (e.g. late for the sequencer).
   void reject(const Rejection& r, std::uint32_t sensor_id);
@@ -175,6 +198,7 @@ class StreamGate {
   StreamCounters& counters_;
   ValidationLimits limits_;
   SequenceTracker tracker_;
+  bool source_restarted_{false};
 };
 
 }  // namespace navbus::bus
