@@ -52,7 +52,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                  {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
                   "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
                   "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated",
-                  "multi_dimensional", "command_issuers", "issuer_identities", "time_jump"},
+                  "multi_dimensional", "command_issuers", "issuer_identities", "time_jump",
+                  "fault_monitor"},
                  bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
@@ -103,6 +104,18 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                                                                      c.issuer_identities);
   for (const std::string& issuer : c.command_issuers)
     c.issuer_identities.emplace(issuer, "navbus-" + issuer);
+  if (const YAML::Node fm = root["fault_monitor"]) {
+    bus::checkKeys(fm, "fault_monitor", {"participant", "identity", "timeout_s"});
+    FaultMonitorWatch w;
+    if (auto it = c.issuer_identities.find("fault-manager"); it != c.issuer_identities.end())
+      w.identity = it->second;
+    w.participant = bus::get<std::string>(fm, "fault_monitor", "participant", w.participant);
+    w.identity = bus::get<std::string>(fm, "fault_monitor", "identity", w.identity);
+    w.timeout_ns =
+        seconds(bus::checkRange(bus::get<double>(fm, "fault_monitor", "timeout_s", 3.0), 0.1,
+                                3600.0, "fault_monitor.timeout_s"));
+    c.fault_monitor = w;
+  }
   for (const auto& [issuer, name] : c.issuer_identities) {
     if (std::find(c.command_issuers.begin(), c.command_issuers.end(), issuer) ==
         c.command_issuers.end())

@@ -20,6 +20,15 @@ struct InputConfig {
   std::int64_t period_ns{0};
 };
 
+/// The fault manager whose health reports (navbus/health) show that faults are monitored.
+struct FaultMonitorWatch {
+  std::string participant{"navbus-fault-manager"};  ///< Health.participant of its reports
+  /// Under DDS Security: the certificate common name its reports must be written by (others
+  /// are ignored and counted as unauthorized).
+  std::string identity{"navbus-fault-manager"};
+  std::int64_t timeout_ns{3'000'000'000};  ///< silence after which it is not alive [ns]
+};
+
 struct FilterConfig {
   core::EngineConfig engine;  ///< aiding mode, fusion structure, tuning, initial state
   std::uint32_t vehicle_id{1};
@@ -51,6 +60,10 @@ struct FilterConfig {
   /// A sample more than this ahead of every input's latest data is not believed until the
   /// samples after it confirm it (bus::TimeJumpRule).
   bus::TimeJumpRule time_jump{2'000'000'000, 3};
+  /// On the bus: while no report of this fault monitor came for its timeout, solutions carry
+  /// FAULT_NO_FAULT_MONITOR (nobody is detecting faults). Absent: the filter runs without one
+  /// and says nothing about it.
+  std::optional<FaultMonitorWatch> fault_monitor;
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid entry.

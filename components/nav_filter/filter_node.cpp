@@ -5,8 +5,11 @@
 
 #include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/GnssPubSubTypes.h>
+#include <navbus_idl/HealthPubSubTypes.h>
 #include <navbus_idl/ImuPubSubTypes.h>
 #include <navbus_idl/StarTrackerPubSubTypes.h>
+
+#include <spdlog/spdlog.h>
 
 #include "navbus/bus/topics.hpp"
 
@@ -83,13 +86,35 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   // Bounded-wait release of inputs held for a silent stream, and the held solution while
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });
+  if (config.fault_monitor) watchFaultMonitor(*config.fault_monitor);
   p.addTimer(std::chrono::milliseconds(20), [this] {
+    if (monitor_) pipeline_.setFaultMonitorAlive(monitor_->alive(steadyNowNs()));
     pump();
     updateState();
   });
   p.addTimer(std::chrono::nanoseconds(config.engine.solution_period_ns),
              [this] { pipeline_.publishHeldSolution(); });
   updateState();
+}
+
+void FilterNode::watchFaultMonitor(const FaultMonitorWatch& watch) {
+  monitor_.emplace(watch.timeout_ns, steadyNowNs());
+  bus::StreamCounters& counters = participant_.health().stream(bus::topic::kHealth);
+  participant_.subscribe<navbus::HealthPubSubType>(
+      bus::topic::kHealth, bus::profile::kHealthReader,
+      [this, watch, &counters](const navbus::Health& h, const auto& info) {
+        if (h.participant().to_string() != watch.participant) return;  // not the monitor
+        const std::optional<std::string> writer = participant_.dds().writerIdentity(info);
+        if (writer && *writer != watch.identity) {
+          // Under DDS Security, a report in the monitor's name by another identity.
+          if (++counters.rejected[navbus::REJECT_UNAUTHORIZED] == 1)
+            spdlog::warn("{}: a report as '{}' written by '{}', not '{}': ignored",
+                         bus::topic::kHealth, watch.participant, *writer, watch.identity);
+          return;
+        }
+        ++counters.accepted;
+        monitor_->onReport(steadyNowNs());
+      });
 }
 
 void FilterNode::pump() {

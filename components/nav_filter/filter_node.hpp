@@ -9,6 +9,7 @@
 
 #include "filter_config.hpp"
 #include "filter_pipeline.hpp"
+#include "monitor_liveness.hpp"
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/writer_gate.hpp"
 
@@ -27,6 +28,8 @@ class FilterNode {
   /// been published for kNotProducingPeriods solution periods (at least kNotProducingMinNs):
   /// health never says RUNNING while the filter is not producing.
   void updateState();
+  /// Follows the configured fault monitor's health reports (FilterConfig::fault_monitor).
+  void watchFaultMonitor(const FaultMonitorWatch& watch);
   static constexpr int kNotProducingPeriods = 3;
   static constexpr std::int64_t kNotProducingMinNs = 1'000'000'000;
 
@@ -38,6 +41,7 @@ class FilterNode {
   std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)
   /// One writer per sensor id on each sensor stream (a second writer's samples are kept out).
   bus::WriterGate imu_writers_, gnss_obs_writers_, gnss_fix_writers_, star_writers_;
+  std::optional<MonitorLiveness> monitor_;  ///< the fault monitor's liveness, when configured
 };
 
 }  // namespace navbus::nav_filter

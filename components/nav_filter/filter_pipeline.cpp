@@ -262,7 +262,7 @@ void FilterPipeline::publishSolution() {
   sol.gyro_bias_b_radps(bus::toArray(engine_.gyroBias()));
   sol.mode(toIdl(engine_.mode()));
   sol.fusion(toIdl(engine_.fusion(), config_.engine.aiding));
-  sol.active_fault_flags(stream_flags_ | faultFlags(engine_.status()));
+  sol.active_fault_flags(stream_flags_ | monitor_flags_ | faultFlags(engine_.status()));
   sol.imu_samples_used(engine_.counters().imu_used);
   sinks_.solution(sol);
 }
@@ -272,7 +272,19 @@ void FilterPipeline::publishHeldSolution() {
 }
 
 bool FilterPipeline::degraded() const {
-  return (stream_flags_ & kStreamLostFlags) != 0;
+  return (stream_flags_ & kStreamLostFlags) != 0 || monitor_flags_ != 0;
+}
+
+void FilterPipeline::setFaultMonitorAlive(bool alive) {
+  const std::uint32_t flags = alive ? 0 : navbus::FAULT_NO_FAULT_MONITOR;
+  if (flags == monitor_flags_) return;
+  monitor_flags_ = flags;
+  if (alive) {
+    spdlog::info("a fault monitor is alive again: faults are monitored");
+  } else {
+    ++monitor_losses_;
+    spdlog::warn("no fault monitor is alive: solutions flagged FAULT_NO_FAULT_MONITOR");
+  }
 }
 
 void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
@@ -546,6 +558,10 @@ std::string FilterPipeline::summary() const {
       << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending()
       << ", recoveries from onset " << history_.rollbacks() << " (onset beyond history "
       << history_.outOfReach() << ")";
+  if (monitor_losses_ > 0) {
+    out << ", fault monitor found not alive " << monitor_losses_ << " time(s)"
+        << (monitor_flags_ != 0 ? " (still not)" : "");
+  }
   if (new_runs_ > 0) {
     out << ", new runs after a source restart " << new_runs_ << " (before the latest: solutions "
         << solutions_earlier_runs_ << ", increments " << increments_earlier_runs_ << ")";

@@ -91,7 +91,11 @@ class FilterPipeline {
   /// While inertial data is lost, the last solution is republished (held, not propagated).
   void publishHeldSolution();
 
-  /// Some stream is currently lost (the participant reports DEGRADED).
+  /// Whether a fault monitor is alive (the participant watches its reports): while not,
+  /// solutions carry FAULT_NO_FAULT_MONITOR. Changes are logged and counted.
+  void setFaultMonitorAlive(bool alive);
+  /// Some stream is currently lost, or no fault monitor is alive (the participant reports
+  /// DEGRADED).
   bool degraded() const;
   /// New runs started because the IMU source restarted at an earlier time.
   std::uint64_t newRuns() const { return new_runs_; }
@@ -155,6 +159,8 @@ class FilterPipeline {
   bus::StreamCounters& command_counters_;  ///< health of the command topic
   std::uint64_t commands_late_{0};
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
+  std::uint32_t monitor_flags_{0};  ///< FAULT_NO_FAULT_MONITOR while no fault monitor is alive
+  std::uint64_t monitor_losses_{0};  ///< times the fault monitor was found not alive
   std::uint64_t new_runs_{0};
   std::uint64_t solutions_earlier_runs_{0};   ///< published before the latest new run
   std::uint64_t increments_earlier_runs_{0};  ///< integrated before the latest new run

@@ -5,6 +5,7 @@
 
 #include "filter_config.hpp"
 #include "filter_pipeline.hpp"
+#include "monitor_liveness.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/topics.hpp"
@@ -130,5 +131,46 @@ TEST(FilterPipelineRestart, SourceRestartingAtAnEarlierTimeStartsANewRun) {
     EXPECT_EQ(a.q_b_to_n(), b.q_b_to_n());
   }
   EXPECT_NE(pipeline.summary().find("new runs after a source restart 1"), std::string::npos)
+      << pipeline.summary();
+}
+
+TEST(FaultMonitorLiveness, AliveWhileReportsComeWithinTheTimeoutAndAtStart) {
+  nav_filter::MonitorLiveness m(3'000'000'000, 10'000'000'000);
+  EXPECT_TRUE(m.alive(12'000'000'000));   // not reported yet, but within the start grace
+  EXPECT_FALSE(m.alive(13'000'000'001));  // never came
+  m.onReport(14'000'000'000);
+  EXPECT_TRUE(m.alive(17'000'000'000));
+  EXPECT_FALSE(m.alive(17'000'000'001));
+  EXPECT_EQ(m.reports(), 1u);
+}
+
+TEST(FaultMonitorLiveness, SolutionsAreFlaggedWhileNoMonitorIsAlive) {
+  const auto cfg = imuOnlyConfig();
+  bus::HealthCounters health("test");
+  std::vector<NavigationSolution> solutions;
+  nav_filter::FilterPipeline pipeline(
+      cfg, health, {[&](const NavigationSolution& s) { solutions.push_back(s); }, nullptr});
+  sim::ScenarioSource src(sourceConfig());
+  std::uint64_t seq = 0;
+  std::int64_t now = 0;
+  auto run = [&](int n) {
+    const std::size_t before = solutions.size();
+    for (int k = 0; k < n; ++k) {
+      pipeline.onImu(bus::toIdl(src.next().increment, 1, ++seq));
+      pipeline.pump(now += 10'000'000);
+    }
+    return std::vector<NavigationSolution>(solutions.begin() + static_cast<std::ptrdiff_t>(before),
+                                           solutions.end());
+  };
+  for (const auto& s : run(50)) EXPECT_EQ(s.active_fault_flags() & FAULT_NO_FAULT_MONITOR, 0u);
+  pipeline.setFaultMonitorAlive(false);
+  EXPECT_TRUE(pipeline.degraded());
+  const auto without = run(50);
+  ASSERT_FALSE(without.empty());
+  for (const auto& s : without) EXPECT_NE(s.active_fault_flags() & FAULT_NO_FAULT_MONITOR, 0u);
+  pipeline.setFaultMonitorAlive(true);
+  for (const auto& s : run(50)) EXPECT_EQ(s.active_fault_flags() & FAULT_NO_FAULT_MONITOR, 0u);
+  EXPECT_FALSE(pipeline.degraded());
+  EXPECT_NE(pipeline.summary().find("fault monitor found not alive 1 time(s)"), std::string::npos)
       << pipeline.summary();
 }
