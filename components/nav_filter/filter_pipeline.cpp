@@ -169,12 +169,12 @@ void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
 
 void FilterPipeline::startNewRun() {
   flush(last_pump_ns_);
-  const std::size_t dropped = sequencer_.newRun();
+  const std::size_t dropped = sequencer_.newRun({kRankImu, config_.imu.id});
   solutions_earlier_runs_ += solution_seq_;
   increments_earlier_runs_ += engine_.counters().imu_used;
   engine_ = core::NavigationEngine(config_.engine);
-  history_ = InputHistory<FilterInput>(config_.recovery_history_ns,
-                                       config_.recovery_snapshot_period_ns);
+  history_ =
+      InputHistory<FilterInput>(config_.recovery_history_ns, config_.recovery_snapshot_period_ns);
   replay_.clear();
   first_input_ns_ = -1;
   solution_seq_ = 0;
@@ -183,9 +183,10 @@ void FilterPipeline::startNewRun() {
   for (bus::StreamGate* g : {&gnss_obs_gate_, &gnss_fix_gate_, &star_gate_})
     g->tracker().resetAll();
   ++new_runs_;
-  spdlog::warn("the IMU source restarted at an earlier time: new run {} (the filter starts over; "
-               "{} held inputs of the previous run could not be released)",
-               new_runs_, dropped);
+  spdlog::warn(
+      "the IMU source restarted at an earlier time: new run {} (the filter starts over; "
+      "{} held inputs of the previous run could not be released)",
+      new_runs_, dropped);
 }
 
 void FilterPipeline::pump(std::int64_t now_ns) {

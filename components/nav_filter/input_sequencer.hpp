@@ -104,17 +104,19 @@ class InputSequencer {
   }
 
   /// A new run of the inputs (their source restarted at an earlier time): forgets the order
-  /// released so far and what each stream promised, as at construction. Streams set aside
-  /// stay so. The caller releases what is held first; anything still queued is dropped and
-  /// its count returned.
-  std::size_t newRun() {
+  /// released so far and what each stream promised. Only `first` holds the others back at
+  /// once; every other stream is set aside until it delivers in the new run (its first samples
+  /// may have come before the restart was recognised). The caller releases what is held
+  /// first; anything still queued is dropped and its count returned.
+  std::size_t newRun(StreamId first) {
     const std::size_t dropped = queue_.size();
     queue_.clear();
     released_any_ = false;
     last_released_ = Key{0, {}};
     head_blocked_since_ns_ = -1;
     for (auto& [id, s] : streams_) {
-      s.seen = false;
+      s.seen = id == first;
+      s.active = id == first;
       s.last_time_ns = 0;
     }
     return dropped;

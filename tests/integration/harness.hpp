@@ -22,6 +22,7 @@
 #include <navbus_idl/StarTrackerPubSubTypes.h>
 
 #include "navbus/bus/participant.hpp"
+#include "navbus/bus/shared_memory.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
@@ -126,17 +127,10 @@ inline bool spinUntil(bus::Participant& p, std::chrono::milliseconds timeout,
   return pred();
 }
 
-/// Removes shared-memory files the Fast DDS SHM transport may have left (our test profiles use
-/// UDP on loopback, so normally there are none).
+/// Removes the shared memory of dead Fast DDS processes (bus/shared_memory.hpp); what live
+/// processes use, those of tests running in parallel among them, is left alone.
 inline void cleanSharedMemory() {
-  for (const auto& e : std::filesystem::directory_iterator("/dev/shm")) {
-    const std::string n = e.path().filename().string();
-    if (n.rfind("fastrtps_", 0) == 0 || n.rfind("sem.fastrtps_", 0) == 0 ||
-        n.rfind("fast_datasharing", 0) == 0) {
-      std::error_code ec;
-      std::filesystem::remove(e.path(), ec);
-    }
-  }
+  bus::reclaimSharedMemory();
 }
 
 /// The test's writers for every sensor stream navbus-filter reads, with the simulator's profiles.

@@ -1,7 +1,11 @@
 #include "navbus/bus/participant.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 
+#include <spdlog/spdlog.h>
+
+#include "navbus/bus/shared_memory.hpp"
 #include "navbus/bus/topics.hpp"
 
 namespace navbus::bus {
@@ -13,6 +17,22 @@ Participant::Participant(const Options& options, ShutdownSignal& shutdown)
   health_writer_ = createWriter<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthWriter);
   waitset_.attach_condition(shutdown_.condition());
   addTimer(options.health_period, [this] { publishHealth(); });
+  reclaimSharedMemoryOfDeadParticipants();
+  addTimer(kShmReclaimPeriod, [] { reclaimSharedMemoryOfDeadParticipants(); });
+}
+
+void Participant::reclaimSharedMemoryOfDeadParticipants() {
+  static const bool off = [] {
+    const char* v = std::getenv("NAVBUS_SHM_RECLAIM");
+    return v != nullptr && std::string(v) == "0";
+  }();
+  if (off) return;
+  const ShmReclaimResult r = reclaimSharedMemory();
+  if (r.zombie_segments + r.zombie_ports == 0) return;
+  spdlog::info(
+      "reclaimed the shared memory of dead Fast DDS participants: {} segments and {} ports, {} "
+      "bytes",
+      r.zombie_segments, r.zombie_ports, r.bytes_reclaimed);
 }
 
 Participant::~Participant() {

@@ -152,6 +152,11 @@ class Participant {
   /// Publishes a health report now.
   void publishHealth();
 
+  /// Removes what crashed or killed Fast DDS participants left in /dev/shm
+  /// (bus/shared_memory.hpp): at start and every kShmReclaimPeriod.
+  static void reclaimSharedMemoryOfDeadParticipants();
+  static constexpr std::chrono::seconds kShmReclaimPeriod{5};
+
  private:
   struct ReaderEntry {
     eprosima::fastdds::dds::DataReader* reader;
