@@ -200,7 +200,8 @@ std::string FaultPipeline::summary() const {
       << "), streams ended as announced " << ended_ << ", commands published " << commands() << "; "
       << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
-  if (filter_new_runs_ > 0) out << "; GLR restarted with the filter's new runs " << filter_new_runs_;
+  if (filter_new_runs_ > 0)
+    out << "; GLR restarted with the filter's new runs " << filter_new_runs_;
   if (other_vehicles_ > 0) out << "; diagnostics of other vehicles ignored " << other_vehicles_;
   return out.str();
 }

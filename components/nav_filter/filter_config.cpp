@@ -48,13 +48,13 @@ Enum choice(const YAML::Node& node, const std::string& where, const std::string&
 
 FilterConfig parseFilterConfig(const YAML::Node& root) {
   FilterConfig c;
-  bus::checkKeys(root, "",
-                 {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
-                  "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
-                  "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated",
-                  "multi_dimensional", "command_issuers", "issuer_identities", "time_jump",
-                  "fault_monitor"},
-                 bus::kParticipantKeys);
+  bus::checkKeys(
+      root, "",
+      {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
+       "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
+       "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional",
+       "command_issuers", "issuer_identities", "time_jump", "fault_monitor"},
+      bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
   const double rate = bus::checkRange(bus::get<double>(root, "", "solution_rate_hz", 10.0), 1.0,
@@ -111,9 +111,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       w.identity = it->second;
     w.participant = bus::get<std::string>(fm, "fault_monitor", "participant", w.participant);
     w.identity = bus::get<std::string>(fm, "fault_monitor", "identity", w.identity);
-    w.timeout_ns =
-        seconds(bus::checkRange(bus::get<double>(fm, "fault_monitor", "timeout_s", 3.0), 0.1,
-                                3600.0, "fault_monitor.timeout_s"));
+    w.timeout_ns = seconds(bus::checkRange(bus::get<double>(fm, "fault_monitor", "timeout_s", 3.0),
+                                           0.1, 3600.0, "fault_monitor.timeout_s"));
     c.fault_monitor = w;
   }
   for (const auto& [issuer, name] : c.issuer_identities) {

@@ -159,7 +159,7 @@ class FilterPipeline {
   bus::StreamCounters& command_counters_;  ///< health of the command topic
   std::uint64_t commands_late_{0};
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
-  std::uint32_t monitor_flags_{0};  ///< FAULT_NO_FAULT_MONITOR while no fault monitor is alive
+  std::uint32_t monitor_flags_{0};   ///< FAULT_NO_FAULT_MONITOR while no fault monitor is alive
   std::uint64_t monitor_losses_{0};  ///< times the fault monitor was found not alive
   std::uint64_t new_runs_{0};
   std::uint64_t solutions_earlier_runs_{0};   ///< published before the latest new run

@@ -201,7 +201,8 @@ TEST(SequenceTracker, DuplicatesOrderAndGaps) {
 
 TEST(SequenceTracker, SourceRestartAtAnEarlierTimeIsConfirmedByTheSamplesAfterIt) {
   SequenceTracker t(navbus::bus::TimeJumpRule{50, 3}, nullptr);
-  for (std::uint64_t k = 1; k <= 10; ++k) EXPECT_FALSE(t.check(1, 100 + k, 1000 + 10 * k).rejection);
+  for (std::uint64_t k = 1; k <= 10; ++k)
+    EXPECT_FALSE(t.check(1, 100 + k, 1000 + 10 * k).rejection);
   // One stale sample (time and sequence behind) followed by the stream going on: rejected, and
   // the candidate forgotten.
   EXPECT_EQ(t.check(1, 50, 500).rejection->reason, navbus::REJECT_TIME_NOT_MONOTONIC);

@@ -355,9 +355,10 @@ void StreamGate::noteSequence(const SequenceTracker::Outcome& o) {
   }
   if (o.source_restarted) {
     ++counters_.source_restarts;
-    spdlog::warn("{}: the source restarted (time and sequence went back, confirmed by the samples "
-                 "after it): a new run",
-                 topic_);
+    spdlog::warn(
+        "{}: the source restarted (time and sequence went back, confirmed by the samples "
+        "after it): a new run",
+        topic_);
   }
   if (o.jump_adopted) {
     spdlog::warn("{}: a forward time jump confirmed by the samples after it: adopted", topic_);
