@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages navbus needs, only those missing. Run as root.
+# --sanitizers adds clang and its sanitizer and libFuzzer runtimes (scripts/sanitize.sh).
 set -euo pipefail
 packages=(
-  build-essential cmake pkg-config git
+  build-essential cmake pkg-config git ccache              # ccache: a rebuild of the same sources is quick
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools   # Fast DDS 2.9, Fast-CDR, code generator, CLI
   libeigen3-dev libfftw3-dev                               # math
   libyaml-cpp-dev libcli11-dev libspdlog-dev               # configuration, command line, logging
@@ -12,6 +13,9 @@ packages=(
   rtklib                                                   # rnx2rtkp: independent GPS fixes for the real-data test
   python3-matplotlib python3-yaml                          # demo summary and figures (scripts/*.py)
 )
+if [ "${1:-}" = --sanitizers ]; then
+  packages+=(clang libclang-rt-14-dev llvm)          # ASan, UBSan, libFuzzer; llvm-symbolizer
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -20,8 +20,10 @@ void band(const YAML::Node& node, const std::string& where, double& low, double&
   if (!b) return;
   if (!b.IsSequence() || b.size() != 2)
     throw bus::ConfigError("configuration " + where + ".band_hz must be [low, high] in Hz");
-  low = bus::checkRange(b[0].as<double>(), 0.0, 1e6, where + ".band_hz[0]");
-  high = bus::checkRange(b[1].as<double>(), low + 1e-3, 1e6, where + ".band_hz[1]");
+  low = bus::checkRange(bus::as<double>(b[0], where + ".band_hz[0]"), 0.0, 1e6,
+                        where + ".band_hz[0]");
+  high = bus::checkRange(bus::as<double>(b[1], where + ".band_hz[1]"), low + 1e-3, 1e6,
+                         where + ".band_hz[1]");
 }
 
 void parseDither(const YAML::Node& n, DitherDetectorConfig& d) {
@@ -40,9 +42,9 @@ void parseDither(const YAML::Node& n, DitherDetectorConfig& d) {
     if (!f.IsSequence() || f.size() != 3)
       throw bus::ConfigError("configuration dither.frequencies_hz must be [x, y, z] in Hz");
     for (std::size_t i = 0; i < 3; ++i) {
+      const std::string path = "dither.frequencies_hz[" + std::to_string(i) + "]";
       m.dither_frequency_hz[i] =
-          bus::checkRange(f[i].as<double>(), 1.0, m.sample_rate_hz / 2,
-                          "dither.frequencies_hz[" + std::to_string(i) + "]");
+          bus::checkRange(bus::as<double>(f[i], path), 1.0, m.sample_rate_hz / 2, path);
     }
   }
   m.tolerance_hz = bus::checkRange(bus::get<double>(n, w, "tolerance_hz", m.tolerance_hz), 0.01,

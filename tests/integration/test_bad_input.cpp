@@ -2,11 +2,17 @@
 // samples among good ones: each is rejected and counted by reason in the filter's health, and
 // the solution stays finite. A GNSS epoch with bad satellites (unknown id, one id twice, an
 // implausible sigma) loses those satellites only: the good ones are fused (diagnostics rows).
+// A hostile writer publishes payloads that are not ImuIncrements under the type's name (a bad
+// encapsulation identifier, a truncated body): the filter drops and counts them (malformed)
+// and goes on; before bus::GuardedType, the first one ended the filter process.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <set>
+#include <vector>
+
+#include <fastdds/dds/topic/TopicDataType.hpp>
 
 #include <gtest/gtest.h>
 #include <navbus_idl/HealthPubSubTypes.h>
@@ -24,6 +30,36 @@ using namespace std::chrono_literals;
 namespace {
 constexpr int kDomain = 74;
 using Counts = std::map<std::string, std::map<RejectReason, std::uint64_t>>;
+
+/// Arbitrary bytes published under the name of navbus's ImuIncrement type (keyed, as the real
+/// one, so that the filter's reader matches): what a faulty or hostile participant can send.
+class RawBytesType : public eprosima::fastdds::dds::TopicDataType {
+ public:
+  using type = std::vector<unsigned char>;
+  RawBytesType() {
+    setName("navbus::ImuIncrement");
+    m_typeSize = 1024;
+    m_isGetKeyDefined = true;
+  }
+  bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
+    const auto& bytes = *static_cast<type*>(data);
+    if (bytes.size() > payload->max_size) return false;
+    std::copy(bytes.begin(), bytes.end(), payload->data);
+    payload->length = static_cast<std::uint32_t>(bytes.size());
+    return true;
+  }
+  bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t*, void*) override { return false; }
+  std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override {
+    return [data] { return static_cast<std::uint32_t>(static_cast<type*>(data)->size()); };
+  }
+  void* createData() override { return new type(); }
+  void deleteData(void* data) override { delete static_cast<type*>(data); }
+  bool getKey(void*, eprosima::fastrtps::rtps::InstanceHandle_t* handle, bool) override {
+    *handle = eprosima::fastrtps::rtps::InstanceHandle_t();
+    handle->value[0] = 1;  // the key of sensor 1
+    return true;
+  }
+};
 }  // namespace
 
 TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
@@ -50,7 +86,12 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
                                      filter_health = h;
                                  });
   test::SensorInputWriters w(me);
-  ASSERT_TRUE(test::spinUntil(me, 20s, [&] { return w.matched(); }));
+  bus::ShutdownSignal hostile_shutdown;
+  bus::Participant hostile(test::testParticipant(kDomain, "hostile-writer"), hostile_shutdown);
+  auto garbage =
+      hostile.createWriter<RawBytesType>(bus::topic::kImuIncrement, bus::profile::kSensorWriter);
+  ASSERT_TRUE(
+      test::spinUntil(me, 20s, [&] { return w.matched() && garbage.matchedReaders() >= 1; }));
 
   sim::ScenarioSource src = test::testScenarioSource();
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -94,7 +135,13 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
       case 160:
         bad.time_gps_ns(good.time_gps_ns() + 3'600'000'000'000ULL);
         w.imu.write(bad);
-        break;  // an hour in the future: not adopted, the genuine samples after it go on
+        break;   // an hour in the future: not adopted, the genuine samples after it go on
+      case 180:  // encapsulation identifier 0x000a: Fast-CDR throws BadParamException
+        garbage.write({0x00, 0x0a, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00});
+        break;
+      case 200:  // a valid header and a body cut short after the sensor id
+        garbage.write({0x00, 0x01, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00});
+        break;
       default:
         break;
     }
@@ -158,14 +205,15 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
         {REJECT_TIME_NOT_MONOTONIC, 1},
         {REJECT_DUPLICATE, 1},
         {REJECT_UNEXPECTED_SOURCE, 1},
-        {REJECT_TIME_JUMP, 1}}},
+        {REJECT_TIME_JUMP, 1},
+        {REJECT_MALFORMED, 2}}},
       {bus::topic::kGnssObservations, {{REJECT_DUPLICATE, 1}}},
       {bus::topic::kGnssFix, {{REJECT_NOT_FINITE, 1}}},
       {bus::topic::kStarTracker, {{REJECT_BAD_QUATERNION, 1}}},
   };
   ASSERT_TRUE(test::spinUntil(me, 20s, [&] {
     const auto* s = stream(bus::topic::kImuIncrement);
-    return s != nullptr && s->received() == 308 && counts() == expected && solutions.size() >= 30;
+    return s != nullptr && s->received() == 310 && counts() == expected && solutions.size() >= 30;
   })) << test::readFile(dir / "filter.log");
   const auto* s = stream(bus::topic::kImuIncrement);
   EXPECT_EQ(s->accepted(), 300u);

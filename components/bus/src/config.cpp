@@ -13,7 +13,7 @@ namespace {
 YAML::Node merge(YAML::Node base, const YAML::Node& over) {
   if (!base.IsMap() || !over.IsMap()) return YAML::Clone(over);
   for (const auto& kv : over) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = as<std::string>(kv.first, "<key>");
     base[key] = base[key] ? merge(YAML::Clone(base[key]), kv.second) : YAML::Clone(kv.second);
   }
   return base;
@@ -32,7 +32,8 @@ YAML::Node loadWithExtends(const std::filesystem::path& path, int depth) {
   }
   if (!node.IsMap() || !node["extends"]) return node;
   // `extends: base.yaml` (relative to this file): this file's keys override the base's.
-  const std::filesystem::path base_path = path.parent_path() / node["extends"].as<std::string>();
+  const std::filesystem::path base_path =
+      path.parent_path() / as<std::string>(node["extends"], "extends");
   YAML::Node base = loadWithExtends(base_path, depth + 1);
   node.remove("extends");
   return merge(base, node);
@@ -43,6 +44,12 @@ YAML::Node loadYamlFile(const std::string& path) {
   return loadWithExtends(path, 0);
 }
 
+void requireMapOrAbsent(const YAML::Node& node, const std::string& where) {
+  if (!node || node.IsNull() || node.IsMap()) return;
+  throw ConfigError("configuration " + (where.empty() ? std::string("file") : where) +
+                    " must be a map of keys, found '" + YAML::Dump(node) + "'");
+}
+
 void checkKeys(const YAML::Node& node, const std::string& where,
                std::initializer_list<const char*> allowed,
                std::initializer_list<const char*> also) {
@@ -50,7 +57,7 @@ void checkKeys(const YAML::Node& node, const std::string& where,
   if (!node.IsMap())
     throw ConfigError("configuration " + (where.empty() ? "file" : where) + " must be a map");
   for (const auto& kv : node) {
-    const auto key = kv.first.as<std::string>();
+    const auto key = as<std::string>(kv.first, (where.empty() ? "" : where + ".") + "<key>");
     auto is_key = [&key](const char* k) { return key == k; };
     const bool known = std::any_of(allowed.begin(), allowed.end(), is_key) ||
                        std::any_of(also.begin(), also.end(), is_key);
@@ -89,7 +96,7 @@ std::string fileDefiningKey(const std::string& path, const std::string& key_path
     }
     if (nodeAt(own, key_path).IsDefined()) return file.string();
     if (!own.IsMap() || !own["extends"]) break;
-    file = file.parent_path() / own["extends"].as<std::string>();
+    file = file.parent_path() / as<std::string>(own["extends"], "extends");
   }
   return path;
 }

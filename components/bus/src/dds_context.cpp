@@ -106,6 +106,10 @@ dds::Topic* DdsContext::topicForType(const std::string& name, dds::TypeSupport t
   return topic;
 }
 
+MalformedCounter* DdsContext::malformedCounter(const std::string& type_name) {
+  return dynamic_cast<MalformedCounter*>(participant_->find_type(type_name).get());
+}
+
 dds::DataWriter* DdsContext::createWriter(dds::Topic* topic, const std::string& profile) {
   dds::DataWriter* writer = publisher_->create_datawriter_with_profile(topic, profile);
   if (writer == nullptr) {

@@ -116,6 +116,8 @@ const char* rejectReasonName(navbus::RejectReason reason) {
       return "stale";
     case navbus::REJECT_NOT_APPLICABLE:
       return "not_applicable";
+    case navbus::REJECT_MALFORMED:
+      return "malformed";
   }
   return "unknown";
 }

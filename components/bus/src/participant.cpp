@@ -42,6 +42,20 @@ Participant::~Participant() {
   }
 }
 
+void Participant::countMalformed(const std::string& topic, StreamCounters& counters,
+                                 std::uint64_t n) {
+  if (n == 0) return;
+  counters.received += n;
+  std::uint64_t& total = counters.rejected[navbus::REJECT_MALFORMED];
+  const std::uint64_t before = total;
+  total += n;
+  if (before == 0 || before / 1000 != total / 1000) {
+    spdlog::warn(
+        "{}: {} payload(s) that do not deserialize as the topic's type dropped ({} so far)", topic,
+        n, total);
+  }
+}
+
 void Participant::addReader(dds::DataReader* reader, const std::string& topic,
                             std::function<void()> take_all, ReaderCallbacks callbacks) {
   auto entry = std::make_unique<ReaderEntry>(

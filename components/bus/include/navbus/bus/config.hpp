@@ -73,24 +73,36 @@ auto parseFile(const std::string& path, Parse&& parse) -> decltype(parse(YAML::N
 /// keys (maps merge recursively, lists and scalars replace).
 YAML::Node loadYamlFile(const std::string& path);
 
+/// Throws ConfigError (naming `where` and the text found) unless `node` is absent, empty or a
+/// map: keys cannot be looked up in a scalar or a list.
+void requireMapOrAbsent(const YAML::Node& node, const std::string& where);
+
+/// `node`, the value at `path` ("dither.band_hz[0]"), as T; throws ConfigError (naming `path`
+/// and the text found) when it is not convertible.
+template <class T>
+T as(const YAML::Node& node, const std::string& path) {
+  try {
+    return node.as<T>();
+  } catch (const YAML::Exception&) {
+    throw ConfigError("configuration " + path + ": cannot read value '" + YAML::Dump(node) + "'");
+  }
+}
+
 /// Reads `key` of `node` as T; returns `fallback` when the key is absent; throws ConfigError
 /// (naming `where.key` and the text found) when present but not convertible.
 template <class T>
 T get(const YAML::Node& node, const std::string& where, const std::string& key, const T& fallback) {
+  requireMapOrAbsent(node, where);
   if (!node || !node[key]) {
     return fallback;
   }
-  try {
-    return node[key].as<T>();
-  } catch (const YAML::Exception&) {
-    throw ConfigError("configuration " + where + "." + key + ": cannot read value '" +
-                      YAML::Dump(node[key]) + "'");
-  }
+  return as<T>(node[key], where + "." + key);
 }
 
 /// As get(), but the key must be present.
 template <class T>
 T require(const YAML::Node& node, const std::string& where, const std::string& key) {
+  requireMapOrAbsent(node, where);
   if (!node || !node[key]) {
     throw ConfigError("configuration " + where + "." + key + " is missing");
   }

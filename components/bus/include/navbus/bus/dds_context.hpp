@@ -16,6 +16,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "navbus/bus/guarded_type.hpp"
 #include "navbus/bus/peer_identities.hpp"
 
 namespace navbus::bus {
@@ -54,9 +55,11 @@ class DdsContext {
   /// Registers PubSubType (once) and returns the topic, created on first use.
   template <class PubSubType>
   eprosima::fastdds::dds::Topic* topic(const std::string& name) {
-    eprosima::fastdds::dds::TypeSupport type(new PubSubType());
+    eprosima::fastdds::dds::TypeSupport type(new GuardedType<PubSubType>());
     return topicForType(name, type);
   }
+  /// The counter of payloads of a registered type that failed to deserialize (GuardedType).
+  MalformedCounter* malformedCounter(const std::string& type_name);
 
   eprosima::fastdds::dds::DataWriter* createWriter(eprosima::fastdds::dds::Topic* topic,
                                                    const std::string& profile);

@@ -113,19 +113,25 @@ class Participant {
     auto* topic = dds_.topic<PubSubType>(topic_name);
     auto* reader = dds_.createReader(topic, profile);
     StreamCounters* counters = &health_.stream(topic_name);
-    auto take_all = [reader, counters, on_sample, on_disposed = callbacks.on_disposed]() {
+    MalformedCounter* malformed = dds_.malformedCounter(topic->get_type_name());
+    auto take_all = [reader, counters, malformed, topic_name, on_sample,
+                     on_disposed = callbacks.on_disposed]() {
       Sample sample;
       eprosima::fastdds::dds::SampleInfo info;
-      while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-        if (info.valid_data) {
-          ++counters->received;
-          on_sample(sample, info);
-        } else if (info.instance_state ==
-                       eprosima::fastdds::dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE &&
-                   on_disposed) {
-          on_disposed(info.instance_handle);
+      {
+        const MalformedCounter::TakeScope taking;
+        while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+          if (info.valid_data) {
+            ++counters->received;
+            on_sample(sample, info);
+          } else if (info.instance_state ==
+                         eprosima::fastdds::dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE &&
+                     on_disposed) {
+            on_disposed(info.instance_handle);
+          }
         }
       }
+      if (malformed != nullptr) countMalformed(topic_name, *counters, malformed->takeMalformed());
     };
     addReader(reader, topic_name, std::move(take_all), std::move(callbacks));
     return reader;
@@ -170,6 +176,9 @@ class Participant {
     std::function<void()> fn;
   };
 
+  /// Counts `n` payloads of `topic` that did not deserialize (received and rejected as
+  /// REJECT_MALFORMED; Fast DDS dropped them); logs the first and every 1000th.
+  static void countMalformed(const std::string& topic, StreamCounters& counters, std::uint64_t n);
   void addReader(eprosima::fastdds::dds::DataReader* reader, const std::string& topic,
                  std::function<void()> take_all, ReaderCallbacks callbacks);
   void dispatch(ReaderEntry& entry);

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Runs the libFuzzer targets (a sanitizer build made by scripts/sanitize.sh, or any build
+# configured with -DNAVBUS_BUILD_FUZZERS=ON) for a given number of executions each:
+#   navbus_fuzz_topics  CDR deserialization of every topic type + the input validators
+#   navbus_fuzz_config  the configuration parsers (participant, simulator, filter, fault manager)
+# Seeds: a valid sample of each topic type and the shipped configurations; the corpus grows in
+# the work directory and is reused by the next run. A crash, leak, undefined behaviour or
+# violated property fails the script and leaves the input under <work>/artifacts.
+#
+#   bash scripts/fuzz.sh [--bin build-san/bin] [--runs 10000000] [--work build-san/fuzz]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+bin=$root/build-san/bin
+runs=10000000
+work=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --bin) bin=$2; shift 2 ;;
+    --runs) runs=$2; shift 2 ;;
+    --work) work=$2; shift 2 ;;
+    *) echo "fuzz.sh: unknown argument '$1'" >&2; exit 2 ;;
+  esac
+done
+work=${work:-$bin/../fuzz}
+for t in navbus_fuzz_topics navbus_fuzz_config navbus_fuzz_seeds; do
+  [ -x "$bin/$t" ] || { echo "fuzz.sh: $bin/$t missing: build with scripts/sanitize.sh first" >&2; exit 2; }
+done
+mkdir -p "$work/corpus/topics" "$work/corpus/config" "$work/artifacts"
+seeds=()
+for f in "$root"/config/filter*.yaml; do seeds+=("filter:$f"); done
+for f in "$root"/config/fault_manager*.yaml; do seeds+=("fault:$f"); done
+for f in "$root"/sim/scenarios/*.yaml; do seeds+=("sim:$f"); done
+seeds+=("participant:$root/config/filter.yaml")
+mkdir -p "$work/seeds/topics" "$work/seeds/config"
+"$bin/navbus_fuzz_seeds" "$work/seeds" "${seeds[@]}"
+
+# LeakSanitizer on; the first finding stops the target.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+status=0
+run() {  # target corpus max_len
+  local log=$work/$1.log
+  echo "fuzz.sh: $1, $runs executions (log $log)"
+  if ! "$bin/$1" -runs="$runs" -max_len="$3" -print_final_stats=1 -timeout=10 -rss_limit_mb=2048 \
+      -artifact_prefix="$work/artifacts/$1-" "$work/corpus/$2" "$work/seeds/$2" > "$log" 2>&1; then
+    echo "fuzz.sh: $1 FAILED"; grep -E "ERROR|SUMMARY|==[0-9]+==|runtime error|Test unit written" "$log" | head -20
+    status=1
+    return
+  fi
+  local execs rate
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
+  echo "fuzz.sh: $1 passed: $execs executions, $rate per second, corpus $(ls "$work/corpus/$2" | wc -l) inputs, 0 crashes"
+}
+run navbus_fuzz_topics topics 65536
+run navbus_fuzz_config config 8192
+exit $status

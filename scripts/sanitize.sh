@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# The sanitizer stage: builds navbus with clang, AddressSanitizer and UndefinedBehaviorSanitizer
+# (any undefined behaviour aborts) into ./build-san, with the libFuzzer targets; runs the unit
+# and integration tests under them and a bounded slice of each fuzz target (ctest fuzz_smoke:
+# scripts/fuzz.sh, 200000 executions each). Benchmarks and the CPU-load timing test are left to
+# the normal build: the sanitizers change the timing they measure.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh --sanitizers
+mkdir -p build-san
+CC=clang CXX=clang++ cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DNAVBUS_SANITIZE=address,undefined -DNAVBUS_BUILD_FUZZERS=ON \
+  -DNAVBUS_BUILD_BENCHMARKS=OFF -DNAVBUS_BUILD_INTEROP=OFF > build-san/configure.log 2>&1 ||
+  { cat build-san/configure.log; exit 1; }
+cmake --build build-san -j"$(nproc)"
+# Leaks are reported at each process's exit; a report fails the test that ran it.
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0
+export LSAN_OPTIONS=suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+(cd build-san && ctest --output-on-failure -j2 --timeout 600 -E "^cpu_load$")
