@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -31,7 +32,8 @@ namespace navbus::test {
 /// A navbus executable run as a child process, its output in a log file. It leads its own
 /// process group, so that signals reach what it starts too (`fastdds discovery` is a launcher
 /// that starts fast-discovery-server as its child: killing the launcher alone left the server
-/// running after the test). Killed, with its group, if still running when destroyed.
+/// running after the test). Killed, with its group, if still running when destroyed, and
+/// killed when the test process dies.
 class ChildProcess {
  public:
   ChildProcess(const std::string& exe, const std::vector<std::string>& args,
@@ -39,6 +41,9 @@ class ChildProcess {
     pid_ = fork();
     if (pid_ == 0) {
       setpgid(0, 0);
+      // Dies with the test process, even when that one aborts (a sanitizer finding) and no
+      // destructor runs: a stray participant would disturb the next test on its domain.
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
       // The test process blocks SIGINT/SIGTERM (ShutdownSignal); the child must not inherit it.
       sigset_t none;
       sigemptyset(&none);
