@@ -3,7 +3,7 @@
 periodically; samples every participant's resident memory and reports its growth after the
 warm-up and the samples lost between the simulator and its readers.
 
-  python3 scripts/soak.py [--hours 24] [--domain 57] [--out build/soak] [--bin build/bin]
+  /usr/bin/python3 scripts/soak.py [--hours 24] [--domain 57] [--out build/soak] [--bin build/bin]
 
 The main demo's vehicle, sensors and configurations (sim/scenarios/demo_fault_loop.yaml,
 config/filter_demo.yaml, config/fault_manager.yaml), driven for --hours in a one-hour loop
@@ -176,6 +176,7 @@ def plot(samples, path):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
+        print("soak: no figure: matplotlib is missing (Debian: python3-matplotlib)")
         return
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for name in sorted({n for _, n, _ in samples}):
