@@ -17,6 +17,5 @@ cmake --build build-san -j"$(nproc)"
 # new_delete_type_mismatch=0: libfastrtps 2.9.1 frees an 88-byte object of its own as a
 # 56-byte one in RTPSWriter::~RTPSWriter (sized delete in a library navbus does not build).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:new_delete_type_mismatch=0
-export LSAN_OPTIONS=suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 (cd build-san && ctest --output-on-failure -j2 --timeout 600 -E "^cpu_load$")

@@ -124,8 +124,8 @@ def published_counts(sim_summary):
 
 
 def rejected_total(field):
-    """'REASON:count;REASON:count' (the recorder's flattening) -> total."""
-    return sum(int(p.split(":")[-1]) for p in field.split(";") if ":" in p)
+    """'reason=count reason=count ' (the recorder's flattening of RejectCount lists) -> total."""
+    return sum(int(p.split("=")[1]) for p in field.split() if "=" in p)
 
 
 # The fault manager's stream watchdogs read best effort (qos/navbus_qos.xml: monitoring never
@@ -237,9 +237,9 @@ def main():
                     w.writerow([f"{t:.1f}", name, r])
             f.flush()
             if t >= next_report:
+                latest = {name: rss for _, name, rss in samples}
                 print(f"soak: {t / 60:.0f} min, RSS " + ", ".join(
-                    f"{n} {s[2] / 1024:.1f} MiB" for n in procs for s in samples[-len(procs):]
-                    if s[1] == n), flush=True)
+                    f"{name} {rss / 1024:.1f} MiB" for name, rss in latest.items()), flush=True)
                 next_report += 600.0
             time.sleep(args.sample_s)
     wall = time.monotonic() - t0

@@ -94,6 +94,15 @@ int roundsPerParticipant() {
   return env != nullptr ? std::max(1, std::atoi(env)) : 2;
 }
 
+/// Prints what dead Fast DDS participants left in /dev/shm; returns the data segments' bytes.
+std::uint64_t printDeadParticipantsShm(const char* what) {
+  const std::uint64_t segments = bus::zombieSharedMemoryBytes();
+  std::printf("shared memory %s: data segments %llu bytes, ports %llu bytes\n", what,
+              static_cast<unsigned long long>(segments),
+              static_cast<unsigned long long>(bus::zombieSharedMemoryBytes("/dev/shm", true)));
+  return segments;
+}
+
 }  // namespace
 
 TEST(KillLoop, EachParticipantKilledAndRestartedSurvivorsReportAndNothingLeftInShm) {
@@ -218,12 +227,7 @@ TEST(KillLoop, EachParticipantKilledAndRestartedSurvivorsReportAndNothingLeftInS
   test::spinUntil(me, 7s, [] { return false; });
   for (auto& p : procs) p->signal(SIGTERM);
   for (auto& p : procs) EXPECT_EQ(p->wait(15s), 0);
-  const std::uint64_t left = bus::zombieSharedMemoryBytes();
-  std::printf(
-      "shared memory left by dead participants after the loop: data segments %llu bytes, "
-      "ports %llu bytes\n",
-      static_cast<unsigned long long>(left),
-      static_cast<unsigned long long>(bus::zombieSharedMemoryBytes("/dev/shm", true)));
+  const std::uint64_t left = printDeadParticipantsShm("left by dead participants after the loop");
   EXPECT_EQ(left, 0u);
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
@@ -256,12 +260,7 @@ TEST(SharedMemory, WhatAKilledParticipantLeftIsReclaimedByALiveOne) {
     filter.signal(SIGKILL);
     filter.wait(5s);
   }
-  const std::uint64_t left = bus::zombieSharedMemoryBytes();
-  std::printf(
-      "left in /dev/shm by the killed participant: data segments %llu bytes, ports %llu "
-      "bytes\n",
-      static_cast<unsigned long long>(left),
-      static_cast<unsigned long long>(bus::zombieSharedMemoryBytes("/dev/shm", true)));
+  const std::uint64_t left = printDeadParticipantsShm("left by the killed participant");
   EXPECT_GT(left, 1'000'000u);  // its 4 MB segment at least
   const auto t0 = Clock::now();
   EXPECT_TRUE(test::spinUntil(me, bus::Participant::kShmReclaimPeriod + 3s,

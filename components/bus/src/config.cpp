@@ -53,9 +53,8 @@ void requireMapOrAbsent(const YAML::Node& node, const std::string& where) {
 void checkKeys(const YAML::Node& node, const std::string& where,
                std::initializer_list<const char*> allowed,
                std::initializer_list<const char*> also) {
+  requireMapOrAbsent(node, where);
   if (!node || node.IsNull()) return;  // absent or empty: every default
-  if (!node.IsMap())
-    throw ConfigError("configuration " + (where.empty() ? "file" : where) + " must be a map");
   for (const auto& kv : node) {
     const auto key = as<std::string>(kv.first, (where.empty() ? "" : where + ".") + "<key>");
     auto is_key = [&key](const char* k) { return key == k; };
