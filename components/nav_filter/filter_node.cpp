@@ -41,7 +41,10 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
       pipeline_(
           config, p.health(),
           {[this](const navbus::NavigationSolution& s) {
-             if (solution_writer_.write(s)) last_solution_ns_ = steadyNowNs();
+             if (!solution_writer_.write(s)) return;
+             const bool first = last_solution_ns_ < 0;
+             last_solution_ns_ = steadyNowNs();
+             if (first) updateState();  // health says RUNNING at once
            },
            publishesDiagnostics(config)
                ? std::function<void(const navbus::FilterDiagnostics&)>(
@@ -55,25 +58,21 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
       gnss_fix_writers_(bus::topic::kGnssFix, p.health().stream(bus::topic::kGnssFix)),
       star_writers_(bus::topic::kStarTracker, p.health().stream(bus::topic::kStarTracker)) {
   using namespace bus;
-  p.subscribe<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorReader,
-                                              [this](const auto& m, const auto& info) {
-                                                if (imu_writers_.admit(m.sensor_id(), info))
-                                                  pipeline_.onImu(m);
-                                              });
-  p.subscribe<navbus::GnssObservationEpochPubSubType>(
-      topic::kGnssObservations, profile::kMeasurementReader,
-      [this](const auto& m, const auto& info) {
-        if (gnss_obs_writers_.admit(m.receiver_id(), info)) pipeline_.onGnssObservations(m);
-      });
-  p.subscribe<navbus::GnssFixPubSubType>(topic::kGnssFix, profile::kMeasurementReader,
-                                         [this](const auto& m, const auto& info) {
-                                           if (gnss_fix_writers_.admit(m.receiver_id(), info))
-                                             pipeline_.onGnssFix(m);
-                                         });
-  p.subscribe<navbus::StarTrackerAttitudePubSubType>(
-      topic::kStarTracker, profile::kMeasurementReader, [this](const auto& m, const auto& info) {
-        if (star_writers_.admit(m.tracker_id(), info)) pipeline_.onStarTracker(m);
-      });
+  subscribeSensor<navbus::ImuIncrementPubSubType>(
+      topic::kImuIncrement, profile::kSensorReader, kRankImu, imu_writers_,
+      [](const auto& m) { return m.sensor_id(); }, [this](const auto& m) { pipeline_.onImu(m); });
+  subscribeSensor<navbus::GnssObservationEpochPubSubType>(
+      topic::kGnssObservations, profile::kMeasurementReader, kRankGnssObs, gnss_obs_writers_,
+      [](const auto& m) { return m.receiver_id(); },
+      [this](const auto& m) { pipeline_.onGnssObservations(m); });
+  subscribeSensor<navbus::GnssFixPubSubType>(
+      topic::kGnssFix, profile::kMeasurementReader, kRankGnssFix, gnss_fix_writers_,
+      [](const auto& m) { return m.receiver_id(); },
+      [this](const auto& m) { pipeline_.onGnssFix(m); });
+  subscribeSensor<navbus::StarTrackerAttitudePubSubType>(
+      topic::kStarTracker, profile::kMeasurementReader, kRankStarTracker, star_writers_,
+      [](const auto& m) { return m.tracker_id(); },
+      [this](const auto& m) { pipeline_.onStarTracker(m); });
   p.subscribe<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader,
                                                [this](const auto& d, const auto&) {
                                                  pipeline_.onDecision(d);
@@ -95,6 +94,27 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   p.addTimer(std::chrono::nanoseconds(config.engine.solution_period_ns),
              [this] { pipeline_.publishHeldSolution(); });
   updateState();
+}
+
+template <class PubSubType, class IdFn, class Handler>
+void FilterNode::subscribeSensor(const std::string& topic, const std::string& profile,
+                                 StreamRank rank, bus::WriterGate& writers, IdFn id,
+                                 Handler handler) {
+  bus::ReaderCallbacks callbacks;
+  callbacks.on_disposed = [this, rank](const eprosima::fastrtps::rtps::InstanceHandle_t& h) {
+    spdlog::info("DEBUG disposed rank {} known {}", static_cast<int>(rank), sensor_instances_.size());
+    auto it = sensor_instances_.find({rank, h});
+    if (it != sensor_instances_.end()) pipeline_.onStreamEnded(rank, it->second);
+  };
+  participant_.subscribe<PubSubType>(
+      topic, profile,
+      [this, rank, &writers, id, handler](const typename PubSubType::type& m,
+                                          const eprosima::fastdds::dds::SampleInfo& info) {
+        if (!writers.admit(id(m), info)) return;
+        sensor_instances_[{rank, info.instance_handle}] = id(m);
+        handler(m);
+      },
+      callbacks);
 }
 
 void FilterNode::watchFaultMonitor(const FaultMonitorWatch& watch) {

@@ -3,7 +3,10 @@
 // and republish the held solution while inertial data is lost.
 #pragma once
 
+#include <cstdint>
+#include <map>
 #include <string>
+#include <utility>
 
 #include <navbus_idl/NavigationPubSubTypes.h>
 
@@ -30,6 +33,12 @@ class FilterNode {
   void updateState();
   /// Follows the configured fault monitor's health reports (FilterConfig::fault_monitor).
   void watchFaultMonitor(const FaultMonitorWatch& watch);
+  /// Subscribes a sensor stream: samples of the stream's owning writer (one writer per sensor
+  /// id) go to `handler`; the disposal of an instance (its writer announced the end of the
+  /// data) ends that stream in the pipeline's ordered merge.
+  template <class PubSubType, class IdFn, class Handler>
+  void subscribeSensor(const std::string& topic, const std::string& profile, StreamRank rank,
+                       bus::WriterGate& writers, IdFn id, Handler handler);
   static constexpr int kNotProducingPeriods = 3;
   static constexpr std::int64_t kNotProducingMinNs = 1'000'000'000;
 
@@ -41,6 +50,10 @@ class FilterNode {
   std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)
   /// One writer per sensor id on each sensor stream (a second writer's samples are kept out).
   bus::WriterGate imu_writers_, gnss_obs_writers_, gnss_fix_writers_, star_writers_;
+  /// The sensor id of each stream instance seen (rank, instance handle): disposals carry only
+  /// the handle.
+  std::map<std::pair<StreamRank, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>
+      sensor_instances_;
   std::optional<MonitorLiveness> monitor_;  ///< the fault monitor's liveness, when configured
 };
 

@@ -1,6 +1,7 @@
 #include "filter_pipeline.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include <cmath>
 #include <sstream>
@@ -187,6 +188,15 @@ void FilterPipeline::startNewRun() {
       "the IMU source restarted at an earlier time: new run {} (the filter starts over; "
       "{} held inputs of the previous run could not be released)",
       new_runs_, dropped);
+}
+
+void FilterPipeline::onStreamEnded(StreamRank rank, std::uint32_t id) {
+  static constexpr std::array<const char*, 4> kTopics{
+      bus::topic::kImuIncrement, bus::topic::kGnssObservations, bus::topic::kGnssFix,
+      bus::topic::kStarTracker};
+  if (!sequencer_.setActive({rank, id}, false)) return;  // a stream this filter does not use
+  spdlog::info("{} id {} ended (its writer disposed it): no longer waited for",
+               rank < static_cast<int>(kTopics.size()) ? kTopics[rank] : "command", id);
 }
 
 void FilterPipeline::pump(std::int64_t now_ns) {

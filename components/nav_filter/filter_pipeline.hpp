@@ -66,6 +66,10 @@ class FilterPipeline {
   void onGnssObservations(const navbus::GnssObservationEpoch& msg);
   void onGnssFix(const navbus::GnssFix& msg);
   void onStarTracker(const navbus::StarTrackerAttitude& msg);
+  /// The writer of a stream announced the end of its data (disposed the instance): the stream
+  /// no longer holds the ordered merge back, so what it preceded is released at once rather
+  /// than after the bounded wait. Offline, flush() is the same end. Logged (streams in use).
+  void onStreamEnded(StreamRank rank, std::uint32_t id);
   /// Decisions are facts: counted and logged, never acted on (commands are).
   void onDecision(const navbus::FaultDecision& d);
   /// A command: stream commands act at once; engine commands enter the deterministic order at

@@ -68,12 +68,13 @@ class InputSequencer {
     return PushResult::kQueued;
   }
 
-  /// A stream declared lost does not hold others back; it blocks again once it delivers.
-  void setActive(StreamId id, bool active) {
+  /// A stream declared lost (or ended) does not hold others back; it blocks again once it
+  /// delivers. False if the stream is not expected.
+  bool setActive(StreamId id, bool active) {
     auto it = streams_.find(id);
-    if (it != streams_.end()) {
-      it->second.active = active;
-    }
+    if (it == streams_.end()) return false;
+    it->second.active = active;
+    return true;
   }
 
   /// Hands every releasable sample, in order, to consume(id, time_ns, payload).

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <type_traits>
 
+#include <spdlog/spdlog.h>
+
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/core/earth.hpp"
@@ -140,8 +142,9 @@ bool FramePublisher::readersMatched() const {
 void FramePublisher::flush() {
   const eprosima::fastrtps::Duration_t timeout(5, 0);
   for (auto* w : {imu_.raw(), raw_.raw(), gnss_.raw(), fix_.raw(), star_.raw()}) {
-    if (w != nullptr) {
-      w->wait_for_acknowledgments(timeout);
+    if (w != nullptr && w->wait_for_acknowledgments(timeout) != ReturnCode_t::RETCODE_OK) {
+      spdlog::warn("{}: not every reliable reader acknowledged the data within {} s",
+                   w->get_topic()->get_name(), timeout.seconds);
     }
   }
 }

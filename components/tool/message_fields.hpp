@@ -227,6 +227,7 @@ void visitFields(const navbus::Health& m, V& v) {
   v("wall_time_ns", m.wall_time_ns());
   v("state", m.state());
   v("samples_published", m.samples_published());
+  v("resume_ns", m.resume_ns());
   v.rows("inputs", m.inputs());
 }
 

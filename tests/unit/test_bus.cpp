@@ -1,8 +1,11 @@
 // Boundary validation, counters, configuration errors and the participant skeleton.
 #include <cmath>
 #include <limits>
+#include <vector>
 
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <gtest/gtest.h>
+#include <navbus_idl/ImuPubSubTypes.h>
 
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/conversions.hpp"
@@ -300,6 +303,92 @@ TEST(Skeleton, UnknownWriterProfileIsAClearErrorAndKnownOnesWork) {
   p.stop();
   p.run();
   EXPECT_EQ(p.state(), navbus::STATE_STOPPING);
+}
+
+// STARTING until the first input, then RUNNING, announced at once with the resume time (the
+// first input to the report); a participant without inputs is RUNNING on its first iteration.
+TEST(Skeleton, RunningWithTheFirstInputAnnouncedAtOnceWithTheResumeTime) {
+  navbus::bus::ShutdownSignal shutdown;
+  navbus::bus::Participant::Options o;
+  o.dds.domain_id = 202;
+  o.dds.participant_profile = navbus::bus::profile::kParticipantLoopback;
+  o.dds.name = "unit-resume";
+  o.health_period = std::chrono::hours(1);  // only the reports the state changes cause
+  navbus::bus::Participant p(o, shutdown);
+  std::vector<navbus::Health> reports;
+  p.subscribe<navbus::HealthPubSubType>(navbus::bus::topic::kHealth,
+                                        navbus::bus::profile::kHealthReader,
+                                        [&](const navbus::Health& h, const auto&) {
+                                          if (h.participant().to_string() == "unit-resume")
+                                            reports.push_back(h);
+                                        });
+  auto writer =
+      p.createWriter<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthWriter);
+  int received = 0;
+  p.subscribe<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthReader,
+                                        [&](const auto&, const auto&) { ++received; });
+  for (int i = 0; i < 5; ++i) p.spinOnce(std::chrono::milliseconds(20));
+  EXPECT_EQ(p.state(), navbus::STATE_STARTING);  // the other participant's health is no input
+  EXPECT_TRUE(reports.empty());
+  ASSERT_TRUE(writer.write(navbus::Health()));
+  for (int i = 0; i < 100 && reports.empty(); ++i) p.spinOnce(std::chrono::milliseconds(20));
+  EXPECT_EQ(received, 1);
+  EXPECT_EQ(p.state(), navbus::STATE_RUNNING);
+  ASSERT_EQ(reports.size(), 1u);
+  EXPECT_EQ(reports[0].state(), navbus::STATE_RUNNING);
+  EXPECT_GT(reports[0].resume_ns(), 0u);
+  EXPECT_LT(reports[0].resume_ns(), 1'000'000'000u);
+
+  o.dds.name = "unit-source";
+  navbus::bus::Participant source(o, shutdown);
+  source.spinOnce(std::chrono::milliseconds(1));
+  EXPECT_EQ(source.state(), navbus::STATE_RUNNING);
+}
+
+// A reliable KEEP_ALL reader (the filter's input profile) learns the announced end of a
+// stream: the writer's dispose reaches it after the data, and the writer's wait for
+// acknowledgments returns at once. Over the wire, not Fast DDS's intraprocess shortcut (which
+// hid that Fast DDS 2.9.1 reliable readers with a DYNAMIC_REUSABLE history drop a dispose).
+TEST(Skeleton, AReliableReaderLearnsTheAnnouncedEndOfAStream) {
+  using eprosima::fastrtps::xmlparser::XMLProfileManager;
+  const eprosima::fastrtps::LibrarySettingsAttributes before =
+      XMLProfileManager::library_settings();
+  eprosima::fastrtps::LibrarySettingsAttributes wire = before;
+  wire.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  XMLProfileManager::library_settings(wire);
+  struct Restore {
+    eprosima::fastrtps::LibrarySettingsAttributes settings;
+    ~Restore() { XMLProfileManager::library_settings(settings); }
+  } restore{before};
+  navbus::bus::ShutdownSignal shutdown;
+  navbus::bus::Participant::Options o;
+  o.dds.domain_id = 203;
+  o.dds.participant_profile = navbus::bus::profile::kParticipantLoopback;
+  o.dds.name = "unit-end";
+  o.health_period = std::chrono::hours(1);
+  navbus::bus::Participant reader_side(o, shutdown);
+  o.dds.name = "unit-end-source";
+  navbus::bus::Participant writer_side(o, shutdown);
+  int samples = 0;
+  int ends = 0;
+  navbus::bus::ReaderCallbacks callbacks;
+  callbacks.on_disposed = [&](const auto&) { ++ends; };
+  reader_side.subscribe<navbus::ImuIncrementPubSubType>(
+      navbus::bus::topic::kImuIncrement, navbus::bus::profile::kSensorReader,
+      [&](const auto&, const auto&) { ++samples; }, callbacks);
+  auto writer = writer_side.createWriter<navbus::ImuIncrementPubSubType>(
+      navbus::bus::topic::kImuIncrement, navbus::bus::profile::kSensorWriter);
+  for (int i = 0; i < 200 && writer.matchedReaders() == 0; ++i)
+    reader_side.spinOnce(std::chrono::milliseconds(10));
+  navbus::ImuIncrement m;
+  m.sensor_id(7);
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(writer.write(m));
+  ASSERT_TRUE(writer.dispose(m));
+  for (int i = 0; i < 200 && ends == 0; ++i) reader_side.spinOnce(std::chrono::milliseconds(10));
+  EXPECT_EQ(samples, 10);
+  EXPECT_EQ(ends, 1);
+  EXPECT_EQ(writer.raw()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0)),
+            ReturnCode_t::RETCODE_OK);
 }
 
 // One writer per sensor id: the owner keeps it while alive, another writer is a second writer

@@ -38,6 +38,7 @@ navbus::Health HealthCounters::report(navbus::ParticipantState state, std::uint6
   h.wall_time_ns(wall_time_ns);
   h.state(state);
   h.samples_published(published_);
+  h.resume_ns(resume_ns_);
   for (const auto& [name, c] : streams_) {
     navbus::StreamHealth s;
     s.topic(name);

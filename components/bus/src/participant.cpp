@@ -21,12 +21,31 @@ Participant::Participant(const Options& options, ShutdownSignal& shutdown)
   addTimer(kShmReclaimPeriod, [] { reclaimSharedMemoryOfDeadParticipants(); });
 }
 
-void Participant::reclaimSharedMemoryOfDeadParticipants() {
+namespace {
+
+/// NAVBUS_SHM_RECLAIM=0 turns the reclaiming off.
+bool shmReclaimOff() {
   static const bool off = [] {
     const char* v = std::getenv("NAVBUS_SHM_RECLAIM");
     return v != nullptr && std::string(v) == "0";
   }();
-  if (off) return;
+  return off;
+}
+
+}  // namespace
+
+Participant::ShmReclaimAtExit::~ShmReclaimAtExit() {
+  if (shmReclaimOff()) return;
+  const ShmReclaimResult r = reclaimIfHostIdle();
+  if (r.zombie_segments + r.zombie_ports == 0) return;
+  spdlog::info(
+      "last shared-memory participant on the host: removed what dead ones left, {} segments "
+      "and {} ports, {} bytes",
+      r.zombie_segments, r.zombie_ports, r.bytes_reclaimed);
+}
+
+void Participant::reclaimSharedMemoryOfDeadParticipants() {
+  if (shmReclaimOff()) return;
   const ShmReclaimResult r = reclaimSharedMemory();
   if (r.zombie_segments + r.zombie_ports == 0) return;
   spdlog::info(
@@ -94,7 +113,41 @@ void Participant::dispatch(ReaderEntry& entry) {
   // while the flag is being reset would otherwise wait for the next arrival, and a reliable
   // writer blocked on its full history sends none, a stall seen once in CI over shared memory.
   // Taking from an empty reader returns at once; the loop runs at least every 20-100 ms.
+  if (first_input_at_ || entry.topic == topic::kHealth) {
+    entry.take_all();
+    return;
+  }
+  const StreamCounters& counters = health_.stream(entry.topic);
+  const std::uint64_t before = counters.received;
   entry.take_all();
+  if (counters.received > before) first_input_at_ = std::chrono::steady_clock::now();
+}
+
+void Participant::setState(navbus::ParticipantState state) {
+  state_managed_ = true;
+  changeState(state);
+}
+
+void Participant::changeState(navbus::ParticipantState state) {
+  const bool starts_processing =
+      state_ == navbus::STATE_STARTING &&
+      (state == navbus::STATE_RUNNING || state == navbus::STATE_DEGRADED);
+  state_ = state;
+  if (!starts_processing) return;
+  if (first_input_at_) {
+    health_.setResumeNs(
+        static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                       std::chrono::steady_clock::now() - *first_input_at_)
+                                       .count()));
+  }
+  publishHealth();
+}
+
+void Participant::promoteIfProcessing() {
+  if (state_managed_ || state_ != navbus::STATE_STARTING) return;
+  const bool source_only = std::all_of(readers_.begin(), readers_.end(),
+                                       [](const auto& r) { return r->topic == topic::kHealth; });
+  if (source_only || first_input_at_) changeState(navbus::STATE_RUNNING);
 }
 
 void Participant::runDueTimers() {
@@ -111,10 +164,7 @@ void Participant::runDueTimers() {
 }
 
 void Participant::spinOnce(std::chrono::nanoseconds max_wait) {
-  if (state_ == navbus::STATE_STARTING && !state_managed_) {
-    state_ = navbus::STATE_RUNNING;
-    publishHealth();
-  }
+  promoteIfProcessing();
   auto next = std::chrono::steady_clock::now() + max_wait;
   for (const auto& t : timers_) {
     next = std::min(next, t.next);
@@ -134,6 +184,7 @@ void Participant::spinOnce(std::chrono::nanoseconds max_wait) {
   if (after_dispatch_) {
     after_dispatch_();
   }
+  promoteIfProcessing();
   runDueTimers();
 }
 

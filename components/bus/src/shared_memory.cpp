@@ -115,6 +115,18 @@ ShmReclaimResult reclaimSharedMemory(const std::string& dir, std::chrono::millis
   return r;
 }
 
+bool sharedMemoryInUse(const std::string& dir) {
+  for (const LockFile& f : lockFiles(dir)) {
+    if (!lockIsFree(f.lock) && fs::exists(f.lock)) return true;
+  }
+  return false;
+}
+
+ShmReclaimResult reclaimIfHostIdle(const std::string& dir) {
+  if (sharedMemoryInUse(dir)) return {};
+  return reclaimSharedMemory(dir, std::chrono::seconds(1), true);
+}
+
 std::uint64_t zombieSharedMemoryBytes(const std::string& dir, bool ports) {
   std::uint64_t bytes = 0;
   for (const LockFile& f : lockFiles(dir)) {

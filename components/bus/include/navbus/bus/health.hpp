@@ -35,6 +35,8 @@ class HealthCounters {
 
   void countPublished(std::uint64_t n = 1) { published_ += n; }
   std::uint64_t published() const { return published_; }
+  /// From the first input to the first processing state (Health::resume_ns) [ns].
+  void setResumeNs(std::uint64_t ns) { resume_ns_ = ns; }
 
   /// Builds the next report (sequence incremented on each call).
   navbus::Health report(navbus::ParticipantState state, std::uint64_t wall_time_ns);
@@ -46,6 +48,7 @@ class HealthCounters {
   std::string participant_;
   std::deque<std::pair<std::string, StreamCounters>> streams_;  // deque: references stay valid
   std::uint64_t published_{0};
+  std::uint64_t resume_ns_{0};
   std::uint64_t seq_{0};
 };
 

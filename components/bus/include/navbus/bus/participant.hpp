@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -86,11 +87,9 @@ class Participant {
   DdsContext& dds() { return dds_; }
   HealthCounters& health() { return health_; }
   /// Sets the reported state; from then on the participant manages it (the skeleton no longer
-  /// promotes STARTING to RUNNING on the first loop iteration by itself).
-  void setState(navbus::ParticipantState state) {
-    state_ = state;
-    state_managed_ = true;
-  }
+  /// promotes STARTING to RUNNING by itself). Leaving STARTING for a processing state
+  /// (RUNNING or DEGRADED) records the resume time and publishes health at once.
+  void setState(navbus::ParticipantState state);
   navbus::ParticipantState state() const { return state_; }
 
   template <class PubSubType>
@@ -183,12 +182,30 @@ class Participant {
                  std::function<void()> take_all, ReaderCallbacks callbacks);
   void dispatch(ReaderEntry& entry);
   void runDueTimers();
+  /// Sets the state; leaving STARTING for RUNNING or DEGRADED records Health::resume_ns (from
+  /// the first input taken) and publishes a report at once.
+  void changeState(navbus::ParticipantState state);
+  /// Unmanaged participants: STARTING becomes RUNNING with the first input taken, or on the
+  /// first loop iteration for a pure source (no readers but health).
+  void promoteIfProcessing();
+
+  /// The last participant out removes what dead ones left in /dev/shm (reclaimIfHostIdle).
+  /// Declared before dds_ so that it runs after the DDS entities are gone.
+  struct ShmReclaimAtExit {
+    ShmReclaimAtExit() = default;
+    ShmReclaimAtExit(const ShmReclaimAtExit&) = delete;
+    ShmReclaimAtExit& operator=(const ShmReclaimAtExit&) = delete;
+    ~ShmReclaimAtExit();
+  };
 
   ShutdownSignal& shutdown_;
+  ShmReclaimAtExit shm_reclaim_at_exit_;
   DdsContext dds_;
   HealthCounters health_;
   navbus::ParticipantState state_{navbus::STATE_STARTING};
   bool state_managed_{false};
+  /// When the first input sample (any topic but others' health) was taken.
+  std::optional<std::chrono::steady_clock::time_point> first_input_at_;
   eprosima::fastdds::dds::WaitSet waitset_;
   std::vector<std::unique_ptr<ReaderEntry>> readers_;
   std::vector<Timer> timers_;

@@ -17,6 +17,8 @@
 // completed). Fast DDS re-initialises a zombie port itself when its number is reused. A port
 // is 52 KiB plus a 32-byte mutex; `reclaim_ports` (for when no Fast DDS process is left on the
 // host) removes them too, under the port's named mutex as Fast DDS does when it closes one.
+// reclaimIfHostIdle() does that at a participant's clean exit when no lock in /dev/shm is held
+// any more (no live shared-memory participant on the host): the last one out leaves nothing.
 #pragma once
 
 #include <chrono>
@@ -39,6 +41,14 @@ struct ShmReclaimResult {
 ShmReclaimResult reclaimSharedMemory(const std::string& dir = "/dev/shm",
                                      std::chrono::milliseconds min_age = std::chrono::seconds(1),
                                      bool reclaim_ports = false);
+
+/// True while a live process holds a Fast DDS lock in `dir` (a participant using shared memory).
+bool sharedMemoryInUse(const std::string& dir = "/dev/shm");
+
+/// When !sharedMemoryInUse(dir) (every participant that used shared memory is gone), removes
+/// everything dead participants left, ports included; otherwise nothing. Returns what was
+/// removed.
+ShmReclaimResult reclaimIfHostIdle(const std::string& dir = "/dev/shm");
 
 /// Bytes in `dir` of the data segments (or, with `ports`, the ports) whose owner is dead: 0
 /// when nothing was left behind.
