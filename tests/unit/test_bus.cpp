@@ -322,15 +322,25 @@ TEST(Skeleton, RunningWithTheFirstInputAnnouncedAtOnceWithTheResumeTime) {
                                           if (h.participant().to_string() == "unit-resume")
                                             reports.push_back(h);
                                         });
-  auto writer =
-      p.createWriter<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthWriter);
+  // Durable history handed over on joining is no input either (an earlier run's decisions).
+  auto durable = p.createWriter<navbus::HealthPubSubType>("navbus/unit-durable",
+                                                          navbus::bus::profile::kHealthWriter);
+  ASSERT_TRUE(durable.write(navbus::Health()));
+  int durable_received = 0;
+  p.subscribe<navbus::HealthPubSubType>("navbus/unit-durable", navbus::bus::profile::kHealthReader,
+                                        [&](const auto&, const auto&) { ++durable_received; });
+  auto writer = p.createWriter<navbus::ImuIncrementPubSubType>("navbus/unit",
+                                                               navbus::bus::profile::kSensorWriter);
   int received = 0;
-  p.subscribe<navbus::HealthPubSubType>("navbus/unit", navbus::bus::profile::kHealthReader,
-                                        [&](const auto&, const auto&) { ++received; });
+  p.subscribe<navbus::ImuIncrementPubSubType>("navbus/unit", navbus::bus::profile::kSensorReader,
+                                              [&](const auto&, const auto&) { ++received; });
   for (int i = 0; i < 5; ++i) p.spinOnce(std::chrono::milliseconds(20));
-  EXPECT_EQ(p.state(), navbus::STATE_STARTING);  // the other participant's health is no input
+  EXPECT_EQ(durable_received, 1);
+  EXPECT_EQ(p.state(), navbus::STATE_STARTING);  // neither health nor durable history is input
   EXPECT_TRUE(reports.empty());
-  ASSERT_TRUE(writer.write(navbus::Health()));
+  for (int i = 0; i < 100 && writer.matchedReaders() == 0; ++i)
+    p.spinOnce(std::chrono::milliseconds(10));
+  ASSERT_TRUE(writer.write(navbus::ImuIncrement()));
   for (int i = 0; i < 100 && reports.empty(); ++i) p.spinOnce(std::chrono::milliseconds(20));
   EXPECT_EQ(received, 1);
   EXPECT_EQ(p.state(), navbus::STATE_RUNNING);

@@ -77,8 +77,12 @@ void Participant::countMalformed(const std::string& topic, StreamCounters& count
 
 void Participant::addReader(dds::DataReader* reader, const std::string& topic,
                             std::function<void()> take_all, ReaderCallbacks callbacks) {
+  // Others' health is no input, nor is the durable history a reader is handed on joining
+  // (an earlier run's decisions and commands): the resume time runs from live data.
+  const bool is_input = topic != topic::kHealth &&
+                        reader->get_qos().durability().kind == dds::VOLATILE_DURABILITY_QOS;
   auto entry = std::make_unique<ReaderEntry>(
-      ReaderEntry{reader, topic, std::move(take_all), std::move(callbacks)});
+      ReaderEntry{reader, topic, is_input, std::move(take_all), std::move(callbacks)});
   dds::StatusMask mask = dds::StatusMask::data_available();
   mask << dds::StatusMask::requested_deadline_missed();
   mask << dds::StatusMask::liveliness_changed();
@@ -113,7 +117,7 @@ void Participant::dispatch(ReaderEntry& entry) {
   // while the flag is being reset would otherwise wait for the next arrival, and a reliable
   // writer blocked on its full history sends none, a stall seen once in CI over shared memory.
   // Taking from an empty reader returns at once; the loop runs at least every 20-100 ms.
-  if (first_input_at_ || entry.topic == topic::kHealth) {
+  if (first_input_at_ || !entry.is_input) {
     entry.take_all();
     return;
   }
@@ -145,8 +149,8 @@ void Participant::changeState(navbus::ParticipantState state) {
 
 void Participant::promoteIfProcessing() {
   if (state_managed_ || state_ != navbus::STATE_STARTING) return;
-  const bool source_only = std::all_of(readers_.begin(), readers_.end(),
-                                       [](const auto& r) { return r->topic == topic::kHealth; });
+  const bool source_only =
+      std::none_of(readers_.begin(), readers_.end(), [](const auto& r) { return r->is_input; });
   if (source_only || first_input_at_) changeState(navbus::STATE_RUNNING);
 }
 

@@ -166,6 +166,7 @@ class Participant {
   struct ReaderEntry {
     eprosima::fastdds::dds::DataReader* reader;
     std::string topic;
+    bool is_input;  ///< live data (volatile durability), not others' health
     std::function<void()> take_all;
     ReaderCallbacks callbacks;
   };
@@ -186,7 +187,7 @@ class Participant {
   /// the first input taken) and publishes a report at once.
   void changeState(navbus::ParticipantState state);
   /// Unmanaged participants: STARTING becomes RUNNING with the first input taken, or on the
-  /// first loop iteration for a pure source (no readers but health).
+  /// first loop iteration for a pure source (no input readers).
   void promoteIfProcessing();
 
   /// The last participant out removes what dead ones left in /dev/shm (reclaimIfHostIdle).
@@ -204,7 +205,7 @@ class Participant {
   HealthCounters health_;
   navbus::ParticipantState state_{navbus::STATE_STARTING};
   bool state_managed_{false};
-  /// When the first input sample (any topic but others' health) was taken.
+  /// When the first input sample (live data: no durable history, no others' health) was taken.
   std::optional<std::chrono::steady_clock::time_point> first_input_at_;
   eprosima::fastdds::dds::WaitSet waitset_;
   std::vector<std::unique_ptr<ReaderEntry>> readers_;
