@@ -102,7 +102,6 @@ void FilterNode::subscribeSensor(const std::string& topic, const std::string& pr
                                  Handler handler) {
   bus::ReaderCallbacks callbacks;
   callbacks.on_disposed = [this, rank](const eprosima::fastrtps::rtps::InstanceHandle_t& h) {
-    spdlog::info("DEBUG disposed rank {} known {}", static_cast<int>(rank), sensor_instances_.size());
     auto it = sensor_instances_.find({rank, h});
     if (it != sensor_instances_.end()) pipeline_.onStreamEnded(rank, it->second);
   };

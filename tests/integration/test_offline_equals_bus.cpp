@@ -113,8 +113,7 @@ void runCase(const Case& c) {
               c.scenario.c_str(), rows.size(), differing == 0 ? "yes" : "NO");
   // The last solutions came without a bounded wait: the announced end released them.
   const std::string log = test::readFile(dir / "filter.log");
-  EXPECT_NE(log.find("navbus/imu/increment id 1 ended (its writer disposed it)"),
-            std::string::npos)
+  EXPECT_NE(log.find("navbus/imu/increment id 1 ended (its writer disposed it)"), std::string::npos)
       << log;
   EXPECT_NE(log.find("sequencer timeouts 0,"), std::string::npos) << log;
   test::cleanSharedMemory();

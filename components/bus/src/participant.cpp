@@ -32,26 +32,24 @@ bool shmReclaimOff() {
   return off;
 }
 
+/// Logs what was reclaimed, if anything.
+void logReclaimed(const char* what, const ShmReclaimResult& r) {
+  if (r.zombie_segments + r.zombie_ports == 0) return;
+  spdlog::info("{}: {} segments and {} ports, {} bytes", what, r.zombie_segments, r.zombie_ports,
+               r.bytes_reclaimed);
+}
+
 }  // namespace
 
 Participant::ShmReclaimAtExit::~ShmReclaimAtExit() {
   if (shmReclaimOff()) return;
-  const ShmReclaimResult r = reclaimIfHostIdle();
-  if (r.zombie_segments + r.zombie_ports == 0) return;
-  spdlog::info(
-      "last shared-memory participant on the host: removed what dead ones left, {} segments "
-      "and {} ports, {} bytes",
-      r.zombie_segments, r.zombie_ports, r.bytes_reclaimed);
+  logReclaimed("last shared-memory participant on the host: removed what dead ones left",
+               reclaimIfHostIdle());
 }
 
 void Participant::reclaimSharedMemoryOfDeadParticipants() {
   if (shmReclaimOff()) return;
-  const ShmReclaimResult r = reclaimSharedMemory();
-  if (r.zombie_segments + r.zombie_ports == 0) return;
-  spdlog::info(
-      "reclaimed the shared memory of dead Fast DDS participants: {} segments and {} ports, {} "
-      "bytes",
-      r.zombie_segments, r.zombie_ports, r.bytes_reclaimed);
+  logReclaimed("reclaimed the shared memory of dead Fast DDS participants", reclaimSharedMemory());
 }
 
 Participant::~Participant() {
