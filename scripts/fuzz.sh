@@ -6,18 +6,21 @@
 # Seeds: a valid sample of each topic type and the shipped configurations; the corpus grows in
 # the work directory and is reused by the next run. A crash, leak, undefined behaviour or
 # violated property fails the script and leaves the input under <work>/artifacts.
+# --parallel runs the two targets side by side (one core each) instead of one after the other.
 #
-#   bash scripts/fuzz.sh [--bin build-san/bin] [--runs 10000000] [--work build-san/fuzz]
+#   bash scripts/fuzz.sh [--bin build-san/bin] [--runs 10000000] [--work build-san/fuzz] [--parallel]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=$root/build-san/bin
 runs=10000000
 work=""
+parallel=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) bin=$2; shift 2 ;;
     --runs) runs=$2; shift 2 ;;
     --work) work=$2; shift 2 ;;
+    --parallel) parallel=1; shift ;;
     *) echo "fuzz.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -37,21 +40,29 @@ mkdir -p "$work/seeds/topics" "$work/seeds/config"
 # LeakSanitizer on; the first finding stops the target.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-status=0
-run() {  # target corpus max_len
+run() {  # target corpus max_len; returns 1 on a finding
   local log=$work/$1.log
   echo "fuzz.sh: $1, $runs executions (log $log)"
   if ! "$bin/$1" -runs="$runs" -max_len="$3" -print_final_stats=1 -timeout=10 -rss_limit_mb=2048 \
       -artifact_prefix="$work/artifacts/$1-" "$work/corpus/$2" "$work/seeds/$2" > "$log" 2>&1; then
     echo "fuzz.sh: $1 FAILED"; grep -E "ERROR|SUMMARY|==[0-9]+==|runtime error|Test unit written" "$log" | head -20
-    status=1
-    return
+    return 1
   fi
-  local execs rate
+  local execs rate rss
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
-  echo "fuzz.sh: $1 passed: $execs executions, $rate per second, corpus $(ls "$work/corpus/$2" | wc -l) inputs, 0 crashes"
+  rss=$(sed -n 's/^stat::peak_rss_mb: *//p' "$log")
+  echo "fuzz.sh: $1 passed: $execs executions, $rate per second, peak RSS $rss MB," \
+    "corpus $(ls "$work/corpus/$2" | wc -l) inputs, 0 crashes"
 }
-run navbus_fuzz_topics topics 65536
-run navbus_fuzz_config config 8192
+status=0
+if [ "$parallel" = 1 ]; then
+  run navbus_fuzz_topics topics 65536 & topics=$!
+  run navbus_fuzz_config config 8192 & config=$!
+  wait "$topics" || status=1
+  wait "$config" || status=1
+else
+  run navbus_fuzz_topics topics 65536 || status=1
+  run navbus_fuzz_config config 8192 || status=1
+fi
 exit $status
