@@ -150,7 +150,7 @@ class FilterPipeline {
   bus::StreamGate gnss_obs_gate_;
   bus::StreamGate gnss_fix_gate_;
   bus::StreamGate star_gate_;
-  std::uint32_t stream_flags_{0};  ///< FAULT_*_STREAM_LOST bits: facts from decisions
+  std::uint32_t stream_flags_{0};  ///< FAULT_*_STREAM_LOST bits, set by stream commands
   std::uint64_t solution_seq_{0};
   std::uint64_t diagnostics_seq_{0};
   std::uint64_t decisions_seen_{0};
