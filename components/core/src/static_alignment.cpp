@@ -1,0 +1,104 @@
+// Static coarse alignment (see the header for the references).
+//
+// Derivation, with the step numbers the code cites. At rest on the Earth, in NED:
+//   (1) f_ib^n  = -g^n = (0, 0, -g)                      specific force
+//   (2) w_ib^n  = w_ie^n = (W cos L, 0, -W sin L)        inertial rate, W the Earth rate
+// and the sensors read f^b = C_n^b f^n, w^b = C_n^b w^n with C_b^n = Rz(yaw) Ry(pitch) Rx(roll).
+// Levelling, from (1) written out, f^b = g (sin p, -sin r cos p, -cos r cos p):
+//   (3) roll  = atan2(-f_y, -f_z)
+//   (4) pitch = atan2(f_x, sqrt(f_y^2 + f_z^2))
+// Gyrocompassing: the rate in the levelled body frame, w^l = Ry(p) Rx(r) w^b, is
+// Rz(yaw)^T w^n = (W cos L cos yaw, -W cos L sin yaw, -W sin L), so
+//   (5) yaw = atan2(-w^l_y, w^l_x).
+// Error budget (first order). An accelerometer error d_f along a horizontal body axis is read
+// as a tilt d_f / g; the mean over T seconds of white noise of density VRW has sigma VRW/sqrt(T):
+//   (6) sigma_level = sqrt(sigma_ba^2 + VRW^2 / T) / g.
+// A gyro error d_w along the levelled east axis is read as a heading error d_w / (W cos L); a
+// tilt d_t about north moves the vertical Earth rate W sin L into the east channel, a heading
+// error d_t tan L:
+//   (7) sigma_yaw^2 = (sigma_bg^2 + ARW^2 / T) / (W cos L)^2 + (sigma_level tan L)^2.
+// (7) is what decides whether a gyro grade can gyrocompass: a 0.01 deg/h gyro at 45 deg
+// latitude gives about 0.05 deg; a 10 deg/h MEMS gyro gives more than a radian (no heading).
+#include "navbus/core/static_alignment.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "navbus/core/earth.hpp"
+#include "navbus/core/rotation.hpp"
+
+namespace navbus::core {
+
+namespace {
+/// Below this |cos L| (about 0.2" from a pole) the horizontal Earth rate points nowhere.
+constexpr double kMinCosLatitude = 1e-6;
+}  // namespace
+
+void StaticWindow::add(const ImuIncrement& inc) {
+  sum_delta_vel_b_mps_ += inc.delta_vel_b_mps;
+  sum_delta_angle_b_rad_ += inc.delta_angle_b_rad;
+  duration_s_ += inc.interval_s;
+  ++count_;
+}
+
+Eigen::Vector3d StaticWindow::meanSpecificForce_b_mps2() const {
+  return duration_s_ > 0.0 ? Eigen::Vector3d(sum_delta_vel_b_mps_ / duration_s_)
+                           : Eigen::Vector3d::Zero();
+}
+
+Eigen::Vector3d StaticWindow::meanRate_ib_b_radps() const {
+  return duration_s_ > 0.0 ? Eigen::Vector3d(sum_delta_angle_b_rad_ / duration_s_)
+                           : Eigen::Vector3d::Zero();
+}
+
+double levellingSigma(const AlignmentErrorBudget& budget, double duration_s, double gravity_mps2) {
+  if (!(duration_s > 0.0)) return std::numeric_limits<double>::infinity();
+  const double vrw = budget.velocity_random_walk_mps_per_sqrts;
+  const double bias = budget.accel_bias_sigma_mps2;
+  return std::sqrt(bias * bias + vrw * vrw / duration_s) / gravity_mps2;  // (6)
+}
+
+double gyrocompassingHeadingSigma(const AlignmentErrorBudget& budget, double duration_s,
+                                  double latitude_rad, double level_sigma_rad) {
+  const double horizontal_rate = earth::kRotationRate_radps * std::cos(latitude_rad);
+  if (!(duration_s > 0.0) ||
+      std::abs(horizontal_rate) < earth::kRotationRate_radps * kMinCosLatitude) {
+    return std::numeric_limits<double>::infinity();
+  }
+  const double arw = budget.angle_random_walk_rad_per_sqrts;
+  const double bias = budget.gyro_bias_sigma_radps;
+  const double rate_term =
+      (bias * bias + arw * arw / duration_s) / (horizontal_rate * horizontal_rate);
+  const double tilt_term = level_sigma_rad * std::tan(latitude_rad);
+  return std::sqrt(rate_term + tilt_term * tilt_term);  // (7)
+}
+
+CoarseAlignment alignStatic(const StaticWindow& window, double latitude_rad, double gravity_mps2,
+                            const AlignmentErrorBudget& budget, double max_heading_sigma_rad) {
+  const Eigen::Vector3d f = window.meanSpecificForce_b_mps2();
+  const double roll = std::atan2(-f.y(), -f.z());                    // (3)
+  const double pitch = std::atan2(f.x(), std::hypot(f.y(), f.z()));  // (4)
+
+  CoarseAlignment out;
+  out.level_sigma_rad = levellingSigma(budget, window.duration_s(), gravity_mps2);
+  out.heading_sigma_rad =
+      gyrocompassingHeadingSigma(budget, window.duration_s(), latitude_rad, out.level_sigma_rad);
+  double yaw = 0.0;
+  if (!(window.duration_s() > 0.0)) {
+    out.heading_limit = HeadingLimit::kNoData;
+  } else if (std::abs(std::cos(latitude_rad)) < kMinCosLatitude) {
+    out.heading_limit = HeadingLimit::kNearPole;
+  } else if (out.heading_sigma_rad > max_heading_sigma_rad) {
+    out.heading_limit = HeadingLimit::kGyroGrade;
+  } else {
+    const Eigen::Vector3d w_l =
+        Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+        (Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()) * window.meanRate_ib_b_radps());
+    yaw = std::atan2(-w_l.y(), w_l.x());  // (5)
+  }
+  out.roll_pitch_yaw_rad = Eigen::Vector3d(roll, pitch, yaw);
+  out.q_b_to_n = Eigen::Quaterniond(dcmFromEuler(out.roll_pitch_yaw_rad)).normalized();
+  return out;
+}
+
+}  // namespace navbus::core
