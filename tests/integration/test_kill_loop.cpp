@@ -16,7 +16,7 @@
 // Rounds per participant: NAVBUS_KILL_ROUNDS (default 2 in CI; the target is 50).
 // Participant profile: NAVBUS_KILL_PROFILE (default UDP loopback; navbus_participant_shm for
 // the shared-memory transport). The resume times are printed against the 1 s target and
-// asserted within 10 s (see the README for the measured figures and why 1 s is not met).
+// asserted within 10 s, a bound a busy CI machine keeps.
 // A second test kills a shared-memory participant and checks that a live one reclaims what it
 // left in /dev/shm.
 #include <algorithm>

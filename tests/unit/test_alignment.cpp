@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "navbus/core/earth.hpp"
+#include "navbus/core/initial_alignment.hpp"
 #include "navbus/core/rotation.hpp"
 #include "navbus/core/static_alignment.hpp"
 #include "navbus/core/units.hpp"
@@ -165,4 +166,201 @@ TEST(StaticAlignment, NoHeadingAtThePoleOrFromAnEmptyWindow) {
       core::alignStatic(core::StaticWindow{}, kLatitude_rad, g, navigationGrade(), 1.0);
   EXPECT_EQ(empty.heading_limit, core::HeadingLimit::kNoData);
   EXPECT_TRUE(std::isinf(empty.level_sigma_rad));
+}
+
+// ---------------------------------------------------------------------------------------------
+// InitialAligner: the source chosen from what arrives, and the state it starts from.
+
+namespace {
+
+constexpr double kLatitudeAligner_rad = 36.5 * units::kDeg;
+const earth::Geodetic kSite{kLatitudeAligner_rad, 127.5 * units::kDeg, 1000.0};
+
+/// Six satellites 22 000 km away in fixed directions from the receiver, exact ranges and rates.
+std::vector<core::SatelliteObservation> satellitesSeenFrom(const earth::Geodetic& rx,
+                                                           const Eigen::Vector3d& vel_ned_mps,
+                                                           double clock_m, double drift_mps) {
+  const Eigen::Matrix3d C_n_e = earth::C_n_e(rx.latitude_rad, rx.longitude_rad);
+  const Eigen::Vector3d rx_ecef = earth::geodeticToEcef(rx);
+  const Eigen::Vector3d rx_vel_ecef = C_n_e * vel_ned_mps;
+  const double az_el_deg[6][2] = {{0, 60}, {70, 30}, {140, 45}, {210, 20}, {280, 50}, {330, 15}};
+  std::vector<core::SatelliteObservation> sats;
+  for (int i = 0; i < 6; ++i) {
+    const double az = az_el_deg[i][0] * units::kDeg;
+    const double el = az_el_deg[i][1] * units::kDeg;
+    const Eigen::Vector3d los_n(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
+                                -std::sin(el));
+    core::SatelliteObservation s;
+    s.sv_id = i + 1;
+    s.sat_pos_ecef_m = rx_ecef + C_n_e * los_n * 2.2e7;
+    s.sat_vel_ecef_mps = C_n_e * los_n.cross(Eigen::Vector3d::UnitZ()).normalized() * 3000.0;
+    const Eigen::Vector3d los_e = (s.sat_pos_ecef_m - rx_ecef).normalized();
+    s.pseudorange_m = (s.sat_pos_ecef_m - rx_ecef).norm() + clock_m;
+    s.pseudorange_rate_mps = los_e.dot(s.sat_vel_ecef_mps - rx_vel_ecef) + drift_mps;
+    s.pseudorange_sigma_m = 3.0;
+    s.pseudorange_rate_sigma_mps = 0.1;
+    sats.push_back(s);
+  }
+  return sats;
+}
+
+/// One error-free increment ending at t_ns of a body with attitude C_b_n (at the site), specific
+/// force f_n and, on top of the Earth rate, a body rate w_nb_b.
+core::ImuIncrement incrementAt(std::int64_t t_ns, const Eigen::Matrix3d& C_b_n,
+                               const Eigen::Vector3d& f_n_mps2,
+                               const Eigen::Vector3d& w_nb_b_radps = Eigen::Vector3d::Zero()) {
+  core::ImuIncrement inc;
+  inc.time_ns = t_ns;
+  inc.interval_s = kDt_s;
+  inc.delta_vel_b_mps = C_b_n.transpose() * f_n_mps2 * kDt_s;
+  inc.delta_angle_b_rad =
+      (C_b_n.transpose() * earth::omegaIeNed(kSite.latitude_rad) + w_nb_b_radps) * kDt_s;
+  return inc;
+}
+
+Eigen::Vector3d restForce_n() {
+  return Eigen::Vector3d(0, 0, -earth::normalGravity(kSite.latitude_rad, kSite.height_m));
+}
+
+double levellingSigmaOf(const core::AlignmentErrorBudget& budget, double duration_s) {
+  return core::levellingSigma(budget, duration_s,
+                              earth::normalGravity(kSite.latitude_rad, kSite.height_m));
+}
+
+double attitudeError(const Eigen::Quaterniond& a, const Eigen::Matrix3d& truth) {
+  return Eigen::AngleAxisd(a.toRotationMatrix() * truth.transpose()).angle();
+}
+
+}  // namespace
+
+TEST(InitialAligner, GyrocompassesAtRestWithPositionAndClockFromPseudoranges) {
+  core::InitialAlignmentConfig config;
+  config.budget = navigationGrade();
+  config.static_window_s = 60.0;
+  core::InitialAligner aligner(config);
+  const Eigen::Matrix3d C_b_n = core::dcmFromEuler(Eigen::Vector3d(1, -2, 123) * units::kDeg);
+  constexpr double kClock_m = 3000.0;
+  constexpr double kDrift_mps = 1.0;
+  std::int64_t aligned_at_ns = -1;
+  for (int i = 1; i <= 7000 && !aligner.aligned(); ++i) {
+    const std::int64_t t_ns = i * 10'000'000LL;
+    aligner.addImu(incrementAt(t_ns, C_b_n, restForce_n()));
+    if (i == 50) {
+      EXPECT_EQ(aligner.phase(), core::AlignmentPhase::kWaitingForPosition);
+    }
+    if (i % 100 == 0) {
+      const double t_s = 1e-9 * static_cast<double>(t_ns);
+      aligner.addPseudoranges(t_ns, satellitesSeenFrom(kSite, Eigen::Vector3d::Zero(),
+                                                       kClock_m + kDrift_mps * t_s, kDrift_mps));
+      if (i == 100) {
+        EXPECT_EQ(aligner.phase(), core::AlignmentPhase::kWaitingForRest);
+      }
+    }
+    if (aligner.aligned()) aligned_at_ns = t_ns;
+  }
+  ASSERT_TRUE(aligner.aligned());
+  const core::AlignedStart& s = aligner.start();
+  // A 60 s window once the detector's first second and one block of margin have passed.
+  EXPECT_NEAR(1e-9 * static_cast<double>(aligned_at_ns), 62.0, 1.0);
+  EXPECT_EQ(s.state.time_ns, aligned_at_ns);
+  EXPECT_EQ(s.attitude_source, core::AttitudeSource::kGyrocompass);
+  EXPECT_EQ(s.position_source, core::PositionSource::kPseudoranges);
+  EXPECT_LT(attitudeError(s.state.q_b_to_n, C_b_n), 1e-7);
+  EXPECT_LT(earth::differenceNed(s.state.position, kSite).norm(), 1e-3);
+  EXPECT_LT(s.state.vel_ned_mps.norm(), 1e-6);
+  ASSERT_TRUE(s.has_clock);
+  const double t_s = 1e-9 * static_cast<double>(aligned_at_ns);
+  EXPECT_NEAR(s.clock_bias_m, kClock_m + kDrift_mps * t_s, 1e-3);
+  EXPECT_NEAR(s.clock_drift_mps, kDrift_mps, 1e-6);
+  // The sigmas are the budget's: level and heading from static_alignment (here 60 s), position
+  // from the DOP and the 3 m pseudorange sigma.
+  EXPECT_NEAR(s.att_sigma_ned_rad.x(), levellingSigmaOf(config.budget, 60.0), 1e-9);
+  EXPECT_DOUBLE_EQ(s.att_sigma_ned_rad.z(), s.gyrocompass_heading_sigma_rad);
+  EXPECT_LT(s.att_sigma_ned_rad.z(), 0.2 * units::kDeg);
+  EXPECT_GT(s.pos_sigma_ned_m.minCoeff(), 3.0);
+  EXPECT_LT(s.pos_sigma_ned_m.maxCoeff(), 30.0);
+}
+
+TEST(InitialAligner, MemsLevelsAtRestThenTakesTheHeadingFromTheGnssCourse) {
+  core::InitialAlignmentConfig config;
+  config.budget.accel_bias_sigma_mps2 = 5 * units::kMilliG;
+  config.budget.gyro_bias_sigma_radps = 10 * units::kDegPerHour;
+  config.static_window_s = 20.0;
+  config.course_min_speed_mps = 5.0;
+  core::InitialAligner aligner(config);
+  // 30 s at rest heading 70 deg, a 30 deg turn on the spot in 3 s, then 2 m/s^2 straight ahead.
+  double yaw_deg = 70.0;
+  double speed_mps = 0.0;
+  earth::Geodetic position = kSite;
+  for (int i = 1; i <= 4000 && !aligner.aligned(); ++i) {
+    const std::int64_t t_ns = i * 10'000'000LL;
+    const double t_s = 1e-9 * static_cast<double>(t_ns);
+    Eigen::Vector3d w_nb_b = Eigen::Vector3d::Zero();
+    double accel_mps2 = 0.0;
+    if (t_s > 30.0 && t_s <= 33.0) w_nb_b.z() = 10.0 * units::kDeg;
+    if (t_s > 33.0) accel_mps2 = 2.0;
+    yaw_deg += w_nb_b.z() / units::kDeg * kDt_s;
+    const Eigen::Matrix3d C_b_n = core::dcmFromEuler(Eigen::Vector3d(0, 0, yaw_deg) * units::kDeg);
+    const Eigen::Vector3d forward_n = C_b_n.col(0);
+    aligner.addImu(incrementAt(t_ns, C_b_n, restForce_n() + forward_n * accel_mps2, w_nb_b));
+    speed_mps += accel_mps2 * kDt_s;
+    position = earth::offsetNed(position, forward_n * speed_mps * kDt_s);
+    if (i % 10 == 0) {  // 10 Hz fixes
+      core::GnssFixMeasurement fix;
+      fix.time_ns = t_ns;
+      fix.position = position;
+      fix.vel_ned_mps = forward_n * speed_mps;
+      fix.pos_sigma_ned_m = Eigen::Vector3d::Constant(2.0);
+      fix.vel_sigma_ned_mps = Eigen::Vector3d::Constant(0.1);
+      aligner.addGnssFix(fix);
+    }
+    if (t_s > 22.5 && t_s < 33.0) {
+      ASSERT_EQ(aligner.phase(), core::AlignmentPhase::kWaitingForCourse) << "at " << t_s << " s";
+    }
+    if (aligner.aligned()) {
+      const core::AlignedStart& s = aligner.start();
+      EXPECT_NEAR(t_s, 33.0 + 2.5, 0.11);  // the first fix at 5 m/s
+      EXPECT_EQ(s.attitude_source, core::AttitudeSource::kGnssCourse);
+      EXPECT_EQ(s.position_source, core::PositionSource::kGnssFix);
+      // The heading is the course; the tilt is off by the horizontal Earth rate left out over the
+      // 2.5 s of motion (about 1.5e-4 rad), which the tilt sigma covers.
+      EXPECT_NEAR(core::eulerFromDcm(s.state.q_b_to_n.toRotationMatrix()).z(),
+                  yaw_deg * units::kDeg, 1e-9);
+      const double error_rad = attitudeError(s.state.q_b_to_n, C_b_n);
+      EXPECT_LT(error_rad, 3e-4);
+      EXPECT_GT(s.att_sigma_ned_rad.x(), error_rad);
+      EXPECT_GT(s.gyrocompass_heading_sigma_rad, 0.5);  // the MEMS gyro cannot gyrocompass
+      EXPECT_NEAR(s.att_sigma_ned_rad.z(), std::hypot(config.course_sigma_rad, 0.1 / 5.0), 1e-3);
+      EXPECT_FALSE(s.has_clock);
+    }
+  }
+  EXPECT_TRUE(aligner.aligned());
+}
+
+TEST(InitialAligner, StarTrackerGivesTheAttitudeAtTheFirstSampleAfterTheFirstFix) {
+  core::InitialAligner aligner(core::InitialAlignmentConfig{});
+  const Eigen::Matrix3d C_b_n = core::dcmFromEuler(Eigen::Vector3d(20, -35, 250) * units::kDeg);
+  const std::int64_t t_ns = 1'400'000'000'000'000'000LL;
+  core::StarAttitudeMeasurement st;
+  st.time_ns = t_ns;
+  st.q_b_to_i = Eigen::Quaterniond(earth::C_i_e(1e-9 * static_cast<double>(t_ns)).transpose() *
+                                   earth::C_n_e(kSite.latitude_rad, kSite.longitude_rad) * C_b_n);
+  st.sigma_b_rad = Eigen::Vector3d(5, 5, 40) * units::kArcsec;
+  aligner.addImu(incrementAt(t_ns, C_b_n, restForce_n()));
+  aligner.addStarAttitude(st);  // no position yet: waits
+  EXPECT_FALSE(aligner.aligned());
+  core::GnssFixMeasurement fix;
+  fix.time_ns = t_ns;
+  fix.position = kSite;
+  fix.vel_ned_mps = Eigen::Vector3d(7000, 500, 0);
+  aligner.addGnssFix(fix);
+  aligner.addStarAttitude(st);
+  ASSERT_TRUE(aligner.aligned());
+  const core::AlignedStart& s = aligner.start();
+  EXPECT_EQ(s.attitude_source, core::AttitudeSource::kStarTracker);
+  EXPECT_LT(attitudeError(s.state.q_b_to_n, C_b_n), 1e-9);
+  EXPECT_LT((s.state.vel_ned_mps - fix.vel_ned_mps).norm(), 1e-9);
+  // The body sigmas seen about NED: between the smallest and the largest body sigma.
+  EXPECT_GE(s.att_sigma_ned_rad.minCoeff(), 5 * units::kArcsec - 1e-12);
+  EXPECT_LE(s.att_sigma_ned_rad.maxCoeff(), 40 * units::kArcsec + 1e-12);
 }

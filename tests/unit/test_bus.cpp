@@ -12,6 +12,7 @@
 #include "navbus/bus/dds_context.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/participant.hpp"
+#include "navbus/bus/stream_end.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/bus/writer_gate.hpp"
@@ -397,6 +398,8 @@ TEST(Skeleton, AReliableReaderLearnsTheAnnouncedEndOfAStream) {
   for (int i = 0; i < 200 && ends == 0; ++i) reader_side.spinOnce(std::chrono::milliseconds(10));
   EXPECT_EQ(samples, 10);
   EXPECT_EQ(ends, 1);
+  // Every sample before the end was received: nothing counted as missed before it.
+  EXPECT_EQ(reader_side.health().stream(navbus::bus::topic::kImuIncrement).sequence_gaps, 0u);
   EXPECT_EQ(writer.raw()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0)),
             ReturnCode_t::RETCODE_OK);
 }
@@ -417,4 +420,17 @@ TEST(WriterPins, OwnerSecondWriterAndTakeover) {
   EXPECT_EQ(pins.check(7, c, 1'900'000'000), V::kTakeover);         // silent 1.0 s: gone
   EXPECT_EQ(pins.check(7, a, 2'000'000'000), V::kNewSecondWriter);  // the old owner is back
   EXPECT_EQ(navbus::bus::toString(a).substr(0, 4), "0100");
+}
+
+// The samples missed before a writer's announced end, from its RTPS sequence numbers (every
+// change it wrote, data and dispose alike, numbered from 1).
+TEST(StreamEndCounter, CountsTheChangesMissedBeforeTheDispose) {
+  navbus::bus::StreamEndCounter ends;
+  const navbus::bus::WriterId a{1}, b{2};
+  EXPECT_EQ(ends.disposed(a, 5), 0u);  // nothing taken from a: nothing to count from
+  for (std::int64_t seq : {1, 2, 3, 7, 8}) ends.taken(b, seq);  // 4-6: gaps a later sample shows
+  EXPECT_EQ(ends.disposed(b, 9), 0u);                           // 8 was the last data
+  ends.taken(a, 10);
+  EXPECT_EQ(ends.disposed(a, 14), 3u);  // 11-13 never arrived
+  EXPECT_EQ(ends.disposed(a, 15), 0u);  // a second instance's dispose right after
 }

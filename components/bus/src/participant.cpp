@@ -59,6 +59,16 @@ Participant::~Participant() {
   }
 }
 
+void Participant::countMissedBeforeEnd(const std::string& topic, StreamCounters& counters,
+                                       std::uint64_t n) {
+  if (n == 0) return;
+  counters.sequence_gaps += n;
+  spdlog::warn(
+      "{}: the last {} sample(s) before the stream's announced end were not received "
+      "(counted as sequence gaps)",
+      topic, n);
+}
+
 void Participant::countMalformed(const std::string& topic, StreamCounters& counters,
                                  std::uint64_t n) {
   if (n == 0) return;

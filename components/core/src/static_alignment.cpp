@@ -41,6 +41,13 @@ void StaticWindow::add(const ImuIncrement& inc) {
   ++count_;
 }
 
+void StaticWindow::add(const StaticWindow& later) {
+  sum_delta_vel_b_mps_ += later.sum_delta_vel_b_mps_;
+  sum_delta_angle_b_rad_ += later.sum_delta_angle_b_rad_;
+  duration_s_ += later.duration_s_;
+  count_ += later.count_;
+}
+
 Eigen::Vector3d StaticWindow::meanSpecificForce_b_mps2() const {
   return duration_s_ > 0.0 ? Eigen::Vector3d(sum_delta_vel_b_mps_ / duration_s_)
                            : Eigen::Vector3d::Zero();

@@ -22,6 +22,7 @@
 #include "navbus/bus/dds_context.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/shutdown.hpp"
+#include "navbus/bus/stream_end.hpp"
 
 namespace navbus::bus {
 
@@ -113,20 +114,23 @@ class Participant {
     auto* reader = dds_.createReader(topic, profile);
     StreamCounters* counters = &health_.stream(topic_name);
     MalformedCounter* malformed = dds_.malformedCounter(topic->get_type_name());
-    auto take_all = [reader, counters, malformed, topic_name, on_sample,
+    auto ends = std::make_shared<StreamEndCounter>();
+    auto take_all = [reader, counters, malformed, topic_name, on_sample, ends,
                      on_disposed = callbacks.on_disposed]() {
       Sample sample;
       eprosima::fastdds::dds::SampleInfo info;
       {
         const MalformedCounter::TakeScope taking;
         while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+          const std::int64_t rtps_seq = info.sample_identity.sequence_number().to64long();
           if (info.valid_data) {
             ++counters->received;
+            ends->taken(writerId(info), rtps_seq);
             on_sample(sample, info);
           } else if (info.instance_state ==
-                         eprosima::fastdds::dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE &&
-                     on_disposed) {
-            on_disposed(info.instance_handle);
+                     eprosima::fastdds::dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE) {
+            countMissedBeforeEnd(topic_name, *counters, ends->disposed(writerId(info), rtps_seq));
+            if (on_disposed) on_disposed(info.instance_handle);
           }
         }
       }
@@ -179,6 +183,10 @@ class Participant {
   /// Counts `n` payloads of `topic` that did not deserialize (received and rejected as
   /// REJECT_MALFORMED; Fast DDS dropped them); logs the first and every 1000th.
   static void countMalformed(const std::string& topic, StreamCounters& counters, std::uint64_t n);
+  /// Counts `n` samples of `topic` missed before the end its writer announced as sequence gaps
+  /// (a best-effort reader that fell behind; stream_end.hpp) and logs them.
+  static void countMissedBeforeEnd(const std::string& topic, StreamCounters& counters,
+                                   std::uint64_t n);
   void addReader(eprosima::fastdds::dds::DataReader* reader, const std::string& topic,
                  std::function<void()> take_all, ReaderCallbacks callbacks);
   void dispatch(ReaderEntry& entry);

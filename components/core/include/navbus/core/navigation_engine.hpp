@@ -9,6 +9,7 @@
 #include <map>
 #include <vector>
 
+#include "navbus/core/aiding_inputs.hpp"
 #include "navbus/core/integrated_filter.hpp"
 #include "navbus/core/multi_dimensional.hpp"
 
@@ -44,20 +45,6 @@ enum EngineStatus : std::uint32_t {
 
 /// Which measurements of a satellite an exclusion concerns (bit mask).
 enum class SatelliteScope : std::uint8_t { kRange = 1, kRate = 2, kAll = 3 };
-
-struct GnssFixMeasurement {
-  std::int64_t time_ns{0};
-  earth::Geodetic position;
-  Eigen::Vector3d vel_ned_mps{Eigen::Vector3d::Zero()};
-  Eigen::Vector3d pos_sigma_ned_m{Eigen::Vector3d::Ones()};
-  Eigen::Vector3d vel_sigma_ned_mps{Eigen::Vector3d::Ones()};
-};
-
-struct StarAttitudeMeasurement {
-  std::int64_t time_ns{0};
-  Eigen::Quaterniond q_b_to_i{Eigen::Quaterniond::Identity()};  ///< body -> ECI
-  Eigen::Vector3d sigma_b_rad{Eigen::Vector3d::Ones()};
-};
 
 struct EngineConfig {
   AidingMode aiding{AidingMode::kInertialOnly};

@@ -24,6 +24,8 @@ class StaticWindow {
  public:
   /// Adds one increment (the caller has checked that the vehicle is at rest).
   void add(const ImuIncrement& inc);
+  /// Adds another window's increments (a later block of the same rest).
+  void add(const StaticWindow& later);
   void reset() { *this = StaticWindow{}; }
 
   double duration_s() const { return duration_s_; }
