@@ -46,15 +46,77 @@ Enum choice(const YAML::Node& node, const std::string& where, const std::string&
 }
 }  // namespace
 
+namespace {
+void parseInitialState(const YAML::Node& init, core::NavState& s) {
+  bus::checkKeys(init, "initial_state",
+                 {"latitude_deg", "longitude_deg", "height_m", "vel_ned_mps", "roll_deg",
+                  "pitch_deg", "yaw_deg"});
+  s.position = bus::getGeodeticDeg(init, "initial_state", nullptr);
+  s.vel_ned_mps = bus::getVector3(init, "initial_state", "vel_ned_mps", 1.0);
+  const Eigen::Vector3d rpy = bus::getRollPitchYawDeg(init, "initial_state");
+  s.q_b_to_n = Eigen::Quaterniond(core::dcmFromEuler(rpy));
+}
+
+/// The alignment (used without an initial_state). Its error budget is the filter's own tuning
+/// (bias sigmas, noise densities), and "at rest" is multi_dimensional.stationary: one place
+/// each.
+void parseAlignment(const YAML::Node& node, core::EngineConfig& e) {
+  const std::string w = "alignment";
+  bus::checkKeys(node, w,
+                 {"static_window_s", "min_static_window_s", "max_heading_sigma_deg",
+                  "course_min_speed_mps", "course_sigma_deg"});
+  core::InitialAlignmentConfig& a = e.alignment;
+  const core::FilterTuning& t = e.tuning;
+  a.budget.accel_bias_sigma_mps2 = t.accel_bias_sigma_mps2;
+  a.budget.gyro_bias_sigma_radps = t.gyro_bias_sigma_radps;
+  a.budget.velocity_random_walk_mps_per_sqrts = t.accel_noise_mps2_per_sqrthz;
+  a.budget.angle_random_walk_rad_per_sqrts = t.gyro_noise_radps_per_sqrthz;
+  a.rest = e.mdf.stationarity;
+  a.imu_period_s = e.imu_period_s;
+  a.static_window_s =
+      bus::checkRange(bus::get<double>(node, w, "static_window_s", a.static_window_s), 1.0, 3600.0,
+                      "alignment.static_window_s");
+  a.min_static_window_s =
+      bus::checkRange(bus::get<double>(node, w, "min_static_window_s", a.min_static_window_s), 0.1,
+                      a.static_window_s, "alignment.min_static_window_s");
+  a.max_heading_sigma_rad = bus::checkRange(bus::get<double>(node, w, "max_heading_sigma_deg",
+                                                             a.max_heading_sigma_rad / units::kDeg),
+                                            0.0, 180.0, "alignment.max_heading_sigma_deg") *
+                            units::kDeg;
+  a.course_min_speed_mps =
+      bus::checkRange(bus::get<double>(node, w, "course_min_speed_mps", a.course_min_speed_mps),
+                      0.1, 1e4, "alignment.course_min_speed_mps");
+  a.course_sigma_rad = bus::checkRange(bus::get<double>(node, w, "course_sigma_deg",
+                                                        a.course_sigma_rad / units::kDeg),
+                                       1e-3, 90.0, "alignment.course_sigma_deg") *
+                       units::kDeg;
+}
+}  // namespace
+
 FilterConfig parseFilterConfig(const YAML::Node& root) {
   FilterConfig c;
-  bus::checkKeys(
-      root, "",
-      {"vehicle_id", "solution_rate_hz", "sequencer_max_wait_s", "recovery",
-       "solution_writer_profile", "initial_state", "inputs", "mode", "fusion",
-       "star_tracker_updates", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional",
-       "command_issuers", "issuer_identities", "time_jump", "fault_monitor"},
-      bus::kParticipantKeys);
+  bus::checkKeys(root, "",
+                 {"vehicle_id",
+                  "solution_rate_hz",
+                  "sequencer_max_wait_s",
+                  "recovery",
+                  "solution_writer_profile",
+                  "initial_state",
+                  "inputs",
+                  "mode",
+                  "fusion",
+                  "star_tracker_updates",
+                  "ekf",
+                  "failed_axis",
+                  "adaptive",
+                  "federated",
+                  "multi_dimensional",
+                  "command_issuers",
+                  "issuer_identities",
+                  "time_jump",
+                  "fault_monitor",
+                  "alignment"},
+                 bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
   const double rate = bus::checkRange(bus::get<double>(root, "", "solution_rate_hz", 10.0), 1.0,
@@ -122,15 +184,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                              "' is not one of command_issuers");
   }
   const YAML::Node init = root["initial_state"];
-  if (!init) throw bus::ConfigError("configuration initial_state is missing");
-  bus::checkKeys(init, "initial_state",
-                 {"latitude_deg", "longitude_deg", "height_m", "vel_ned_mps", "roll_deg",
-                  "pitch_deg", "yaw_deg"});
-  auto& s = e.initial_state;
-  s.position = bus::getGeodeticDeg(init, "initial_state", nullptr);
-  s.vel_ned_mps = bus::getVector3(init, "initial_state", "vel_ned_mps", 1.0);
-  const Eigen::Vector3d rpy = bus::getRollPitchYawDeg(init, "initial_state");
-  s.q_b_to_n = Eigen::Quaterniond(core::dcmFromEuler(rpy));
+  e.start = init ? core::StartSource::kConfigured : core::StartSource::kAligned;
+  if (init) parseInitialState(init, e.initial_state);
 
   const YAML::Node inputs = root["inputs"];
   if (!inputs) throw bus::ConfigError("configuration inputs is missing");
@@ -160,6 +215,11 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
     throw bus::ConfigError(
         "configuration mode = loosely_coupled / multi_dimensional needs "
         "inputs.gnss_fix");
+  }
+  if (e.start == core::StartSource::kAligned && !c.gnss_fix && !c.gnss_observations) {
+    throw bus::ConfigError(
+        "configuration has no initial_state, so the filter aligns from its inputs: that needs "
+        "inputs.gnss_fix or inputs.gnss_observations for its position");
   }
   if (e.use_star_tracker && !c.star_tracker) {
     throw bus::ConfigError("configuration star_tracker_updates = true needs inputs.star_tracker");
@@ -306,6 +366,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   m.stationarity.accel_std_mps2 = bus::get<double>(st, ws, "accel_std_mps2", 0.03);
   m.stationarity.gyro_std_radps = bus::get<double>(st, ws, "gyro_std_dps", 0.3) * kDeg;
   m.stationarity.speed_mps = bus::get<double>(st, ws, "speed_mps", 0.3);
+  parseAlignment(root["alignment"], e);
   return c;
 }
 

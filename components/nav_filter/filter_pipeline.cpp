@@ -65,8 +65,25 @@ navbus::FilterMode toIdl(core::EngineMode mode) {
       return navbus::MODE_MDF_F4_CIF;
     case core::EngineMode::kAidedAxisFailed:
       return navbus::MODE_AIDED_AXIS_FAILED;
+    case core::EngineMode::kAligning:
+      return navbus::MODE_ALIGNING;
   }
   return navbus::MODE_INITIALIZING;
+}
+
+navbus::StartSource toIdl(core::StartSource start, core::AttitudeSource attitude) {
+  if (start == core::StartSource::kConfigured) return navbus::START_CONFIGURED;
+  switch (attitude) {
+    case core::AttitudeSource::kStarTracker:
+      return navbus::START_STAR_TRACKER;
+    case core::AttitudeSource::kGyrocompass:
+      return navbus::START_GYROCOMPASS;
+    case core::AttitudeSource::kGnssCourse:
+      return navbus::START_GNSS_COURSE;
+    case core::AttitudeSource::kNone:
+      break;  // not aligned yet: no solution is published
+  }
+  return navbus::START_CONFIGURED;
 }
 
 navbus::FusionStructure toIdl(core::FusionStructure s, core::AidingMode aiding) {
@@ -230,7 +247,8 @@ void FilterPipeline::process(std::int64_t time_ns, const FilterInput& input) {
   if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {
     if (engine_.addImu(*inc) && !replaying_) publishSolution();
   } else if (const auto* epoch = std::get_if<GnssEpochInput>(&input)) {
-    if (engine_.addGnssEpoch(epoch->satellites) && !replaying_) publishDiagnostics();
+    if (engine_.addGnssEpoch(epoch->time_ns, epoch->satellites) && !replaying_)
+      publishDiagnostics();
   } else if (const auto* fix = std::get_if<core::GnssFixMeasurement>(&input)) {
     engine_.addGnssFix(*fix);
   } else if (const auto* st = std::get_if<core::StarAttitudeMeasurement>(&input)) {
@@ -275,6 +293,7 @@ void FilterPipeline::publishSolution() {
   sol.fusion(toIdl(engine_.fusion(), config_.engine.aiding));
   sol.active_fault_flags(stream_flags_ | monitor_flags_ | faultFlags(engine_.status()));
   sol.imu_samples_used(engine_.counters().imu_used);
+  sol.start_source(toIdl(config_.engine.start, engine_.aligner().start().attitude_source));
   sinks_.solution(sol);
 }
 
@@ -554,6 +573,27 @@ bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
   }
 }
 
+std::string FilterPipeline::alignmentSummary() const {
+  static const char* const phases[] = {"waiting for a GNSS position", "waiting for rest",
+                                       "levelled, waiting for the GNSS course", "aligned"};
+  static const char* const attitude[] = {"none", "star tracker", "gyrocompassing", "GNSS course"};
+  static const char* const position[] = {"none", "GNSS fix", "pseudoranges"};
+  const core::InitialAligner& a = engine_.aligner();
+  std::ostringstream out;
+  out << "alignment: " << phases[static_cast<int>(a.phase())] << " after "
+      << engine_.counters().imu_aligning << " increments";
+  if (a.aligned()) {
+    const core::AlignedStart& s = a.start();
+    out << " (attitude from " << attitude[static_cast<int>(s.attitude_source)] << ", position from "
+        << position[static_cast<int>(s.position_source)] << "; 1-sigma tilt "
+        << s.att_sigma_ned_rad.x() * 1e3 << " mrad, heading " << s.att_sigma_ned_rad.z() * 1e3
+        << " mrad; gyrocompassing would reach " << s.gyrocompass_heading_sigma_rad * 1e3
+        << " mrad)";
+  }
+  if (a.failedSolutions() > 0) out << ", pseudorange solutions failed " << a.failedSolutions();
+  return out.str();
+}
+
 std::string FilterPipeline::summary() const {
   const core::EngineCounters& n = engine_.counters();
   std::ostringstream out;
@@ -573,6 +613,7 @@ std::string FilterPipeline::summary() const {
     out << ", fault monitor found not alive " << monitor_losses_ << " time(s)"
         << (monitor_flags_ != 0 ? " (still not)" : "");
   }
+  if (config_.engine.start == core::StartSource::kAligned) out << ", " << alignmentSummary();
   if (new_runs_ > 0) {
     out << ", new runs after a source restart " << new_runs_ << " (before the latest: solutions "
         << solutions_earlier_runs_ << ", increments " << increments_earlier_runs_ << ")";

@@ -105,6 +105,9 @@ class FilterPipeline {
   std::uint64_t newRuns() const { return new_runs_; }
   const core::NavigationEngine& engine() const { return engine_; }
   std::string summary() const;
+  /// Where the alignment stands, and what it started from (configurations without an
+  /// initial_state).
+  std::string alignmentSummary() const;
 
  private:
   template <class Sample>
@@ -176,5 +179,6 @@ core::SatelliteScope toCore(navbus::SatelliteScope s);
 /// IDL names of the engine's modes and structures.
 navbus::FilterMode toIdl(core::EngineMode mode);
 navbus::FusionStructure toIdl(core::FusionStructure s, core::AidingMode aiding);
+navbus::StartSource toIdl(core::StartSource start, core::AttitudeSource attitude);
 
 }  // namespace navbus::nav_filter

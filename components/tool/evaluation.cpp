@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -53,6 +54,13 @@ std::string fmt(double v) {
   return formatNumber(v);
 }
 
+/// A filter YAML; with `align`, without its initial_state (the filter aligns from its inputs).
+YAML::Node filterYaml(const std::string& path, bool align) {
+  YAML::Node y = YAML::Clone(bus::loadYamlFile(path));
+  if (align) y.remove("initial_state");
+  return y;
+}
+
 void writeTruthHeader(std::ofstream& f) {
   f << "time_gps_ns,latitude_rad,longitude_rad,height_m,vel_ned_mps[0],vel_ned_mps[1],"
        "vel_ned_mps[2],roll_rad,pitch_rad,yaw_rad\n";
@@ -73,6 +81,7 @@ struct Stats {
   std::size_t n{0};
   // NEES: per epoch index, summed over runs.
   std::vector<double> nees_sum;
+  std::vector<Eigen::Vector3d> nees_blocks_sum;  ///< position, velocity, attitude
   std::vector<int> nees_runs;
   std::vector<double> nees_time_s;  ///< of epoch index k, from the start (the first run's)
   std::vector<double> recovery_s;   ///< per run and instant; NaN when not converged
@@ -93,10 +102,12 @@ void accumulate(Stats& st, const OfflineResult& r, std::int64_t from_ns, const M
     ++st.n;
     if (st.nees_sum.size() <= k) {
       st.nees_sum.resize(k + 1, 0.0);
+      st.nees_blocks_sum.resize(k + 1, Eigen::Vector3d::Zero());
       st.nees_runs.resize(k + 1, 0);
       st.nees_time_s.push_back(1e-9 * static_cast<double>(e.time_ns - start_ns));
     }
     st.nees_sum[k] += e.nees9;
+    st.nees_blocks_sum[k] += e.nees_blocks;
     ++st.nees_runs[k];
     ++k;
   }
@@ -105,6 +116,65 @@ void accumulate(Stats& st, const OfflineResult& r, std::int64_t from_ns, const M
     st.recovery_s.push_back(
         convergenceTime(r.errors, t0, o.recovery_threshold_m, o.recovery_window_s));
   }
+}
+
+double median(std::vector<double> v);
+
+/// What one run's alignment started from, against the truth.
+struct AlignmentOutcome {
+  bool aligned{false};
+  core::AlignedStart start;
+  EpochError error;  ///< start minus truth, with the start's own sigmas
+  double time_s{0};  ///< from the scenario's start to the aligned start
+};
+
+const char* attitudeSourceName(core::AttitudeSource s) {
+  switch (s) {
+    case core::AttitudeSource::kStarTracker:
+      return "star tracker";
+    case core::AttitudeSource::kGyrocompass:
+      return "gyrocompassing";
+    case core::AttitudeSource::kGnssCourse:
+      return "GNSS course";
+    case core::AttitudeSource::kNone:
+      break;
+  }
+  return "none";
+}
+
+/// The alignment's starts of one configuration: how long they took, where the attitude came
+/// from, and whether the start's error is inside 3 of its own sigmas (tilt N, tilt E, heading).
+void printAlignment(const std::string& label, const std::vector<AlignmentOutcome>& runs) {
+  std::vector<double> times, heading_sigma, limit;
+  std::map<std::string, int> sources;
+  double heading2 = 0, tilt2 = 0;
+  int aligned = 0, inside = 0;
+  for (const AlignmentOutcome& a : runs) {
+    if (!a.aligned) continue;
+    ++aligned;
+    times.push_back(a.time_s);
+    ++sources[attitudeSourceName(a.start.attitude_source)];
+    const Eigen::Vector3d& e = a.error.att_ned_rad;
+    const Eigen::Vector3d& s = a.start.att_sigma_ned_rad;
+    heading2 += e.z() * e.z();
+    tilt2 += 0.5 * e.head<2>().squaredNorm();
+    heading_sigma.push_back(s.z());
+    limit.push_back(a.start.gyrocompass_heading_sigma_rad);
+    inside += (e.array().abs() <= 3.0 * s.array()).all() ? 1 : 0;
+  }
+  std::string from;
+  for (const auto& [name, n] : sources)
+    from += (from.empty() ? "" : ", ") + name + " " + std::to_string(n);
+  const double n = std::max(aligned, 1);
+  std::printf(
+      "\nalignment, %s: %d of %zu runs aligned (attitude from %s); time to align median %.1f s,"
+      " max %.1f s\n  attitude error of the start: tilt RMS %.3f mrad, heading RMS %.2f mrad "
+      "against a reported heading sigma of %.2f mrad (median); gyrocompassing limit with this "
+      "IMU here %.2f mrad (median);\n  every axis within 3 of its own sigmas in %d of %d runs\n",
+      label.c_str(), aligned, runs.size(), from.empty() ? "-" : from.c_str(), median(times),
+      times.empty() ? 0.0 : *std::max_element(times.begin(), times.end()),
+      1e3 * std::sqrt(tilt2 / n), 1e3 * std::sqrt(heading2 / n), 1e3 * median(heading_sigma),
+      1e3 * median(limit), inside, aligned);
 }
 
 /// Median with runs that never converged counted as infinitely slow.
@@ -116,6 +186,27 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t m = v.size() / 2;
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+/// Average NEES per state block (3 degrees of freedom each) over the epochs every run reached.
+template <class Rows>
+void printBlockNees(const Rows& rows, int runs) {
+  const double lo = chiSquareQuantile(0.025, 3.0 * runs) / runs;
+  const double hi = chiSquareQuantile(0.975, 3.0 * runs) / runs;
+  std::printf("\naverage NEES per block (3 degrees of freedom each, 95%% band [%.2f, %.2f])\n", lo,
+              hi);
+  std::printf("%-34s %10s %10s %10s\n", "configuration", "position", "velocity", "attitude");
+  for (const auto& r : rows) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    int epochs = 0;
+    for (std::size_t k = 0; k < r.st.nees_blocks_sum.size(); ++k) {
+      if (r.st.nees_runs[k] != runs) continue;
+      mean += r.st.nees_blocks_sum[k] / runs;
+      ++epochs;
+    }
+    mean /= std::max(epochs, 1);
+    std::printf("%-34s %10.2f %10.2f %10.2f\n", r.label.c_str(), mean.x(), mean.y(), mean.z());
+  }
 }
 
 /// Average NEES over the runs at every epoch all of them reached, with the 95 % band.
@@ -193,7 +284,7 @@ double chiSquareQuantile(double p, double dof) {
 }
 
 int runOfflineCommand(const OfflineOptions& o) {
-  const OfflineSetup setup = loadSetup(o.scenario, bus::loadYamlFile(o.filter), o.filter, o.seed,
+  const OfflineSetup setup = loadSetup(o.scenario, filterYaml(o.filter, o.align), o.filter, o.seed,
                                        o.duration_s, o.fault_manager);
   std::filesystem::create_directories(o.out_dir);
   std::ofstream sol_f(o.out_dir + "/solution.csv"), truth_f(o.out_dir + "/truth.csv"),
@@ -264,7 +355,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
         o.policies.empty() ? std::vector<std::string>{""} : o.policies;
     for (const auto& fu : fusions) {
       for (const auto& po : policies) {
-        YAML::Node y = YAML::Clone(bus::loadYamlFile(file));
+        YAML::Node y = filterYaml(file, o.align);
         std::string label = stem;
         if (!fu.empty()) {
           y["fusion"] = fu;
@@ -282,10 +373,14 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
       "Monte Carlo: scenario %s, %d runs per configuration (seeds %llu..%llu)%s\n",
       o.scenario.c_str(), o.runs, static_cast<unsigned long long>(o.first_seed),
       static_cast<unsigned long long>(o.first_seed + static_cast<std::uint64_t>(o.runs) - 1),
-      o.perturb_initial ? ", initial state drawn from the filter's initial sigmas" : "");
+      o.align             ? ", every filter aligned from its inputs"
+      : o.perturb_initial ? ", initial state drawn from the filter's initial sigmas (filters "
+                            "without an initial_state align)"
+                          : "");
   struct Row {
     std::string label;
     Stats st;
+    std::vector<AlignmentOutcome> alignments;  ///< one per run, filters that aligned
   };
   std::vector<Row> rows;
   struct FaultTable {
@@ -296,7 +391,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
   };
   std::vector<FaultTable> fault_tables;
   for (const Variant& v : variants) {
-    Row row{v.label, {}};
+    Row row{v.label, {}, {}};
     // Runs in parallel (one per core unless --threads), gathered in seed order.
     std::vector<OfflineResult> results(static_cast<std::size_t>(o.runs));
     std::vector<OfflineSetup> setups(static_cast<std::size_t>(o.runs));
@@ -304,6 +399,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
       const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
       OfflineSetup& setup = setups[static_cast<std::size_t>(i)];
       setup = loadSetup(o.scenario, v.yaml, v.path, seed, o.duration_s, o.fault_manager);
+      if (setup.filter.engine.start == core::StartSource::kAligned) continue;
       const core::NavState truth0 = initialTruth(setup.sim.scenario);
       setup.filter.engine.initial_state =
           o.perturb_initial
@@ -334,6 +430,10 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
       const std::int64_t start = setup.sim.scenario.start_time_ns;
       accumulate(row.st, r, start + static_cast<std::int64_t>(std::llround(o.from_s * 1e9)), o,
                  start);
+      if (setup.filter.engine.start == core::StartSource::kAligned)
+        row.alignments.push_back(
+            {r.aligned, r.aligned_start, r.aligned_start_error,
+             1e-9 * static_cast<double>(r.aligned_start.state.time_ns - start)});
       if (setup.fault_manager) {
         fault = detectableFault(setup.sim.scenario.faults);
         outcomes.push_back(
@@ -370,6 +470,10 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
                 r.label.c_str(), std::sqrt(s.sum_pos2 / n), s.max_pos, std::sqrt(s.sum_vel2 / n),
                 s.max_vel, std::sqrt(s.sum_att2 / n) * kArcsecPerRad, s.max_att * kArcsecPerRad,
                 nees_mean, lo, hi, 100.0 * in_band / std::max(epochs, 1));
+  }
+  printBlockNees(rows, o.runs);
+  for (const Row& r : rows) {
+    if (!r.alignments.empty()) printAlignment(r.label, r.alignments);
   }
   for (const FaultTable& t : fault_tables) printFaultTable(t.label, t.fault, t.runs, t.hours);
   if (!o.csv_dir.empty()) {

@@ -17,6 +17,7 @@ struct OfflineOptions {
   double duration_s{0.0};  ///< 0: the scenario's
   std::string out_dir;
   std::string fault_manager;  ///< navbus-fault-manager YAML: run the fault pipeline too
+  bool align{false};  ///< align from the inputs even when the filter YAML has an initial_state
 };
 
 /// Writes solution.csv, truth.csv and error.csv (columns in the README); returns an exit code.
@@ -32,6 +33,9 @@ struct MonteCarloOptions {
   double duration_s{0.0};
   double from_s{0.0};          ///< statistics from this many seconds after the start
   bool perturb_initial{true};  ///< draw the initial state from the filter's initial sigmas
+  /// Align from the inputs (every filter as if it had no initial_state); filters without an
+  /// initial_state align anyway.
+  bool align{false};
   std::vector<double> recovery_after_s;  ///< convergence times after these instants
   double recovery_threshold_m{3.0};      ///< horizontal position error that counts as converged
   double recovery_window_s{15.0};        ///< ... and must stay below it this long

@@ -217,6 +217,8 @@ int main(int argc, char** argv) {
                    "seconds of data (0: the scenario's timing.duration_s)")
       ->check(CLI::Range(0.0, 1e6));
   offline_cmd->add_option("-o,--out", offline.out_dir, "output directory (created)")->required();
+  offline_cmd->add_flag("--align", offline.align,
+                        "align from the inputs even if the filter YAML has an initial_state");
   offline_cmd
       ->add_option("--fault-manager", offline.fault_manager,
                    "navbus-fault-manager YAML: run the fault pipeline (GLR) in the same process, "
@@ -261,6 +263,9 @@ int main(int argc, char** argv) {
   mc_cmd->add_flag("--no-perturb", mc_no_perturb,
                    "start every run at the true initial state instead of a draw from the "
                    "filter's initial sigmas");
+  mc_cmd->add_flag("--align", mc.align,
+                   "every filter aligns from its inputs (as if it had no initial_state); prints "
+                   "the alignment's time, attitude source and start error against its sigmas");
   mc_cmd
       ->add_option("--recovery-after", mc.recovery_after_s,
                    "instants [s after start] after which to measure the convergence time")

@@ -24,6 +24,21 @@ const char* enumName(navbus::FilterMode v) {
       return "INERTIAL_LOST";
     case navbus::MODE_AIDED_AXIS_FAILED:
       return "AIDED_AXIS_FAILED";
+    case navbus::MODE_ALIGNING:
+      return "ALIGNING";
+  }
+  return "UNKNOWN";
+}
+const char* enumName(navbus::StartSource v) {
+  switch (v) {
+    case navbus::START_CONFIGURED:
+      return "CONFIGURED";
+    case navbus::START_STAR_TRACKER:
+      return "STAR_TRACKER";
+    case navbus::START_GYROCOMPASS:
+      return "GYROCOMPASS";
+    case navbus::START_GNSS_COURSE:
+      return "GNSS_COURSE";
   }
   return "UNKNOWN";
 }

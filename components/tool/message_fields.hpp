@@ -21,6 +21,7 @@ namespace navbus::tool {
 
 const char* enumName(navbus::FilterMode v);
 const char* enumName(navbus::FusionStructure v);
+const char* enumName(navbus::StartSource v);
 const char* enumName(navbus::FaultSource v);
 const char* enumName(navbus::FaultEvent v);
 const char* enumName(navbus::FaultShape v);
@@ -130,6 +131,7 @@ void visitFields(const navbus::NavigationSolution& m, V& v) {
   v("covariance_valid", m.covariance_valid());
   v("active_fault_flags", m.active_fault_flags());
   v("imu_samples_used", m.imu_samples_used());
+  v("start_source", m.start_source());
 }
 template <class V>
 void visitFields(const navbus::FilterDiagnostics& m, V& v) {

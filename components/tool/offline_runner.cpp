@@ -46,6 +46,26 @@ EpochError epochError(const core::NavState& e, const core::NavState& t) {
   return out;
 }
 
+namespace {
+/// Once, when the engine has just aligned: its start against the truth at the start's time.
+void recordAlignedStart(const core::NavigationEngine& engine,
+                        const std::deque<core::NavState>& truths, OfflineResult& result) {
+  if (result.aligned || !engine.aligner().aligned()) return;
+  const core::AlignedStart& a = engine.aligner().start();
+  for (const core::NavState& t : truths) {
+    if (t.time_ns != a.state.time_ns) continue;
+    result.aligned = true;
+    result.aligned_start = a;
+    EpochError& e = result.aligned_start_error;
+    e = epochError(a.state, t);
+    e.pos_sigma_ned_m = a.pos_sigma_ned_m;
+    e.vel_sigma_ned_mps = a.vel_sigma_ned_mps;
+    e.att_sigma_ned_rad = a.att_sigma_ned_rad;
+    return;
+  }
+}
+}  // namespace
+
 OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   OfflineResult result;
   const sensor_sim::SimConfig& sim = setup.sim;
@@ -72,6 +92,10 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     d << err.pos_ned_m, err.vel_ned_mps, err.att_ned_rad;
     const Eigen::Matrix<double, 9, 9> P9 = P.topLeftCorner<9, 9>();
     err.nees9 = d.dot(P9.ldlt().solve(d));
+    for (int b = 0; b < 3; ++b) {
+      const Eigen::Vector3d db = d.segment<3>(3 * b);
+      err.nees_blocks[b] = db.dot(P9.block<3, 3>(3 * b, 3 * b).ldlt().solve(db));
+    }
     err.mode = static_cast<int>(sol.mode());
     result.errors.push_back(err);
     if (hook) hook(sol, truths.front(), err);
@@ -124,6 +148,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     sensor_sim::emitFrame(f, emitted, seq, feed);
     // Data time bounds the wait for a silent stream (the bus uses steady time).
     pipeline.pump(f.increment.time_ns);
+    recordAlignedStart(pipeline.engine(), truths, result);
   }
   // End of data: whatever waits for a stream that will not speak again is released.
   pipeline.flush(sim.scenario.start_time_ns + total * period_ns);

@@ -16,6 +16,7 @@
 #include "fault_config.hpp"
 #include "filter_config.hpp"
 #include "glr_detector.hpp"
+#include "navbus/core/initial_alignment.hpp"
 #include "navbus/core/strapdown.hpp"
 #include "scenario_config.hpp"
 
@@ -31,7 +32,9 @@ struct EpochError {
   Eigen::Vector3d vel_sigma_ned_mps{Eigen::Vector3d::Zero()};
   Eigen::Vector3d att_sigma_ned_rad{Eigen::Vector3d::Zero()};
   double nees9{0.0};  ///< position, velocity, attitude against the full 9x9 covariance
-  int mode{0};        ///< navbus::FilterMode of the solution
+  /// NEES of the position, velocity and attitude blocks, each against its own 3x3 block.
+  Eigen::Vector3d nees_blocks{Eigen::Vector3d::Zero()};
+  int mode{0};  ///< navbus::FilterMode of the solution
 };
 
 struct OfflineSetup {
@@ -54,6 +57,11 @@ struct OfflineResult {
   double max_glr_statistic{0.0};
   std::vector<fault_manager::GlrEpochStatistic>
       glr_trace;  ///< every epoch the GLR accepted, in order
+  /// Configurations without an initial_state: what the alignment started from, and the error
+  /// of that start against the truth at the same instant (its sigmas are the start's own).
+  bool aligned{false};
+  core::AlignedStart aligned_start;
+  EpochError aligned_start_error;
 };
 
 using SolutionHook = std::function<void(const navbus::NavigationSolution&,

@@ -71,7 +71,7 @@ Result run(core::EngineConfig cfg, const std::vector<Input>& inputs, bool aid) {
     engine.addImu(in.inc);
     if (!aid) continue;
     if (in.has_epoch && cfg.aiding == core::AidingMode::kTightlyCoupled)
-      engine.addGnssEpoch(in.sats);
+      engine.addGnssEpoch(in.inc.time_ns, in.sats);
     if (in.has_fix) engine.addGnssFix(in.fix);
     if (in.has_star) engine.addStarAttitude(in.star);
   }

@@ -88,7 +88,7 @@ Figures run(const navbus::sim::ScenarioConfig& scenario, int seconds, int window
                      m.pseudorange_rate_sigma_mps});
     }
     t0 = Clock::now();
-    const bool fused = engine.addGnssEpoch(obs);
+    const bool fused = engine.addGnssEpoch(f.increment.time_ns, obs);
     const double update_time = us(Clock::now() - t0);
     if (!fused) continue;
     toGlrEpoch(engine.lastEpoch(), engine.state().time_ns, epoch);

@@ -74,10 +74,35 @@ TEST_F(ConfigKeys, FilterTypoAtEveryLevelNamesKeyAndFile) {
            {"initial_state: {latitude_deg: 1, longitude_deg: 2, height_m: 3, heading_deg: 4}\n",
             "initial_state.heading_deg"},
            {"multi_dimensional: {stationary: {speed: 1}}\n", "multi_dimensional.stationary.speed"},
-           {"recovery: {history: 10}\n", "recovery.history"}}) {
+           {"recovery: {history: 10}\n", "recovery.history"},
+           {"alignment: {static_window: 30}\n", "alignment.static_window"}}) {
     const std::string path = write("filter.yaml", "extends: " + kSrc + "/filter.yaml\n" + text);
     EXPECT_TRUE(names(errorOf(path, filter), key, path)) << text;
   }
+}
+
+TEST_F(ConfigKeys, WithoutAnInitialStateTheFilterAlignsAndNeedsAGnssPosition) {
+  // No initial_state: the filter aligns from its inputs ...
+  const std::string ok =
+      write("ok.yaml",
+            "mode: inertial_only\ninputs: {imu: {id: 1, period_s: 0.01}, "
+            "gnss_fix: {id: 1, period_s: 1}}\nalignment: {static_window_s: 30}\n");
+  const auto c = navbus::bus::parseFile(ok, filter);
+  EXPECT_EQ(c.engine.start, navbus::core::StartSource::kAligned);
+  EXPECT_DOUBLE_EQ(c.engine.alignment.static_window_s, 30.0);
+  EXPECT_DOUBLE_EQ(c.engine.alignment.budget.accel_bias_sigma_mps2,
+                   c.engine.tuning.accel_bias_sigma_mps2);
+  // ... which needs a GNSS position: refused, naming the file, without one.
+  const std::string bad =
+      write("bad.yaml", "mode: inertial_only\ninputs: {imu: {id: 1, period_s: 0.01}}\n");
+  const std::string message = errorOf(bad, filter);
+  EXPECT_NE(message.find("inputs.gnss_fix or inputs.gnss_observations"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find(bad), std::string::npos) << message;
+  // A value out of range names the key.
+  const std::string range = write(
+      "range.yaml", "extends: " + kSrc + "/filter.yaml\nalignment: {course_sigma_deg: 200}\n");
+  EXPECT_NE(errorOf(range, filter).find("alignment.course_sigma_deg"), std::string::npos);
 }
 
 TEST_F(ConfigKeys, TypoInAnExtendedFileNamesThatFile) {

@@ -175,3 +175,107 @@ TEST(ChiSquare, QuantilesMatchTables) {
   EXPECT_NEAR(tool::chiSquareQuantile(0.025, 9), 2.700, 0.03);
   EXPECT_NEAR(tool::chiSquareQuantile(0.975, 360), 414.0, 0.5);
 }
+
+namespace {
+
+/// One run with the filter aligning from its inputs (the configuration's initial_state
+/// removed): the alignment's start against the truth, and the first solution.
+struct AlignedRun {
+  tool::OfflineResult result;
+  navbus::StartSource first_source{navbus::START_CONFIGURED};
+  double first_solution_s{-1};
+};
+
+AlignedRun alignedRun(const std::string& scenario, const std::string& filter, std::uint64_t seed,
+                      double duration_s) {
+  YAML::Node fy = YAML::Clone(navbus::bus::loadYamlFile(kConfig + "/" + filter));
+  fy.remove("initial_state");
+  tool::OfflineSetup s;
+  s.sim =
+      navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(kScenarios + "/" + scenario));
+  s.sim.scenario.seed = seed;
+  s.filter = navbus::nav_filter::parseFilterConfig(fy);
+  s.duration_s = duration_s;
+  AlignedRun run;
+  run.result =
+      tool::runOffline(s, [&](const navbus::NavigationSolution& sol, const auto&, const auto&) {
+        if (run.first_solution_s >= 0) return;
+        run.first_solution_s = 1e-9 * static_cast<double>(sol.time_gps_ns() - kStart);
+        run.first_source = sol.start_source();
+      });
+  return run;
+}
+
+double alignedAt(const tool::OfflineResult& r) {
+  return 1e-9 * static_cast<double>(r.aligned_start.state.time_ns - kStart);
+}
+
+}  // namespace
+
+TEST(Alignment, Seed000GyrocompassesAtRestWithinItsOwnSigmas) {
+  // Given the seed-000 aircraft at rest for 500 s, a navigation-grade IMU (1 deg/h, 1 mg) and
+  // no configured initial state, 6 seeds,
+  double normalized = 0;
+  const int runs = 6;
+  for (int seed = 1; seed <= runs; ++seed) {
+    const AlignedRun run = alignedRun("seed000_aircraft.yaml", "filter_seed000_tc.yaml",
+                                      static_cast<unsigned>(seed), 80);
+    const tool::OfflineResult& r = run.result;
+    // when the filter aligns itself,
+    ASSERT_TRUE(r.aligned) << "seed " << seed << ": " << r.summary;
+    // then it levels and gyrocompasses over the 60 s window at rest (the attitude source is in
+    // every solution, no solution before the start),
+    EXPECT_EQ(r.aligned_start.attitude_source, navbus::core::AttitudeSource::kGyrocompass);
+    EXPECT_EQ(run.first_source, navbus::START_GYROCOMPASS);
+    EXPECT_GE(alignedAt(r), 60.0);
+    EXPECT_GT(run.first_solution_s, alignedAt(r));
+    // the heading sigma it reports is the gyrocompassing limit of this gyro grade here,
+    // 1 deg/h / (W cos 36.5 deg) = 82.7 mrad,
+    EXPECT_NEAR(r.aligned_start.att_sigma_ned_rad.z(), 0.0827, 0.001);
+    EXPECT_NEAR(r.aligned_start.gyrocompass_heading_sigma_rad, 0.0827, 0.001);
+    const Eigen::Vector3d z =
+        r.aligned_start_error.att_ned_rad.cwiseQuotient(r.aligned_start.att_sigma_ned_rad);
+    normalized += z.squaredNorm();
+    std::printf("seed %d: aligned at %.1f s, attitude error / sigma (N, E, D) %.2f %.2f %.2f\n",
+                seed, alignedAt(r), z.x(), z.y(), z.z());
+  }
+  // and the attitude errors of the starts are consistent with those sigmas (chi-square with
+  // 3 x runs degrees of freedom, 99.9 % bound).
+  EXPECT_LT(normalized, tool::chiSquareQuantile(0.999, 3.0 * runs));
+}
+
+TEST(Alignment, Seed001TakesTheAttitudeFromTheFirstStarTrackerSampleAfterTheFirstFix) {
+  // Given the LEO orbit, GNSS fixes at 10 Hz and a 5 Hz star tracker, no configured state,
+  const AlignedRun run = alignedRun("seed001_leo.yaml", "filter_seed001_lc.yaml", 1, 5);
+  const tool::OfflineResult& r = run.result;
+  ASSERT_TRUE(r.aligned) << r.summary;
+  // then the attitude comes from the star tracker and the position from the first fix, at
+  // once (the first star-tracker sample at 0.2 s),
+  EXPECT_EQ(r.aligned_start.attitude_source, navbus::core::AttitudeSource::kStarTracker);
+  EXPECT_EQ(r.aligned_start.position_source, navbus::core::PositionSource::kGnssFix);
+  EXPECT_NEAR(alignedAt(r), 0.2, 0.01);
+  EXPECT_EQ(run.first_source, navbus::START_STAR_TRACKER);
+  // within 3 of the star tracker's own sigmas, and without an inertial gap at the hand-over.
+  EXPECT_TRUE((r.aligned_start_error.att_ned_rad.array().abs() <=
+               3.0 * r.aligned_start.att_sigma_ned_rad.array())
+                  .all());
+  EXPECT_NE(r.summary.find("inertial gaps 0"), std::string::npos) << r.summary;
+}
+
+TEST(Alignment, Seed004MemsLevelsAtRestAndTakesTheHeadingFromTheGnssCourse) {
+  // Given the land vehicle with MEMS gyros (0.1 deg/s: no gyrocompassing), at rest for 10 s and
+  // then accelerating, no configured state,
+  const AlignedRun run = alignedRun("seed004_land_vehicle.yaml", "filter_seed004_mdf.yaml", 1, 30);
+  const tool::OfflineResult& r = run.result;
+  ASSERT_TRUE(r.aligned) << r.summary;
+  // then the heading comes from the GNSS course once the vehicle is faster than 5 m/s, and the
+  // alignment says gyrocompassing could not reach 10 deg here,
+  EXPECT_EQ(r.aligned_start.attitude_source, navbus::core::AttitudeSource::kGnssCourse);
+  EXPECT_EQ(run.first_source, navbus::START_GNSS_COURSE);
+  EXPECT_GT(alignedAt(r), 10.0);
+  EXPECT_LT(alignedAt(r), 15.0);
+  EXPECT_GT(r.aligned_start.gyrocompass_heading_sigma_rad, 10.0 * M_PI / 180.0);
+  EXPECT_TRUE((r.aligned_start_error.att_ned_rad.array().abs() <=
+               3.0 * r.aligned_start.att_sigma_ned_rad.array())
+                  .all());
+}

@@ -1,6 +1,7 @@
 // Initial alignment from the inputs on the bus (see the header for the order of sources).
 #include "navbus/core/initial_alignment.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "navbus/core/earth.hpp"
@@ -34,7 +35,12 @@ void InitialAligner::addImu(const ImuIncrement& inc) {
   if (aligned()) return;
   last_imu_ns_ = inc.time_ns;
   if (phase_ == AlignmentPhase::kWaitingForCourse) propagateAttitude(inc);
-  const double speed_mps = hasFix() ? fix_.measurement.vel_ned_mps.head<2>().norm() : 0.0;
+  // The GNSS speed beyond 3 of its own sigmas: at rest it is noise of that size, which alone
+  // must not break a rest window.
+  const double speed_mps =
+      hasFix() ? std::max(0.0, fix_.measurement.vel_ned_mps.head<2>().norm() -
+                                   3.0 * fix_.measurement.vel_sigma_ned_mps.head<2>().maxCoeff())
+               : 0.0;
   rest_.update(inc, speed_mps);
   if (!(rest_.ready() && rest_.stationary())) {
     onMotion();
@@ -138,20 +144,27 @@ void InitialAligner::onRestWindowEnd() {
     finish(
         coarse.q_b_to_n,
         Eigen::Vector3d(coarse.level_sigma_rad, coarse.level_sigma_rad, coarse.heading_sigma_rad),
-        AttitudeSource::kGyrocompass);
+        AttitudeSource::kGyrocompass,
+        alignmentSensitivity(coarse.q_b_to_n.toRotationMatrix(),
+                             fix_.measurement.position.latitude_rad, gravity(), true));
     return;
   }
   q_levelled_b_to_n_ = coarse.q_b_to_n;
+  q_at_levelling_b_to_n_ = q_levelled_b_to_n_;
   level_sigma_rad_ = coarse.level_sigma_rad;
   levelled_for_s_ = 0.0;
   phase_ = AlignmentPhase::kWaitingForCourse;
   tryCourse();
 }
 
-CoarseAlignment InitialAligner::alignWindow(double max_heading_sigma_rad) const {
+double InitialAligner::gravity() const {
   const earth::Geodetic& p = fix_.measurement.position;
-  const double g = earth::normalGravity(p.latitude_rad, p.height_m);
-  return alignStatic(window_, p.latitude_rad, g, config_.budget, max_heading_sigma_rad);
+  return earth::normalGravity(p.latitude_rad, p.height_m);
+}
+
+CoarseAlignment InitialAligner::alignWindow(double max_heading_sigma_rad) const {
+  return alignStatic(window_, fix_.measurement.position.latitude_rad, gravity(), config_.budget,
+                     max_heading_sigma_rad);
 }
 
 void InitialAligner::relevel() {
@@ -163,6 +176,7 @@ void InitialAligner::relevel() {
       Eigen::Quaterniond(dcmFromEuler(Eigen::Vector3d(coarse.roll_pitch_yaw_rad.x(),
                                                       coarse.roll_pitch_yaw_rad.y(), yaw_rad)))
           .normalized();
+  q_at_levelling_b_to_n_ = q_levelled_b_to_n_;
   level_sigma_rad_ = coarse.level_sigma_rad;
   levelled_for_s_ = 0.0;
 }
@@ -203,12 +217,20 @@ void InitialAligner::tryCourse() {
   const double tilt_rate_radps =
       std::hypot(config_.budget.gyro_bias_sigma_radps, horizontal_earth_rate_radps);
   const double level_sigma_rad = std::hypot(level_sigma_rad_, tilt_rate_radps * levelled_for_s_);
+  // The tilt errors are those of the latest levelling, whose attitude is now known with the
+  // course's heading correction (step 8, levelling rows only).
+  const Eigen::Matrix3d C_at_levelling =
+      Eigen::AngleAxisd(course_rad - yaw_rad, Eigen::Vector3d::UnitZ()) *
+      q_at_levelling_b_to_n_.toRotationMatrix();
   finish(q.normalized(), Eigen::Vector3d(level_sigma_rad, level_sigma_rad, heading_sigma_rad),
-         AttitudeSource::kGnssCourse);
+         AttitudeSource::kGnssCourse,
+         alignmentSensitivity(C_at_levelling, fix_.measurement.position.latitude_rad, gravity(),
+                              false));
 }
 
 void InitialAligner::finish(const Eigen::Quaterniond& q_b_to_n,
-                            const Eigen::Vector3d& att_sigma_ned_rad, AttitudeSource source) {
+                            const Eigen::Vector3d& att_sigma_ned_rad, AttitudeSource source,
+                            const AlignmentSensitivity& sensitivity) {
   // The fix is carried to the time of the last increment with its velocity.
   const double dt_s = 1e-9 * static_cast<double>(last_imu_ns_ - fix_.time_ns);
   const GnssFixMeasurement& m = fix_.measurement;
@@ -229,6 +251,7 @@ void InitialAligner::finish(const Eigen::Quaterniond& q_b_to_n,
   start_.attitude_source = source;
   start_.position_source = fix_.source;
   start_.gyrocompass_heading_sigma_rad = gyrocompass_sigma_rad_;
+  start_.sensitivity = sensitivity;
   phase_ = AlignmentPhase::kAligned;
 }
 

@@ -17,16 +17,7 @@ constexpr std::size_t kGnssLocal = 0;
 constexpr std::size_t kStarLocal = 1;
 }  // namespace
 
-void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
-                                  double clock_drift_mps, const FilterTuning& tuning,
-                                  const StateMask& active, FusionStructure structure) {
-  tuning_ = tuning;
-  ins_ = StrapdownNed(tuning.gravity);
-  ins_.initialize(state);
-  clock_bias_m_ = clock_bias_m;
-  clock_drift_mps_ = clock_drift_mps;
-  accel_bias_.setZero();
-  gyro_bias_.setZero();
+Vector17 IntegratedFilter::initialSigma(const FilterTuning& tuning) {
   Vector17 sigma;
   sigma.segment<3>(kPos.index).setConstant(tuning.pos_sigma_m);
   sigma.segment<3>(kVel.index).setConstant(tuning.vel_sigma_mps);
@@ -36,7 +27,29 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   sigma.segment<3>(kGyroBias.index).setConstant(tuning.gyro_bias_sigma_radps);
   sigma[kClockBias.index] = tuning.clock_bias_sigma_m;
   sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
-  central_.initialize(sigma.array().square().matrix().asDiagonal(), active);
+  return sigma;
+}
+
+void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
+                                  double clock_drift_mps, const FilterTuning& tuning,
+                                  const StateMask& active, FusionStructure structure) {
+  const Vector17 sigma = initialSigma(tuning);
+  initialize(state, clock_bias_m, clock_drift_mps, tuning, active, structure,
+             sigma.array().square().matrix().asDiagonal());
+}
+
+void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
+                                  double clock_drift_mps, const FilterTuning& tuning,
+                                  const StateMask& active, FusionStructure structure,
+                                  const Matrix17& initial_covariance) {
+  tuning_ = tuning;
+  ins_ = StrapdownNed(tuning.gravity);
+  ins_.initialize(state);
+  clock_bias_m_ = clock_bias_m;
+  clock_drift_mps_ = clock_drift_mps;
+  accel_bias_.setZero();
+  gyro_bias_.setZero();
+  central_.initialize(initial_covariance, active);
   const Eigen::Vector3d floor_pos = Eigen::Vector3d::Constant(tuning.adaptive_floor_position_m);
   windows_[0].configure(tuning.adaptive_window, floor_pos);
   windows_[1].configure(tuning.adaptive_window,

@@ -22,13 +22,15 @@ EngineMode stageMode(MdfStage s) {
 }
 }  // namespace
 
-NavigationEngine::NavigationEngine(const EngineConfig& config) : config_(config) {
+NavigationEngine::NavigationEngine(const EngineConfig& config)
+    : config_(config), aligner_(config.alignment) {
   used_.reserve(32);
   reset();
 }
 
 void NavigationEngine::reset() {
   filter_ = IntegratedFilter();
+  aligner_ = InitialAligner(config_.alignment);
   mode_ = EngineMode::kInitializing;
   status_ = 0;
   failed_axes_ = 0;
@@ -57,6 +59,15 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
     ++counters_.imu_refused;
     return false;
   }
+  if (aligning()) {
+    aligner_.addImu(inc);
+    ++counters_.imu_aligning;
+    mode_ = EngineMode::kAligning;
+    if (aligner_.aligned()) startFromAlignment();  // at the end of this increment
+    // Every input is taken by the aligner until it has aligned; the filter starts at the time
+    // of the latest increment it took, so the next one continues without a gap.
+    return false;
+  }
   const auto interval_ns = static_cast<std::int64_t>(std::llround(inc.interval_s * 1e9));
   const std::int64_t start_ns = inc.time_ns - interval_ns;
   const std::int64_t period = config_.solution_period_ns;
@@ -67,13 +78,9 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
   if (!filter_.initialized()) {
     NavState s = config_.initial_state;
     s.time_ns = start_ns;
-    filter_.initialize(s, config_.initial_clock_bias_m, config_.initial_clock_drift_mps,
-                       config_.tuning, baseMask(), config_.fusion);
-    for (int i = 0; i < 6; ++i) {
-      if (failed_axes_ & (1u << i)) filter_.setAxisFailed(i < 3, i % 3, true);
-    }
-    next_output_ns_ = (start_ns / period + 1) * period;
-    next_constraint_ns_ = start_ns;
+    const Vector17 sigma = IntegratedFilter::initialSigma(config_.tuning);
+    start(s, config_.initial_clock_bias_m, config_.initial_clock_drift_mps,
+          sigma.array().square().matrix().asDiagonal());
   } else if (start_ns - filter_.state().time_ns > interval_ns / 2) {
     // Inertial data is missing between the state time and this interval: nothing can be
     // propagated across the gap, so restart the integration and flag the solution.
@@ -110,6 +117,62 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
     return true;
   }
   return false;
+}
+
+void NavigationEngine::start(const NavState& state, double clock_bias_m, double clock_drift_mps,
+                             const Matrix17& initial_covariance) {
+  filter_.initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
+                     config_.fusion, initial_covariance);
+  for (int i = 0; i < 6; ++i) {
+    if (failed_axes_ & (1u << i)) filter_.setAxisFailed(i < 3, i % 3, true);
+  }
+  const std::int64_t period = config_.solution_period_ns;
+  next_output_ns_ = (state.time_ns / period + 1) * period;
+  next_constraint_ns_ = state.time_ns;
+}
+
+Matrix17 NavigationEngine::alignedCovariance(const AlignedStart& a) const {
+  // Position, velocity and clock with the alignment's sigmas; the sensor biases keep the
+  // tuning's. The alignment read those biases as tilt and heading (static_alignment.cpp step
+  // 8), so the attitude errors are correlated with them: with phi = S_a b_a + S_g b_g + n and
+  // the bias error states e = estimate - truth = -b (the estimates start at 0),
+  //   P_phi,phi = S_a Sa S_a^T + S_g Sg S_g^T + N,  P_phi,e_a = -S_a Sa,  P_phi,e_g = -S_g Sg,
+  // with Sa, Sg the tuning's bias variances and N the rest of the alignment's own budget
+  // (noise; at least 0 per axis).
+  Vector17 sigma = IntegratedFilter::initialSigma(config_.tuning);
+  sigma.segment<3>(kPos.index) = a.pos_sigma_ned_m;
+  sigma.segment<3>(kVel.index) = a.vel_sigma_ned_mps;
+  if (a.has_clock) {
+    sigma[kClockBias.index] = a.clock_bias_sigma_m;
+    sigma[kClockDrift.index] = a.clock_drift_sigma_mps;
+  }
+  Matrix17 P = sigma.array().square().matrix().asDiagonal();
+  const Eigen::Matrix3d& S_a = a.sensitivity.d_att_d_accel_bias_b;
+  const Eigen::Matrix3d& S_g = a.sensitivity.d_att_d_gyro_bias_b;
+  const double var_a = config_.tuning.accel_bias_sigma_mps2 * config_.tuning.accel_bias_sigma_mps2;
+  const double var_g = config_.tuning.gyro_bias_sigma_radps * config_.tuning.gyro_bias_sigma_radps;
+  const Eigen::Matrix3d from_biases = var_a * S_a * S_a.transpose() + var_g * S_g * S_g.transpose();
+  const Eigen::Vector3d rest =
+      (a.att_sigma_ned_rad.cwiseAbs2() - from_biases.diagonal()).cwiseMax(0.0);
+  P.block<3, 3>(kAtt.index, kAtt.index) = from_biases + Eigen::Matrix3d(rest.asDiagonal());
+  P.block<3, 3>(kAtt.index, kAccelBias.index) = -var_a * S_a;
+  P.block<3, 3>(kAtt.index, kGyroBias.index) = -var_g * S_g;
+  P.block<3, 3>(kAccelBias.index, kAtt.index) = -var_a * S_a.transpose();
+  P.block<3, 3>(kGyroBias.index, kAtt.index) = -var_g * S_g.transpose();
+  return P;
+}
+
+void NavigationEngine::startFromAlignment() {
+  // The clock from the pseudorange solution when there was one.
+  const AlignedStart& a = aligner_.start();
+  double clock_bias_m = config_.initial_clock_bias_m;
+  double clock_drift_mps = config_.initial_clock_drift_mps;
+  if (a.has_clock) {
+    clock_bias_m = a.clock_bias_m;
+    clock_drift_mps = a.clock_drift_mps;
+  }
+  start(a.state, clock_bias_m, clock_drift_mps, alignedCovariance(a));
+  mode_ = EngineMode::kInertialOnly;  // aided modes with the next measurement
 }
 
 void NavigationEngine::applyStage(const StageDecision& d) {
@@ -179,9 +242,11 @@ EngineMode NavigationEngine::aidedMode() const {
                                                        : EngineMode::kLooselyCoupled;
 }
 
-bool NavigationEngine::addGnssEpoch(const std::vector<SatelliteObservation>& satellites) {
-  if (config_.aiding != AidingMode::kTightlyCoupled || !filter_.initialized() ||
-      mode_ == EngineMode::kInertialLost) {
+bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
+                                    const std::vector<SatelliteObservation>& satellites) {
+  // While aligning, any mode's pseudoranges serve the alignment's position.
+  if (mode_ == EngineMode::kInertialLost ||
+      (!aligning() && (config_.aiding != AidingMode::kTightlyCoupled || !filter_.initialized()))) {
     return false;
   }
   // Excluded measurements stay in the epoch, monitored only (their innovations go to the
@@ -198,6 +263,11 @@ bool NavigationEngine::addGnssEpoch(const std::vector<SatelliteObservation>& sat
     any = any || o.use_range || o.use_rate;
     used_.push_back(o);
   }
+  if (aligning()) {
+    aligner_.addPseudoranges(time_ns, used_);  // excluded satellites are not used there either
+    if (aligner_.aligned()) startFromAlignment();
+    return false;
+  }
   if (!any) return false;
   for (const auto& rep : filter_.update(used_)) {
     counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
@@ -208,6 +278,11 @@ bool NavigationEngine::addGnssEpoch(const std::vector<SatelliteObservation>& sat
 }
 
 void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
+  if (aligning()) {
+    aligner_.addGnssFix(fix);
+    if (aligner_.aligned()) startFromAlignment();  // the course: from the next increment on
+    return;
+  }
   if (!filter_.initialized() || mode_ == EngineMode::kInertialLost) return;
   if (config_.aiding == AidingMode::kMultiDimensional) {
     last_fix_ns_ = fix.time_ns;
@@ -233,6 +308,11 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
 }
 
 void NavigationEngine::addStarAttitude(const StarAttitudeMeasurement& st) {
+  if (aligning()) {
+    aligner_.addStarAttitude(st);
+    if (aligner_.aligned()) startFromAlignment();
+    return;
+  }
   if (!config_.use_star_tracker || !filter_.initialized() || mode_ == EngineMode::kInertialLost ||
       config_.aiding == AidingMode::kInertialOnly ||
       config_.aiding == AidingMode::kMultiDimensional)

@@ -19,6 +19,13 @@
 //   (7) sigma_yaw^2 = (sigma_bg^2 + ARW^2 / T) / (W cos L)^2 + (sigma_level tan L)^2.
 // (7) is what decides whether a gyro grade can gyrocompass: a 0.01 deg/h gyro at 45 deg
 // latitude gives about 0.05 deg; a 10 deg/h MEMS gyro gives more than a radian (no heading).
+// The same first order, as sensitivities of the attitude error phi (NED, C_b^n computed =
+// (I - [phi x]) C_b^n true) to the true biases b_a, b_g (body), for a filter that starts with
+// its attitude and bias errors correlated as they are. With b^n = C_b^n b, levelling makes the
+// computed horizontal specific force vanish, b^n_h - (phi x f^n)_h = 0 with f^n from (1);
+// gyrocompassing makes the computed east rate vanish, b_g^n_E - (phi x w^n)_E = 0 with (2):
+//   (8) phi_N = b_a^n_E / g,  phi_E = -b_a^n_N / g,
+//       phi_D = b_g^n_E / (W cos L) - phi_N tan L.
 #include "navbus/core/static_alignment.hpp"
 
 #include <cmath>
@@ -105,6 +112,21 @@ CoarseAlignment alignStatic(const StaticWindow& window, double latitude_rad, dou
   }
   out.roll_pitch_yaw_rad = Eigen::Vector3d(roll, pitch, yaw);
   out.q_b_to_n = Eigen::Quaterniond(dcmFromEuler(out.roll_pitch_yaw_rad)).normalized();
+  return out;
+}
+
+AlignmentSensitivity alignmentSensitivity(const Eigen::Matrix3d& C_b_n, double latitude_rad,
+                                          double gravity_mps2, bool heading_from_gyros) {
+  AlignmentSensitivity out;
+  const Eigen::RowVector3d north = C_b_n.row(0) / gravity_mps2;
+  const Eigen::RowVector3d east = C_b_n.row(1) / gravity_mps2;
+  out.d_att_d_accel_bias_b.row(0) = east;    // (8) phi_N
+  out.d_att_d_accel_bias_b.row(1) = -north;  // (8) phi_E
+  const double horizontal_rate = earth::kRotationRate_radps * std::cos(latitude_rad);
+  if (heading_from_gyros && std::abs(std::cos(latitude_rad)) >= kMinCosLatitude) {
+    out.d_att_d_accel_bias_b.row(2) = -std::tan(latitude_rad) * east;  // (8) phi_D, tilt
+    out.d_att_d_gyro_bias_b.row(2) = C_b_n.row(1) / horizontal_rate;   // (8) phi_D, gyro
+  }
   return out;
 }
 

@@ -66,6 +66,9 @@ struct AlignedStart {
   /// Heading sigma gyrocompassing reaches with this IMU here (static_alignment.cpp step 7),
   /// reported even when another source was used; 0 before a window at rest.
   double gyrocompass_heading_sigma_rad{0.0};
+  /// How the attitude error depends on the true sensor biases (static_alignment.cpp step 8):
+  /// the filter starts with these correlations. Zero for a star-tracker attitude.
+  AlignmentSensitivity sensitivity;
 };
 
 class InitialAligner {
@@ -103,7 +106,8 @@ class InitialAligner {
   void propagateAttitude(const ImuIncrement& inc);
   void tryCourse();
   void finish(const Eigen::Quaterniond& q_b_to_n, const Eigen::Vector3d& att_sigma_ned_rad,
-              AttitudeSource source);
+              AttitudeSource source, const AlignmentSensitivity& sensitivity = {});
+  double gravity() const;
   bool hasFix() const { return fix_.time_ns >= 0; }
 
   InitialAlignmentConfig config_;
@@ -117,6 +121,9 @@ class InitialAligner {
   // Levelled, waiting for the course: yaw 0 at the first levelling, then carried by the gyros;
   // roll and pitch levelled again while at rest.
   Eigen::Quaterniond q_levelled_b_to_n_{Eigen::Quaterniond::Identity()};
+  /// The attitude at the latest levelling (yaw as carried then): its tilt errors are the ones
+  /// the accelerometer biases made (step 8 once the course gives the heading).
+  Eigen::Quaterniond q_at_levelling_b_to_n_{Eigen::Quaterniond::Identity()};
   double level_sigma_rad_{0.0};
   double levelled_for_s_{0.0};
   double gyrocompass_sigma_rad_{0.0};

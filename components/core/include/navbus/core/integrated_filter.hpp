@@ -80,9 +80,17 @@ class IntegratedFilter {
   /// only the GNSS local filter observes.
   static constexpr int kFusedStates = tc17::kClockBias.index;
 
+  /// Starts from `state` with the tuning's initial sigmas (initialSigma).
   void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
                   const FilterTuning& tuning, const StateMask& active,
                   FusionStructure structure = FusionStructure::kCentralized);
+  /// Starts from `state` with an explicit initial covariance (an alignment's own budget, with
+  /// its attitude-bias correlations), in the units of the state layout.
+  void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
+                  const FilterTuning& tuning, const StateMask& active, FusionStructure structure,
+                  const Matrix17& initial_covariance);
+  /// The tuning's initial 1-sigma of every state (also what the reset rules re-initialize to).
+  static Vector17 initialSigma(const FilterTuning& tuning);
   /// Mechanizes one increment (bias-corrected) and propagates the clock and, unless
   /// `suspend_filter` (the filter is not run: seed 004's case I during an outage), the
   /// covariance(s).

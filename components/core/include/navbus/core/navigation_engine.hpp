@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "navbus/core/aiding_inputs.hpp"
+#include "navbus/core/initial_alignment.hpp"
 #include "navbus/core/integrated_filter.hpp"
 #include "navbus/core/multi_dimensional.hpp"
 
@@ -32,7 +33,14 @@ enum class EngineMode {
   kMdfF2,
   kMdfF3,
   kMdfF4,
-  kAidedAxisFailed  ///< tightly or loosely coupled with a failed IMU axis
+  kAidedAxisFailed,  ///< tightly or loosely coupled with a failed IMU axis
+  kAligning          ///< aligning from the inputs (InitialAligner): no solution yet
+};
+
+/// Where the filter's start comes from.
+enum class StartSource {
+  kConfigured,  ///< EngineConfig::initial_state with the tuning's initial sigmas
+  kAligned      ///< InitialAligner from the inputs, with the alignment's own sigmas
 };
 
 /// Engine status bits (the participant maps them to the solution's fault flags).
@@ -53,7 +61,9 @@ struct EngineConfig {
   bool use_star_tracker{false};  ///< loosely coupled: star-tracker attitude updates
   MdfConfig mdf;                 ///< multi-dimensional mode only
   double imu_period_s{0.01};     ///< nominal increment interval (stationarity window)
-  NavState initial_state;        ///< time is taken from the first increment
+  StartSource start{StartSource::kConfigured};
+  NavState initial_state;            ///< kConfigured; time is taken from the first increment
+  InitialAlignmentConfig alignment;  ///< kAligned (budget, rest detection, course)
   double initial_clock_bias_m{0.0};
   double initial_clock_drift_mps{0.0};
   std::int64_t solution_period_ns{100'000'000};
@@ -61,6 +71,7 @@ struct EngineConfig {
 
 struct EngineCounters {
   std::uint64_t imu_used{0}, imu_gaps{0};
+  std::uint64_t imu_aligning{0};  ///< increments the alignment took before the filter started
   /// Increments refused: interval not positive and finite, or not after the state time (an
   /// embedding application may call the engine without the bus validation).
   std::uint64_t imu_refused{0};
@@ -77,8 +88,9 @@ class NavigationEngine {
   /// Integrates one increment; true when the state time reached a solution epoch. An increment
   /// with a bad interval or one that does not follow the state time is refused and counted.
   bool addImu(const ImuIncrement& inc);
-  /// Fuses a pseudorange epoch (tightly coupled mode); true when fused (diagnostics ready).
-  bool addGnssEpoch(const std::vector<SatelliteObservation>& satellites);
+  /// Fuses a pseudorange epoch of time `time_ns` (tightly coupled mode); true when fused
+  /// (diagnostics ready). While aligning, the epoch goes to the aligner.
+  bool addGnssEpoch(std::int64_t time_ns, const std::vector<SatelliteObservation>& satellites);
   void addGnssFix(const GnssFixMeasurement& fix);
   void addStarAttitude(const StarAttitudeMeasurement& st);
 
@@ -119,6 +131,9 @@ class NavigationEngine {
   const EngineCounters& counters() const { return counters_; }
   const EpochDiagnostics& lastEpoch() const { return filter_.lastEpoch(); }
   const IntegratedFilter& filter() const { return filter_; }
+  /// StartSource::kAligned: where the alignment stands, and once aligned what it started from
+  /// (attitude and position sources, its sigmas, the gyrocompassing limit).
+  const InitialAligner& aligner() const { return aligner_; }
 
  private:
   StateMask baseMask() const;
@@ -126,9 +141,15 @@ class NavigationEngine {
   void applyStage(const StageDecision& d);
   void constraintUpdate();
   void countGated(const ScalarUpdateResult* results, int n);
+  void start(const NavState& state, double clock_bias_m, double clock_drift_mps,
+             const Matrix17& initial_covariance);
+  void startFromAlignment();
+  Matrix17 alignedCovariance(const AlignedStart& a) const;
+  bool aligning() const { return config_.start == StartSource::kAligned && !filter_.initialized(); }
 
   EngineConfig config_;
   IntegratedFilter filter_;
+  InitialAligner aligner_;
   StationarityDetector stationarity_;
   StageSelector stages_;
   EngineMode mode_{EngineMode::kInitializing};

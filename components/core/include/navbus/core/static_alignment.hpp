@@ -81,4 +81,18 @@ double levellingSigma(const AlignmentErrorBudget& budget, double duration_s, dou
 CoarseAlignment alignStatic(const StaticWindow& window, double latitude_rad, double gravity_mps2,
                             const AlignmentErrorBudget& budget, double max_heading_sigma_rad);
 
+/// First-order sensitivity of the alignment's attitude error phi (NED) to the true sensor
+/// biases (body), step 8: phi = d_att_d_accel_bias_b b_a + d_att_d_gyro_bias_b b_g (+ noise).
+/// A filter started from the alignment needs these correlations: at rest it observes only
+/// combinations of attitude and bias errors that the alignment has already made zero.
+struct AlignmentSensitivity {
+  Eigen::Matrix3d d_att_d_accel_bias_b{Eigen::Matrix3d::Zero()};  ///< [rad / (m/s^2)]
+  Eigen::Matrix3d d_att_d_gyro_bias_b{Eigen::Matrix3d::Zero()};   ///< [rad / (rad/s)]
+};
+
+/// Step 8 for the aligned attitude C_b_n. `heading_from_gyros`: the heading came from
+/// gyrocompassing (otherwise only the levelling rows are filled).
+AlignmentSensitivity alignmentSensitivity(const Eigen::Matrix3d& C_b_n, double latitude_rad,
+                                          double gravity_mps2, bool heading_from_gyros);
+
 }  // namespace navbus::core
