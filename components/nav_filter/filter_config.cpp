@@ -183,9 +183,16 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       throw bus::ConfigError("configuration issuer_identities: '" + issuer +
                              "' is not one of command_issuers");
   }
+  // No initial_state, or `initial_state: align` (to override an extended file's state): the
+  // filter aligns from its inputs.
   const YAML::Node init = root["initial_state"];
-  e.start = init ? core::StartSource::kConfigured : core::StartSource::kAligned;
-  if (init) parseInitialState(init, e.initial_state);
+  const bool align = !init || (init.IsScalar() && init.Scalar() == "align");
+  e.start = align ? core::StartSource::kAligned : core::StartSource::kConfigured;
+  if (init && init.IsScalar() && !align) {
+    throw bus::ConfigError("configuration initial_state = '" + init.Scalar() +
+                           "': expected a state (latitude_deg, ...) or 'align'");
+  }
+  if (!align) parseInitialState(init, e.initial_state);
 
   const YAML::Node inputs = root["inputs"];
   if (!inputs) throw bus::ConfigError("configuration inputs is missing");

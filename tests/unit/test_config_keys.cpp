@@ -99,6 +99,14 @@ TEST_F(ConfigKeys, WithoutAnInitialStateTheFilterAlignsAndNeedsAGnssPosition) {
   EXPECT_NE(message.find("inputs.gnss_fix or inputs.gnss_observations"), std::string::npos)
       << message;
   EXPECT_NE(message.find(bad), std::string::npos) << message;
+  // `initial_state: align` overrides an extended file's state; another word is an error.
+  const std::string over =
+      write("over.yaml", "extends: " + kSrc + "/filter_seed000_tc.yaml\ninitial_state: align\n");
+  EXPECT_EQ(navbus::bus::parseFile(over, filter).engine.start, navbus::core::StartSource::kAligned);
+  const std::string word =
+      write("word.yaml", "extends: " + kSrc + "/filter_seed000_tc.yaml\ninitial_state: alig\n");
+  EXPECT_NE(errorOf(word, filter).find("initial_state = 'alig'"), std::string::npos)
+      << errorOf(word, filter);
   // A value out of range names the key.
   const std::string range = write(
       "range.yaml", "extends: " + kSrc + "/filter.yaml\nalignment: {course_sigma_deg: 200}\n");
