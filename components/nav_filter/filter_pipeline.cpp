@@ -144,7 +144,7 @@ void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time
 }
 
 template <class Sample>
-bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, std::uint32_t id,
+bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, StreamId id,
                            const std::optional<InputConfig>& expected) {
   if (!expected) {
     // A stream this configuration does not use (e.g. pseudoranges in loosely coupled mode):
@@ -152,18 +152,25 @@ bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, std::uint32
     ++unused_samples_;
     return false;
   }
-  return gate.admit(msg, id, msg.seq(), msg.time_gps_ns());
+  if (!sequencer_.expects(id)) {
+    // A sensor id this filter was not configured with: refused before its sequence numbers
+    // are tracked (they are not this stream's).
+    gate.reject({navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id.sensor_id)},
+                id.sensor_id);
+    return false;
+  }
+  return gate.admit(msg, id.sensor_id, msg.seq(), msg.time_gps_ns());
 }
 
 void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
-  if (!imu_gate_.admit(msg, msg.sensor_id(), msg.seq(), msg.time_gps_ns())) return;
+  if (!admit(imu_gate_, msg, {kRankImu, msg.sensor_id()}, config_.imu)) return;
   if (imu_gate_.sourceRestarted()) startNewRun();
   queue(imu_gate_, {kRankImu, msg.sensor_id()}, static_cast<std::int64_t>(msg.time_gps_ns()),
         bus::toCore(msg));
 }
 
 void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
-  if (!admit(gnss_obs_gate_, m, m.receiver_id(), config_.gnss_observations)) return;
+  if (!admit(gnss_obs_gate_, m, {kRankGnssObs, m.receiver_id()}, config_.gnss_observations)) return;
   // A bad satellite costs that satellite only (counted per reason); the others are used.
   const std::vector<bus::SatelliteRejection> dropped =
       bus::screenSatellites(m, gnss_obs_gate_.limits());
@@ -174,13 +181,13 @@ void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
 }
 
 void FilterPipeline::onGnssFix(const navbus::GnssFix& m) {
-  if (!admit(gnss_fix_gate_, m, m.receiver_id(), config_.gnss_fix)) return;
+  if (!admit(gnss_fix_gate_, m, {kRankGnssFix, m.receiver_id()}, config_.gnss_fix)) return;
   queue(gnss_fix_gate_, {kRankGnssFix, m.receiver_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
         bus::toCore(m));
 }
 
 void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
-  if (!admit(star_gate_, m, m.tracker_id(), config_.star_tracker)) return;
+  if (!admit(star_gate_, m, {kRankStarTracker, m.tracker_id()}, config_.star_tracker)) return;
   queue(star_gate_, {kRankStarTracker, m.tracker_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
         bus::toCore(m));
 }

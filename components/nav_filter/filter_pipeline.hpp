@@ -111,7 +111,7 @@ class FilterPipeline {
 
  private:
   template <class Sample>
-  bool admit(bus::StreamGate& gate, const Sample& msg, std::uint32_t id,
+  bool admit(bus::StreamGate& gate, const Sample& msg, StreamId id,
              const std::optional<InputConfig>& expected);
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
   void process(std::int64_t time_ns, const FilterInput& input);

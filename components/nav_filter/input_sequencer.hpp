@@ -68,6 +68,9 @@ class InputSequencer {
     return PushResult::kQueued;
   }
 
+  /// True if the stream is configured (push would not answer kUnexpected).
+  bool expects(StreamId id) const { return streams_.count(id) > 0; }
+
   /// A stream declared lost (or ended) does not hold others back; it blocks again once it
   /// delivers. False if the stream is not expected.
   bool setActive(StreamId id, bool active) {

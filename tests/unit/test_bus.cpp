@@ -203,6 +203,24 @@ TEST(SequenceTracker, DuplicatesOrderAndGaps) {
   EXPECT_FALSE(t.check(2, 1, 50).rejection);  // sensors are independent
 }
 
+TEST(SequenceTracker, SamplesNumberedBeforeTheFirstOneTakenAreCounted) {
+  // Counters start at 1: a first sample numbered 187 means 186 were never received (the soak
+  // found a best-effort reader that missed the start of a stream, uncounted).
+  SequenceTracker t;
+  auto o = t.check(1, 187, 100);
+  EXPECT_EQ(o.missing, 186u);
+  EXPECT_EQ(o.missing_before_first, 186u);
+  EXPECT_EQ(t.check(2, 1, 100).missing, 0u);  // a stream taken from its first sample
+  // After a stream was set aside (declared lost), its start is not counted again.
+  t.reset(1);
+  o = t.check(1, 500, 200);
+  EXPECT_EQ(o.missing, 0u);
+  EXPECT_EQ(o.missing_before_first, 0u);
+  // A new run (the source restarted) counts from its start again.
+  t.resetAll();
+  EXPECT_EQ(t.check(1, 3, 300).missing_before_first, 2u);
+}
+
 TEST(SequenceTracker, SourceRestartAtAnEarlierTimeIsConfirmedByTheSamplesAfterIt) {
   SequenceTracker t(navbus::bus::TimeJumpRule{50, 3}, nullptr);
   for (std::uint64_t k = 1; k <= 10; ++k)

@@ -266,7 +266,9 @@ SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::ui
     out.rejection = r;
     return out;
   }
-  if (it != last_.end() && !out.jump_adopted) {
+  if (started_.insert(sensor_id).second && seq > 1) {
+    out.missing = out.missing_before_first = seq - 1;
+  } else if (it != last_.end() && !out.jump_adopted) {
     if (seq > it->second.seq + 1) {
       out.missing = seq - it->second.seq - 1;
     } else if (seq <= it->second.seq) {
@@ -350,6 +352,12 @@ void StreamGate::unaccept() {
 void StreamGate::noteSequence(const SequenceTracker::Outcome& o) {
   ++counters_.accepted;
   counters_.sequence_gaps += o.missing;
+  if (o.missing_before_first > 0) {
+    spdlog::warn(
+        "{}: the first sample taken is number {}: the {} before it were not received (the "
+        "reader joined late or missed the start), counted as sequence gaps",
+        topic_, o.missing_before_first + 1, o.missing_before_first);
+  }
   if (o.restarted) {
     spdlog::info("{}: sequence restarted (writer restart)", topic_);
   }

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,9 @@ class SequenceTracker {
   struct Outcome {
     std::optional<Rejection> rejection;
     std::uint64_t missing{0};  ///< samples skipped according to the sequence number
+    /// Of `missing`: samples numbered before the first one this tracker saw of the sensor
+    /// (sequence counters start at 1): the reader joined late or missed the start.
+    std::uint64_t missing_before_first{0};
     bool restarted{false};     ///< sequence went back while time went forward (writer restart)
     bool jump_adopted{false};  ///< a forward jump confirmed by the samples after it
     /// Time and sequence went back, confirmed by the samples after it: the source started a
@@ -113,6 +117,7 @@ class SequenceTracker {
   /// Forgets every sensor (the participant started a new run).
   void resetAll() {
     last_.clear();
+    started_.clear();
     candidate_.clear();
     restart_candidate_.clear();
   }
@@ -122,6 +127,8 @@ class SequenceTracker {
     std::uint64_t seq;
     std::uint64_t time_ns;
   };
+  /// Sensors seen in this run (a reset after a lost stream does not count the start again).
+  std::set<std::uint32_t> started_;
   struct Candidate {
     std::uint64_t seq;
     std::uint64_t time_ns;
