@@ -1,11 +1,13 @@
 #include "formatters.hpp"
 
+#include <fmt/format.h>
+
 namespace navbus::tool {
 
 std::string formatNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+  // fmt's default for a double is the shortest text that reads back to the same bits
+  // (0.0098066500000000001 with %.17g is 0.00980665 here).
+  return fmt::format("{}", v);
 }
 
 std::string csvQuote(const std::string& s) {

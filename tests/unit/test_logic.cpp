@@ -172,5 +172,13 @@ TEST(Formatters, CsvHasOneRowPerSatelliteAndRoundTripsDoubles) {
   const auto hr = navbus::tool::csvRows(h);
   ASSERT_EQ(hr.size(), 1u);  // no inputs: one row with empty input cells
   EXPECT_EQ(hr[0].rfind("navbus-filter,0,0,DEGRADED,0", 0), 0u);
-  EXPECT_DOUBLE_EQ(std::stod(navbus::tool::formatNumber(0.1 + 0.2)), 0.1 + 0.2);
+  // Shortest text that reads back to the same bits.
+  for (const double v :
+       {0.1 + 0.2, 0.00980665, 9.80665 / 1000.0, 1e-300, -3000.0, 6378137.0, 1.1309733552923256}) {
+    const std::string text = navbus::tool::formatNumber(v);
+    EXPECT_EQ(std::stod(text), v) << text;
+  }
+  EXPECT_EQ(navbus::tool::formatNumber(0.00980665), "0.00980665");
+  EXPECT_EQ(navbus::tool::formatNumber(0.1 + 0.2), "0.30000000000000004");
+  EXPECT_EQ(navbus::tool::formatNumber(3000.0), "3000");
 }
