@@ -151,6 +151,10 @@ int main(int argc, char** argv) {
   nb::bus::CommonOptions common;
   nb::bus::addCommonOptions(app, common, false);
   app.require_subcommand(1);
+  bool publish_health = false;
+  app.add_flag("--health", publish_health,
+               "publish this tool's own health reports on navbus/health (off: the tool does not "
+               "show up in the bus it inspects)");
   app.footer(
       "Exit codes: 0 ok, 1 fewer samples than --count, 2 usage or configuration error, 3 DDS "
       "error.");
@@ -315,6 +319,7 @@ int main(int argc, char** argv) {
       return nb::tool::runMonteCarloCommand(mc);
     }
     auto options = nb::bus::participantOptions(common, yaml, "navbus");
+    options.publish_health = publish_health;  // an inspection tool is not part of what it inspects
     if (*latency_cmd) {
       options.dds.name = "navbus-latency-" + latency.role;
       return nb::tool::runLatencyCommand(options, latency, shutdown);

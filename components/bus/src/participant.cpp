@@ -13,10 +13,15 @@ namespace navbus::bus {
 namespace dds = eprosima::fastdds::dds;
 
 Participant::Participant(const Options& options, ShutdownSignal& shutdown)
-    : shutdown_(shutdown), dds_(options.dds), health_(options.dds.name) {
-  health_writer_ = createWriter<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthWriter);
+    : shutdown_(shutdown),
+      dds_(options.dds),
+      health_(options.dds.name),
+      publish_health_(options.publish_health) {
   waitset_.attach_condition(shutdown_.condition());
-  addTimer(options.health_period, [this] { publishHealth(); });
+  if (publish_health_) {
+    health_writer_ = createWriter<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthWriter);
+    addTimer(options.health_period, [this] { publishHealth(); });
+  }
   reclaimSharedMemoryOfDeadParticipants();
   addTimer(kShmReclaimPeriod, [] { reclaimSharedMemoryOfDeadParticipants(); });
 }
@@ -213,6 +218,7 @@ void Participant::finish() {
 }
 
 void Participant::publishHealth() {
+  if (!publish_health_) return;
   health_writer_.write(health_.report(state_, wallTimeNowNs()));
 }
 

@@ -78,6 +78,9 @@ class Participant {
   struct Options {
     ParticipantOptions dds;
     std::chrono::milliseconds health_period{1000};
+    /// False: no health reports on the bus (an inspection tool that must not show up in what
+    /// it inspects); the counters are still kept.
+    bool publish_health{true};
   };
 
   Participant(const Options& options, ShutdownSignal& shutdown);
@@ -211,6 +214,7 @@ class Participant {
   ShmReclaimAtExit shm_reclaim_at_exit_;
   DdsContext dds_;
   HealthCounters health_;
+  bool publish_health_{true};
   navbus::ParticipantState state_{navbus::STATE_STARTING};
   bool state_managed_{false};
   /// When the first input sample (live data: no durable history, no others' health) was taken.
