@@ -135,6 +135,8 @@ void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time
       gate.reject({navbus::REJECT_LATE, "time_gps_ns", static_cast<double>(time_ns)}, id.sensor_id);
       break;
     case InputSequencer<FilterInput>::PushResult::kUnexpected:
+      // admit() refuses unconfigured sources before their sequence is tracked; this stays so
+      // that a caller which did not go through admit() cannot drop a sample uncounted.
       gate.unaccept();
       gate.reject(
           {navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id.sensor_id)},

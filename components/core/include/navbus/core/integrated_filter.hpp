@@ -89,7 +89,7 @@ class IntegratedFilter {
   void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
                   const FilterTuning& tuning, const StateMask& active, FusionStructure structure,
                   const Matrix17& initial_covariance);
-  /// The tuning's initial 1-sigma of every state (also what the reset rules re-initialize to).
+  /// The tuning's initial 1-sigma of every state (the configured start).
   static Vector17 initialSigma(const FilterTuning& tuning);
   /// Mechanizes one increment (bias-corrected) and propagates the clock and, unless
   /// `suspend_filter` (the filter is not run: seed 004's case I during an outage), the
