@@ -47,10 +47,11 @@ wait $rec 2>/dev/null || true
 trap - EXIT
 
 # The same scenario without DDS: its truth (the simulator is deterministic), and the same data
-# without the fault manager, to show what the loop saves.
+# without the fault manager, to show what the loop saves. --start config: the filter starts as
+# its file says, as navbus-filter did on the bus.
 "$bin/navbus" offline --scenario "$scenario" --filter "$filter_cfg" --fault-manager "$fm_cfg" \
-  -o "$out/offline" > "$out/offline.log" 2>&1
-"$bin/navbus" offline --scenario "$scenario" --filter "$filter_cfg" \
+  --start config -o "$out/offline" > "$out/offline.log" 2>&1
+"$bin/navbus" offline --scenario "$scenario" --filter "$filter_cfg" --start config \
   -o "$out/offline_without_fault_manager" > "$out/offline_without_fault_manager.log" 2>&1
 
 echo

@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config git ccache              # ccache: a rebuild of the same sources is quick
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools   # Fast DDS 2.9, Fast-CDR, code generator, CLI
-  libeigen3-dev libfftw3-dev                               # math
+  libeigen3-dev libfftw3-dev libboost-dev                  # math (Boost.Math: noncentral chi-square)
   libyaml-cpp-dev libcli11-dev libspdlog-dev               # configuration, command line, logging
   libgtest-dev libbenchmark-dev                            # tests and benchmarks
   cyclonedds-dev cyclonedds-tools                          # second DDS vendor for the interop test

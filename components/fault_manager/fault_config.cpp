@@ -99,24 +99,7 @@ FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
   GlrDetectorConfig& d = c.glr;
   core::GlrConfig& m = d.glr;
   d.enabled = bus::get<bool>(g, "glr", "enabled", d.enabled);
-  m.window = static_cast<int>(bus::checkRange(bus::get<double>(g, "glr", "window_epochs", m.window),
-                                              1, core::glr::kMaxWindow, "glr.window_epochs"));
-  m.threshold = bus::checkRange(bus::get<double>(g, "glr", "threshold", m.threshold), 0.1, 1e6,
-                                "glr.threshold");
-  m.ambiguity_margin =
-      bus::checkRange(bus::get<double>(g, "glr", "ambiguity_margin", m.ambiguity_margin), 0.0, 1e3,
-                      "glr.ambiguity_margin");
-  m.ambiguity_correlation =
-      bus::checkRange(bus::get<double>(g, "glr", "ambiguity_correlation", m.ambiguity_correlation),
-                      0.0, 1.0, "glr.ambiguity_correlation");
-  m.rank_tolerance = bus::checkRange(bus::get<double>(g, "glr", "rank_tolerance", m.rank_tolerance),
-                                     1e-15, 0.5, "glr.rank_tolerance");
-  const YAML::Node h = g ? g["hypotheses"] : YAML::Node();
-  checkKeys(h, "glr.hypotheses", {"imu_steps", "range_steps", "range_ramps", "rate_steps"});
-  m.imu_steps = bus::get<bool>(h, "glr.hypotheses", "imu_steps", m.imu_steps);
-  m.range_steps = bus::get<bool>(h, "glr.hypotheses", "range_steps", m.range_steps);
-  m.range_ramps = bus::get<bool>(h, "glr.hypotheses", "range_ramps", m.range_ramps);
-  m.rate_steps = bus::get<bool>(h, "glr.hypotheses", "rate_steps", m.rate_steps);
+  bus::parseGlrStatistics(g, "glr", m);
   const YAML::Node a = g ? g["actions"] : YAML::Node();
   checkKeys(a, "glr.actions", {"satellite", "imu", "imu_relative_sigma"});
   d.compensation_relative_sigma =

@@ -91,6 +91,37 @@ void parseAlignment(const YAML::Node& node, core::EngineConfig& e) {
                                        1e-3, 90.0, "alignment.course_sigma_deg") *
                        units::kDeg;
 }
+
+/// Protection levels (tightly coupled): the risks, the alert limits and the GLR the fault
+/// manager runs (its statistics keys, as in the fault manager's `glr` block).
+void parseIntegrity(const YAML::Node& node, core::EngineConfig& e) {
+  const std::string w = "integrity";
+  bus::checkKeys(node, w,
+                 {"enabled", "integrity_risk", "missed_detection_probability",
+                  "horizontal_alert_limit_m", "vertical_alert_limit_m", "detector"});
+  core::IntegrityConfig& i = e.integrity;
+  i.enabled = bus::get<bool>(node, w, "enabled", static_cast<bool>(node));
+  i.integrity_risk = bus::checkRange(bus::get<double>(node, w, "integrity_risk", i.integrity_risk),
+                                     1e-15, 0.1, "integrity.integrity_risk");
+  i.missed_detection_probability = bus::checkRange(
+      bus::get<double>(node, w, "missed_detection_probability", i.missed_detection_probability),
+      1e-12, 0.5, "integrity.missed_detection_probability");
+  i.horizontal_alert_limit_m = bus::checkRange(
+      bus::get<double>(node, w, "horizontal_alert_limit_m", i.horizontal_alert_limit_m), 0.01, 1e7,
+      "integrity.horizontal_alert_limit_m");
+  i.vertical_alert_limit_m =
+      bus::checkRange(bus::get<double>(node, w, "vertical_alert_limit_m", i.vertical_alert_limit_m),
+                      0.01, 1e7, "integrity.vertical_alert_limit_m");
+  const YAML::Node d = node ? node["detector"] : YAML::Node();
+  bus::checkKeys(d, w + ".detector",
+                 {"window_epochs", "threshold", "ambiguity_margin", "ambiguity_correlation",
+                  "rank_tolerance", "hypotheses"});
+  bus::parseGlrStatistics(d, w + ".detector", i.detector);
+  if (i.enabled && e.aiding != core::AidingMode::kTightlyCoupled)
+    throw bus::ConfigError(
+        "configuration integrity.enabled: true needs mode: tightly_coupled (the protection "
+        "levels come from the GLR on pseudoranges)");
+}
 }  // namespace
 
 FilterConfig parseFilterConfig(const YAML::Node& root) {
@@ -115,7 +146,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                   "issuer_identities",
                   "time_jump",
                   "fault_monitor",
-                  "alignment"},
+                  "alignment",
+                  "integrity"},
                  bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
@@ -374,6 +406,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   m.stationarity.gyro_std_radps = bus::get<double>(st, ws, "gyro_std_dps", 0.3) * kDeg;
   m.stationarity.speed_mps = bus::get<double>(st, ws, "speed_mps", 0.3);
   parseAlignment(root["alignment"], e);
+  parseIntegrity(root["integrity"], e);
   return c;
 }
 

@@ -43,6 +43,20 @@ std::uint32_t faultFlags(std::uint32_t engine_status) {
 
 }  // namespace
 
+navbus::IntegrityState toIdl(core::IntegrityState s) {
+  switch (s) {
+    case core::IntegrityState::kNotMonitored:
+      return navbus::INTEGRITY_NOT_MONITORED;
+    case core::IntegrityState::kInitializing:
+      return navbus::INTEGRITY_INITIALIZING;
+    case core::IntegrityState::kAvailable:
+      return navbus::INTEGRITY_AVAILABLE;
+    case core::IntegrityState::kUnavailable:
+      return navbus::INTEGRITY_UNAVAILABLE;
+  }
+  return navbus::INTEGRITY_NOT_MONITORED;
+}
+
 navbus::FilterMode toIdl(core::EngineMode mode) {
   switch (mode) {
     case core::EngineMode::kInitializing:
@@ -303,6 +317,13 @@ void FilterPipeline::publishSolution() {
   sol.active_fault_flags(stream_flags_ | monitor_flags_ | faultFlags(engine_.status()));
   sol.imu_samples_used(engine_.counters().imu_used);
   sol.start_source(toIdl(config_.engine.start, engine_.aligner().start().attitude_source));
+  // The levels assume the fault manager's GLR is watching: without it nothing bounds a fault.
+  if (monitor_flags_ == 0) {
+    const core::ProtectionLevels pl = engine_.protectionLevels();
+    sol.integrity(toIdl(pl.state));
+    sol.horizontal_protection_level_m(pl.horizontal_m);
+    sol.vertical_protection_level_m(pl.vertical_m);
+  }
   sinks_.solution(sol);
 }
 

@@ -178,6 +178,7 @@ core::SatelliteScope toCore(navbus::SatelliteScope s);
 
 /// IDL names of the engine's modes and structures.
 navbus::FilterMode toIdl(core::EngineMode mode);
+navbus::IntegrityState toIdl(core::IntegrityState s);
 navbus::FusionStructure toIdl(core::FusionStructure s, core::AidingMode aiding);
 navbus::StartSource toIdl(core::StartSource start, core::AttitudeSource attitude);
 

@@ -16,6 +16,7 @@
 #include "fault_config.hpp"
 #include "fault_evaluation.hpp"
 #include "formatters.hpp"
+#include "integrity_evaluation.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/rotation.hpp"
@@ -29,6 +30,30 @@ constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
 
 /// `filter_yaml` is the filter file's content (the Monte Carlo overrides some keys);
 /// `filter_path` names it in errors.
+/// The protection levels assume the detector the fault manager runs: refuses a filter whose
+/// integrity.detector differs from the fault manager's glr block, naming the key and both values.
+void checkIntegrityDetector(const nav_filter::FilterConfig& filter,
+                            const fault_manager::FaultManagerConfig& faults,
+                            const std::string& filter_path, const std::string& faults_path) {
+  const core::IntegrityConfig& i = filter.engine.integrity;
+  if (!i.enabled) return;
+  const core::GlrConfig& a = i.detector;
+  const core::GlrConfig& b = faults.glr.glr;
+  const auto differ = [&](const char* key, double x, double y) {
+    if (x == y) return;
+    throw bus::ConfigError("configuration integrity.detector." + std::string(key) + " of " +
+                           filter_path + " is " + formatNumber(x) + " but glr." + key + " of " +
+                           faults_path + " is " + formatNumber(y) +
+                           ": the protection levels assume the fault manager's detector");
+  };
+  differ("window_epochs", a.window, b.window);
+  differ("threshold", a.threshold, b.threshold);
+  differ("hypotheses.imu_steps", a.imu_steps, b.imu_steps);
+  differ("hypotheses.range_steps", a.range_steps, b.range_steps);
+  differ("hypotheses.range_ramps", a.range_ramps, b.range_ramps);
+  differ("hypotheses.rate_steps", a.rate_steps, b.rate_steps);
+}
+
 OfflineSetup loadSetup(const std::string& scenario, const YAML::Node& filter_yaml,
                        const std::string& filter_path, std::uint64_t seed, double duration_s,
                        const std::string& fault_manager = "") {
@@ -42,6 +67,8 @@ OfflineSetup loadSetup(const std::string& scenario, const YAML::Node& filter_yam
   } catch (const bus::ConfigError& e) {
     bus::rethrowNamingFile(filter_path, e);
   }
+  if (s.fault_manager)
+    checkIntegrityDetector(s.filter, *s.fault_manager, filter_path, fault_manager);
   s.duration_s = duration_s > 0.0 ? duration_s : s.sim.duration_s;
   if (!(s.duration_s > 0.0)) {
     throw bus::ConfigError("scenario " + scenario +
@@ -381,6 +408,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
     std::string label;
     Stats st;
     std::vector<AlignmentOutcome> alignments;  ///< one per run, filters that aligned
+    IntegrityTally integrity;                  ///< protection levels against the errors
   };
   std::vector<Row> rows;
   struct FaultTable {
@@ -391,7 +419,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
   };
   std::vector<FaultTable> fault_tables;
   for (const Variant& v : variants) {
-    Row row{v.label, {}, {}};
+    Row row{v.label, {}, {}, {}};
     // Runs in parallel (one per core unless --threads), gathered in seed order.
     std::vector<OfflineResult> results(static_cast<std::size_t>(o.runs));
     std::vector<OfflineSetup> setups(static_cast<std::size_t>(o.runs));
@@ -430,6 +458,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
       const std::int64_t start = setup.sim.scenario.start_time_ns;
       accumulate(row.st, r, start + static_cast<std::int64_t>(std::llround(o.from_s * 1e9)), o,
                  start);
+      row.integrity.add(r);
       if (setup.filter.engine.start == core::StartSource::kAligned)
         row.alignments.push_back(
             {r.aligned, r.aligned_start, r.aligned_start_error,
@@ -476,6 +505,9 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
     if (!r.alignments.empty()) printAlignment(r.label, r.alignments);
   }
   for (const FaultTable& t : fault_tables) printFaultTable(t.label, t.fault, t.runs, t.hours);
+  std::vector<std::pair<std::string, IntegrityTally>> integrity;
+  for (const Row& r : rows) integrity.emplace_back(r.label, r.integrity);
+  printIntegrityTable(integrity);
   if (!o.csv_dir.empty()) {
     std::filesystem::create_directories(o.csv_dir);
     std::ofstream nees(o.csv_dir + "/nees.csv");

@@ -17,7 +17,7 @@ struct OfflineOptions {
   double duration_s{0.0};  ///< 0: the scenario's
   std::string out_dir;
   std::string fault_manager;  ///< navbus-fault-manager YAML: run the fault pipeline too
-  bool align{false};  ///< align from the inputs even when the filter YAML has an initial_state
+  bool align{true};  ///< align from the inputs even when the filter YAML has an initial_state
 };
 
 /// Writes solution.csv, truth.csv and error.csv (columns in the README); returns an exit code.
@@ -35,7 +35,7 @@ struct MonteCarloOptions {
   bool perturb_initial{true};  ///< draw the initial state from the filter's initial sigmas
   /// Align from the inputs (every filter as if it had no initial_state); filters without an
   /// initial_state align anyway.
-  bool align{false};
+  bool align{true};
   std::vector<double> recovery_after_s;  ///< convergence times after these instants
   double recovery_threshold_m{3.0};      ///< horizontal position error that counts as converged
   double recovery_window_s{15.0};        ///< ... and must stay below it this long

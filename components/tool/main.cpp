@@ -145,6 +145,9 @@ void runFor(nb::bus::Participant& p, double duration_s, const std::function<bool
 
 }  // namespace
 
+/// `--start` of offline and montecarlo: align from the inputs (true) or as the filter file says.
+const std::map<std::string, bool> kStartChoices{{"align", true}, {"config", false}};
+
 int main(int argc, char** argv) {
   nb::bus::ShutdownSignal shutdown;
   CLI::App app{"navbus: inspect and record the navbus DDS bus; offline evaluation", "navbus"};
@@ -221,8 +224,13 @@ int main(int argc, char** argv) {
                    "seconds of data (0: the scenario's timing.duration_s)")
       ->check(CLI::Range(0.0, 1e6));
   offline_cmd->add_option("-o,--out", offline.out_dir, "output directory (created)")->required();
-  offline_cmd->add_flag("--align", offline.align,
-                        "align from the inputs even if the filter YAML has an initial_state");
+  offline_cmd
+      ->add_option("--start", offline.align,
+                   "align: the filter aligns from its inputs, as on a bus where nobody knows the "
+                   "truth (default); config: it starts as the filter YAML says (its initial_state "
+                   "if it has one), as navbus-filter with that file would")
+      ->transform(CLI::CheckedTransformer(kStartChoices))
+      ->default_str("align");
   offline_cmd
       ->add_option("--fault-manager", offline.fault_manager,
                    "navbus-fault-manager YAML: run the fault pipeline (GLR) in the same process, "
@@ -267,9 +275,14 @@ int main(int argc, char** argv) {
   mc_cmd->add_flag("--no-perturb", mc_no_perturb,
                    "start every run at the true initial state instead of a draw from the "
                    "filter's initial sigmas");
-  mc_cmd->add_flag("--align", mc.align,
-                   "every filter aligns from its inputs (as if it had no initial_state); prints "
-                   "the alignment's time, attitude source and start error against its sigmas");
+  mc_cmd
+      ->add_option("--start", mc.align,
+                   "align: every filter aligns from its inputs (default; prints the alignment's "
+                   "time, attitude source and start error against its sigmas); config: a filter "
+                   "with an initial_state starts from a draw around the truth with its initial "
+                   "sigmas (--no-perturb: the truth), one without aligns")
+      ->transform(CLI::CheckedTransformer(kStartChoices))
+      ->default_str("align");
   mc_cmd
       ->add_option("--recovery-after", mc.recovery_after_s,
                    "instants [s after start] after which to measure the convergence time")

@@ -29,6 +29,20 @@ const char* enumName(navbus::FilterMode v) {
   }
   return "UNKNOWN";
 }
+const char* enumName(navbus::IntegrityState v) {
+  switch (v) {
+    case navbus::INTEGRITY_NOT_MONITORED:
+      return "NOT_MONITORED";
+    case navbus::INTEGRITY_INITIALIZING:
+      return "INITIALIZING";
+    case navbus::INTEGRITY_AVAILABLE:
+      return "AVAILABLE";
+    case navbus::INTEGRITY_UNAVAILABLE:
+      return "UNAVAILABLE";
+  }
+  return "UNKNOWN";
+}
+
 const char* enumName(navbus::StartSource v) {
   switch (v) {
     case navbus::START_CONFIGURED:

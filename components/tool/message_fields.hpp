@@ -22,6 +22,7 @@ namespace navbus::tool {
 const char* enumName(navbus::FilterMode v);
 const char* enumName(navbus::FusionStructure v);
 const char* enumName(navbus::StartSource v);
+const char* enumName(navbus::IntegrityState v);
 const char* enumName(navbus::FaultSource v);
 const char* enumName(navbus::FaultEvent v);
 const char* enumName(navbus::FaultShape v);
@@ -132,6 +133,9 @@ void visitFields(const navbus::NavigationSolution& m, V& v) {
   v("active_fault_flags", m.active_fault_flags());
   v("imu_samples_used", m.imu_samples_used());
   v("start_source", m.start_source());
+  v("integrity", m.integrity());
+  v("horizontal_protection_level_m", m.horizontal_protection_level_m());
+  v("vertical_protection_level_m", m.vertical_protection_level_m());
 }
 template <class V>
 void visitFields(const navbus::FilterDiagnostics& m, V& v) {

@@ -97,6 +97,9 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
       err.nees_blocks[b] = db.dot(P9.block<3, 3>(3 * b, 3 * b).ldlt().solve(db));
     }
     err.mode = static_cast<int>(sol.mode());
+    err.integrity = static_cast<int>(sol.integrity());
+    err.hpl_m = sol.horizontal_protection_level_m();
+    err.vpl_m = sol.vertical_protection_level_m();
     result.errors.push_back(err);
     if (hook) hook(sol, truths.front(), err);
   };
@@ -107,9 +110,13 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   if (setup.fault_manager) {
     faults.emplace(*setup.fault_manager, health,
                    fault_manager::FaultPipeline::Sinks{
-                       [&](const navbus::FaultDecision& d) { result.decisions.push_back(d); },
+                       [&](const navbus::FaultDecision& d) {
+                         result.decisions.push_back(d);
+                         result.decision_after_solutions.push_back(result.errors.size());
+                       },
                        [&](const navbus::FilterCommand& c) {
                          result.commands.push_back(c);
+                         result.command_after_solutions.push_back(result.errors.size());
                          filter_ptr->onCommand(c);
                        }});
   }

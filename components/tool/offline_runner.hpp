@@ -34,7 +34,10 @@ struct EpochError {
   double nees9{0.0};  ///< position, velocity, attitude against the full 9x9 covariance
   /// NEES of the position, velocity and attitude blocks, each against its own 3x3 block.
   Eigen::Vector3d nees_blocks{Eigen::Vector3d::Zero()};
-  int mode{0};  ///< navbus::FilterMode of the solution
+  int mode{0};        ///< navbus::FilterMode of the solution
+  int integrity{0};   ///< navbus::IntegrityState of the solution
+  double hpl_m{0.0};  ///< its horizontal protection level [m]
+  double vpl_m{0.0};  ///< its vertical protection level [m]
 };
 
 struct OfflineSetup {
@@ -53,7 +56,11 @@ struct OfflineResult {
   std::string summary;                       ///< the pipeline's counters
   std::string fault_summary;                 ///< the fault pipeline's counters
   std::vector<navbus::FaultDecision> decisions;
+  /// Per decision: how many solutions had been published when it was (an alarm covers the
+  /// solutions from this index on).
+  std::vector<std::size_t> decision_after_solutions;
   std::vector<navbus::FilterCommand> commands;
+  std::vector<std::size_t> command_after_solutions;  ///< per command, as for the decisions
   double max_glr_statistic{0.0};
   std::vector<fault_manager::GlrEpochStatistic>
       glr_trace;  ///< every epoch the GLR accepted, in order

@@ -55,6 +55,7 @@ std::vector<Input> makeInputs(const navbus::sim::ScenarioConfig& c, int n) {
 struct Result {
   double us_per_cycle;
   double allocations_per_cycle;
+  std::uint64_t aligning_cycles;  ///< increments the alignment took before the filter started
 };
 
 Result run(core::EngineConfig cfg, const std::vector<Input>& inputs, bool aid) {
@@ -78,7 +79,46 @@ Result run(core::EngineConfig cfg, const std::vector<Input>& inputs, bool aid) {
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double cycles = static_cast<double>(inputs.size() - warmup);
   return {1e6 * s / cycles,
-          static_cast<double>(navbus::bench::g_allocations.load() - alloc0) / cycles};
+          static_cast<double>(navbus::bench::g_allocations.load() - alloc0) / cycles,
+          engine.counters().imu_aligning};
+}
+
+void printRow(const char* name, const Result& r, const Result& base) {
+  std::printf("%-44s %10.2f %8.3f %14.3f %9llu\n", name, r.us_per_cycle,
+              r.us_per_cycle / base.us_per_cycle, r.allocations_per_cycle,
+              static_cast<unsigned long long>(r.aligning_cycles));
+}
+
+/// Seed 000 (navigation-grade IMU at 100 Hz, 1 Hz pseudoranges, 500 s at rest first): the
+/// tightly coupled filter from a configured state against the same filter aligning itself
+/// (gyrocompassing, then fine alignment) and with protection levels (issue target: <= 1.2).
+void integrityAndAlignment(const std::string& dir, int n) {
+  auto aircraft =
+      navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(dir + "/seed000_aircraft.yaml"))
+          .scenario;
+  const auto inputs = makeInputs(aircraft, n);
+  core::EngineConfig cfg;
+  cfg.tuning.gravity = aircraft.gravity;
+  cfg.imu_period_s = 0.01;
+  cfg.aiding = core::AidingMode::kTightlyCoupled;
+  {
+    navbus::sim::ScenarioSource s(aircraft);
+    cfg.initial_state = s.truth();
+  }
+  std::printf("\nseed 000 inputs, %d IMU cycles at 100 Hz (pseudoranges 1 Hz), tightly coupled\n",
+              n);
+  std::printf("%-44s %10s %8s %14s %9s\n", "configuration", "us/cycle", "ratio", "allocs/cycle",
+              "aligning");
+  const Result base = run(cfg, inputs, true);
+  printRow("configured start (base)", base, base);
+  core::EngineConfig aligned = cfg;
+  aligned.start = core::StartSource::kAligned;
+  printRow("aligned start (alignment, then the filter)", run(aligned, inputs, true), base);
+  core::EngineConfig integrity = cfg;
+  integrity.integrity.enabled = true;
+  printRow("configured start + protection levels", run(integrity, inputs, true), base);
+  integrity.start = core::StartSource::kAligned;
+  printRow("aligned start + protection levels", run(integrity, inputs, true), base);
 }
 
 }  // namespace
@@ -120,5 +160,6 @@ int main(int argc, char** argv) {
   const Result tc = run(cfg, inputs, true);
   std::printf("%-36s %10.2f %8.2f %14.3f\n", "tightly coupled (pseudoranges)", tc.us_per_cycle,
               tc.us_per_cycle / base.us_per_cycle, tc.allocations_per_cycle);
+  integrityAndAlignment(dir, n);
   return 0;
 }

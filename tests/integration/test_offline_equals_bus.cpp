@@ -73,10 +73,11 @@ void runCase(const Case& c) {
   const std::string fm_cfg = test::writeFile(dir / "fm.yaml", domain);
 
   // Offline first: no DDS at all.
-  test::ChildProcess offline(NAVBUS_TOOL_EXE,
-                             {"offline", "--scenario", sim_cfg, "--filter", filter_cfg, "--seed",
-                              std::to_string(c.seed), "-o", (dir / "offline").string()},
-                             (dir / "offline.log").string());
+  test::ChildProcess offline(
+      NAVBUS_TOOL_EXE,
+      {"offline", "--scenario", sim_cfg, "--filter", filter_cfg, "--start", "config", "--seed",
+       std::to_string(c.seed), "-o", (dir / "offline").string()},
+      (dir / "offline.log").string());
   ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
   const std::vector<std::string> expected = readCsvRows(dir / "offline" / "solution.csv");
   ASSERT_GT(expected.size(), 100u);

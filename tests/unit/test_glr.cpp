@@ -14,6 +14,7 @@
 
 #include "navbus/core/chi_square.hpp"
 #include "navbus/core/glr.hpp"
+#include "navbus/core/glr_protection_level.hpp"
 
 namespace nc = navbus::core;
 using nc::GlrFault;
@@ -102,6 +103,7 @@ struct Fault {
 /// Error state of the closed loop with its epoch matrices, simulated forward.
 struct LoopRun {
   std::vector<Eigen::VectorXd> innovations;
+  std::vector<Vector17> corrected;  ///< dx after each epoch's update
   std::vector<nc::GlrEpoch> epochs;
 };
 
@@ -144,6 +146,7 @@ LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& fault
       eps[rowOf(f.h)] -= value;  // predicted minus measured: a long range lowers it
     }
     dx -= loop.k() * eps;
+    run.corrected.push_back(dx);
     nc::GlrEpoch e;
     e.time_ns = (k + 1) * kSecond;
     e.rows = kRows;
@@ -365,4 +368,115 @@ TEST(Glr, RefusesBadEpochsAndCountsThem) {
   EXPECT_TRUE(glr.update(run.epochs[0]).valid);
   EXPECT_FALSE(glr.update(run.epochs[0]).valid);  // same time again: not after the previous
   EXPECT_EQ(glr.refused(), 4u);
+}
+
+namespace {
+
+const nc::GlrMonitor::PositionSignature* findSignature(
+    const std::vector<nc::GlrMonitor::PositionSignature>& all, const GlrHypothesis& h, int age) {
+  for (const auto& s : all) {
+    if (s.onset_age == age && s.hypothesis.fault == h.fault && s.hypothesis.axis == h.axis &&
+        s.hypothesis.sv_id == h.sv_id)
+      return &s;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+// The protection levels rest on mu+, the effect of a unit fault on the corrected state: it must
+// be the difference of the corrected states of a faulty and a fault-free run (here the
+// noise-free faulty run itself), for every kind of direction and several onsets.
+TEST(GlrProtection, PositionSignaturesAreTheFaultsEffectOnTheCorrectedState) {
+  const std::uint64_t seed = 11;
+  const int k = 14;
+  const LoopRun data = simulate(seed, k + 1, {}, true);
+  nc::GlrMonitor monitor;
+  for (const auto& e : data.epochs) ASSERT_TRUE(monitor.update(e).valid);
+  std::vector<nc::GlrMonitor::PositionSignature> all;
+  monitor.positionSignatures(all);
+  ASSERT_EQ(all.size(), static_cast<std::size_t>(k * (6 + 3 * kSats)));
+  const GlrHypothesis directions[] = {{GlrFault::kAccelStep, 0, 0},
+                                      {GlrFault::kGyroStep, 2, 0},
+                                      {GlrFault::kRangeStep, 0, 6},
+                                      {GlrFault::kRangeRamp, 0, 9},
+                                      {GlrFault::kRateStep, 0, 13}};
+  for (const GlrHypothesis& h : directions) {
+    for (int onset : {1, 5, k}) {
+      const LoopRun sig = simulate(seed, k + 1, {{h, onset, 1.0}}, false);
+      const auto* s = findSignature(all, h, k - onset);
+      ASSERT_NE(s, nullptr) << nc::glrFaultName(h.fault) << " onset " << onset;
+      const Eigen::Vector3d expected = sig.corrected[static_cast<std::size_t>(k)].head<3>();
+      EXPECT_LT((s->position_ned - expected).norm(), 1e-9 * (1.0 + expected.norm()))
+          << nc::glrFaultName(h.fault) << " onset " << onset << ": " << s->position_ned.transpose()
+          << " vs " << expected.transpose();
+      const auto sums = monitor.directionSums(k - onset, h);
+      EXPECT_DOUBLE_EQ(s->information, sums.r);
+    }
+  }
+}
+
+// The minimum detectable magnitude: for one direction 2 l = (z + sqrt(lambda))^2 with z
+// standard normal, so P(2 l < 2h) = P_md gives sqrt(lambda) = sqrt(2h) + z_{1-P_md} up to the
+// far tail (below 1e-30 here). For every group size, the noncentral chi-square as a Poisson
+// mixture of central ones (chi_square.hpp, independent of Boost) gives P_md back at that
+// lambda; against one threshold, more directions need less noncentrality.
+TEST(GlrProtection, DetectableSigmasFollowTheNoncentralChiSquare) {
+  nc::IntegrityConfig c;
+  c.enabled = true;
+  c.detector.threshold = 35.718;
+  c.missed_detection_probability = 1e-3;
+  nc::GlrProtectionLevel pl;
+  pl.configure(c);
+  EXPECT_NEAR(pl.detectableSigmas(1), std::sqrt(2.0 * 35.718) + 3.090232, 1e-4);
+  for (int dof = 1; dof <= 6; ++dof) {
+    const double lambda = pl.detectableSigmas(dof) * pl.detectableSigmas(dof);
+    double cdf = 0.0, weight = std::exp(-lambda / 2.0);
+    for (int j = 0; j < 400; ++j) {
+      cdf += weight * (1.0 - nc::chiSquareSurvival(2.0 * 35.718, dof + 2 * j));
+      weight *= lambda / 2.0 / (j + 1);
+    }
+    EXPECT_NEAR(cdf, 1e-3, 1e-7) << dof << " degrees of freedom";
+    if (dof > 1) {
+      EXPECT_LT(pl.detectableSigmas(dof), pl.detectableSigmas(dof - 1));
+    }
+  }
+  EXPECT_EQ(pl.detectableSigmas(0), 0.0);
+  EXPECT_EQ(pl.detectableSigmas(7), 0.0);
+}
+
+// Levels of a fault-free filter before any hypothesis exists (one epoch): the fault-free bound
+// alone, with its factors (horizontal sqrt(-2 ln(IR/2)) on the major axis, vertical the
+// two-sided Gaussian quantile of IR/2); with hypotheses, at least the bias of the worst one.
+TEST(GlrProtection, LevelsAreTheFaultFreeBoundOrTheWorstUndetectedFault) {
+  nc::IntegrityConfig c;
+  c.enabled = true;
+  c.integrity_risk = 1e-7;
+  nc::GlrProtectionLevel pl;
+  pl.configure(c);
+  const Eigen::Matrix3d cov = Eigen::Vector3d(4.0, 1.0, 9.0).asDiagonal();
+  nc::ProtectionLevels l = pl.levels(cov);
+  EXPECT_EQ(l.state, nc::IntegrityState::kInitializing);
+  EXPECT_NEAR(l.horizontal_m, 2.0 * std::sqrt(-2.0 * std::log(0.5e-7)), 1e-9);
+  EXPECT_NEAR(l.vertical_m, 3.0 * 5.45131, 1e-4);  // P(|z| > 5.45131) = 5e-8
+  const LoopRun data = simulate(5, 12, {}, true);
+  for (const auto& e : data.epochs) {
+    nc::EpochDiagnostics d;
+    for (int r = 0; r < e.rows; ++r) {
+      d.sv_ids.push_back(e.sv_id[static_cast<std::size_t>(r)]);
+      d.is_rate.push_back(e.is_rate[static_cast<std::size_t>(r)]);
+    }
+    d.innovation = e.innovation;
+    d.innovation_cov = e.innovation_cov;
+    d.h = e.h;
+    d.k = e.k;
+    d.phi = e.phi;
+    pl.onEpoch(e.time_ns, d);
+  }
+  l = pl.levels(cov);
+  EXPECT_NE(l.state, nc::IntegrityState::kInitializing);
+  EXPECT_FALSE(l.horizontal_bound.fault_free);
+  EXPECT_GE(l.horizontal_m,
+            l.horizontal_bound.bias_m + std::sqrt(-2.0 * std::log(1e-3)) * 2.0 - 1e-9);
+  EXPECT_GT(l.horizontal_bound.minimum_detectable_magnitude, 0.0);
 }

@@ -156,4 +156,24 @@ Eigen::Vector3d getRollPitchYawDeg(const YAML::Node& node, const std::string& wh
       checkRange(get<double>(node, where, "yaw_deg", 0.0), -180, 360, where + ".yaw_deg") * kDeg);
 }
 
+void parseGlrStatistics(const YAML::Node& g, const std::string& w, core::GlrConfig& m) {
+  m.window = static_cast<int>(checkRange(get<double>(g, w, "window_epochs", m.window), 1,
+                                         core::glr::kMaxWindow, w + ".window_epochs"));
+  m.threshold = checkRange(get<double>(g, w, "threshold", m.threshold), 0.1, 1e6, w + ".threshold");
+  m.ambiguity_margin = checkRange(get<double>(g, w, "ambiguity_margin", m.ambiguity_margin), 0.0,
+                                  1e3, w + ".ambiguity_margin");
+  m.ambiguity_correlation =
+      checkRange(get<double>(g, w, "ambiguity_correlation", m.ambiguity_correlation), 0.0, 1.0,
+                 w + ".ambiguity_correlation");
+  m.rank_tolerance = checkRange(get<double>(g, w, "rank_tolerance", m.rank_tolerance), 1e-15, 0.5,
+                                w + ".rank_tolerance");
+  const YAML::Node h = g ? g["hypotheses"] : YAML::Node();
+  const std::string wh = w + ".hypotheses";
+  checkKeys(h, wh, {"imu_steps", "range_steps", "range_ramps", "rate_steps"});
+  m.imu_steps = get<bool>(h, wh, "imu_steps", m.imu_steps);
+  m.range_steps = get<bool>(h, wh, "range_steps", m.range_steps);
+  m.range_ramps = get<bool>(h, wh, "range_ramps", m.range_ramps);
+  m.rate_steps = get<bool>(h, wh, "rate_steps", m.rate_steps);
+}
+
 }  // namespace navbus::bus

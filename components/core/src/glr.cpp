@@ -565,6 +565,58 @@ double GlrMonitor::satelliteStatistic(int age, int sv_id) const {
   return fitGroup<kSatDirections>(o.rSat(slot), f, config_.rank_tolerance).statistic;
 }
 
+void GlrMonitor::positionSignatures(std::vector<PositionSignature>& out) const {
+  out.clear();
+  if (!have_previous_ || onset_count_ == 0) return;
+  // mu+ = mu - K (H mu + D) on the position rows (doc eqs. C1, C3), with this epoch's K and H.
+  constexpr int kPos = tc17::kPos.index;
+  const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxRows> k_pos =
+      prev_k_.middleRows<3>(kPos);
+  const Eigen::Matrix<double, 3, kSupport> kh = k_pos * prev_h_support_;
+  const auto after = [&](int column, double d, int row) {
+    Eigen::Vector3d p = mu_.block<3, 1>(kPos, column) - kh * ms_.col(column);
+    if (row >= 0) p -= d * k_pos.col(row);
+    return p;
+  };
+  if (config_.imu_steps) {
+    for (int age = 0; age < onset_count_; ++age) {
+      const int ring = onsetIndex(age);
+      const OnsetView o = onset(age);
+      for (int j = 0; j < kImuDirections; ++j) {
+        const GlrHypothesis h{j < 3 ? GlrFault::kAccelStep : GlrFault::kGyroStep, j % 3, 0};
+        out.push_back({h, age, after(firstColumn(j) + ring, 0.0, -1), o.r_imu(j, j)});
+      }
+    }
+  }
+  for (int s = 0; s < slots_used_; ++s) {
+    const Slot& slot = slots_[static_cast<std::size_t>(s)];
+    if (slot.quarantined) continue;
+    const int step_first = firstColumn(muColumn(s, kRangeStep));
+    const int rate_first = firstColumn(muColumn(s, kRateStep));
+    // Newest onset to oldest: a ramp is the spacing-weighted sum of the newer steps (doc: ramps
+    // from steps), and so is its effect, the map from signature to effect being linear.
+    Eigen::Vector3d ramp = Eigen::Vector3d::Zero();
+    for (int age = 0; age < onset_count_; ++age) {
+      const int ring = onsetIndex(age);
+      const OnsetView o = onset(age);
+      const Eigen::Matrix3d r = o.rSat(s);
+      const Eigen::Vector3d step = after(step_first + ring, kStepInput, slot.range_row);
+      ramp += spacing_s_[ring] * step;
+      if (config_.range_steps)
+        out.push_back(
+            {{GlrFault::kRangeStep, 0, slot.sv_id}, age, step, r(kRangeStep, kRangeStep)});
+      if (config_.range_ramps)
+        out.push_back(
+            {{GlrFault::kRangeRamp, 0, slot.sv_id}, age, ramp, r(kRangeRamp, kRangeRamp)});
+      if (config_.rate_steps)
+        out.push_back({{GlrFault::kRateStep, 0, slot.sv_id},
+                       age,
+                       after(rate_first + ring, kStepInput, slot.rate_row),
+                       r(kRateStep, kRateStep)});
+    }
+  }
+}
+
 double GlrMonitor::onsetStatistic(const OnsetView& o) const {
   double l = 0.0;
   if (config_.imu_steps) {

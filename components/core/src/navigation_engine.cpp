@@ -24,6 +24,7 @@ EngineMode stageMode(MdfStage s) {
 
 NavigationEngine::NavigationEngine(const EngineConfig& config)
     : config_(config), aligner_(config.alignment) {
+  integrity_.configure(config.integrity);
   used_.reserve(32);
   reset();
 }
@@ -31,6 +32,7 @@ NavigationEngine::NavigationEngine(const EngineConfig& config)
 void NavigationEngine::reset() {
   filter_ = IntegratedFilter();
   aligner_ = InitialAligner(config_.alignment);
+  integrity_.reset();
   mode_ = EngineMode::kInitializing;
   status_ = 0;
   failed_axes_ = 0;
@@ -123,6 +125,7 @@ void NavigationEngine::start(const NavState& state, double clock_bias_m, double 
                              const Matrix17& initial_covariance) {
   filter_.initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
                      config_.fusion, initial_covariance);
+  integrity_.reset();  // the hypotheses describe the previous run of the filter
   for (int i = 0; i < 6; ++i) {
     if (failed_axes_ & (1u << i)) filter_.setAxisFailed(i < 3, i % 3, true);
   }
@@ -274,7 +277,15 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   }
   ++counters_.gnss_epochs_fused;
   mode_ = aidedMode();
+  if (config_.integrity.enabled) integrity_.onEpoch(time_ns, filter_.lastEpoch());
   return true;
+}
+
+ProtectionLevels NavigationEngine::protectionLevels() const {
+  if (!config_.integrity.enabled || config_.aiding != AidingMode::kTightlyCoupled ||
+      !filter_.initialized())
+    return {};
+  return integrity_.levels(filter_.covariance().block<3, 3>(kPos.index, kPos.index));
 }
 
 void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "navbus/core/earth.hpp"
+#include "navbus/core/glr.hpp"
 
 namespace navbus::bus {
 
@@ -123,5 +124,11 @@ core::earth::Geodetic getGeodeticDeg(const YAML::Node& node, const std::string& 
 
 /// roll_deg, pitch_deg and yaw_deg of `node` (0 when absent), converted to radians.
 Eigen::Vector3d getRollPitchYawDeg(const YAML::Node& node, const std::string& where);
+
+/// The GLR's statistics keys of `node` (window_epochs, threshold, ambiguity_margin,
+/// ambiguity_correlation, rank_tolerance, hypotheses), over the defaults in `m`: the fault
+/// manager's detector and the filter's protection levels read the same keys. The caller
+/// checks the node's key set.
+void parseGlrStatistics(const YAML::Node& node, const std::string& where, core::GlrConfig& m);
 
 }  // namespace navbus::bus

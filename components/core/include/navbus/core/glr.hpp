@@ -184,6 +184,23 @@ class GlrMonitor {
   /// -1 when it has left the window.
   int onsetAge(std::int64_t onset_time_ns) const;
   double satelliteStatistic(int onset_age, int sv_id) const;
+
+  /// What a fault of unit magnitude along one direction, begun at one onset in the window,
+  /// does to the position after the latest epoch's update, with what the test knows of it.
+  struct PositionSignature {
+    GlrHypothesis hypothesis;
+    int onset_age{0};
+    /// mu+ = mu - K rho (doc eqs. C1, C3) on the position error states [m per unit of the
+    /// fault's magnitude, N E D]
+    Eigen::Vector3d position_ned{Eigen::Vector3d::Zero()};
+    /// R* = T^T R T (eqs. 10, 14): under this fault of magnitude nu, 2 l of its group is
+    /// noncentral chi-square with noncentrality nu^2 R*.
+    double information{0.0};
+  };
+  /// Every enabled direction at every onset, after update(); `out` is cleared and refilled
+  /// (no allocation once its capacity suffices: kMaxDirections * window). Quarantined
+  /// satellites are left out (they cannot raise a detection).
+  void positionSignatures(std::vector<PositionSignature>& out) const;
   std::uint64_t epochs() const { return epochs_; }
   std::uint64_t refused() const { return refused_; }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "navbus/core/aiding_inputs.hpp"
+#include "navbus/core/glr_protection_level.hpp"
 #include "navbus/core/initial_alignment.hpp"
 #include "navbus/core/integrated_filter.hpp"
 #include "navbus/core/multi_dimensional.hpp"
@@ -67,6 +68,8 @@ struct EngineConfig {
   double initial_clock_bias_m{0.0};
   double initial_clock_drift_mps{0.0};
   std::int64_t solution_period_ns{100'000'000};
+  /// Protection levels from the GLR's statistics (tightly coupled mode only).
+  IntegrityConfig integrity;
 };
 
 struct EngineCounters {
@@ -134,6 +137,10 @@ class NavigationEngine {
   /// StartSource::kAligned: where the alignment stands, and once aligned what it started from
   /// (attitude and position sources, its sigmas, the gyrocompassing limit).
   const InitialAligner& aligner() const { return aligner_; }
+  /// Horizontal and vertical protection levels of the current state (kNotMonitored unless
+  /// integrity is enabled in tightly coupled mode and the filter runs).
+  ProtectionLevels protectionLevels() const;
+  const GlrProtectionLevel& integrity() const { return integrity_; }
 
  private:
   StateMask baseMask() const;
@@ -150,6 +157,7 @@ class NavigationEngine {
   EngineConfig config_;
   IntegratedFilter filter_;
   InitialAligner aligner_;
+  GlrProtectionLevel integrity_;
   StationarityDetector stationarity_;
   StageSelector stages_;
   EngineMode mode_{EngineMode::kInitializing};

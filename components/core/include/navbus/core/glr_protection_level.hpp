@@ -1,0 +1,102 @@
+// Horizontal and vertical protection levels of the tightly coupled filter from the GLR fault
+// detector's own statistics (seed 000 eqs. 9-15): for every fault hypothesis the detector
+// tests (bias steps, pseudorange steps and ramps, rate steps, each from every onset in its
+// window), the smallest magnitude it detects with the configured missed-detection probability
+// (minimum detectable bias, from the noncentral chi-square of its group statistic), projected
+// into the position error through the filter's own closed-loop response. The derivation, the
+// references and what the bound does not cover: components/core/doc/protection_levels.md.
+//
+// The engine feeds it each fused pseudorange epoch (the same numbers it publishes as
+// diagnostics for the fault manager) and asks for the levels at each solution with the
+// solution's covariance. Pure math; the GLR's storage is allocated once in configure().
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "navbus/core/epoch_diagnostics.hpp"
+#include "navbus/core/glr.hpp"
+
+namespace navbus::core {
+
+struct IntegrityConfig {
+  bool enabled{false};
+  /// The fault detector the levels assume: it must be the GLR the fault manager runs on this
+  /// filter (window M, threshold h and the hypotheses tested).
+  GlrConfig detector;
+  /// Probability that the error exceeds a level without a fault (per solution); split evenly
+  /// between the horizontal and the vertical level.
+  double integrity_risk{1e-7};
+  /// Probability that the detector misses a fault of the minimum detectable magnitude.
+  double missed_detection_probability{1e-3};
+  double horizontal_alert_limit_m{40.0};  ///< [m] levels above a limit: integrity unavailable
+  double vertical_alert_limit_m{50.0};    ///< [m]
+};
+
+enum class IntegrityState {
+  kNotMonitored,  ///< integrity disabled, or the aiding mode has no GLR (not tightly coupled)
+  kInitializing,  ///< fewer than two pseudorange epochs since the start: no fault hypothesis yet
+  kAvailable,     ///< both levels within their alert limits
+  kUnavailable    ///< a level exceeds its alert limit
+};
+
+/// The protection levels of one solution and what bounds them.
+struct ProtectionLevels {
+  IntegrityState state{IntegrityState::kNotMonitored};
+  double horizontal_m{0.0};  ///< HPL [m]: radius in the local horizontal (N E) plane
+  double vertical_m{0.0};    ///< VPL [m]: along the local vertical
+  /// The hypothesis that sets each level (fault_free: the fault-free bound does).
+  struct Bound {
+    bool fault_free{true};
+    GlrHypothesis hypothesis;
+    int onset_epochs_ago{0};
+    double bias_m{0.0};  ///< position error of that fault at its minimum detectable magnitude
+    double minimum_detectable_magnitude{0.0};  ///< [m/s^2, rad/s, m or m/s]
+  };
+  Bound horizontal_bound, vertical_bound;
+};
+
+class GlrProtectionLevel {
+ public:
+  GlrProtectionLevel();
+  /// Derives the multipliers: the noncentrality each group's statistic needs to exceed 2h
+  /// with probability 1 - P_md, and the Gaussian factors of the two risks.
+  void configure(const IntegrityConfig& config);
+  /// Forgets the fault hypotheses (the filter restarted).
+  void reset();
+
+  /// One fused pseudorange epoch of the filter (after its update). Recomputes the largest
+  /// position bias of a just-undetectable fault over every hypothesis and onset.
+  void onEpoch(std::int64_t time_ns, const EpochDiagnostics& epoch);
+
+  /// The levels for a solution whose position error covariance is `pos_cov_ned` [m^2, N E D],
+  /// with the fault biases of the latest epoch.
+  ProtectionLevels levels(const Eigen::Matrix3d& pos_cov_ned) const;
+
+  const IntegrityConfig& config() const { return config_; }
+  /// sqrt(noncentrality) at which a group statistic of `dof` degrees of freedom (1..6; 0
+  /// otherwise) exceeds h with probability 1 - P_md.
+  double detectableSigmas(int dof) const;
+  std::uint64_t epochs() const { return monitor_.epochs(); }
+  std::uint64_t refused() const { return monitor_.refused(); }
+
+ private:
+  IntegrityConfig config_;
+  GlrMonitor monitor_;
+  GlrEpoch epoch_;
+  std::vector<GlrMonitor::PositionSignature> signatures_;
+  std::array<double, glr::kImuDirections + 1> sqrt_lambda_{};  ///< by group dof
+  double k_ff_h_{0.0}, k_ff_v_{0.0};  ///< fault-free multipliers of sigma_major and sigma_D
+  double k_md_h_{0.0}, k_md_v_{0.0};  ///< the same at the missed-detection probability
+  bool have_biases_{false};
+  ProtectionLevels::Bound worst_h_, worst_v_;  ///< of the latest epoch
+};
+
+/// The detector's view of one filter epoch (what bus::toGlrEpoch reads from the diagnostics
+/// message, without the message).
+void toGlrEpoch(std::int64_t time_ns, const EpochDiagnostics& d, GlrEpoch& out);
+
+}  // namespace navbus::core

@@ -1,0 +1,138 @@
+#include "navbus/core/glr_protection_level.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <boost/math/distributions/non_central_chi_squared.hpp>
+#include <boost/math/distributions/normal.hpp>
+
+#include "navbus/core/state_layout.hpp"
+
+namespace navbus::core {
+
+namespace {
+
+/// k with P(|x| > k sigma) = p for a Gaussian x (doc eq. PL4).
+double twoSidedGaussianFactor(double p) {
+  return boost::math::quantile(
+      boost::math::complement(boost::math::normal_distribution<>{}, p / 2));
+}
+
+/// k with P(|x| > k sigma_major) <= p for a horizontal Gaussian error whose larger principal
+/// standard deviation is sigma_major: |x|^2 / sigma_major^2 is at most chi-square(2), whose
+/// tail is exp(-k^2 / 2) (doc eq. PL5).
+double horizontalFactor(double p) {
+  return std::sqrt(-2.0 * std::log(p));
+}
+
+}  // namespace
+
+void toGlrEpoch(std::int64_t time_ns, const EpochDiagnostics& d, GlrEpoch& out) {
+  const auto m = std::min<Eigen::Index>(d.h.rows(), glr::kMaxRows);
+  out.time_ns = time_ns;
+  out.rows = static_cast<int>(m);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    out.sv_id[static_cast<std::size_t>(r)] = d.sv_ids[static_cast<std::size_t>(r)];
+    out.is_rate[static_cast<std::size_t>(r)] = d.is_rate[static_cast<std::size_t>(r)];
+  }
+  out.innovation = d.innovation.head(m);
+  out.innovation_cov = d.innovation_cov.topLeftCorner(m, m);
+  out.h = d.h.topRows(m);
+  out.k = d.k.leftCols(m);
+  out.phi = d.phi;
+}
+
+GlrProtectionLevel::GlrProtectionLevel() {
+  configure(IntegrityConfig{});
+}
+
+void GlrProtectionLevel::configure(const IntegrityConfig& config) {
+  config_ = config;
+  monitor_.configure(config.detector);
+  signatures_.reserve(static_cast<std::size_t>(glr::kMaxDirections * monitor_.config().window));
+  // Noncentrality lambda at which 2 l of a group of `dof` directions stays below 2h with
+  // probability P_md (doc eq. PL2); its square root is the minimum detectable magnitude in
+  // standard errors of the magnitude estimate.
+  const double x = 2.0 * config.detector.threshold;
+  for (int dof = 1; dof < static_cast<int>(sqrt_lambda_.size()); ++dof) {
+    using Dist = boost::math::non_central_chi_squared_distribution<double>;
+    sqrt_lambda_[static_cast<std::size_t>(dof)] =
+        std::sqrt(Dist::find_non_centrality(dof, x, config.missed_detection_probability));
+  }
+  k_ff_h_ = horizontalFactor(config.integrity_risk / 2.0);
+  k_ff_v_ = twoSidedGaussianFactor(config.integrity_risk / 2.0);
+  k_md_h_ = horizontalFactor(config.missed_detection_probability);
+  k_md_v_ = twoSidedGaussianFactor(config.missed_detection_probability);
+  reset();
+}
+
+void GlrProtectionLevel::reset() {
+  monitor_.reset();
+  have_biases_ = false;
+  worst_h_ = worst_v_ = ProtectionLevels::Bound{};
+}
+
+double GlrProtectionLevel::detectableSigmas(int dof) const {
+  return dof >= 1 && dof < static_cast<int>(sqrt_lambda_.size())
+             ? sqrt_lambda_[static_cast<std::size_t>(dof)]
+             : 0.0;
+}
+
+void GlrProtectionLevel::onEpoch(std::int64_t time_ns, const EpochDiagnostics& epoch) {
+  toGlrEpoch(time_ns, epoch, epoch_);
+  if (!monitor_.update(epoch_).valid) return;  // refused: counted by the monitor
+  monitor_.positionSignatures(signatures_);
+  worst_h_ = worst_v_ = ProtectionLevels::Bound{};
+  have_biases_ = !signatures_.empty();
+  // The group statistics have as many degrees of freedom as the rank of their directions (up
+  // to 6 for the IMU, 3 per satellite), and against the one threshold h a lower rank needs the
+  // larger noncentrality: rank 1, the largest, bounds every group (within 2.2 % of rank 6 at
+  // h = 35.7, P_md = 1e-3; doc eq. PL2).
+  const double sigmas = detectableSigmas(1);
+  for (const auto& s : signatures_) {
+    // Minimum detectable magnitude nu = sqrt(lambda / R*) (doc eq. PL2) and the position
+    // error it leaves after this epoch's update, nu mu+ (eq. PL3).
+    if (!(s.information > 0.0)) continue;  // the data cannot see it: reported by the monitor
+    const double nu = sigmas / std::sqrt(s.information);
+    const Eigen::Vector3d bias = nu * s.position_ned;
+    const double h = bias.head<2>().norm(), v = std::abs(bias.z());
+    if (h > worst_h_.bias_m) worst_h_ = {false, s.hypothesis, s.onset_age, h, nu};
+    if (v > worst_v_.bias_m) worst_v_ = {false, s.hypothesis, s.onset_age, v, nu};
+  }
+}
+
+ProtectionLevels GlrProtectionLevel::levels(const Eigen::Matrix3d& pos_cov_ned) const {
+  ProtectionLevels out;
+  if (!config_.enabled) return out;
+  const Eigen::Matrix2d horizontal = pos_cov_ned.topLeftCorner<2, 2>();
+  const double sigma_major = std::sqrt(std::max(
+      0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(horizontal, Eigen::EigenvaluesOnly)
+               .eigenvalues()
+               .maxCoeff()));
+  const double sigma_down = std::sqrt(std::max(0.0, pos_cov_ned(2, 2)));
+  // Fault-free against every fault hypothesis (eq. PL3), the larger of the two (doc: the levels).
+  out.horizontal_m = k_ff_h_ * sigma_major;
+  out.vertical_m = k_ff_v_ * sigma_down;
+  const double faulted_h = worst_h_.bias_m + k_md_h_ * sigma_major;
+  const double faulted_v = worst_v_.bias_m + k_md_v_ * sigma_down;
+  if (have_biases_ && faulted_h > out.horizontal_m) {
+    out.horizontal_m = faulted_h;
+    out.horizontal_bound = worst_h_;
+  }
+  if (have_biases_ && faulted_v > out.vertical_m) {
+    out.vertical_m = faulted_v;
+    out.vertical_bound = worst_v_;
+  }
+  if (!have_biases_) {
+    out.state = IntegrityState::kInitializing;
+  } else {
+    out.state = out.horizontal_m <= config_.horizontal_alert_limit_m &&
+                        out.vertical_m <= config_.vertical_alert_limit_m
+                    ? IntegrityState::kAvailable
+                    : IntegrityState::kUnavailable;
+  }
+  return out;
+}
+
+}  // namespace navbus::core
