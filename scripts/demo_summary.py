@@ -27,6 +27,25 @@ def errors(solutions, truth_by_time):
     return out
 
 
+def integrity(solutions, truth_by_time):
+    """One line: the protection levels of the recorded solutions against their true errors."""
+    rows = [(s, truth_by_time[s["time_gps_ns"]]) for s in solutions
+            if s.get("integrity") in ("AVAILABLE", "UNAVAILABLE") and s["time_gps_ns"] in truth_by_time]
+    if not rows:
+        return "integrity: no protection levels (no integrity block, or not tightly coupled)"
+    hpl = sorted(float(s["horizontal_protection_level_m"]) for s, _ in rows)
+    vpl = sorted(float(s["vertical_protection_level_m"]) for s, _ in rows)
+    beyond = 0
+    for s, t in rows:
+        e = ned_error(s, t)
+        beyond += norm(e[:2]) > float(s["horizontal_protection_level_m"]) or \
+            abs(e[2]) > float(s["vertical_protection_level_m"])
+    available = sum(1 for s, _ in rows if s["integrity"] == "AVAILABLE")
+    return (f"integrity: {len(rows)} solutions with protection levels, {100 * available / len(rows):.1f} % "
+            f"available; HPL median {hpl[len(hpl) // 2]:.1f} m, VPL median {vpl[len(vpl) // 2]:.1f} m; "
+            f"true error beyond a level in {beyond}")
+
+
 def window(errs, start_ns, t0, t1):
     sel = [e for e in errs if t0 <= seconds(e[0], start_ns) < t1]
     if not sel:
@@ -80,6 +99,7 @@ def main(scenario_path, record_dir, truth_dir, without_dir):
 
     print(f"scenario {scenario['name']}: {len(bus)} solutions recorded over {duration:.0f} s, "
           f"{len(decisions)} decisions, {len(commands)} commands")
+    print(integrity(read_csv(f"{record_dir}/navbus_nav_solution.csv"), truth))
     for k, f in enumerate(faults):
         t_fault = float(f["start_s"])
         t_next = float(faults[k + 1]["start_s"]) if k + 1 < len(faults) else duration

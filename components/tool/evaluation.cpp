@@ -458,7 +458,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
       const std::int64_t start = setup.sim.scenario.start_time_ns;
       accumulate(row.st, r, start + static_cast<std::int64_t>(std::llround(o.from_s * 1e9)), o,
                  start);
-      row.integrity.add(r);
+      row.integrity.add(r, o.first_seed + static_cast<std::uint64_t>(i));
       if (setup.filter.engine.start == core::StartSource::kAligned)
         row.alignments.push_back(
             {r.aligned, r.aligned_start, r.aligned_start_error,

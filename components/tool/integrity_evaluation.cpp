@@ -18,19 +18,29 @@ double quantile(std::vector<double> v, double q) {
 
 }  // namespace
 
-void IntegrityTally::add(const OfflineResult& r) {
+void IntegrityTally::add(const OfflineResult& r, std::uint64_t seed) {
   ++runs;
+  // Alarms: from each decision to the first command after it (the fault manager's answer; no
+  // answer: to the end of the run). Outside them the solution claims its levels.
   const std::size_t none = r.errors.size();
-  const std::size_t first_alarm =
-      r.decision_after_solutions.empty() ? none : r.decision_after_solutions.front();
-  // The alarm is answered by the first command the fault manager sent after it.
-  std::size_t answered = none;
-  for (std::size_t c : r.command_after_solutions) {
-    if (c >= first_alarm) {
-      answered = c;
-      break;
+  std::vector<std::pair<std::size_t, std::size_t>> alarms;
+  for (std::size_t d : r.decision_after_solutions) {
+    std::size_t answer = none;
+    for (std::size_t c : r.command_after_solutions) {
+      if (c >= d) {
+        answer = c;
+        break;
+      }
     }
+    alarms.emplace_back(d, answer);
   }
+  const auto alarmed = [&alarms](std::size_t i) {
+    for (const auto& [from, to] : alarms)
+      if (i >= from && i < to) return true;
+    return false;
+  };
+  const std::size_t first_decision =
+      r.decision_after_solutions.empty() ? none : r.decision_after_solutions.front();
   bool run_misleading = false;
   for (std::size_t i = 0; i < r.errors.size(); ++i) {
     const EpochError& e = r.errors[i];
@@ -45,17 +55,19 @@ void IntegrityTally::add(const OfflineResult& r) {
     max_ratio_h = std::max(max_ratio_h, eh / e.hpl_m);
     max_ratio_v = std::max(max_ratio_v, ev / e.vpl_m);
     if (eh <= e.hpl_m && ev <= e.vpl_m) continue;
-    if (i < first_alarm) {
-      ++misleading;
-      misleading_unavailable += e.integrity == navbus::INTEGRITY_UNAVAILABLE ? 1 : 0;
-      run_misleading = true;
-    } else if (i < answered) {
+    if (alarmed(i)) {
       ++beyond_during_alarm;
     } else {
-      ++beyond_after_answer;
+      ++misleading;
+      misleading_unavailable += e.integrity == navbus::INTEGRITY_UNAVAILABLE ? 1 : 0;
+      misleading_after_answer += i >= first_decision ? 1 : 0;
+      run_misleading = true;
     }
   }
-  runs_with_misleading += run_misleading ? 1 : 0;
+  if (run_misleading) {
+    ++runs_with_misleading;
+    misleading_seeds.push_back(seed);
+  }
 }
 
 void printIntegrityTable(const std::vector<std::pair<std::string, IntegrityTally>>& rows) {
@@ -64,24 +76,32 @@ void printIntegrityTable(const std::vector<std::pair<std::string, IntegrityTally
   if (!any) return;
   std::printf(
       "\nintegrity: protection levels against the true position error, every solution with "
-      "levels\n  (misleading: error beyond a level before any alarm; alarmed / answered: beyond "
-      "a level after the first decision, before / after the command answering it; available: "
-      "both levels within the alert limits)\n");
-  std::printf("%-34s %9s %9s %9s %9s %9s %10s %10s %12s %8s %8s\n", "configuration", "epochs",
-              "available", "HPL p50 m", "HPL p99", "VPL p50 m", "max eH/HPL", "max eV/VPL",
-              "misleading", "alarmed", "answered");
+      "levels\n  (misleading: error beyond a level while no alarm stands, an alarm standing from "
+      "a decision to the fault manager's next command; of them after an answered alarm; "
+      "alarmed: beyond a level while one stands; available: both levels within the alert "
+      "limits; unavail.: of the misleading, while a level exceeded its alert limit)\n");
+  std::printf("%-34s %9s %9s %9s %9s %9s %10s %10s %12s %8s %8s %8s\n", "configuration",
+              "epochs", "available", "HPL p50 m", "HPL p99", "VPL p50 m", "max eH/HPL",
+              "max eV/VPL", "misleading", "answered", "unavail.", "alarmed");
   for (const auto& [label, t] : rows) {
     if (t.epochs == 0) continue;
     const double n = static_cast<double>(t.epochs);
     std::printf(
-        "%-34s %9llu %8.2f%% %9.2f %9.2f %9.2f %10.3f %10.3f %5llu (%d run%s) %8llu %8llu\n",
+        "%-34s %9llu %8.2f%% %9.2f %9.2f %9.2f %10.3f %10.3f %5llu (%d run%s) %8llu %8llu %8llu\n",
         label.c_str(), static_cast<unsigned long long>(t.epochs),
         100.0 * static_cast<double>(t.available) / n, quantile(t.hpl_m, 0.5),
         quantile(t.hpl_m, 0.99), quantile(t.vpl_m, 0.5), t.max_ratio_h, t.max_ratio_v,
         static_cast<unsigned long long>(t.misleading), t.runs_with_misleading,
         t.runs_with_misleading == 1 ? "" : "s",
-        static_cast<unsigned long long>(t.beyond_during_alarm),
-        static_cast<unsigned long long>(t.beyond_after_answer));
+        static_cast<unsigned long long>(t.misleading_after_answer),
+        static_cast<unsigned long long>(t.misleading_unavailable),
+        static_cast<unsigned long long>(t.beyond_during_alarm));
+    if (!t.misleading_seeds.empty()) {
+      std::printf("  seeds with misleading information:");
+      for (std::uint64_t s : t.misleading_seeds)
+        std::printf(" %llu", static_cast<unsigned long long>(s));
+      std::printf("\n");
+    }
   }
 }
 
