@@ -102,8 +102,9 @@ TEST(StaticAlignment, ErrorsFollowTheBudgetToFirstOrder) {
   const double arw = budget.angle_random_walk_rad_per_sqrts;
   const double level = std::sqrt(ba * ba + vrw * vrw / T) / g;
   EXPECT_NEAR(a.level_sigma_rad, level, 1e-12);
-  const double heading = std::hypot(std::sqrt(bg * bg + arw * arw / T) / horizontal_rate,
-                                    level * std::tan(kLatitude_rad));
+  const double rate = (bg * bg + arw * arw / T) / (horizontal_rate * horizontal_rate);
+  const double heading =
+      std::sqrt(rate + rate * rate + std::pow(level * std::tan(kLatitude_rad), 2));
   EXPECT_NEAR(a.heading_sigma_rad, heading, 1e-12);
 }
 
@@ -147,8 +148,10 @@ TEST(StaticAlignment, MemsGyrosCannotGyrocompassAndSaySo) {
                         kLatitude_rad, g, mems, 5.0 * units::kDeg);
   EXPECT_FALSE(a.hasHeading());
   EXPECT_EQ(a.heading_limit, core::HeadingLimit::kGyroGrade);
-  // 10 deg/h against 15.04 cos 45 deg/h of horizontal Earth rate: about 0.94 rad.
-  EXPECT_NEAR(a.heading_sigma_rad, 10.0 / (15.041 * std::cos(kLatitude_rad)), 0.02);
+  // 10 deg/h against 15.04 cos 45 deg/h of horizontal Earth rate: r = 0.94^2 rad^2 to first
+  // order, sqrt(r + r^2) = 1.29 rad with the second order of (7).
+  const double r = std::pow(10.0 / (15.041 * std::cos(kLatitude_rad)), 2);
+  EXPECT_NEAR(a.heading_sigma_rad, std::sqrt(r + r * r), 0.02);
   EXPECT_EQ(a.roll_pitch_yaw_rad.z(), 0.0);
   // Levelling still works: the error-free window gives the true roll and pitch.
   EXPECT_NEAR(a.roll_pitch_yaw_rad.x(), rpy.x(), 1e-9);
