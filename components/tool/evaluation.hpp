@@ -53,8 +53,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o);
 double convergenceTime(const std::vector<EpochError>& errors, std::int64_t t0_ns,
                        double threshold_m, double window_s);
 
-/// Quantile of the chi-square distribution (Wilson-Hilferty; relative error < 1e-3 for the
-/// degrees of freedom used here).
+/// Quantile of the chi-square distribution (Boost.Math).
 double chiSquareQuantile(double p, double dof);
 
 }  // namespace navbus::tool

@@ -9,14 +9,14 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 scenario=$src/sim/scenarios/demo_fault_loop.yaml
 "$navbus" offline --scenario "$scenario" --filter "$src/config/filter_demo.yaml" \
-  --fault-manager "$src/config/fault_manager.yaml" --duration 45 -o "$work/with" > "$work/with.log" 2>&1
+  --fault-manager "$src/config/fault_manager.yaml" --start config --duration 45 -o "$work/with" > "$work/with.log" 2>&1
 "$navbus" offline --scenario "$scenario" --filter "$src/config/filter_demo.yaml" --duration 45 \
-  -o "$work/without" > "$work/without.log" 2>&1
+  --start config -o "$work/without" > "$work/without.log" 2>&1
 "$sim" -c "$src/sim/scenarios/seed003_laser_ins.yaml" --files "$work/raw" --duration 41 \
   > "$work/raw.log" 2>&1
 "$navbus" montecarlo --scenario "$src/sim/scenarios/seed000_pseudorange_ramp_12p5.yaml" \
   --filter "$src/config/filter_seed000_tc.yaml" --fault-manager "$src/config/fault_manager.yaml" \
-  --runs 4 --duration 700 --from 100 --csv "$work/mc" > "$work/mc.log" 2>&1
+  --runs 4 --start config --duration 700 --from 100 --csv "$work/mc" > "$work/mc.log" 2>&1
 # The CSV files carry what the figures show: the demo's ramp detected by the GLR, and one row
 # per Monte Carlo run with its detection.
 grep -q ',1$' "$work/with/glr.csv" || { echo "glr.csv: no detected epoch"; exit 1; }

@@ -218,10 +218,11 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
   const std::string fm_cfg =
       test::writeFile(dir / "fm.yaml", "extends: " + src + "/config/fault_manager.yaml\n" + domain);
 
-  test::ChildProcess offline(NAVBUS_TOOL_EXE,
-                             {"offline", "--scenario", sim_cfg, "--filter", filter_cfg,
-                              "--fault-manager", fm_cfg, "-o", (dir / "offline").string()},
-                             (dir / "offline.log").string());
+  test::ChildProcess offline(
+      NAVBUS_TOOL_EXE,
+      {"offline", "--scenario", sim_cfg, "--filter", filter_cfg, "--fault-manager", fm_cfg,
+       "--start", "config", "-o", (dir / "offline").string()},
+      (dir / "offline.log").string());
   ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
   const std::vector<std::string> expected = readCsvRows(dir / "offline" / "solution.csv");
   ASSERT_EQ(expected.size(), 350u);
