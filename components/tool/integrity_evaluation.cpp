@@ -80,9 +80,9 @@ void printIntegrityTable(const std::vector<std::pair<std::string, IntegrityTally
       "a decision to the fault manager's next command; of them after an answered alarm; "
       "alarmed: beyond a level while one stands; available: both levels within the alert "
       "limits; unavail.: of the misleading, while a level exceeded its alert limit)\n");
-  std::printf("%-34s %9s %9s %9s %9s %9s %10s %10s %12s %8s %8s %8s\n", "configuration",
-              "epochs", "available", "HPL p50 m", "HPL p99", "VPL p50 m", "max eH/HPL",
-              "max eV/VPL", "misleading", "answered", "unavail.", "alarmed");
+  std::printf("%-34s %9s %9s %9s %9s %9s %10s %10s %12s %8s %8s %8s\n", "configuration", "epochs",
+              "available", "HPL p50 m", "HPL p99", "VPL p50 m", "max eH/HPL", "max eV/VPL",
+              "misleading", "answered", "unavail.", "alarmed");
   for (const auto& [label, t] : rows) {
     if (t.epochs == 0) continue;
     const double n = static_cast<double>(t.epochs);

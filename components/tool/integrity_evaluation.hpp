@@ -16,16 +16,16 @@
 namespace navbus::tool {
 
 struct IntegrityTally {
-  std::uint64_t epochs{0};                  ///< solutions with protection levels
-  std::uint64_t available{0};               ///< ... both within the alert limits
+  std::uint64_t epochs{0};                   ///< solutions with protection levels
+  std::uint64_t available{0};                ///< ... both within the alert limits
   std::uint64_t misleading{0};               ///< error beyond a level while no alarm stands
   std::uint64_t misleading_after_answer{0};  ///< of `misleading`: after an answered alarm
   std::uint64_t beyond_during_alarm{0};      ///< error beyond a level while an alarm stands
-  std::uint64_t misleading_unavailable{0};  ///< of `misleading`: while unavailable
+  std::uint64_t misleading_unavailable{0};   ///< of `misleading`: while unavailable
   int runs{0}, runs_with_misleading{0};
   std::vector<std::uint64_t> misleading_seeds;  ///< the runs with misleading information
-  double max_ratio_h{0.0}, max_ratio_v{0.0};  ///< largest error / level
-  std::vector<double> hpl_m, vpl_m;           ///< every level, for the quantiles
+  double max_ratio_h{0.0}, max_ratio_v{0.0};    ///< largest error / level
+  std::vector<double> hpl_m, vpl_m;             ///< every level, for the quantiles
 
   /// Adds one run's solutions (OfflineResult::errors and the decisions' order).
   void add(const OfflineResult& r, std::uint64_t seed);
