@@ -644,6 +644,10 @@ std::string FilterPipeline::summary() const {
         << (monitor_flags_ != 0 ? " (still not)" : "");
   }
   if (config_.engine.start == core::StartSource::kAligned) out << ", " << alignmentSummary();
+  if (config_.engine.integrity.enabled) {
+    out << ", protection-level epochs " << engine_.integrity().epochs() << " refused "
+        << engine_.integrity().refused();
+  }
   if (new_runs_ > 0) {
     out << ", new runs after a source restart " << new_runs_ << " (before the latest: solutions "
         << solutions_earlier_runs_ << ", increments " << increments_earlier_runs_ << ")";

@@ -29,8 +29,6 @@ namespace {
 
 constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
 
-/// `filter_yaml` is the filter file's content (the Monte Carlo overrides some keys);
-/// `filter_path` names it in errors.
 /// The protection levels assume the detector the fault manager runs: refuses a filter whose
 /// integrity.detector differs from the fault manager's glr block, naming the key and both values.
 void checkIntegrityDetector(const nav_filter::FilterConfig& filter,
@@ -55,6 +53,8 @@ void checkIntegrityDetector(const nav_filter::FilterConfig& filter,
   differ("hypotheses.rate_steps", a.rate_steps, b.rate_steps);
 }
 
+/// `filter_yaml` is the filter file's content (the Monte Carlo overrides some keys);
+/// `filter_path` names it in errors.
 OfflineSetup loadSetup(const std::string& scenario, const YAML::Node& filter_yaml,
                        const std::string& filter_path, std::uint64_t seed, double duration_s,
                        const std::string& fault_manager = "") {

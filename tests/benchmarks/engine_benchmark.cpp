@@ -83,6 +83,20 @@ Result run(core::EngineConfig cfg, const std::vector<Input>& inputs, bool aid) {
           engine.counters().imu_aligning};
 }
 
+/// An engine configuration for a scenario's IMU period and gravity, started at its truth.
+core::EngineConfig configFor(const navbus::sim::ScenarioConfig& c, double imu_period_s) {
+  core::EngineConfig cfg;
+  cfg.tuning.gravity = c.gravity;
+  cfg.imu_period_s = imu_period_s;
+  navbus::sim::ScenarioSource s(c);
+  cfg.initial_state = s.truth();
+  return cfg;
+}
+
+navbus::sim::ScenarioConfig scenarioFile(const std::string& path) {
+  return navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(path)).scenario;
+}
+
 void printRow(const char* name, const Result& r, const Result& base) {
   std::printf("%-44s %10.2f %8.3f %14.3f %9llu\n", name, r.us_per_cycle,
               r.us_per_cycle / base.us_per_cycle, r.allocations_per_cycle,
@@ -93,18 +107,10 @@ void printRow(const char* name, const Result& r, const Result& base) {
 /// tightly coupled filter from a configured state against the same filter aligning itself
 /// (gyrocompassing, then fine alignment) and with protection levels (issue target: <= 1.2).
 void integrityAndAlignment(const std::string& dir, int n) {
-  auto aircraft =
-      navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(dir + "/seed000_aircraft.yaml"))
-          .scenario;
+  const auto aircraft = scenarioFile(dir + "/seed000_aircraft.yaml");
   const auto inputs = makeInputs(aircraft, n);
-  core::EngineConfig cfg;
-  cfg.tuning.gravity = aircraft.gravity;
-  cfg.imu_period_s = 0.01;
+  core::EngineConfig cfg = configFor(aircraft, 0.01);
   cfg.aiding = core::AidingMode::kTightlyCoupled;
-  {
-    navbus::sim::ScenarioSource s(aircraft);
-    cfg.initial_state = s.truth();
-  }
   std::printf("\nseed 000 inputs, %d IMU cycles at 100 Hz (pseudoranges 1 Hz), tightly coupled\n",
               n);
   std::printf("%-44s %10s %8s %14s %9s\n", "configuration", "us/cycle", "ratio", "allocs/cycle",
@@ -126,17 +132,9 @@ void integrityAndAlignment(const std::string& dir, int n) {
 int main(int argc, char** argv) {
   const std::string dir = argc > 1 ? argv[1] : "sim/scenarios";
   const int n = argc > 2 ? std::atoi(argv[2]) : 40000;
-  auto leo =
-      navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(dir + "/seed001_leo.yaml"))
-          .scenario;
+  const auto leo = scenarioFile(dir + "/seed001_leo.yaml");
   const auto inputs = makeInputs(leo, n);
-  core::EngineConfig cfg;
-  cfg.tuning.gravity = leo.gravity;
-  cfg.imu_period_s = 0.005;
-  {
-    navbus::sim::ScenarioSource s(leo);
-    cfg.initial_state = s.truth();
-  }
+  core::EngineConfig cfg = configFor(leo, 0.005);
   cfg.aiding = core::AidingMode::kInertialOnly;
   const Result base = run(cfg, inputs, false);
   std::printf("seed 001 inputs, %d IMU cycles at 200 Hz (GPS 10 Hz, star tracker 5 Hz)\n", n);

@@ -422,15 +422,10 @@ TEST(GlrProtection, PositionSignaturesAreTheFaultsEffectOnTheCorrectedState) {
 // mixture of central ones (chi_square.hpp, independent of Boost) gives P_md back at that
 // lambda; against one threshold, more directions need less noncentrality.
 TEST(GlrProtection, DetectableSigmasFollowTheNoncentralChiSquare) {
-  nc::IntegrityConfig c;
-  c.enabled = true;
-  c.detector.threshold = 35.718;
-  c.missed_detection_probability = 1e-3;
-  nc::GlrProtectionLevel pl;
-  pl.configure(c);
-  EXPECT_NEAR(pl.detectableSigmas(1), std::sqrt(2.0 * 35.718) + 3.090232, 1e-4);
+  const auto sigmas = [](int dof) { return nc::minimumDetectableSigmas(dof, 35.718, 1e-3); };
+  EXPECT_NEAR(sigmas(1), std::sqrt(2.0 * 35.718) + 3.090232, 1e-4);
   for (int dof = 1; dof <= 6; ++dof) {
-    const double lambda = pl.detectableSigmas(dof) * pl.detectableSigmas(dof);
+    const double lambda = sigmas(dof) * sigmas(dof);
     double cdf = 0.0, weight = std::exp(-lambda / 2.0);
     for (int j = 0; j < 400; ++j) {
       cdf += weight * (1.0 - nc::chiSquareSurvival(2.0 * 35.718, dof + 2 * j));
@@ -438,16 +433,15 @@ TEST(GlrProtection, DetectableSigmasFollowTheNoncentralChiSquare) {
     }
     EXPECT_NEAR(cdf, 1e-3, 1e-7) << dof << " degrees of freedom";
     if (dof > 1) {
-      EXPECT_LT(pl.detectableSigmas(dof), pl.detectableSigmas(dof - 1));
+      EXPECT_LT(sigmas(dof), sigmas(dof - 1));
     }
   }
-  EXPECT_EQ(pl.detectableSigmas(0), 0.0);
-  EXPECT_EQ(pl.detectableSigmas(7), 0.0);
 }
 
 // Levels of a fault-free filter before any hypothesis exists (one epoch): the fault-free bound
 // alone, with its factors (horizontal sqrt(-2 ln(IR/2)) on the major axis, vertical the
-// two-sided Gaussian quantile of IR/2); with hypotheses, at least the bias of the worst one.
+// two-sided Gaussian quantile of IR/2); with hypotheses, the worst fault's bias plus the
+// missed-detection multiple of sigma where that is larger (here it is, horizontally).
 TEST(GlrProtection, LevelsAreTheFaultFreeBoundOrTheWorstUndetectedFault) {
   nc::IntegrityConfig c;
   c.enabled = true;
@@ -475,8 +469,12 @@ TEST(GlrProtection, LevelsAreTheFaultFreeBoundOrTheWorstUndetectedFault) {
   }
   l = pl.levels(cov);
   EXPECT_NE(l.state, nc::IntegrityState::kInitializing);
-  EXPECT_FALSE(l.horizontal_bound.fault_free);
-  EXPECT_GE(l.horizontal_m,
-            l.horizontal_bound.bias_m + std::sqrt(-2.0 * std::log(1e-3)) * 2.0 - 1e-9);
-  EXPECT_GT(l.horizontal_bound.minimum_detectable_magnitude, 0.0);
+  const nc::FaultBiases& b = pl.faultBiases();
+  EXPECT_GT(b.horizontal_m, 0.0);
+  EXPECT_GT(b.vertical_m, 0.0);
+  const double faulted_h = b.horizontal_m + std::sqrt(-2.0 * std::log(1e-3)) * 2.0;
+  const double fault_free_h = 2.0 * std::sqrt(-2.0 * std::log(0.5e-7));
+  EXPECT_GT(faulted_h, fault_free_h);
+  EXPECT_NEAR(l.horizontal_m, faulted_h, 1e-9);
+  EXPECT_NEAR(l.vertical_m, std::max(3.0 * 5.45131, b.vertical_m + 3.0 * 3.290527), 1e-4);
 }

@@ -28,6 +28,11 @@ double horizontalFactor(double p) {
 
 }  // namespace
 
+double minimumDetectableSigmas(int dof, double threshold, double missed_detection_probability) {
+  using Dist = boost::math::non_central_chi_squared_distribution<double>;
+  return std::sqrt(Dist::find_non_centrality(dof, 2.0 * threshold, missed_detection_probability));
+}
+
 void toGlrEpoch(std::int64_t time_ns, const EpochDiagnostics& d, GlrEpoch& out) {
   const auto m = std::min<Eigen::Index>(d.h.rows(), glr::kMaxRows);
   out.time_ns = time_ns;
@@ -51,15 +56,12 @@ void GlrProtectionLevel::configure(const IntegrityConfig& config) {
   config_ = config;
   monitor_.configure(config.detector);
   signatures_.reserve(static_cast<std::size_t>(glr::kMaxDirections * monitor_.config().window));
-  // Noncentrality lambda at which 2 l of a group of `dof` directions stays below 2h with
-  // probability P_md (doc eq. PL2); its square root is the minimum detectable magnitude in
-  // standard errors of the magnitude estimate.
-  const double x = 2.0 * config.detector.threshold;
-  for (int dof = 1; dof < static_cast<int>(sqrt_lambda_.size()); ++dof) {
-    using Dist = boost::math::non_central_chi_squared_distribution<double>;
-    sqrt_lambda_[static_cast<std::size_t>(dof)] =
-        std::sqrt(Dist::find_non_centrality(dof, x, config.missed_detection_probability));
-  }
+  // The group statistics have as many degrees of freedom as the rank of their directions (up
+  // to 6 for the IMU, 3 per satellite), and against the one threshold h a lower rank needs the
+  // larger noncentrality: rank 1, the largest, bounds every group (within 2.2 % of rank 6 at
+  // h = 35.7, P_md = 1e-3; doc eq. PL2).
+  detectable_sigmas_ =
+      minimumDetectableSigmas(1, config.detector.threshold, config.missed_detection_probability);
   k_ff_h_ = horizontalFactor(config.integrity_risk / 2.0);
   k_ff_v_ = twoSidedGaussianFactor(config.integrity_risk / 2.0);
   k_md_h_ = horizontalFactor(config.missed_detection_probability);
@@ -70,35 +72,22 @@ void GlrProtectionLevel::configure(const IntegrityConfig& config) {
 void GlrProtectionLevel::reset() {
   monitor_.reset();
   have_biases_ = false;
-  worst_h_ = worst_v_ = ProtectionLevels::Bound{};
-}
-
-double GlrProtectionLevel::detectableSigmas(int dof) const {
-  return dof >= 1 && dof < static_cast<int>(sqrt_lambda_.size())
-             ? sqrt_lambda_[static_cast<std::size_t>(dof)]
-             : 0.0;
+  biases_ = FaultBiases{};
 }
 
 void GlrProtectionLevel::onEpoch(std::int64_t time_ns, const EpochDiagnostics& epoch) {
   toGlrEpoch(time_ns, epoch, epoch_);
   if (!monitor_.update(epoch_).valid) return;  // refused: counted by the monitor
   monitor_.positionSignatures(signatures_);
-  worst_h_ = worst_v_ = ProtectionLevels::Bound{};
+  biases_ = FaultBiases{};
   have_biases_ = !signatures_.empty();
-  // The group statistics have as many degrees of freedom as the rank of their directions (up
-  // to 6 for the IMU, 3 per satellite), and against the one threshold h a lower rank needs the
-  // larger noncentrality: rank 1, the largest, bounds every group (within 2.2 % of rank 6 at
-  // h = 35.7, P_md = 1e-3; doc eq. PL2).
-  const double sigmas = detectableSigmas(1);
   for (const auto& s : signatures_) {
     // Minimum detectable magnitude nu = sqrt(lambda / R*) (doc eq. PL2) and the position
     // error it leaves after this epoch's update, nu mu+ (eq. PL3).
     if (!(s.information > 0.0)) continue;  // the data cannot see it: reported by the monitor
-    const double nu = sigmas / std::sqrt(s.information);
-    const Eigen::Vector3d bias = nu * s.position_ned;
-    const double h = bias.head<2>().norm(), v = std::abs(bias.z());
-    if (h > worst_h_.bias_m) worst_h_ = {false, s.hypothesis, s.onset_age, h, nu};
-    if (v > worst_v_.bias_m) worst_v_ = {false, s.hypothesis, s.onset_age, v, nu};
+    const Eigen::Vector3d bias = detectable_sigmas_ / std::sqrt(s.information) * s.position_ned;
+    biases_.horizontal_m = std::max(biases_.horizontal_m, bias.head<2>().norm());
+    biases_.vertical_m = std::max(biases_.vertical_m, std::abs(bias.z()));
   }
 }
 
@@ -114,15 +103,9 @@ ProtectionLevels GlrProtectionLevel::levels(const Eigen::Matrix3d& pos_cov_ned) 
   // Fault-free against every fault hypothesis (eq. PL3), the larger of the two (doc: the levels).
   out.horizontal_m = k_ff_h_ * sigma_major;
   out.vertical_m = k_ff_v_ * sigma_down;
-  const double faulted_h = worst_h_.bias_m + k_md_h_ * sigma_major;
-  const double faulted_v = worst_v_.bias_m + k_md_v_ * sigma_down;
-  if (have_biases_ && faulted_h > out.horizontal_m) {
-    out.horizontal_m = faulted_h;
-    out.horizontal_bound = worst_h_;
-  }
-  if (have_biases_ && faulted_v > out.vertical_m) {
-    out.vertical_m = faulted_v;
-    out.vertical_bound = worst_v_;
+  if (have_biases_) {
+    out.horizontal_m = std::max(out.horizontal_m, biases_.horizontal_m + k_md_h_ * sigma_major);
+    out.vertical_m = std::max(out.vertical_m, biases_.vertical_m + k_md_v_ * sigma_down);
   }
   if (!have_biases_) {
     out.state = IntegrityState::kInitializing;

@@ -11,7 +11,6 @@
 // solution's covariance. Pure math; the GLR's storage is allocated once in configure().
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -43,27 +42,30 @@ enum class IntegrityState {
   kUnavailable    ///< a level exceeds its alert limit
 };
 
-/// The protection levels of one solution and what bounds them.
+/// The protection levels of one solution.
 struct ProtectionLevels {
   IntegrityState state{IntegrityState::kNotMonitored};
   double horizontal_m{0.0};  ///< HPL [m]: radius in the local horizontal (N E) plane
   double vertical_m{0.0};    ///< VPL [m]: along the local vertical
-  /// The hypothesis that sets each level (fault_free: the fault-free bound does).
-  struct Bound {
-    bool fault_free{true};
-    GlrHypothesis hypothesis;
-    int onset_epochs_ago{0};
-    double bias_m{0.0};  ///< position error of that fault at its minimum detectable magnitude
-    double minimum_detectable_magnitude{0.0};  ///< [m/s^2, rad/s, m or m/s]
-  };
-  Bound horizontal_bound, vertical_bound;
 };
+
+/// The largest position errors a just-undetectable fault leaves, over every hypothesis and
+/// onset of the latest epoch (doc eq. PL3) [m].
+struct FaultBiases {
+  double horizontal_m{0.0};
+  double vertical_m{0.0};
+};
+
+/// sqrt(lambda) at which a group statistic 2 l of `dof` degrees of freedom exceeds 2h with
+/// probability 1 - P_md (doc eq. PL2): the minimum detectable magnitude in standard errors of
+/// its estimate.
+double minimumDetectableSigmas(int dof, double threshold, double missed_detection_probability);
 
 class GlrProtectionLevel {
  public:
   GlrProtectionLevel();
-  /// Derives the multipliers: the noncentrality each group's statistic needs to exceed 2h
-  /// with probability 1 - P_md, and the Gaussian factors of the two risks.
+  /// Derives the multipliers: the noncentrality a group's statistic needs to exceed 2h with
+  /// probability 1 - P_md, and the Gaussian factors of the two risks.
   void configure(const IntegrityConfig& config);
   /// Forgets the fault hypotheses (the filter restarted).
   void reset();
@@ -77,9 +79,7 @@ class GlrProtectionLevel {
   ProtectionLevels levels(const Eigen::Matrix3d& pos_cov_ned) const;
 
   const IntegrityConfig& config() const { return config_; }
-  /// sqrt(noncentrality) at which a group statistic of `dof` degrees of freedom (1..6; 0
-  /// otherwise) exceeds h with probability 1 - P_md.
-  double detectableSigmas(int dof) const;
+  const FaultBiases& faultBiases() const { return biases_; }
   std::uint64_t epochs() const { return monitor_.epochs(); }
   std::uint64_t refused() const { return monitor_.refused(); }
 
@@ -88,11 +88,11 @@ class GlrProtectionLevel {
   GlrMonitor monitor_;
   GlrEpoch epoch_;
   std::vector<GlrMonitor::PositionSignature> signatures_;
-  std::array<double, glr::kImuDirections + 1> sqrt_lambda_{};  ///< by group dof
+  double detectable_sigmas_{0.0};     ///< sqrt(lambda_md) of a one-direction group
   double k_ff_h_{0.0}, k_ff_v_{0.0};  ///< fault-free multipliers of sigma_major and sigma_D
   double k_md_h_{0.0}, k_md_v_{0.0};  ///< the same at the missed-detection probability
   bool have_biases_{false};
-  ProtectionLevels::Bound worst_h_, worst_v_;  ///< of the latest epoch
+  FaultBiases biases_;  ///< of the latest epoch
 };
 
 /// The detector's view of one filter epoch (what bus::toGlrEpoch reads from the diagnostics
