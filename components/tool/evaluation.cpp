@@ -310,23 +310,37 @@ int runOfflineCommand(const OfflineOptions& o) {
         t0.position.height_m, t0.vel_ned_mps.x(), t0.vel_ned_mps.y(), t0.vel_ned_mps.z(), rpy.x(),
         rpy.y(), rpy.z());
   }
+  // Lines go into buffers, flushed in blocks (the files are tens of MB for an hour of data).
+  fmt::memory_buffer sol_b, truth_b, err_b;
+  const auto flush = [&](std::size_t above) {
+    for (auto [buf, file] : {std::pair{&sol_b, &sol_f}, {&truth_b, &truth_f}, {&err_b, &err_f}}) {
+      if (buf->size() <= above) continue;
+      file->write(buf->data(), static_cast<std::streamsize>(buf->size()));
+      buf->clear();
+    }
+  };
+  const auto out = [](fmt::memory_buffer& b) { return std::back_inserter(b); };
   const OfflineResult r = runOffline(setup, [&](const navbus::NavigationSolution& s,
                                                 const core::NavState& t, const EpochError& e) {
-    for (const auto& row : csvRows(s)) sol_f << row << "\n";
+    if (!appendCsvLine(s, sol_b)) {
+      for (const auto& row : csvRows(s)) fmt::format_to(out(sol_b), "{}\n", row);
+    }
     const Eigen::Vector3d rpy = core::eulerFromDcm(t.q_b_to_n.toRotationMatrix());
-    truth_f << t.time_ns << "," << fmt(t.position.latitude_rad) << ","
-            << fmt(t.position.longitude_rad) << "," << fmt(t.position.height_m) << ","
-            << fmt(t.vel_ned_mps.x()) << "," << fmt(t.vel_ned_mps.y()) << ","
-            << fmt(t.vel_ned_mps.z()) << "," << fmt(rpy.x()) << "," << fmt(rpy.y()) << ","
-            << fmt(rpy.z()) << "\n";
-    err_f << e.time_ns << "," << e.mode;
+    fmt::format_to(out(truth_b), "{},{},{},{},{},{},{},{},{},{}\n", t.time_ns,
+                   t.position.latitude_rad, t.position.longitude_rad, t.position.height_m,
+                   t.vel_ned_mps.x(), t.vel_ned_mps.y(), t.vel_ned_mps.z(), rpy.x(), rpy.y(),
+                   rpy.z());
+    fmt::format_to(out(err_b), "{},{}", e.time_ns, e.mode);
     for (const Eigen::Vector3d* v :
          {&e.pos_ned_m, &e.vel_ned_mps, &e.att_ned_rad, &e.pos_sigma_ned_m, &e.vel_sigma_ned_mps,
           &e.att_sigma_ned_rad}) {
-      err_f << "," << fmt(v->x()) << "," << fmt(v->y()) << "," << fmt(v->z());
+      fmt::format_to(out(err_b), ",{},{},{}", v->x(), v->y(), v->z());
     }
-    err_f << "," << fmt(e.nees9) << "\n";
+    fmt::format_to(out(err_b), ",{}\n", e.nees9);
+    flush(1 << 20);
   });
+  flush(0);
+  if (!sol_f || !truth_f || !err_f) throw bus::ConfigError("cannot write into --out " + o.out_dir);
   spdlog::info("offline: scenario '{}' seed {}: {} solutions ({} without a truth sample); {}",
                setup.sim.scenario.name, setup.sim.scenario.seed, r.solutions,
                r.solutions_without_truth, r.summary);

@@ -5,9 +5,12 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <fastrtps/utils/fixed_size_string.hpp>
 
 #include "message_fields.hpp"
@@ -84,6 +87,72 @@ class CellCollector {
 };
 
 std::string joinCsv(const std::vector<std::string>& cells);
+
+/// Appends the CSV cells of one message to a buffer, comma-separated, with no names and no
+/// string per cell: the fast path for large files (the offline solution file). The cells are
+/// those of CellCollector. A message with a sequence of structs (several rows) is not written:
+/// complete() is then false and the caller uses csvRows.
+class CsvCellWriter {
+ public:
+  explicit CsvCellWriter(fmt::memory_buffer& out) : out_(out) {}
+
+  template <class T>
+  void operator()(std::string_view, const T& value) {
+    separate();
+    if constexpr (std::is_enum_v<T>) {
+      append(enumName(value));
+    } else if constexpr (std::is_same_v<T, bool>) {
+      append(value ? "1" : "0");
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      fmt::format_to(std::back_inserter(out_), "{}", value);  // as formatNumber / to_string
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      append(csvQuote(value));
+    } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+      fmt::format_to(std::back_inserter(out_), "{}", fmt::join(value, ";"));
+    } else {  // std::array<double, N>: a cell each
+      fmt::format_to(std::back_inserter(out_), "{}", fmt::join(value, ","));
+    }
+  }
+  template <std::size_t N>
+  void operator()(std::string_view, const eprosima::fastrtps::fixed_string<N>& value) {
+    separate();
+    append(csvQuote(value.to_string()));
+  }
+  void text(std::string_view, const std::string& s) {
+    separate();
+    append(csvQuote(s));
+  }
+  template <class S>
+  void rows(std::string_view, const std::vector<S>&) {
+    complete_ = false;
+  }
+  bool complete() const { return complete_; }
+
+ private:
+  void separate() {
+    if (!first_) out_.push_back(',');
+    first_ = false;
+  }
+  void append(std::string_view s) { out_.append(s.data(), s.data() + s.size()); }
+  fmt::memory_buffer& out_;
+  bool first_{true};
+  bool complete_{true};
+};
+
+/// Appends one message's CSV line (with its newline) to `out`; false, with `out` unchanged, for a
+/// message with a sequence of structs (use csvRows).
+template <class T>
+bool appendCsvLine(const T& msg, fmt::memory_buffer& out) {
+  const std::size_t size = out.size();
+  CsvCellWriter w(out);
+  visitFields(msg, w);
+  if (!w.complete()) {
+    out.resize(size);
+    return false;
+  }
+  out.push_back('\n');
+  return true;
+}
 
 template <class T>
 std::string csvHeader() {

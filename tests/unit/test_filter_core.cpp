@@ -8,6 +8,8 @@
 
 #include "navbus/core/gnss_measurement.hpp"
 #include "navbus/core/kalman_update.hpp"
+#include "navbus/core/rotation.hpp"
+#include "navbus/core/sparse_rows.hpp"
 #include "navbus/sim/constellation.hpp"
 
 namespace earth = navbus::core::earth;
@@ -219,5 +221,40 @@ TEST(InsErrorModel, TransitionMatrixPredictsTheNonlinearErrorGrowth) {
         b.index, actual.segment<3>(b.index).norm(), predicted.segment<3>(b.index).norm(),
         100 * rel);
     EXPECT_LT(rel, 0.03) << "block at " << b.index;
+  }
+}
+
+TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
+  // Given transition matrices of the error model at random states (and one with states switched
+  // off, rows and columns of Phi zeroed as the error state does) and a random covariance,
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    navbus::core::NavState s = ins();
+    s.vel_ned_mps = 200.0 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+    s.q_b_to_n =
+        navbus::core::quaternionFromRotationVector(Eigen::Vector3d(u(rng), u(rng), u(rng)));
+    Mat17 Phi = navbus::core::transitionMatrix(
+        navbus::core::errorDynamics(s, Eigen::Vector3d(u(rng), u(rng), -9.8),
+                                    earth::GravityModel::kWgs84Normal),
+        0.005);
+    if (trial % 2 == 1) {
+      Phi.row(tc17::kClockBias.index).setZero();
+      Phi.col(tc17::kClockBias.index).setZero();
+    }
+    const Mat17 A = Mat17::Random();
+    const Mat17 P = A * A.transpose();
+    const navbus::core::SparseRows<tc17::kSize> sparse(Phi);
+    // then Phi P Phi^T, Phi P, Phi x and Phi Phi agree with the dense products to rounding,
+    const Mat17 dense = Phi * P * Phi.transpose();
+    const Mat17 sandwich = sparse.sandwich(P);
+    EXPECT_LT((sandwich - dense).cwiseAbs().maxCoeff(), 1e-12 * dense.cwiseAbs().maxCoeff());
+    EXPECT_LT((sparse.times(P) - Phi * P).cwiseAbs().maxCoeff(), 1e-12 * P.cwiseAbs().maxCoeff());
+    const Vec17 x = Vec17::Random();
+    EXPECT_LT((sparse.times(x) - Phi * x).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((sparse.times(sparse) - Phi * Phi).cwiseAbs().maxCoeff(), 1e-12);
+    // the covariance is exactly symmetric, and most of Phi is skipped.
+    EXPECT_EQ(sandwich, sandwich.transpose());
+    EXPECT_LT(sparse.nonZeros(), tc17::kSize * tc17::kSize / 2);
   }
 }

@@ -1,5 +1,7 @@
 #include "navbus/core/error_state.hpp"
 
+#include "navbus/core/sparse_rows.hpp"
+
 namespace navbus::core {
 
 StateMask maskOf(std::initializer_list<StateBlock> blocks) {
@@ -28,9 +30,10 @@ void ErrorState::predict(const Matrix17& Phi_full, const Matrix17& Q_full) {
     Q.row(i).setZero();
     Q.col(i).setZero();
   }
-  x_ = Phi * x_;
-  P_ = Phi * P_ * Phi.transpose() + Q;
-  P_ = 0.5 * (P_ + P_.transpose());
+  // Phi is sparse (sparse_rows.hpp); the product is symmetric by construction.
+  const SparseRows<tc17::kSize> phi(Phi);
+  x_ = phi.times(x_);
+  P_ = phi.sandwich(P_) + Q;
 }
 
 void ErrorState::zeroOffDiagonal() {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "navbus/core/rotation.hpp"
+#include "navbus/core/sparse_rows.hpp"
 
 namespace navbus::core {
 
@@ -39,7 +40,8 @@ Matrix17 errorDynamics(const NavState& s, const Eigen::Vector3d& f_b, earth::Gra
 
 Matrix17 transitionMatrix(const Matrix17& F, double dt) {
   const Matrix17 Fdt = F * dt;
-  return Matrix17::Identity() + Fdt + 0.5 * Fdt * Fdt;
+  const SparseRows<tc17::kSize> sparse(Fdt);
+  return Matrix17::Identity() + Fdt + 0.5 * sparse.times(sparse);
 }
 
 }  // namespace navbus::core

@@ -7,6 +7,7 @@
 
 #include "navbus/core/information_fusion.hpp"
 #include "navbus/core/rotation.hpp"
+#include "navbus/core/sparse_rows.hpp"
 
 namespace navbus::core {
 
@@ -112,7 +113,7 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   }
   // The master (federated) covariance is propagated too, so that it is valid between updates.
   central_.predict(Phi, Q);
-  phi_since_update_ = Phi * phi_since_update_;
+  phi_since_update_ = SparseRows<tc17::kSize>(Phi).times(phi_since_update_);
 }
 
 ErrorState& IntegratedFilter::target(AidingKind kind) {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "navbus/core/earth.hpp"
+#include "navbus/core/sparse_rows.hpp"
 
 namespace navbus::core {
 
@@ -38,7 +39,7 @@ void StaticReceiverFilter::propagate(double dt_s) {
       tuning_.clock_drift_noise_mps_per_sqrts * tuning_.clock_drift_noise_mps_per_sqrts * dt_s;
   error_.predict(Phi, Q);
   clock_bias_m_ += clock_drift_mps_ * dt_s;
-  phi_ = Phi * phi_;
+  phi_ = SparseRows<tc17::kSize>(Phi).times(phi_);
 }
 
 const EpochDiagnostics& StaticReceiverFilter::update(
