@@ -19,21 +19,25 @@ void ErrorState::initialize(const Matrix17& P0, const StateMask& active) {
   removeInactiveCoupling();
 }
 
-void ErrorState::predict(const Matrix17& Phi_full, const Matrix17& Q_full) {
-  Matrix17 Phi = Phi_full;
-  Matrix17 Q = Q_full;
-  for (int i = 0; i < tc17::kSize; ++i) {
-    if (active_[static_cast<std::size_t>(i)]) continue;
-    Phi.row(i).setZero();
-    Phi.col(i).setZero();
-    Phi(i, i) = 1.0;
-    Q.row(i).setZero();
-    Q.col(i).setZero();
+void ErrorState::predict(const Matrix17& Phi_full, const Vector17& q_diagonal) {
+  Vector17 q = q_diagonal;
+  const bool all_active = active_.all();
+  Matrix17 Phi_reduced;
+  if (!all_active) {
+    Phi_reduced = Phi_full;
+    for (int i = 0; i < tc17::kSize; ++i) {
+      if (active_[static_cast<std::size_t>(i)]) continue;
+      Phi_reduced.row(i).setZero();
+      Phi_reduced.col(i).setZero();
+      Phi_reduced(i, i) = 1.0;
+      q[i] = 0.0;
+    }
   }
   // Phi is sparse (sparse_rows.hpp); the product is symmetric by construction.
-  const SparseRows<tc17::kSize> phi(Phi);
+  const SparseRows<tc17::kSize> phi(all_active ? Phi_full : Phi_reduced);
   x_ = phi.times(x_);
-  P_ = phi.sandwich(P_) + Q;
+  P_ = phi.sandwich(P_);
+  P_.diagonal() += q;
 }
 
 void ErrorState::zeroOffDiagonal() {

@@ -54,8 +54,13 @@ GlrProtectionLevel::GlrProtectionLevel() {
 
 void GlrProtectionLevel::configure(const IntegrityConfig& config) {
   config_ = config;
-  monitor_.configure(config.detector);
-  signatures_.reserve(static_cast<std::size_t>(glr::kMaxDirections * monitor_.config().window));
+  monitor_.reset();
+  if (!config.enabled) {
+    reset();
+    return;
+  }
+  monitor_.emplace(config.detector);
+  signatures_.reserve(static_cast<std::size_t>(glr::kMaxDirections * monitor_->config().window));
   // The group statistics have as many degrees of freedom as the rank of their directions (up
   // to 6 for the IMU, 3 per satellite), and against the one threshold h a lower rank needs the
   // larger noncentrality: rank 1, the largest, bounds every group (within 2.2 % of rank 6 at
@@ -70,15 +75,16 @@ void GlrProtectionLevel::configure(const IntegrityConfig& config) {
 }
 
 void GlrProtectionLevel::reset() {
-  monitor_.reset();
+  if (monitor_) monitor_->reset();
   have_biases_ = false;
   biases_ = FaultBiases{};
 }
 
 void GlrProtectionLevel::onEpoch(std::int64_t time_ns, const EpochDiagnostics& epoch) {
+  if (!monitor_) return;
   toGlrEpoch(time_ns, epoch, epoch_);
-  if (!monitor_.update(epoch_).valid) return;  // refused: counted by the monitor
-  monitor_.positionSignatures(signatures_);
+  if (!monitor_->update(epoch_).valid) return;  // refused: counted by the monitor
+  monitor_->positionSignatures(signatures_);
   biases_ = FaultBiases{};
   have_biases_ = !signatures_.empty();
   for (const auto& s : signatures_) {

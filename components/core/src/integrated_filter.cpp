@@ -90,30 +90,23 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   if (suspend_filter) return;
   // Discrete process noise: white specific force / rate noise into velocity / attitude
   // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3).
-  Matrix17 Q = Matrix17::Zero();
-  Q.block<3, 3>(kVel.index, kVel.index)
-      .diagonal()
-      .setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt);
-  Q.block<3, 3>(kAtt.index, kAtt.index)
-      .diagonal()
-      .setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt);
-  Q(kClockBias.index, kClockBias.index) = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
-  Q(kClockDrift.index, kClockDrift.index) =
-      std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
+  Vector17 q = Vector17::Zero();
+  q.segment<3>(kVel.index).setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt);
+  q.segment<3>(kAtt.index).setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt);
+  q[kClockBias.index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
+  q[kClockDrift.index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
   for (int a = 0; a < 3; ++a) {
     if (axis_failed_[static_cast<std::size_t>(a)])
-      Q(kAccelBias.index + a, kAccelBias.index + a) =
-          std::pow(tuning_.failed_accel_bias_rw_mps2_per_sqrts, 2) * dt;
+      q[kAccelBias.index + a] = std::pow(tuning_.failed_accel_bias_rw_mps2_per_sqrts, 2) * dt;
     if (axis_failed_[static_cast<std::size_t>(3 + a)])
-      Q(kGyroBias.index + a, kGyroBias.index + a) =
-          std::pow(tuning_.failed_gyro_bias_rw_radps_per_sqrts, 2) * dt;
+      q[kGyroBias.index + a] = std::pow(tuning_.failed_gyro_bias_rw_radps_per_sqrts, 2) * dt;
   }
   if (structure_ == FusionStructure::kFederated) {
-    for (ErrorState& l : local_) l.predict(Phi, Q * tuning_.federated_share);
+    for (ErrorState& l : local_) l.predict(Phi, q * tuning_.federated_share);
   }
   // The master (federated) covariance is propagated too, so that it is valid between updates.
-  central_.predict(Phi, Q);
-  phi_since_update_ = SparseRows<tc17::kSize>(Phi).times(phi_since_update_);
+  central_.predict(Phi, q);
+  if (keep_transition_) phi_since_update_ = SparseRows<tc17::kSize>(Phi).times(phi_since_update_);
 }
 
 ErrorState& IntegratedFilter::target(AidingKind kind) {

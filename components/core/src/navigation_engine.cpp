@@ -125,6 +125,7 @@ void NavigationEngine::start(const NavState& state, double clock_bias_m, double 
                              const Matrix17& initial_covariance) {
   filter_.initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
                      config_.fusion, initial_covariance);
+  filter_.keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled);
   integrity_.reset();  // the hypotheses describe the previous run of the filter
   for (int i = 0; i < 6; ++i) {
     if (failed_axes_ & (1u << i)) filter_.setAxisFailed(i < 3, i % 3, true);

@@ -32,12 +32,12 @@ void StaticReceiverFilter::propagate(double dt_s) {
   // Position constant; clock bias integrates the drift (seed 000 eq. 3).
   Matrix17 Phi = Matrix17::Identity();
   Phi(kClockBias.index, kClockDrift.index) = dt_s;
-  Matrix17 Q = Matrix17::Zero();
-  Q(kClockBias.index, kClockBias.index) =
+  Vector17 q = Vector17::Zero();
+  q[kClockBias.index] =
       tuning_.clock_bias_noise_m_per_sqrts * tuning_.clock_bias_noise_m_per_sqrts * dt_s;
-  Q(kClockDrift.index, kClockDrift.index) =
+  q[kClockDrift.index] =
       tuning_.clock_drift_noise_mps_per_sqrts * tuning_.clock_drift_noise_mps_per_sqrts * dt_s;
-  error_.predict(Phi, Q);
+  error_.predict(Phi, q);
   clock_bias_m_ += clock_drift_mps_ * dt_s;
   phi_ = SparseRows<tc17::kSize>(Phi).times(phi_);
 }

@@ -25,10 +25,11 @@ class ErrorState {
  public:
   void initialize(const Matrix17& P0, const StateMask& active);
 
-  /// x = Phi x, P = Phi P Phi^T + Q on the active states only: an inactive state keeps its
+  /// x = Phi x, P = Phi P Phi^T + Q, Q = diag(q_diagonal) (the process noises of every
+  /// configuration are uncorrelated), on the active states only: an inactive state keeps its
   /// variance, is not driven by the active ones and does not drive them (seed 004 fig. 9: each
   /// reduced filter uses its region of the 15-state system matrix).
-  void predict(const Matrix17& Phi, const Matrix17& Q);
+  void predict(const Matrix17& Phi, const Vector17& q_diagonal);
 
   /// Sequential Joseph-form update, rows decorrelated by the Cholesky factor of R, inactive
   /// columns of H ignored. gate_sigma <= 0 disables gating. Returns one result per row.

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -70,8 +71,9 @@ class GlrProtectionLevel {
   /// Forgets the fault hypotheses (the filter restarted).
   void reset();
 
-  /// One fused pseudorange epoch of the filter (after its update). Recomputes the largest
-  /// position bias of a just-undetectable fault over every hypothesis and onset.
+  /// One fused pseudorange epoch of the filter (after its update); ignored unless enabled.
+  /// Recomputes the largest position bias of a just-undetectable fault over every hypothesis and
+  /// onset.
   void onEpoch(std::int64_t time_ns, const EpochDiagnostics& epoch);
 
   /// The levels for a solution whose position error covariance is `pos_cov_ned` [m^2, N E D],
@@ -80,12 +82,14 @@ class GlrProtectionLevel {
 
   const IntegrityConfig& config() const { return config_; }
   const FaultBiases& faultBiases() const { return biases_; }
-  std::uint64_t epochs() const { return monitor_.epochs(); }
-  std::uint64_t refused() const { return monitor_.refused(); }
+  std::uint64_t epochs() const { return monitor_ ? monitor_->epochs() : 0; }
+  std::uint64_t refused() const { return monitor_ ? monitor_->refused() : 0; }
 
  private:
   IntegrityConfig config_;
-  GlrMonitor monitor_;
+  /// Only with integrity enabled: its windows are about 0.5 MB, copied with every snapshot of
+  /// the engine the filter's recovery history takes.
+  std::optional<GlrMonitor> monitor_;
   GlrEpoch epoch_;
   std::vector<GlrMonitor::PositionSignature> signatures_;
   double detectable_sigmas_{0.0};     ///< sqrt(lambda_md) of a one-direction group

@@ -127,7 +127,10 @@ class IntegratedFilter {
   const Eigen::Vector3d& gyroBias() const { return gyro_bias_; }
   double clockBias() const { return clock_bias_m_; }
   double clockDrift() const { return clock_drift_mps_; }
-  const Matrix17& accumulatedPhi() const { return phi_since_update_; }
+  /// Whether the transition since the last update is kept for the pseudorange epochs'
+  /// diagnostics (the GLR's Phi): on for tightly coupled aiding, off otherwise (it costs a third
+  /// of the covariance propagation).
+  void keepTransitionSinceUpdate(bool on) { keep_transition_ = on; }
   const EpochDiagnostics& lastEpoch() const { return last_epoch_; }
   void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
   bool initialized() const { return ins_.initialized(); }
@@ -149,6 +152,7 @@ class IntegratedFilter {
   std::array<ErrorState, 2> local_;  ///< federated: [0] GNSS/INS, [1] star tracker/INS
   std::array<InnovationWindow<3>, 3> windows_;  ///< adaptive: position, velocity, attitude
   Matrix17 phi_since_update_{Matrix17::Identity()};
+  bool keep_transition_{true};
   EpochDiagnostics last_epoch_;
   Matrix17 prior_P_{Matrix17::Zero()};  ///< P- of the latest GNSS epoch
   AppliedGain applied_gain_;            ///< the diagnostics' K from the sequential updates
