@@ -52,18 +52,27 @@ Constellation::Constellation(std::vector<KeplerElements> almanac) : almanac_(std
       throw std::invalid_argument("almanac entry for sv " + std::to_string(k.sv_id) +
                                   " is not a valid orbit");
     }
+    perifocal_to_eci_.push_back((Eigen::AngleAxisd(k.raan_rad, Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(k.inclination_rad, Eigen::Vector3d::UnitX()) *
+                                 Eigen::AngleAxisd(k.arg_perigee_rad, Eigen::Vector3d::UnitZ()))
+                                    .toRotationMatrix());
   }
 }
 
 const KeplerElements& Constellation::elements(int sv_id) const {
-  for (const auto& k : almanac_) {
-    if (k.sv_id == sv_id) return k;
+  return almanac_[indexOf(sv_id)];
+}
+
+std::size_t Constellation::indexOf(int sv_id) const {
+  for (std::size_t i = 0; i < almanac_.size(); ++i) {
+    if (almanac_[i].sv_id == sv_id) return i;
   }
   throw std::out_of_range("sv " + std::to_string(sv_id) + " is not in the almanac");
 }
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> Constellation::eci(int sv_id, double t) const {
-  const KeplerElements& k = elements(sv_id);
+  const std::size_t index = indexOf(sv_id);
+  const KeplerElements& k = almanac_[index];
   const double a = k.semi_major_axis_m, e = k.eccentricity;
   const double n = std::sqrt(earth::kGm_m3ps2 / (a * a * a));
   const double E = eccentricAnomaly(k.mean_anomaly_rad + n * (t - k.epoch_gps_s), e);
@@ -73,10 +82,7 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> Constellation::eci(int sv_id, double
   const Eigen::Vector3d r_pf(a * (cE - e), b * sE, 0.0);
   const double Edot = n / (1.0 - e * cE);
   const Eigen::Vector3d v_pf(-a * sE * Edot, b * cE * Edot, 0.0);
-  const Eigen::Matrix3d C = (Eigen::AngleAxisd(k.raan_rad, Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(k.inclination_rad, Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(k.arg_perigee_rad, Eigen::Vector3d::UnitZ()))
-                                .toRotationMatrix();
+  const Eigen::Matrix3d& C = perifocal_to_eci_[index];
   return {C * r_pf, C * v_pf};
 }
 

@@ -60,7 +60,10 @@ class Constellation {
 
  private:
   const KeplerElements& elements(int sv_id) const;
+  std::size_t indexOf(int sv_id) const;
   std::vector<KeplerElements> almanac_;
+  /// Per almanac entry: perifocal -> ECI, R3(raan) R1(i) R3(omega); fixed for two-body orbits.
+  std::vector<Eigen::Matrix3d> perifocal_to_eci_;
 };
 
 }  // namespace navbus::sim
