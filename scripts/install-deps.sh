@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libbenchmark-dev                            # tests and benchmarks
   cyclonedds-dev cyclonedds-tools                          # second DDS vendor for the interop test
   iproute2                                                 # network namespaces for the topology test
+  time                                                     # GNU time: peak RSS in scripts/bench.sh
   rtklib                                                   # rnx2rtkp: independent GPS fixes for the real-data test
   python3-matplotlib python3-yaml                          # demo summary and figures (scripts/*.py)
 )

@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# Runs every benchmark and prints one table: each figure beside the baseline measured in the
+# same run (or the issue's absolute target), and the raw outputs under $BENCH_DIR.
+#   bash scripts/bench.sh            (builds first if needed; under a minute on 2 cores)
+# Environment: BENCH_DIR (default: a new temporary directory), BENCH_DOMAIN (DDS domain of the
+# latency ping/pong, default 150), BENCH_RUNS (offline repetitions, default 3).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ -x build/bin/navbus ] && [ -x build/bin/navbus_engine_benchmark ] || bash scripts/build.sh
+dir=${BENCH_DIR:-$(mktemp -d)}
+mkdir -p "$dir"
+domain=${BENCH_DOMAIN:-150}
+runs=${BENCH_RUNS:-3}
+bin=build/bin
+
+echo "bench: engine benchmark (60000 IMU cycles per configuration)" >&2
+"$bin/navbus_engine_benchmark" sim/scenarios 60000 >"$dir/engine.txt" 2>&1
+echo "bench: GLR and dither benchmarks" >&2
+"$bin/navbus_glr_benchmark" >"$dir/glr.txt" 2>&1
+"$bin/navbus_dither_benchmark" >"$dir/dither.txt" 2>&1
+
+echo "bench: navbus offline, seed 001, 3600 s, $runs runs" >&2
+for i in $(seq "$runs"); do
+  /usr/bin/time -f "%e %M" -o "$dir/offline_time_$i.txt" \
+    "$bin/navbus" --log-level warn offline --scenario sim/scenarios/seed001_leo.yaml \
+    --filter config/filter_seed001_lc.yaml --duration 3600 --start config -o "$dir/offline"
+done
+
+echo "bench: raw Fast DDS ping/pong, UDP loopback, domain $domain" >&2
+"$bin/navbus" -d "$domain" --log-level warn latency pong --duration 60 >"$dir/pong.txt" 2>&1 &
+pong=$!
+"$bin/navbus" -d "$domain" --log-level warn latency ping --samples 5000 --warmup 500 --rate 1000 \
+  >"$dir/ping.txt" 2>&1 || true
+kill "$pong" 2>/dev/null || true
+wait "$pong" 2>/dev/null || true
+rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2>/dev/null || true
+
+python3 - "$dir" "$runs" <<'EOF'
+import re, statistics, sys
+d, runs = sys.argv[1], int(sys.argv[2])
+rows = []
+def row(figure, value, reference, verdict=""):
+    rows.append((figure, value, reference, verdict))
+
+engine = open(f"{d}/engine.txt").read()
+def us(label):
+    m = re.search(re.escape(label) + r"\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)", engine)
+    return (float(m.group(1)), float(m.group(2)), float(m.group(3))) if m else None
+base = us("mechanization + covariance (base)")
+if base:
+    row("engine: mechanization + covariance, seed 001", f"{base[0]:.2f} us/cycle",
+        "target <= 2 us", "met" if base[0] <= 2.0 else "NOT met")
+    row("engine: heap allocations per cycle", f"{base[2]:.3f}", "target 0",
+        "met" if base[2] == 0 else "NOT met")
+for label in ("loosely coupled, centralized", "loosely coupled, federated",
+              "tightly coupled (pseudoranges)"):
+    v = us(label)
+    if v:
+        row(f"engine: {label}", f"{v[0]:.2f} us/cycle", f"{v[1]:.2f} x base")
+v = us("aligned start + protection levels")
+if v:
+    row("engine: aligned start + protection levels, seed 000", f"{v[0]:.2f} us/cycle",
+        f"{v[1]:.3f} x configured start", "met (<= 1.20)" if v[1] <= 1.2 else "NOT met (> 1.20)")
+
+times, rss = [], []
+for i in range(1, runs + 1):
+    t, m = open(f"{d}/offline_time_{i}.txt").read().split()[-2:]
+    times.append(float(t)); rss.append(int(m) / 1024.0)
+med = statistics.median(times)
+row(f"offline seed 001, 3600 s (median of {runs})", f"{med:.2f} s", "target < 2 s",
+    "met" if med < 2.0 else "NOT met")
+row("offline peak RSS", f"{max(rss):.1f} MiB", "")
+
+glr = re.search(r"seed 001 LEO: 12 satellites\s+12.0\s+20\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)",
+                open(f"{d}/glr.txt").read())
+if glr:
+    row("GLR per epoch, 12 satellites, M = 20", f"{float(glr.group(3)):.1f} us",
+        f"{float(glr.group(3)) / float(glr.group(2)):.2f} x the TC update; target <= 50 us",
+        "met" if float(glr.group(3)) <= 50 else "NOT met")
+dither = re.search(r"monitor\s+([0-9.]+) s\s+=\s+([0-9.]+) % of one core", open(f"{d}/dither.txt").read())
+if dither:
+    row("dither monitor, share of one core", f"{dither.group(2)} %", "target < 1 %",
+        "met" if float(dither.group(2)) < 1 else "NOT met")
+
+ping = open(f"{d}/ping.txt").read()
+ow = re.search(r"one way \[us\]\s+median ([0-9.]+)\s+p90 ([0-9.]+)\s+p99 ([0-9.]+)\s+p99.9 ([0-9.]+)\s+max ([0-9.]+)", ping)
+if ow:
+    row("raw Fast DDS one-way, UDP loopback, median / p99",
+        f"{float(ow.group(1)):.0f} / {float(ow.group(3)):.0f} us",
+        f"two hops: {2 * float(ow.group(1)):.0f} / {2 * float(ow.group(3)):.0f} us")
+else:
+    row("raw Fast DDS one-way, UDP loopback", "no result", f"see {d}/ping.txt")
+
+w = [max(len(r[i]) for r in rows + [("figure", "value", "baseline / target", "")]) for i in range(4)]
+fmt = "  ".join(f"{{:<{x}}}" for x in w)
+print(fmt.format("figure", "value", "baseline / target", ""))
+for r in rows:
+    print(fmt.format(*r))
+print(f"raw outputs: {d}")
+EOF
