@@ -147,7 +147,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                   "time_jump",
                   "fault_monitor",
                   "alignment",
-                  "integrity"},
+                  "integrity",
+                  "low_latency_output"},
                  bus::kParticipantKeys);
   core::EngineConfig& e = c.engine;
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
@@ -157,6 +158,13 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   c.sequencer_max_wait_ns =
       seconds(bus::checkRange(bus::get<double>(root, "", "sequencer_max_wait_s", 0.5), 0.001, 60.0,
                               "sequencer_max_wait_s"));
+
+  const YAML::Node low = root["low_latency_output"];
+  bus::checkKeys(low, "low_latency_output", {"enabled", "max_buffered_increments"});
+  c.low_latency_output = bus::get<bool>(low, "low_latency_output", "enabled", false);
+  c.low_latency_max_buffered = static_cast<std::size_t>(
+      bus::checkRange(bus::get<double>(low, "low_latency_output", "max_buffered_increments", 400),
+                      1.0, 100000.0, "low_latency_output.max_buffered_increments"));
 
   const YAML::Node rec = root["recovery"];
   bus::checkKeys(rec, "recovery",

@@ -38,6 +38,11 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
               ? p.createWriter<navbus::FilterDiagnosticsPubSubType>(
                     bus::topic::kFilterDiagnostics, bus::profile::kDiagnosticsWriter)
               : bus::Writer<navbus::FilterDiagnostics>()),
+      low_latency_writer_(
+          config.low_latency_output
+              ? p.createWriter<navbus::NavigationSolutionPubSubType>(
+                    bus::topic::kNavSolutionLowLatency, bus::profile::kLowLatencySolutionWriter)
+              : bus::Writer<navbus::NavigationSolution>()),
       pipeline_(
           config, p.health(),
           {[this](const navbus::NavigationSolution& s) {
@@ -49,7 +54,8 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
            publishesDiagnostics(config)
                ? std::function<void(const navbus::FilterDiagnostics&)>(
                      [this](const navbus::FilterDiagnostics& d) { diagnostics_writer_.write(d); })
-               : nullptr}),
+               : nullptr,
+           [this](const navbus::NavigationSolution& s) { low_latency_writer_.write(s); }}),
       not_producing_ns_(
           std::max(kNotProducingMinNs, kNotProducingPeriods * config.engine.solution_period_ns)),
       imu_writers_(bus::topic::kImuIncrement, p.health().stream(bus::topic::kImuIncrement)),

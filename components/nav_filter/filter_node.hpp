@@ -45,6 +45,7 @@ class FilterNode {
   bus::Participant& participant_;
   bus::Writer<navbus::NavigationSolution> solution_writer_;
   bus::Writer<navbus::FilterDiagnostics> diagnostics_writer_;
+  bus::Writer<navbus::NavigationSolution> low_latency_writer_;  ///< when configured
   FilterPipeline pipeline_;
   std::int64_t not_producing_ns_;      ///< silence of the solution output that is "not producing"
   std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)

@@ -119,6 +119,7 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
       sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
       history_(config.recovery_history_ns, config.recovery_snapshot_period_ns),
       engine_(config.engine),
+      predictor_(config.engine.tuning.gravity, config.low_latency_max_buffered),
       imu_gate_(bus::topic::kImuIncrement, health.stream(bus::topic::kImuIncrement),
                 config.time_jump, &time_reference_),
       gnss_obs_gate_(bus::topic::kGnssObservations, health.stream(bus::topic::kGnssObservations),
@@ -181,8 +182,20 @@ bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, StreamId id
 void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
   if (!admit(imu_gate_, msg, {kRankImu, msg.sensor_id()}, config_.imu)) return;
   if (imu_gate_.sourceRestarted()) startNewRun();
-  queue(imu_gate_, {kRankImu, msg.sensor_id()}, static_cast<std::int64_t>(msg.time_gps_ns()),
-        bus::toCore(msg));
+  const core::ImuIncrement inc = bus::toCore(msg);
+  queue(imu_gate_, {kRankImu, msg.sensor_id()}, inc.time_ns, inc);
+  if (config_.low_latency_output && sinks_.low_latency) publishLowLatency(inc);
+}
+
+void FilterPipeline::publishLowLatency(const core::ImuIncrement& inc) {
+  const std::optional<core::NavState> s = predictor_.addIncrement(inc);
+  if (!s) return;
+  navbus::NavigationSolution out = anchor_solution_;
+  out.seq(++low_latency_seq_);
+  bus::fillSolution(*s, out);
+  out.output(navbus::OUTPUT_LOW_LATENCY);
+  out.propagated_from_gps_ns(anchor_solution_.time_gps_ns());
+  sinks_.low_latency(out);
 }
 
 void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
@@ -217,6 +230,8 @@ void FilterPipeline::startNewRun() {
   history_ =
       InputHistory<FilterInput>(config_.recovery_history_ns, config_.recovery_snapshot_period_ns);
   replay_.clear();
+  predictor_.reset();
+  low_latency_seq_ = 0;
   first_input_ns_ = -1;
   solution_seq_ = 0;
   diagnostics_seq_ = 0;
@@ -325,6 +340,10 @@ void FilterPipeline::publishSolution() {
     sol.vertical_protection_level_m(pl.vertical_m);
   }
   sinks_.solution(sol);
+  if (config_.low_latency_output && sinks_.low_latency) {
+    predictor_.setAnchor({engine_.state(), engine_.accelBias(), engine_.gyroBias()});
+    anchor_solution_ = sol;
+  }
 }
 
 void FilterPipeline::publishHeldSolution() {
@@ -647,6 +666,12 @@ std::string FilterPipeline::summary() const {
   if (config_.engine.integrity.enabled) {
     out << ", protection-level epochs " << engine_.integrity().epochs() << " refused "
         << engine_.integrity().refused();
+  }
+  if (config_.low_latency_output) {
+    const core::OutputPredictorCounters& l = predictor_.counters();
+    out << ", low-latency outputs " << l.outputs << " (increments not after the anchor "
+        << l.before_anchor << ", out of order " << l.not_after_previous << ", gaps " << l.gaps
+        << ", beyond the buffer " << l.overflow << ")";
   }
   if (new_runs_ > 0) {
     out << ", new runs after a source restart " << new_runs_ << " (before the latest: solutions "

@@ -25,6 +25,7 @@
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/navigation_engine.hpp"
+#include "navbus/core/output_predictor.hpp"
 
 namespace navbus::nav_filter {
 
@@ -58,6 +59,9 @@ class FilterPipeline {
   struct Sinks {
     std::function<void(const navbus::NavigationSolution&)> solution;
     std::function<void(const navbus::FilterDiagnostics&)> diagnostics;  ///< may be empty
+    /// The low-latency output (FilterConfig::low_latency_output): one per IMU increment as it
+    /// arrives, before the ordered merge; may be empty.
+    std::function<void(const navbus::NavigationSolution&)> low_latency{};
   };
 
   FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks);
@@ -138,6 +142,8 @@ class FilterPipeline {
   void startNewRun();
   void publishSolution();
   void publishDiagnostics();
+  /// Propagates the low-latency output with an arrived increment and publishes it.
+  void publishLowLatency(const core::ImuIncrement& inc);
   bool applyStreamCommand(const navbus::FilterCommand& c);
 
   FilterConfig config_;
@@ -147,6 +153,9 @@ class FilterPipeline {
   std::deque<FilterInput> replay_;
   bool replaying_{false};
   core::NavigationEngine engine_;
+  core::OutputPredictor predictor_;
+  navbus::NavigationSolution anchor_solution_;  ///< the low-latency output's anchor, as published
+  std::uint64_t low_latency_seq_{0};
   bus::TimeReference
       time_reference_;  ///< latest data time accepted on any input (before the gates)
   bus::StreamGate imu_gate_;

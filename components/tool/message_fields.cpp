@@ -43,6 +43,16 @@ const char* enumName(navbus::IntegrityState v) {
   return "UNKNOWN";
 }
 
+const char* enumName(navbus::SolutionOutput v) {
+  switch (v) {
+    case navbus::OUTPUT_DETERMINISTIC:
+      return "DETERMINISTIC";
+    case navbus::OUTPUT_LOW_LATENCY:
+      return "LOW_LATENCY";
+  }
+  return "UNKNOWN";
+}
+
 const char* enumName(navbus::StartSource v) {
   switch (v) {
     case navbus::START_CONFIGURED:

@@ -22,6 +22,7 @@ namespace navbus::tool {
 const char* enumName(navbus::FilterMode v);
 const char* enumName(navbus::FusionStructure v);
 const char* enumName(navbus::StartSource v);
+const char* enumName(navbus::SolutionOutput v);
 const char* enumName(navbus::IntegrityState v);
 const char* enumName(navbus::FaultSource v);
 const char* enumName(navbus::FaultEvent v);
@@ -136,6 +137,8 @@ void visitFields(const navbus::NavigationSolution& m, V& v) {
   v("integrity", m.integrity());
   v("horizontal_protection_level_m", m.horizontal_protection_level_m());
   v("vertical_protection_level_m", m.vertical_protection_level_m());
+  v("output", m.output());
+  v("propagated_from_gps_ns", m.propagated_from_gps_ns());
 }
 template <class V>
 void visitFields(const navbus::FilterDiagnostics& m, V& v) {

@@ -39,6 +39,8 @@ const std::vector<TopicEntry>& topicRegistry() {
       entry<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker,
                                                    profile::kMeasurementReader),
       entry<navbus::NavigationSolutionPubSubType>(topic::kNavSolution, profile::kSolutionReader),
+      entry<navbus::NavigationSolutionPubSubType>(topic::kNavSolutionLowLatency,
+                                                  profile::kLowLatencySolutionReader),
       entry<navbus::FilterDiagnosticsPubSubType>(topic::kFilterDiagnostics,
                                                  profile::kDiagnosticsReader),
       entry<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader),

@@ -5,11 +5,14 @@
 
 #include "filter_config.hpp"
 #include "filter_pipeline.hpp"
+#include "frame_publisher.hpp"
 #include "monitor_liveness.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/sim/scenario_source.hpp"
+
+#include <map>
 
 using namespace navbus;
 
@@ -173,4 +176,111 @@ TEST(FaultMonitorLiveness, SolutionsAreFlaggedWhileNoMonitorIsAlive) {
   EXPECT_FALSE(pipeline.degraded());
   EXPECT_NE(pipeline.summary().find("fault monitor found not alive 1 time(s)"), std::string::npos)
       << pipeline.summary();
+}
+
+// The low-latency output: one per arriving increment once a solution exists, each the anchor
+// solution (as published) mechanized through the increments after it, so that a subscriber can
+// reproduce every output bit for bit from the bus; and it stays close to the deterministic
+// solution of the same time (it lacks only the fixes after its anchor).
+TEST(LowLatencyOutput, ReproducibleFromItsAnchorSolutionAndCloseToTheFilter) {
+  auto cfg = nav_filter::parseFilterConfig(
+      YAML::Load("initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
+                 "mode: loosely_coupled\n"
+                 "inputs: {imu: {id: 1, period_s: 0.01}, gnss_fix: {id: 1, period_s: 1.0}}\n"
+                 "sequencer_max_wait_s: 2.0\n"  // waits for the first fix (1 s into the data)
+                 "low_latency_output: {enabled: true}\n"));
+  bus::HealthCounters health("test");
+  std::vector<NavigationSolution> solutions, fast;
+  std::vector<std::int64_t> ahead_ns;
+  const nav_filter::FilterPipeline* pipeline_ptr = nullptr;
+  nav_filter::FilterPipeline pipeline(
+      cfg, health,
+      {[&](const NavigationSolution& s) { solutions.push_back(s); }, nullptr,
+       [&](const NavigationSolution& s) {
+         fast.push_back(s);
+         // How far this output is ahead of what the ordered filter has integrated.
+         ahead_ns.push_back(static_cast<std::int64_t>(s.time_gps_ns()) -
+                            pipeline_ptr->engine().state().time_ns);
+       }});
+  pipeline_ptr = &pipeline;
+  sim::ScenarioConfig src_cfg = sourceConfig();
+  src_cfg.gnss_every_n_increments = 100;
+  src_cfg.segments.resize(1);
+  src_cfg.segments[0].duration_s = 100.0;
+  src_cfg.segments[0].accel_mps2 = 0.5;
+  sim::ScenarioSource src(src_cfg);
+  std::vector<core::ImuIncrement> increments;
+  std::uint64_t seq = 0, fix_seq = 0;
+  std::int64_t now = 0;
+  // The fixes come 35 ms late (as on a bus), so the filter holds the increments after them.
+  std::vector<std::pair<std::int64_t, GnssFix>> late_fixes;
+  for (int k = 0; k < 3000; ++k) {
+    const sim::SensorFrame f = src.next();
+    increments.push_back(f.increment);
+    pipeline.onImu(bus::toIdl(f.increment, 1, ++seq));
+    if (f.has_gnss)
+      late_fixes.emplace_back(f.time_ns + 35'000'000, sensor_sim::toIdl(f.fix, 1, ++fix_seq));
+    while (!late_fixes.empty() && late_fixes.front().first <= f.time_ns) {
+      pipeline.onGnssFix(late_fixes.front().second);
+      late_fixes.erase(late_fixes.begin());
+    }
+    pipeline.pump(now += 10'000'000);
+  }
+  ASSERT_GT(solutions.size(), 100u);
+  ASSERT_GT(fast.size(), 2500u);
+  // Every output is its anchor, as published, mechanized by an independent strapdown.
+  std::map<std::uint64_t, const NavigationSolution*> by_time;
+  for (const auto& s : solutions) by_time[s.time_gps_ns()] = &s;
+  std::size_t compared = 0;
+  double max_diff_m = 0.0;
+  std::uint64_t max_lead_ns = 0;  // how far an output runs ahead of its anchor
+  for (const auto& out : fast) {
+    EXPECT_EQ(out.output(), OUTPUT_LOW_LATENCY);
+    max_lead_ns = std::max(max_lead_ns, out.time_gps_ns() - out.propagated_from_gps_ns());
+    const auto anchor = by_time.find(out.propagated_from_gps_ns());
+    ASSERT_NE(anchor, by_time.end()) << "output at " << out.time_gps_ns();
+    const NavigationSolution& a = *anchor->second;
+    EXPECT_LT(a.time_gps_ns(), out.time_gps_ns());
+    core::NavState s;
+    s.time_ns = static_cast<std::int64_t>(a.time_gps_ns());
+    s.position = {a.latitude_rad(), a.longitude_rad(), a.height_m()};
+    s.vel_ned_mps = Eigen::Vector3d(a.vel_ned_mps().data());
+    s.q_b_to_n =
+        Eigen::Quaterniond(a.q_b_to_n()[0], a.q_b_to_n()[1], a.q_b_to_n()[2], a.q_b_to_n()[3]);
+    core::StrapdownNed ins(core::earth::GravityModel::kWgs84Normal);
+    ins.initialize(s);
+    const Eigen::Vector3d ba(a.accel_bias_b_mps2().data()), bg(a.gyro_bias_b_radps().data());
+    for (core::ImuIncrement inc : increments) {
+      if (inc.time_ns <= s.time_ns || inc.time_ns > static_cast<std::int64_t>(out.time_gps_ns()))
+        continue;
+      inc.delta_vel_b_mps -= ba * inc.interval_s;
+      inc.delta_angle_b_rad -= bg * inc.interval_s;
+      ins.propagate(inc);
+    }
+    EXPECT_EQ(ins.state().position.latitude_rad, out.latitude_rad());
+    EXPECT_EQ(ins.state().vel_ned_mps.z(), out.vel_ned_mps()[2]);
+    EXPECT_EQ(ins.state().q_b_to_n.w(), out.q_b_to_n()[0]);
+    // Close to the deterministic solution of the same time, where there is one.
+    const auto same = by_time.find(out.time_gps_ns());
+    if (same != by_time.end()) {
+      ++compared;
+      const double dn = (same->second->latitude_rad() - out.latitude_rad()) * 6.4e6;
+      const double de = (same->second->longitude_rad() - out.longitude_rad()) * 5.1e6;
+      max_diff_m = std::max(max_diff_m, std::hypot(dn, de));
+    }
+  }
+  std::printf(
+      "low-latency outputs %zu, deterministic solutions %zu, compared %zu, max horizontal "
+      "difference %.4f m, max lead over the anchor %.3f s\n",
+      fast.size(), solutions.size(), compared, max_diff_m, 1e-9 * static_cast<double>(max_lead_ns));
+  EXPECT_GT(pipeline.engine().counters().fixes_fused, 25u);
+  // The filter holds the increments after a fix's time until the fix arrives (35 ms): the
+  // outputs of those increments run ahead of it.
+  const auto held = std::count_if(ahead_ns.begin(), ahead_ns.end(),
+                                  [](std::int64_t a) { return a >= 30'000'000; });
+  std::printf("outputs ahead of the filter by >= 30 ms: %td\n", held);
+  EXPECT_GE(held, 25);
+  EXPECT_GT(compared, 100u);
+  EXPECT_LT(max_diff_m, 5.0);
+  EXPECT_NE(pipeline.summary().find("low-latency outputs"), std::string::npos);
 }
