@@ -6,9 +6,12 @@
 #include <fstream>
 
 #include <navbus_idl/ImuPubSubTypes.h>
+#include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "navbus/bus/app.hpp"
+#include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
+#include "navbus/core/earth.hpp"
 
 namespace navbus::tool {
 
@@ -110,6 +113,109 @@ int runPing(bus::Participant& p, const LatencyOptions& o) {
   return lost == 0 ? bus::kExitOk : bus::kExitRuntimeError;
 }
 
+void printOneWay(const char* what, const LatencyStats& s, std::size_t expected) {
+  const auto us = [](double ns) { return ns / 1000.0; };
+  std::printf("%-34s median %8.1f  p90 %8.1f  p99 %8.1f  p99.9 %8.1f  max %9.1f  (%zu of %zu)\n",
+              what, us(s.median_ns), us(s.p90_ns), us(s.p99_ns), us(s.p999_ns), us(s.max_ns),
+              s.count, expected);
+}
+
+/// The increment of a body at rest, level, x north, at `lat_rad` (specific force against
+/// gravity, the Earth rate), over `dt_s`.
+core::ImuIncrement restingIncrement(double lat_rad, double height_m, double dt_s) {
+  core::ImuIncrement inc;
+  inc.interval_s = dt_s;
+  inc.delta_vel_b_mps = -core::earth::gravityNed(lat_rad, height_m) * dt_s;
+  inc.delta_angle_b_rad = core::earth::omegaIeNed(lat_rad) * dt_s;
+  return inc;
+}
+
+/// End to end: this process is the IMU of a running navbus-filter (sensor 1 at --rate, time
+/// stamps from the system clock's GPS-like count) and times each increment from its write to
+/// the reception of the low-latency output of the same time, and of the deterministic
+/// solution where one has that time.
+int runImuSource(bus::Participant& p, const LatencyOptions& o) {
+  auto imu = p.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement,
+                                                    bus::profile::kSensorWriter);
+  const std::size_t total = static_cast<std::size_t>(o.warmup + o.samples);
+  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / o.rate_hz));
+  // Data time of increment k: t0 + (k + 1) period; its write time is kept by k.
+  const std::int64_t t0 = (std::chrono::duration_cast<std::chrono::nanoseconds>(
+                               std::chrono::system_clock::now().time_since_epoch())
+                               .count() /
+                           period_ns) *
+                          period_ns;
+  std::vector<std::int64_t> sent_ns(total, 0), fast_ns(total, -1), solution_ns(total, -1);
+  const auto index = [&](std::uint64_t time_gps_ns) -> std::int64_t {
+    const std::int64_t k = (static_cast<std::int64_t>(time_gps_ns) - t0) / period_ns - 1;
+    return k >= 0 && static_cast<std::size_t>(k) < total &&
+                   t0 + (k + 1) * period_ns == static_cast<std::int64_t>(time_gps_ns)
+               ? k
+               : -1;
+  };
+  const auto receiver = [&](std::vector<std::int64_t>& into) {
+    return [&, into_ptr = &into](const NavigationSolution& s, const auto&) {
+      const std::int64_t k = index(s.time_gps_ns());
+      if (k >= 0 && (*into_ptr)[static_cast<std::size_t>(k)] < 0 &&
+          sent_ns[static_cast<std::size_t>(k)] > 0)
+        (*into_ptr)[static_cast<std::size_t>(k)] = nowNs() - sent_ns[static_cast<std::size_t>(k)];
+    };
+  };
+  auto* fast = p.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolutionLowLatency,
+                                                         bus::profile::kLowLatencySolutionReader,
+                                                         receiver(fast_ns));
+  auto* det = p.subscribe<NavigationSolutionPubSubType>(
+      bus::topic::kNavSolution, bus::profile::kSolutionReader, receiver(solution_ns));
+  if (!spinUntil(p, o.match_timeout_s, [&] {
+        return imu.matchedReaders() > 0 && matchedWriters(fast) > 0 && matchedWriters(det) > 0;
+      })) {
+    spdlog::error(
+        "no navbus-filter with the low-latency output matched within {} s (run navbus-filter "
+        "with config/filter_latency.yaml, or any configuration with low_latency_output.enabled "
+        "and this IMU: sensor 1 at --rate, same domain, profile and QoS file)",
+        o.match_timeout_s);
+    return bus::kExitRuntimeError;
+  }
+  const double lat = 36.5 * M_PI / 180.0, height = 100.0;  // config/filter_latency.yaml
+  core::ImuIncrement inc = restingIncrement(lat, height, 1e-9 * static_cast<double>(period_ns));
+  const auto period =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::nanoseconds(period_ns));
+  auto next = Clock::now();
+  const auto start = next;
+  for (std::size_t k = 0; k < total && !p.stopping(); ++k) {
+    while (Clock::now() < next) p.spinOnce(next - Clock::now());
+    inc.time_ns = t0 + static_cast<std::int64_t>(k + 1) * period_ns;
+    const ImuIncrement msg = bus::toIdl(inc, 1, k + 1);
+    sent_ns[k] = nowNs();
+    imu.write(msg);
+    next += period;
+  }
+  spinUntil(p, 2.0, [&] { return fast_ns.back() >= 0; });
+  const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+  const auto timed = [&](const std::vector<std::int64_t>& v) {
+    std::vector<std::int64_t> out;
+    for (std::size_t k = static_cast<std::size_t>(o.warmup); k < v.size(); ++k)
+      if (v[k] >= 0) out.push_back(v[k]);
+    return out;
+  };
+  const std::vector<std::int64_t> fast_t = timed(fast_ns), det_t = timed(solution_ns);
+  const std::size_t solutions_expected = static_cast<std::size_t>(std::count_if(
+      solution_ns.begin() + o.warmup, solution_ns.end(), [](std::int64_t v) { return v >= 0; }));
+  std::printf("IMU written -> received [us], %zu increments at %.1f Hz over %.1f s:\n",
+              static_cast<std::size_t>(o.samples), o.rate_hz, elapsed_s);
+  printOneWay("low-latency output", latencyStats(fast_t), static_cast<std::size_t>(o.samples));
+  printOneWay("deterministic solution", latencyStats(det_t), solutions_expected);
+  if (!o.csv.empty()) {
+    std::ofstream csv(o.csv);
+    csv << "seq,low_latency_ns,solution_ns\n";
+    for (std::size_t k = static_cast<std::size_t>(o.warmup); k < total; ++k)
+      csv << k + 1 << ',' << fast_ns[k] << ',' << solution_ns[k] << '\n';
+  }
+  p.finish();
+  return fast_t.size() == static_cast<std::size_t>(o.samples) ? bus::kExitOk
+                                                              : bus::kExitRuntimeError;
+}
+
 }  // namespace
 
 LatencyStats latencyStats(std::vector<std::int64_t> v) {
@@ -132,7 +238,9 @@ LatencyStats latencyStats(std::vector<std::int64_t> v) {
 int runLatencyCommand(const bus::Participant::Options& participant, const LatencyOptions& o,
                       bus::ShutdownSignal& shutdown) {
   bus::Participant p(participant, shutdown);
-  return o.role == "pong" ? runPong(p, o) : runPing(p, o);
+  if (o.role == "pong") return runPong(p, o);
+  if (o.role == "imu") return runImuSource(p, o);
+  return runPing(p, o);
 }
 
 }  // namespace navbus::tool

@@ -2,7 +2,9 @@
 // process pings (writes navbus/latency/ping at a fixed rate, times the echo), another pongs
 // (echoes each ping on navbus/latency/pong at once). Both use the sensor stream profiles, so
 // the figure is what an IMU increment costs on the participant profile under test (UDP
-// loopback, shared memory, LAN, discovery server, DDS Security).
+// loopback, shared memory, LAN, discovery server, DDS Security). A third role, `imu`, is the
+// IMU of a running navbus-filter: increment written -> low-latency output (and deterministic
+// solution) received, the end-to-end figure to compare with the raw two hops.
 #pragma once
 
 #include <cstdint>
@@ -14,7 +16,7 @@
 namespace navbus::tool {
 
 struct LatencyOptions {
-  std::string role;              ///< "ping" or "pong"
+  std::string role;              ///< "ping", "pong" or "imu"
   int samples{2000};             ///< pings timed (after the warm-up)
   int warmup{100};               ///< pings sent first and not timed
   double rate_hz{200.0};         ///< ping rate [Hz] (the navigation IMU rate)

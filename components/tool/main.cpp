@@ -191,11 +191,13 @@ int main(int argc, char** argv) {
   nb::tool::LatencyOptions latency;
   auto* latency_cmd = app.add_subcommand(
       "latency",
-      "round-trip latency with navbus's message type: run `pong` in one process, "
-      "`ping` in another (same domain, --profile, --qos)");
-  latency_cmd->add_option("role", latency.role, "ping or pong")
+      "latency over the bus: `ping` against a `pong` process (raw Fast DDS, navbus's message "
+      "type), or `imu` as the IMU of a running navbus-filter with the low-latency output "
+      "(config/filter_latency.yaml): increment written -> output received (same domain, "
+      "--profile, --qos)");
+  latency_cmd->add_option("role", latency.role, "ping, pong or imu")
       ->required()
-      ->check(CLI::IsMember({"ping", "pong"}));
+      ->check(CLI::IsMember({"ping", "pong", "imu"}));
   latency_cmd->add_option("--samples", latency.samples, "pings timed after the warm-up")
       ->check(CLI::Range(1, 10'000'000));
   latency_cmd->add_option("--warmup", latency.warmup, "pings sent first, not timed")
@@ -207,7 +209,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.1, 600.0));
   latency_cmd->add_option("--duration", latency.pong_duration_s,
                           "pong: stop after this many seconds (0: until SIGINT)");
-  latency_cmd->add_option("--csv", latency.csv, "ping: write every round trip [ns] to this file");
+  latency_cmd->add_option("--csv", latency.csv,
+                          "ping: every round trip [ns]; imu: every increment's latencies [ns] "
+                          "(-1: not received)");
 
   nb::tool::OfflineOptions offline;
   auto* offline_cmd = app.add_subcommand(
