@@ -234,10 +234,9 @@ TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
     s.vel_ned_mps = 200.0 * Eigen::Vector3d(u(rng), u(rng), u(rng));
     s.q_b_to_n =
         navbus::core::quaternionFromRotationVector(Eigen::Vector3d(u(rng), u(rng), u(rng)));
-    Mat17 Phi = navbus::core::transitionMatrix(
-        navbus::core::errorDynamics(s, Eigen::Vector3d(u(rng), u(rng), -9.8),
-                                    earth::GravityModel::kWgs84Normal),
-        0.005);
+    const Mat17 F = navbus::core::errorDynamics(s, Eigen::Vector3d(u(rng), u(rng), -9.8),
+                                                earth::GravityModel::kWgs84Normal);
+    Mat17 Phi = navbus::core::transitionMatrix(F, 0.005);
     if (trial % 2 == 1) {
       Phi.row(tc17::kClockBias.index).setZero();
       Phi.col(tc17::kClockBias.index).setZero();
@@ -253,8 +252,13 @@ TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
     const Vec17 x = Vec17::Random();
     EXPECT_LT((sparse.times(x) - Phi * x).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((sparse.times(sparse) - Phi * Phi).cwiseAbs().maxCoeff(), 1e-12);
-    // the covariance is exactly symmetric, and most of Phi is skipped.
+    // the covariance is exactly symmetric, and most of Phi is skipped;
     EXPECT_EQ(sandwich, sandwich.transpose());
     EXPECT_LT(sparse.nonZeros(), tc17::kSize * tc17::kSize / 2);
+    // the structural patterns cover F and Phi, and give the same products.
+    EXPECT_TRUE(navbus::core::errorDynamicsPattern().covers(F));
+    EXPECT_TRUE(navbus::core::transitionPattern().covers(Phi));
+    const navbus::core::SparseRows<tc17::kSize> structural(Phi, navbus::core::transitionPattern());
+    EXPECT_EQ(structural.sandwich(P), sandwich);
   }
 }

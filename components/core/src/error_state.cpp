@@ -1,5 +1,7 @@
 #include "navbus/core/error_state.hpp"
 
+#include <cassert>
+
 #include "navbus/core/sparse_rows.hpp"
 
 namespace navbus::core {
@@ -33,8 +35,11 @@ void ErrorState::predict(const Matrix17& Phi_full, const Vector17& q_diagonal) {
       q[i] = 0.0;
     }
   }
-  // Phi is sparse (sparse_rows.hpp); the product is symmetric by construction.
-  const SparseRows<tc17::kSize> phi(all_active ? Phi_full : Phi_reduced);
+  // Phi is sparse, within the error model's transition pattern (sparse_rows.hpp,
+  // ins_error_model.hpp); the product is symmetric by construction.
+  const Matrix17& Phi = all_active ? Phi_full : Phi_reduced;
+  assert(transitionPattern().covers(Phi));
+  const SparseRows<tc17::kSize> phi(Phi, transitionPattern());
   x_ = phi.times(x_);
   P_ = phi.sandwich(P_);
   P_.diagonal() += q;

@@ -40,8 +40,35 @@ Matrix17 errorDynamics(const NavState& s, const Eigen::Vector3d& f_b, earth::Gra
 
 Matrix17 transitionMatrix(const Matrix17& F, double dt) {
   const Matrix17 Fdt = F * dt;
-  const SparseRows<tc17::kSize> sparse(Fdt);
+  const SparseRows<tc17::kSize> sparse(Fdt, errorDynamicsPattern());
   return Matrix17::Identity() + Fdt + 0.5 * sparse.times(sparse);
+}
+
+namespace {
+/// F at a state where every term of errorDynamics() is nonzero: off the equator and the
+/// meridians, moving in all three axes, rotated about a skew axis, a specific force with
+/// three components.
+Matrix17 genericErrorDynamics() {
+  NavState s;
+  s.position = {0.6, 2.2, 1000.0};
+  s.vel_ned_mps = Eigen::Vector3d(120.0, -80.0, 15.0);
+  s.q_b_to_n = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  return errorDynamics(s, Eigen::Vector3d(0.3, -0.2, -9.7), earth::GravityModel::kWgs84Normal);
+}
+}  // namespace
+
+const SparsityPattern<tc17::kSize>& errorDynamicsPattern() {
+  static const auto pattern = SparsityPattern<tc17::kSize>::of(genericErrorDynamics());
+  return pattern;
+}
+
+const SparsityPattern<tc17::kSize>& transitionPattern() {
+  // Magnitudes, so that no sum cancels to an accidental zero.
+  static const auto pattern = [] {
+    const Matrix17 A = genericErrorDynamics().cwiseAbs();
+    return SparsityPattern<tc17::kSize>::of(Matrix17::Identity() + A + A * A);
+  }();
+  return pattern;
 }
 
 }  // namespace navbus::core

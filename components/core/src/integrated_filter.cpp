@@ -106,7 +106,8 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   }
   // The master (federated) covariance is propagated too, so that it is valid between updates.
   central_.predict(Phi, q);
-  if (keep_transition_) phi_since_update_ = SparseRows<tc17::kSize>(Phi).times(phi_since_update_);
+  if (keep_transition_)
+    phi_since_update_ = SparseRows<tc17::kSize>(Phi, transitionPattern()).times(phi_since_update_);
 }
 
 ErrorState& IntegratedFilter::target(AidingKind kind) {

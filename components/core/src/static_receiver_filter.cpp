@@ -39,7 +39,7 @@ void StaticReceiverFilter::propagate(double dt_s) {
       tuning_.clock_drift_noise_mps_per_sqrts * tuning_.clock_drift_noise_mps_per_sqrts * dt_s;
   error_.predict(Phi, q);
   clock_bias_m_ += clock_drift_mps_ * dt_s;
-  phi_ = SparseRows<tc17::kSize>(Phi).times(phi_);
+  phi_ = SparseRows<tc17::kSize>(Phi, transitionPattern()).times(phi_);
 }
 
 const EpochDiagnostics& StaticReceiverFilter::update(

@@ -28,7 +28,9 @@ class ErrorState {
   /// x = Phi x, P = Phi P Phi^T + Q, Q = diag(q_diagonal) (the process noises of every
   /// configuration are uncorrelated), on the active states only: an inactive state keeps its
   /// variance, is not driven by the active ones and does not drive them (seed 004 fig. 9: each
-  /// reduced filter uses its region of the 15-state system matrix).
+  /// reduced filter uses its region of the 15-state system matrix). Phi's nonzero elements
+  /// must lie within transitionPattern() (ins_error_model.hpp), as every transitionMatrix()
+  /// does (asserted in builds without NDEBUG).
   void predict(const Matrix17& Phi, const Vector17& q_diagonal);
 
   /// Sequential Joseph-form update, rows decorrelated by the Cholesky factor of R, inactive

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "navbus/core/sparse_rows.hpp"
 #include "navbus/core/state_layout.hpp"
 #include "navbus/core/strapdown.hpp"
 
@@ -24,5 +25,11 @@ Matrix17 errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
 
 /// Transition matrix over dt: I + F dt + (F dt)^2 / 2.
 Matrix17 transitionMatrix(const Matrix17& F, double dt);
+
+/// The elements errorDynamics() can fill (read once from a state where all of them are
+/// nonzero), and those of a transitionMatrix() built from such an F (I + F + F^2). Every
+/// transition matrix of the filters lies within the latter (tested at random states).
+const SparsityPattern<tc17::kSize>& errorDynamicsPattern();
+const SparsityPattern<tc17::kSize>& transitionPattern();
 
 }  // namespace navbus::core
