@@ -8,6 +8,7 @@
 
 #include "fault_pipeline.hpp"
 #include "filter_pipeline.hpp"
+#include "frame_prefetcher.hpp"
 #include "frame_publisher.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
@@ -147,8 +148,9 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   sensor_sim::SimConfig emitted = sim;
   // Raw blocks only feed the fault manager's dither monitor.
   emitted.publish_raw = sim.publish_raw && faults && faults->dither().has_value();
-  while (source.index() < total) {
-    const sim::SensorFrame f = source.next();
+  FramePrefetcher frames(source, total);
+  while (const std::optional<sim::SensorFrame> next = frames.next()) {
+    const sim::SensorFrame& f = *next;
     truths.push_back(f.truth);
     // The same samples, in the same order and with the same sequence numbers as the
     // simulator participant publishes them.
