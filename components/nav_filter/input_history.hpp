@@ -15,6 +15,7 @@
 #include <navbus_idl/Fault.h>
 
 #include "navbus/core/navigation_engine.hpp"
+#include "navbus/core/ring_buffer.hpp"
 
 namespace navbus::nav_filter {
 
@@ -32,7 +33,16 @@ class InputHistory {
   void record(std::int64_t time_ns, const Item& item, const core::NavigationEngine& engine) {
     if (!enabled()) return;
     if (snapshots_.empty() || time_ns - snapshots_.back().time_ns >= snapshot_period_ns_) {
-      snapshots_.push_back({time_ns, first_index_ + items_.size(), engine});
+      const std::size_t first_item = first_index_ + items_.size();
+      snapshots_.push_back_reusing(
+          [&] {
+            return Snapshot{time_ns, first_item, engine};
+          },
+          [&](Snapshot& s) {
+            s.time_ns = time_ns;
+            s.first_item = first_item;
+            s.engine = engine;  // copy-assigned: storage reused
+          });
     }
     items_.push_back(item);
     // Forget snapshots (and the items before them) older than the span, keeping one.
@@ -56,9 +66,9 @@ class InputHistory {
       engine = s.engine;
       replay.clear();
       const std::size_t from = s.first_item - first_index_;
-      replay.insert(replay.end(), items_.begin() + static_cast<std::ptrdiff_t>(from), items_.end());
-      items_.erase(items_.begin() + static_cast<std::ptrdiff_t>(from), items_.end());
-      snapshots_.erase(snapshots_.begin() + static_cast<std::ptrdiff_t>(i), snapshots_.end());
+      for (std::size_t k = from; k < items_.size(); ++k) replay.push_back(items_[k]);
+      items_.truncate(from);
+      snapshots_.truncate(i);
       ++rollbacks_;
       return true;
     }
@@ -77,8 +87,9 @@ class InputHistory {
   };
   std::int64_t span_ns_;
   std::int64_t snapshot_period_ns_;
-  std::deque<Snapshot> snapshots_;
-  std::deque<Item> items_;
+  // Ring buffers: in the steady state (as many forgotten as recorded) nothing is allocated.
+  core::RingBuffer<Snapshot> snapshots_;
+  core::RingBuffer<Item> items_;
   std::size_t first_index_{0};  ///< absolute index of items_.front()
   std::uint64_t rollbacks_{0};
   std::uint64_t out_of_reach_{0};

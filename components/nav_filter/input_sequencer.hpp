@@ -13,6 +13,7 @@
 // Pure logic: the caller supplies wall time.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -64,7 +65,7 @@ class InputSequencer {
     it->second.seen = true;
     it->second.active = true;
     it->second.last_time_ns = std::max(it->second.last_time_ns, time_ns);
-    queue_.emplace(key, std::move(payload));
+    queue_.insert(pendingEnd(key), {key, std::move(payload)});  // after equal keys: arrival order
     return PushResult::kQueued;
   }
 
@@ -83,15 +84,16 @@ class InputSequencer {
   /// Hands every releasable sample, in order, to consume(id, time_ns, payload).
   void release(std::int64_t wall_now_ns,
                const std::function<void(StreamId, std::int64_t, const Payload&)>& consume) {
-    while (!queue_.empty()) {
-      auto head = queue_.begin();
-      const std::vector<StreamId> blocking = blockingStreams(head->first);
+    while (head_ < queue_.size()) {
+      const Key key = queue_[head_].first;
+      const std::vector<StreamId>& blocking = blockingStreams(key);
       if (!blocking.empty()) {
-        if (head_blocked_since_ns_ < 0 || !(blocked_key_ == head->first)) {
+        if (head_blocked_since_ns_ < 0 || !(blocked_key_ == key)) {
           head_blocked_since_ns_ = wall_now_ns;
-          blocked_key_ = head->first;
+          blocked_key_ = key;
         }
         if (wall_now_ns - head_blocked_since_ns_ < max_wait_ns_) {
+          compact();
           return;
         }
         ++timeouts_;
@@ -100,11 +102,14 @@ class InputSequencer {
         }
       }
       head_blocked_since_ns_ = -1;
-      last_released_ = head->first;
+      last_released_ = key;
       released_any_ = true;
-      consume(head->first.stream, head->first.time_ns, head->second);
-      queue_.erase(head);
+      // Moved out first: consume may push more samples (a command in answer to this one),
+      // which may move the buffer.
+      const Payload payload = std::move(queue_[head_++].second);
+      consume(key.stream, key.time_ns, payload);
     }
+    compact();
   }
 
   /// A new run of the inputs (their source restarted at an earlier time): forgets the order
@@ -113,8 +118,9 @@ class InputSequencer {
   /// may have come before the restart was recognised). The caller releases what is held
   /// first; anything still queued is dropped and its count returned.
   std::size_t newRun(StreamId first) {
-    const std::size_t dropped = queue_.size();
+    const std::size_t dropped = pending();
     queue_.clear();
+    head_ = 0;
     released_any_ = false;
     last_released_ = Key{0, {}};
     head_blocked_since_ns_ = -1;
@@ -126,7 +132,7 @@ class InputSequencer {
     return dropped;
   }
 
-  std::size_t pending() const { return queue_.size(); }
+  std::size_t pending() const { return queue_.size() - head_; }
   std::uint64_t timeouts() const { return timeouts_; }
 
  private:
@@ -146,19 +152,42 @@ class InputSequencer {
     std::int64_t last_time_ns{0};
   };
 
-  /// The expected, active streams that may still deliver a sample ordered before `key`.
-  std::vector<StreamId> blockingStreams(const Key& key) const {
-    std::vector<StreamId> out;
+  /// The expected, active streams that may still deliver a sample ordered before `key` (a
+  /// buffer reused from call to call).
+  const std::vector<StreamId>& blockingStreams(const Key& key) {
+    blocking_.clear();
     for (const auto& [id, s] : streams_) {
       if (id == key.stream || !s.active || s.sporadic) continue;
       const Key earliest_next{s.last_time_ns + s.period_ns, id};
-      if (!s.seen || earliest_next < key) out.push_back(id);
+      if (!s.seen || earliest_next < key) blocking_.push_back(id);
     }
-    return out;
+    return blocking_;
+  }
+
+  /// Where a sample with `key` goes: after every pending one not ordered after it.
+  typename std::vector<std::pair<Key, Payload>>::iterator pendingEnd(const Key& key) {
+    return std::upper_bound(queue_.begin() + static_cast<std::ptrdiff_t>(head_), queue_.end(), key,
+                            [](const Key& k, const auto& e) { return k < e.first; });
+  }
+
+  /// Drops the released samples from the front once they are half the buffer (moves, no
+  /// allocation: the buffer keeps its capacity, so the steady state allocates nothing).
+  void compact() {
+    if (head_ == queue_.size()) {
+      queue_.clear();
+      head_ = 0;
+    } else if (head_ > 64 && 2 * head_ > queue_.size()) {
+      queue_.erase(queue_.begin(), queue_.begin() + static_cast<std::ptrdiff_t>(head_));
+      head_ = 0;
+    }
   }
 
   std::map<StreamId, State> streams_;
-  std::multimap<Key, Payload> queue_;
+  /// Pending samples in release order from head_ (those before it are released), equal keys
+  /// in arrival order.
+  std::vector<std::pair<Key, Payload>> queue_;
+  std::size_t head_{0};
+  std::vector<StreamId> blocking_;
   std::int64_t max_wait_ns_;
   Key last_released_{0, {}};
   bool released_any_{false};

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <string_view>
 
 #include "navbus/bus/health.hpp"
 
@@ -11,23 +12,25 @@ namespace navbus::bus {
 
 namespace {
 
-std::string indexed(const char* name, std::size_t i) {
+// Field names are string views: a valid sample builds no string (the names are only spelled
+// out in a rejection).
+std::string indexed(std::string_view name, std::size_t i) {
   return std::string(name) + "[" + std::to_string(i) + "]";
 }
 
 template <std::size_t N>
-std::optional<Rejection> finiteArray(const std::array<double, N>& a, const std::string& name) {
+std::optional<Rejection> finiteArray(const std::array<double, N>& a, std::string_view name) {
   for (std::size_t i = 0; i < N; ++i) {
     if (!std::isfinite(a[i])) {
-      return Rejection{navbus::REJECT_NOT_FINITE, indexed(name.c_str(), i), a[i]};
+      return Rejection{navbus::REJECT_NOT_FINITE, indexed(name, i), a[i]};
     }
   }
   return std::nullopt;
 }
 
-std::optional<Rejection> finite(double v, const std::string& name) {
+std::optional<Rejection> finite(double v, std::string_view name) {
   if (!std::isfinite(v)) {
-    return Rejection{navbus::REJECT_NOT_FINITE, name, v};
+    return Rejection{navbus::REJECT_NOT_FINITE, std::string(name), v};
   }
   return std::nullopt;
 }
@@ -41,16 +44,18 @@ double norm(const std::array<double, N>& a) {
   return std::sqrt(s);
 }
 
-std::optional<Rejection> range(double v, double lo, double hi, const std::string& name) {
+std::optional<Rejection> range(double v, double lo, double hi, std::string_view name) {
   if (v < lo || v > hi) {
-    return Rejection{navbus::REJECT_OUT_OF_RANGE, name, v};
+    return Rejection{navbus::REJECT_OUT_OF_RANGE, std::string(name), v};
   }
   return std::nullopt;
 }
 
-std::optional<Rejection> positive(double v, const std::string& name) {
-  if (!(v > 0.0)) {
-    return Rejection{navbus::REJECT_OUT_OF_RANGE, name, v};
+/// Every element > 0 (name[i] in the rejection).
+template <std::size_t N>
+std::optional<Rejection> positiveArray(const std::array<double, N>& a, std::string_view name) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (!(a[i] > 0.0)) return Rejection{navbus::REJECT_OUT_OF_RANGE, indexed(name, i), a[i]};
   }
   return std::nullopt;
 }
@@ -175,10 +180,8 @@ std::optional<Rejection> validate(const navbus::GnssFix& s, const ValidationLimi
   if (auto r = range(s.latitude_rad(), -M_PI / 2, M_PI / 2, "latitude_rad")) return r;
   if (auto r = range(s.longitude_rad(), -M_PI, M_PI, "longitude_rad")) return r;
   if (auto r = range(s.height_m(), l.min_height_m, l.max_height_m, "height_m")) return r;
-  for (std::size_t i = 0; i < 3; ++i) {
-    if (auto r = positive(s.pos_sigma_ned_m()[i], indexed("pos_sigma_ned_m", i))) return r;
-    if (auto r = positive(s.vel_sigma_ned_mps()[i], indexed("vel_sigma_ned_mps", i))) return r;
-  }
+  if (auto r = positiveArray(s.pos_sigma_ned_m(), "pos_sigma_ned_m")) return r;
+  if (auto r = positiveArray(s.vel_sigma_ned_mps(), "vel_sigma_ned_mps")) return r;
   return std::nullopt;
 }
 
@@ -188,11 +191,10 @@ std::optional<Rejection> validate(const navbus::StarTrackerAttitude& s, const Va
   if (s.valid() && std::abs(norm(s.q_b_to_i()) - 1.0) > l.quaternion_norm_tolerance) {
     return Rejection{navbus::REJECT_BAD_QUATERNION, "|q_b_to_i|", norm(s.q_b_to_i())};
   }
-  for (std::size_t i = 0; i < 3; ++i) {
-    if (auto r = positive(s.sigma_b_rad()[i], indexed("sigma_b_rad", i))) return r;
-    if (auto r =
-            range(s.sigma_b_rad()[i], 0.0, l.max_star_tracker_sigma_rad, indexed("sigma_b_rad", i)))
-      return r;
+  for (std::size_t i = 0; i < 3; ++i) {  // each > 0 and within the limit
+    const double v = s.sigma_b_rad()[i];
+    if (!(v > 0.0) || v > l.max_star_tracker_sigma_rad)
+      return Rejection{navbus::REJECT_OUT_OF_RANGE, indexed("sigma_b_rad", i), v};
   }
   return std::nullopt;
 }

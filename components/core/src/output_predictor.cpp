@@ -5,7 +5,7 @@
 namespace navbus::core {
 
 OutputPredictor::OutputPredictor(earth::GravityModel gravity, std::size_t max_buffered)
-    : gravity_(gravity), max_buffered_(max_buffered), ins_(gravity) {}
+    : gravity_(gravity), max_buffered_(max_buffered), buffered_(max_buffered), ins_(gravity) {}
 
 void OutputPredictor::reset() {
   anchor_.reset();
@@ -25,8 +25,8 @@ void OutputPredictor::repropagate() {
   ins_ = StrapdownNed(gravity_);
   ins_.initialize(anchor_->state);
   continuous_ = true;
-  for (const ImuIncrement& inc : buffered_) {
-    if (!step(inc)) {
+  for (std::size_t k = 0; k < buffered_.size(); ++k) {
+    if (!step(buffered_[k])) {
       continuous_ = false;  // a gap after the anchor: no output until the next anchor
       return;
     }

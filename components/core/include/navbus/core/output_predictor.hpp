@@ -14,11 +14,11 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <optional>
 
 #include <Eigen/Core>
 
+#include "navbus/core/ring_buffer.hpp"
 #include "navbus/core/strapdown.hpp"
 
 namespace navbus::core {
@@ -64,7 +64,7 @@ class OutputPredictor {
   earth::GravityModel gravity_;
   std::size_t max_buffered_;
   std::optional<OutputAnchor> anchor_;
-  std::deque<ImuIncrement> buffered_;  ///< accepted increments after the anchor, in time order
+  RingBuffer<ImuIncrement> buffered_;  ///< accepted increments after the anchor, in time order
   StrapdownNed ins_;
   bool continuous_{false};  ///< the output has integrated every buffered increment
   OutputPredictorCounters counters_;
