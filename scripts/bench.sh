@@ -1,20 +1,24 @@
 #!/usr/bin/env bash
 # Runs every benchmark and prints one table: each figure beside the baseline measured in the
 # same run (or the issue's absolute target), and the raw outputs under $BENCH_DIR.
-#   bash scripts/bench.sh            (builds first if needed; about 75 s on 2 cores)
+#   bash scripts/bench.sh            (builds first if needed; about 90 s on 2 cores)
 # Environment: BENCH_DIR (default: a new temporary directory), BENCH_DOMAIN (DDS domain of the
 # latency ping/pong, default 150), BENCH_RUNS (offline repetitions, default 3).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-[ -x build/bin/navbus ] && [ -x build/bin/navbus_engine_benchmark ] || bash scripts/build.sh
+[ -x build/bin/navbus ] && [ -x build/bin/navbus_pipeline_benchmark ] || bash scripts/build.sh
 dir=${BENCH_DIR:-$(mktemp -d)}
 mkdir -p "$dir"
 domain=${BENCH_DOMAIN:-150}
 runs=${BENCH_RUNS:-3}
 bin=build/bin
 
-echo "bench: engine benchmark (60000 IMU cycles per configuration)" >&2
-"$bin/navbus_engine_benchmark" sim/scenarios 60000 >"$dir/engine.txt" 2>&1
+echo "bench: engine benchmark (60000 IMU cycles per configuration, 3 runs)" >&2
+for i in 1 2 3; do
+  "$bin/navbus_engine_benchmark" sim/scenarios 60000 >"$dir/engine_$i.txt" 2>&1
+done
+echo "bench: filter pipeline (validation, ordered merge, history, engine, messages)" >&2
+"$bin/navbus_pipeline_benchmark" . 40000 >"$dir/pipeline.txt" 2>&1
 echo "bench: GLR and dither benchmarks" >&2
 "$bin/navbus_glr_benchmark" >"$dir/glr.txt" 2>&1
 "$bin/navbus_dither_benchmark" >"$dir/dither.txt" 2>&1
@@ -53,13 +57,16 @@ rows = []
 def row(figure, value, reference, verdict=""):
     rows.append((figure, value, reference, verdict))
 
-engine = open(f"{d}/engine.txt").read()
+engines = [open(f"{d}/engine_{i}.txt").read() for i in (1, 2, 3)]
 def us(label):
-    m = re.search(re.escape(label) + r"\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)", engine)
-    return (float(m.group(1)), float(m.group(2)), float(m.group(3))) if m else None
+    """(us/cycle, ratio, allocations) of a row: medians over the three runs."""
+    found = [re.search(re.escape(label) + r"\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)", e) for e in engines]
+    if not all(found):
+        return None
+    return tuple(statistics.median(float(m.group(k)) for m in found) for k in (1, 2, 3))
 base = us("mechanization + covariance (base)")
 if base:
-    row("engine: mechanization + covariance, seed 001", f"{base[0]:.2f} us/cycle",
+    row("engine: mechanization + covariance, seed 001 (median of 3)", f"{base[0]:.2f} us/cycle",
         "target <= 2 us", "met" if base[0] <= 2.0 else "NOT met")
     row("engine: heap allocations per cycle", f"{base[2]:.3f}", "target 0",
         "met" if base[2] == 0 else "NOT met")
@@ -72,6 +79,13 @@ v = us("aligned start + protection levels")
 if v:
     row("engine: aligned start + protection levels, seed 000", f"{v[0]:.2f} us/cycle",
         f"{v[1]:.3f} x configured start", "met (<= 1.20)" if v[1] <= 1.2 else "NOT met (> 1.20)")
+
+pipe = re.search(r"([0-9.]+) us per cycle, ([0-9.]+) heap allocations per cycle, ([0-9]+) of the cycles",
+                 open(f"{d}/pipeline.txt").read())
+if pipe:
+    row("filter pipeline (participant path without DDS), per IMU cycle",
+        f"{pipe.group(1)} us, {pipe.group(2)} allocs", "target 0 allocations",
+        "met" if int(pipe.group(3)) == 0 else f"NOT met ({pipe.group(3)} cycles allocated)")
 
 times, rss = [], []
 for i in range(1, runs + 1):
