@@ -36,7 +36,7 @@ echo "bench: raw Fast DDS ping/pong, UDP loopback, 200 Hz, domain $domain" >&2
 "$bin/navbus" -d "$domain" --log-level warn latency pong --duration 60 >"$dir/pong.txt" 2>&1 &
 pong=$!
 "$bin/navbus" -d "$domain" --log-level warn latency ping --samples 4000 --warmup 200 --rate 200 \
-  >"$dir/ping.txt" 2>&1 || true
+  --csv "$dir/ping.csv" >"$dir/ping.txt" 2>&1 || true
 kill "$pong" 2>/dev/null || true
 wait "$pong" 2>/dev/null || true
 
@@ -45,12 +45,16 @@ echo "bench: navbus-filter (config/filter_latency.yaml) fed by navbus latency im
   >"$dir/filter.txt" 2>&1 &
 filter=$!
 "$bin/navbus" -d "$((domain + 1))" --log-level warn latency imu --samples 4000 --warmup 200 \
-  --rate 200 >"$dir/e2e.txt" 2>&1 || true
+  --rate 200 --csv "$dir/e2e.csv" >"$dir/e2e.txt" 2>&1 || true
+# Peak resident memory of the filter participant over the run.
+grep VmHWM "/proc/$filter/status" >"$dir/filter_rss.txt" 2>/dev/null || true
 kill -INT "$filter" 2>/dev/null || true
 wait "$filter" 2>/dev/null || true
 rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2>/dev/null || true
+/usr/bin/python3 scripts/plot_navbus.py latency --raw "$dir/ping.csv" --e2e "$dir/e2e.csv" -o "$dir" \
+  >/dev/null 2>&1 || echo "bench: no latency figure (see the CSV files in $dir)" >&2
 
-python3 - "$dir" "$runs" <<'EOF'
+/usr/bin/python3 - "$dir" "$runs" <<'EOF'
 import re, statistics, sys
 d, runs = sys.argv[1], int(sys.argv[2])
 rows = []
@@ -130,10 +134,17 @@ if rt and det:
         f"{float(det.group(1)):.0f} / {float(det.group(3)):.0f} us",
         f"{float(det.group(1)) / float(rt.group(1)):.2f} / {float(det.group(3)) / float(rt.group(3)):.2f} x two hops (IMU-only filter: nothing to wait for)")
 
+try:
+    hwm_kib = int(open(f"{d}/filter_rss.txt").read().split()[1])
+    row("navbus-filter peak RSS (latency run, low-latency output on)", f"{hwm_kib / 1024:.1f} MiB",
+        "target < 15 MB", "met" if hwm_kib * 1024 < 15e6 else "NOT met")
+except (OSError, IndexError, ValueError):
+    row("navbus-filter peak RSS", "not read", f"see {d}/filter_rss.txt")
+
 w = [max(len(r[i]) for r in rows + [("figure", "value", "baseline / target", "")]) for i in range(4)]
 fmt = "  ".join(f"{{:<{x}}}" for x in w)
 print(fmt.format("figure", "value", "baseline / target", ""))
 for r in rows:
     print(fmt.format(*r))
-print(f"raw outputs: {d}")
+print(f"raw outputs and the latency figure (latency.png): {d}")
 EOF

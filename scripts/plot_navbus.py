@@ -18,6 +18,10 @@
       from `navbus montecarlo --csv CSV_DIR`: average NEES per epoch of each configuration with
       its 95 % band -> nees.png; with --fault-manager, the detection delays after the injected
       fault, one histogram per configuration -> detection_delay.png
+  plot_navbus.py latency [--raw PING_CSV] [--e2e IMU_CSV] -o OUT_DIR
+      latency histogram and CDF from `navbus latency ping --csv` (round trips: the raw two
+      hops) and `navbus latency imu --csv` (increment -> low-latency output / deterministic
+      solution) -> latency.png
   With --scenario, times are seconds from the scenario's start (timing.start); without, from
   the first row of the file.
   plot_navbus.py demo SCENARIO DEMO_DIR -o OUT_DIR
@@ -247,6 +251,41 @@ def montecarlo(csv_dir, out_dir):
     return paths
 
 
+def latency(raw_csv, e2e_csv, out_dir):
+    series = []
+    if raw_csv:
+        series.append(("raw Fast DDS, two hops (round trip)",
+                       [int(r["round_trip_ns"]) for r in read_csv(raw_csv)]))
+    if e2e_csv:
+        rows = read_csv(e2e_csv)
+        series.append(("IMU -> low-latency output",
+                       [int(r["low_latency_ns"]) for r in rows if int(r["low_latency_ns"]) >= 0]))
+        series.append(("IMU -> deterministic solution",
+                       [int(r["solution_ns"]) for r in rows if int(r["solution_ns"]) >= 0]))
+    series = [(name, np.array(v) * 1e-3) for name, v in series if v]
+    if not series:
+        raise SystemExit("latency: give --raw and/or --e2e with at least one sample")
+    fig, (hist, cdf) = plt.subplots(1, 2, figsize=(11, 4))
+    hi = max(np.percentile(v, 99.5) for _, v in series)
+    bins = np.linspace(0.0, hi, 80)
+    for name, v in series:
+        med, p99 = np.percentile(v, 50), np.percentile(v, 99)
+        label = f"{name}: median {med:.0f}, p99 {p99:.0f} us (n = {len(v)})"
+        hist.hist(np.clip(v, 0, hi), bins=bins, histtype="step", label=label)
+        xs = np.sort(v)
+        cdf.plot(xs, np.arange(1, len(xs) + 1) / len(xs), label=name)
+    hist.set_xlabel("latency [us] (beyond the 99.5th percentile piled in the last bin)")
+    hist.set_ylabel("samples")
+    hist.legend(fontsize=7)
+    cdf.set_xscale("log")
+    cdf.set_xlabel("latency [us]")
+    cdf.set_ylabel("fraction of samples")
+    cdf.grid(True, which="both", lw=0.3)
+    cdf.legend(fontsize=7)
+    fig.suptitle("navbus latency (write -> received)")
+    return _save(fig, out_dir, "latency.png")
+
+
 def demo(scenario_path, demo_dir, out_dir):
     start_ns = int(load_scenario(scenario_path)["timing"]["start"])
     paths = [errors(os.path.join(demo_dir, "offline"), out_dir, start_ns,
@@ -281,6 +320,10 @@ def main():
     a = sub.add_parser("montecarlo")
     a.add_argument("csv_dir")
     a.add_argument("-o", "--out", required=True)
+    a = sub.add_parser("latency")
+    a.add_argument("--raw", help="navbus latency ping --csv file")
+    a.add_argument("--e2e", help="navbus latency imu --csv file")
+    a.add_argument("-o", "--out", required=True)
     a = sub.add_parser("demo")
     a.add_argument("scenario")
     a.add_argument("demo_dir")
@@ -300,6 +343,8 @@ def main():
         paths = [glr(args.offline_dir, args.out, start_ns)]
     elif args.cmd == "montecarlo":
         paths = montecarlo(args.csv_dir, args.out)
+    elif args.cmd == "latency":
+        paths = [latency(args.raw, args.e2e, args.out)]
     else:
         paths = demo(args.scenario, args.demo_dir, args.out)
     for path in paths:
