@@ -86,21 +86,26 @@ navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_
 FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& config)
     : participant_(participant), config_(config) {
   using namespace bus;
+  // Fast pacing writes asynchronously (several samples per datagram); real time synchronously
+  // (no thread hop in the latency). qos/navbus_qos.xml says what each measured.
+  const bool fast = config.pacing == Pacing::kFast;
+  const char* sensor_profile = fast ? profile::kSensorWriterFastPacing : profile::kSensorWriter;
+  const char* measurement_profile =
+      fast ? profile::kMeasurementWriterFastPacing : profile::kMeasurementWriter;
   imu_ = participant.createWriter<navbus::ImuIncrementPubSubType>(topic::kImuIncrement,
-                                                                  profile::kSensorWriter);
+                                                                  sensor_profile);
   if (config.publish_raw) {
-    raw_ = participant.createWriter<navbus::ImuRawBlockPubSubType>(topic::kImuRaw,
-                                                                   profile::kSensorWriter);
+    raw_ = participant.createWriter<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, sensor_profile);
   }
   if (config.publish_gnss) {
     gnss_ = participant.createWriter<navbus::GnssObservationEpochPubSubType>(
-        topic::kGnssObservations, profile::kMeasurementWriter);
-    fix_ = participant.createWriter<navbus::GnssFixPubSubType>(topic::kGnssFix,
-                                                               profile::kMeasurementWriter);
+        topic::kGnssObservations, measurement_profile);
+    fix_ =
+        participant.createWriter<navbus::GnssFixPubSubType>(topic::kGnssFix, measurement_profile);
   }
   if (config.publish_star_tracker) {
-    star_ = participant.createWriter<navbus::StarTrackerAttitudePubSubType>(
-        topic::kStarTracker, profile::kMeasurementWriter);
+    star_ = participant.createWriter<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker,
+                                                                            measurement_profile);
   }
 }
 

@@ -28,6 +28,14 @@ navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_
 /// Sequence numbers of the last samples emitted per stream.
 struct FrameSequence {
   std::uint64_t imu{0}, raw{0}, gnss_epochs{0}, gnss_fixes{0}, star_tracker{0};
+  std::uint64_t raw_samples{0};  ///< raw IMU samples in the raw blocks
+
+  /// DDS samples written, all streams.
+  std::uint64_t samples() const { return imu + raw + gnss_epochs + gnss_fixes + star_tracker; }
+  /// Measurements carried: each increment, raw sample, GNSS epoch and fix, attitude.
+  std::uint64_t measurements() const {
+    return imu + raw_samples + gnss_epochs + gnss_fixes + star_tracker;
+  }
 };
 
 /// The bus samples of one simulator frame, in emit order (the increment first, then the raw
@@ -42,6 +50,7 @@ bool emitFrame(const sim::SensorFrame& f, const SimConfig& c, FrameSequence& seq
   if (c.publish_raw) {
     if (!emit(toIdl(f.raw, c.imu_sensor_id, seq.raw + 1))) return false;
     ++seq.raw;
+    seq.raw_samples += f.raw.samples.size();
   }
   if (c.publish_gnss && f.has_gnss) {
     if (!emit(toIdl(f.gnss, c.gnss_receiver_id, seq.gnss_epochs + 1))) return false;

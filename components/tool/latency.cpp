@@ -36,11 +36,17 @@ std::size_t matchedWriters(eprosima::fastdds::dds::DataReader* reader) {
   return static_cast<std::size_t>(status.current_count);
 }
 
+std::string writerProfile(const LatencyOptions& o) {
+  return o.writer_profile.empty() ? bus::profile::kSensorWriter : o.writer_profile;
+}
+std::string readerProfile(const LatencyOptions& o) {
+  return o.reader_profile.empty() ? bus::profile::kSensorReader : o.reader_profile;
+}
+
 int runPong(bus::Participant& p, const LatencyOptions& o) {
-  auto pong =
-      p.createWriter<ImuIncrementPubSubType>(bus::topic::kLatencyPong, bus::profile::kSensorWriter);
+  auto pong = p.createWriter<ImuIncrementPubSubType>(bus::topic::kLatencyPong, writerProfile(o));
   std::uint64_t echoed = 0;
-  p.subscribe<ImuIncrementPubSubType>(bus::topic::kLatencyPing, bus::profile::kSensorReader,
+  p.subscribe<ImuIncrementPubSubType>(bus::topic::kLatencyPing, readerProfile(o),
                                       [&](const ImuIncrement& s, const auto&) {
                                         if (pong.write(s)) ++echoed;
                                       });
@@ -64,17 +70,14 @@ void printStats(const LatencyStats& s, std::uint64_t lost, std::size_t sent, dou
 }
 
 int runPing(bus::Participant& p, const LatencyOptions& o) {
-  auto ping =
-      p.createWriter<ImuIncrementPubSubType>(bus::topic::kLatencyPing, bus::profile::kSensorWriter);
+  auto ping = p.createWriter<ImuIncrementPubSubType>(bus::topic::kLatencyPing, writerProfile(o));
   const std::size_t total = static_cast<std::size_t>(o.warmup + o.samples);
   std::vector<std::int64_t> sent_ns(total, 0), rtt_ns(total, -1);
-  auto* reader =
-      p.subscribe<ImuIncrementPubSubType>(bus::topic::kLatencyPong, bus::profile::kSensorReader,
-                                          [&](const ImuIncrement& s, const auto&) {
-                                            const std::size_t k = s.seq();
-                                            if (k < total && rtt_ns[k] < 0 && sent_ns[k] > 0)
-                                              rtt_ns[k] = nowNs() - sent_ns[k];
-                                          });
+  auto* reader = p.subscribe<ImuIncrementPubSubType>(
+      bus::topic::kLatencyPong, readerProfile(o), [&](const ImuIncrement& s, const auto&) {
+        const std::size_t k = s.seq();
+        if (k < total && rtt_ns[k] < 0 && sent_ns[k] > 0) rtt_ns[k] = nowNs() - sent_ns[k];
+      });
   if (!spinUntil(p, o.match_timeout_s,
                  [&] { return ping.matchedReaders() > 0 && matchedWriters(reader) > 0; })) {
     spdlog::error(
@@ -135,8 +138,7 @@ core::ImuIncrement restingIncrement(double lat_rad, double height_m, double dt_s
 /// the reception of the low-latency output of the same time, and of the deterministic
 /// solution where one has that time.
 int runImuSource(bus::Participant& p, const LatencyOptions& o) {
-  auto imu = p.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement,
-                                                    bus::profile::kSensorWriter);
+  auto imu = p.createWriter<ImuIncrementPubSubType>(bus::topic::kImuIncrement, writerProfile(o));
   const std::size_t total = static_cast<std::size_t>(o.warmup + o.samples);
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / o.rate_hz));
   // Data time of increment k: t0 + (k + 1) period; its write time is kept by k.
@@ -216,7 +218,101 @@ int runImuSource(bus::Participant& p, const LatencyOptions& o) {
                                                               : bus::kExitRuntimeError;
 }
 
+/// Writes `count` samples numbered from `first_seq` as fast as the writer takes them (a write
+/// that times out on a full history is retried); returns the retries, or -1 if stopped.
+std::int64_t writeAsFastAsPossible(bus::Participant& p, bus::Writer<ImuIncrement>& writer,
+                                   std::uint64_t first_seq, std::size_t count) {
+  ImuIncrement s;
+  s.sensor_id(1);
+  s.interval_ns(5'000'000);
+  std::int64_t retries = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    s.seq(first_seq + k);
+    while (!writer.raw()->write(&s)) {
+      if (p.stopping()) return -1;
+      ++retries;
+    }
+  }
+  return retries;
+}
+
+/// Saturation: --warmup samples, then --samples timed from the first write until every one is
+/// acknowledged (a reliable writer; a best-effort one counts them sent); disposes the instance
+/// at the end so that the sink stops.
+int runFlood(bus::Participant& p, const LatencyOptions& o) {
+  auto flood = p.createWriter<ImuIncrementPubSubType>(bus::topic::kLatencyPing, writerProfile(o));
+  if (!spinUntil(p, o.match_timeout_s, [&] { return flood.matchedReaders() > 0; })) {
+    spdlog::error(
+        "no sink matched within {} s (run `navbus latency sink` with the same domain, profile "
+        "and QoS file)",
+        o.match_timeout_s);
+    return bus::kExitRuntimeError;
+  }
+  const eprosima::fastrtps::Duration_t ack_timeout(30, 0);
+  const auto warmup = static_cast<std::size_t>(o.warmup);
+  if (writeAsFastAsPossible(p, flood, 1, warmup) < 0) return bus::kExitRuntimeError;
+  flood.raw()->wait_for_acknowledgments(ack_timeout);
+  const auto start = Clock::now();
+  const std::int64_t retries =
+      writeAsFastAsPossible(p, flood, warmup + 1, static_cast<std::size_t>(o.samples));
+  if (retries < 0) return bus::kExitRuntimeError;
+  const bool acknowledged =
+      flood.raw()->wait_for_acknowledgments(ack_timeout) == ReturnCode_t::RETCODE_OK;
+  const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+  ImuIncrement key;
+  key.sensor_id(1);
+  flood.dispose(key);
+  ImuIncrementPubSubType type;
+  const double bytes = type.getSerializedSizeProvider(&key)();
+  const double rate = static_cast<double>(o.samples) / elapsed_s;
+  std::printf(
+      "flood: %d samples of %.0f bytes written%s in %.3f s: %.0f samples/s, %.2f MB/s; "
+      "write retries %lld\n",
+      o.samples, bytes, acknowledged ? " and acknowledged" : " (NOT all acknowledged)", elapsed_s,
+      rate, rate * bytes * 1e-6, static_cast<long long>(retries));
+  flood.raw()->wait_for_acknowledgments(ack_timeout);  // the dispose
+  p.finish();
+  return acknowledged ? bus::kExitOk : bus::kExitRuntimeError;
+}
+
+/// Counts what a flood sends until the flood disposes its instance (or --duration passes);
+/// exit 1 if a sample was missing or none came.
+int runSink(bus::Participant& p, const LatencyOptions& o) {
+  SinkCount count;
+  bool ended = false;
+  bus::ReaderCallbacks callbacks;
+  callbacks.on_disposed = [&](const auto&) { ended = true; };
+  p.subscribe<ImuIncrementPubSubType>(
+      bus::topic::kLatencyPing, readerProfile(o),
+      [&](const ImuIncrement& s, const auto&) { count.take(s.seq(), nowNs()); }, callbacks);
+  spinUntil(p, o.pong_duration_s > 0 ? o.pong_duration_s : 1e9, [&] { return ended; });
+  const double span_s =
+      count.taken > 1 ? 1e-9 * static_cast<double>(count.last_ns - count.first_ns) : 0.0;
+  std::printf(
+      "sink: took %llu samples in %.3f s (first to last): %.0f samples/s; missing %llu "
+      "(sequence gaps), out of order %llu; %s\n",
+      static_cast<unsigned long long>(count.taken), span_s,
+      span_s > 0 ? static_cast<double>(count.taken - 1) / span_s : 0.0,
+      static_cast<unsigned long long>(count.missing),
+      static_cast<unsigned long long>(count.out_of_order),
+      ended ? "the flood ended its stream" : "stopped before the flood ended its stream");
+  p.finish();
+  return count.taken > 0 && count.missing == 0 ? bus::kExitOk : bus::kExitRuntimeError;
+}
+
 }  // namespace
+
+void SinkCount::take(std::uint64_t seq, std::int64_t now_ns) {
+  if (first_ns < 0) first_ns = now_ns;
+  last_ns = now_ns;
+  ++taken;
+  if (seq <= last_seq) {
+    ++out_of_order;
+    return;
+  }
+  missing += seq - last_seq - 1;
+  last_seq = seq;
+}
 
 LatencyStats latencyStats(std::vector<std::int64_t> v) {
   LatencyStats s;
@@ -240,6 +336,8 @@ int runLatencyCommand(const bus::Participant::Options& participant, const Latenc
   bus::Participant p(participant, shutdown);
   if (o.role == "pong") return runPong(p, o);
   if (o.role == "imu") return runImuSource(p, o);
+  if (o.role == "flood") return runFlood(p, o);
+  if (o.role == "sink") return runSink(p, o);
   return runPing(p, o);
 }
 

@@ -4,7 +4,10 @@
 // the figure is what an IMU increment costs on the participant profile under test (UDP
 // loopback, shared memory, LAN, discovery server, DDS Security). A third role, `imu`, is the
 // IMU of a running navbus-filter: increment written -> low-latency output (and deterministic
-// solution) received, the end-to-end figure to compare with the raw two hops.
+// solution) received, the end-to-end figure to compare with the raw two hops. `flood` and
+// `sink` measure saturation throughput: flood writes as fast as the writer takes samples (a
+// reliable KEEP_ALL writer blocks while its history is full) and times them until every one is
+// acknowledged; sink takes them and counts gaps in their sequence numbers (lost samples).
 #pragma once
 
 #include <cstdint>
@@ -16,13 +19,25 @@
 namespace navbus::tool {
 
 struct LatencyOptions {
-  std::string role;              ///< "ping", "pong" or "imu"
+  std::string role;              ///< "ping", "pong", "imu", "flood" or "sink"
   int samples{2000};             ///< pings timed (after the warm-up)
   int warmup{100};               ///< pings sent first and not timed
   double rate_hz{200.0};         ///< ping rate [Hz] (the navigation IMU rate)
   double match_timeout_s{20.0};  ///< wait this long for the other side
   double pong_duration_s{0.0};   ///< pong: stop after this long (0: at SIGINT/SIGTERM)
   std::string csv;               ///< ping: write each round trip [ns] here if not empty
+  std::string writer_profile;    ///< ping, pong, flood: data writer profile (default: sensor)
+  std::string reader_profile;    ///< ping, pong, sink: data reader profile (default: sensor)
+};
+
+/// What a sink saw: samples taken, samples missing between them (sequence gaps), and the time
+/// from the first to the last one taken.
+struct SinkCount {
+  std::uint64_t taken{0}, missing{0}, out_of_order{0};
+  std::uint64_t last_seq{0};
+  std::int64_t first_ns{-1}, last_ns{-1};
+  /// Counts sample `seq` (the flood numbers from 1) taken at `now_ns`.
+  void take(std::uint64_t seq, std::int64_t now_ns);
 };
 
 /// Nearest-rank statistics of round-trip times [ns].

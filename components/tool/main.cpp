@@ -192,13 +192,15 @@ int main(int argc, char** argv) {
   auto* latency_cmd = app.add_subcommand(
       "latency",
       "latency over the bus: `ping` against a `pong` process (raw Fast DDS, navbus's message "
-      "type), or `imu` as the IMU of a running navbus-filter with the low-latency output "
-      "(config/filter_latency.yaml): increment written -> output received (same domain, "
-      "--profile, --qos)");
-  latency_cmd->add_option("role", latency.role, "ping, pong or imu")
+      "type), `imu` as the IMU of a running navbus-filter with the low-latency output "
+      "(config/filter_latency.yaml): increment written -> output received, or `flood` against "
+      "a `sink` process: saturation throughput with zero loss checked (same domain, --profile, "
+      "--qos)");
+  latency_cmd->add_option("role", latency.role, "ping, pong, imu, flood or sink")
       ->required()
-      ->check(CLI::IsMember({"ping", "pong", "imu"}));
-  latency_cmd->add_option("--samples", latency.samples, "pings timed after the warm-up")
+      ->check(CLI::IsMember({"ping", "pong", "imu", "flood", "sink"}));
+  latency_cmd
+      ->add_option("--samples", latency.samples, "pings (flood: samples) timed after the warm-up")
       ->check(CLI::Range(1, 10'000'000));
   latency_cmd->add_option("--warmup", latency.warmup, "pings sent first, not timed")
       ->check(CLI::Range(0, 1'000'000));
@@ -208,7 +210,15 @@ int main(int argc, char** argv) {
       ->add_option("--match-timeout", latency.match_timeout_s, "seconds to wait for the other side")
       ->check(CLI::Range(0.1, 600.0));
   latency_cmd->add_option("--duration", latency.pong_duration_s,
-                          "pong: stop after this many seconds (0: until SIGINT)");
+                          "pong, sink: stop after this many seconds (0: until SIGINT; a sink "
+                          "also stops when the flood ends its stream)");
+  latency_cmd->add_option("--writer-profile", latency.writer_profile,
+                          "data writer profile of ping, pong, flood (default "
+                          "navbus_sensor_writer; e.g. navbus_latency_best_effort_writer, or "
+                          "one of your --qos file)");
+  latency_cmd->add_option("--reader-profile", latency.reader_profile,
+                          "data reader profile of ping, pong, sink (default "
+                          "navbus_sensor_reader; e.g. navbus_latency_best_effort_reader)");
   latency_cmd->add_option("--csv", latency.csv,
                           "ping: every round trip [ns]; imu: every increment's latencies [ns] "
                           "(-1: not received)");

@@ -66,3 +66,35 @@ TEST(LowLatencyBus, EveryIncrementGetsItsOutputOverTheBus) {
       << log;
   test::cleanSharedMemory();
 }
+
+// Saturation throughput over the bus: `navbus latency flood` writes as fast as the reliable
+// sensor writer takes samples, `navbus latency sink` (another process) takes them. The sink
+// counts every sample and no sequence gap, and sees the flood end its stream. Domain 99.
+TEST(LatencyFlood, ReliableFloodReachesTheSinkWithoutLoss) {
+  constexpr int kDomain = 99;
+  constexpr int kSamples = 20000, kWarmup = 1000;
+  test::cleanSharedMemory();
+  const auto dir = test::scratchDir("latency-flood");
+  test::ChildProcess sink(NAVBUS_TOOL_EXE,
+                          {"-d", std::to_string(kDomain), "latency", "sink", "--duration", "60"},
+                          (dir / "sink.log").string());
+  test::ChildProcess flood(NAVBUS_TOOL_EXE,
+                           {"-d", std::to_string(kDomain), "latency", "flood", "--samples",
+                            std::to_string(kSamples), "--warmup", std::to_string(kWarmup)},
+                           (dir / "flood.log").string());
+  const auto flood_rc = flood.wait(std::chrono::seconds(60));
+  ASSERT_TRUE(flood_rc.has_value()) << test::readFile(dir / "flood.log");
+  EXPECT_EQ(*flood_rc, 0) << test::readFile(dir / "flood.log");
+  const auto sink_rc = sink.wait(std::chrono::seconds(30));
+  ASSERT_TRUE(sink_rc.has_value()) << test::readFile(dir / "sink.log");
+  EXPECT_EQ(*sink_rc, 0) << test::readFile(dir / "sink.log");
+  const std::string flood_log = test::readFile(dir / "flood.log");
+  const std::string sink_log = test::readFile(dir / "sink.log");
+  std::printf("%s%s", flood_log.c_str(), sink_log.c_str());
+  EXPECT_NE(flood_log.find("20000 samples of 88 bytes written and acknowledged"),
+            std::string::npos);
+  EXPECT_NE(sink_log.find("took 21000 samples"), std::string::npos);
+  EXPECT_NE(sink_log.find("missing 0 (sequence gaps), out of order 0; the flood ended its stream"),
+            std::string::npos);
+  test::cleanSharedMemory();
+}

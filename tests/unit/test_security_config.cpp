@@ -116,3 +116,15 @@ TEST(Latency, NearestRankStatistics) {
   EXPECT_EQ(s.max_ns, 1000);
   EXPECT_EQ(navbus::tool::latencyStats({}).count, 0u);
 }
+
+TEST(Latency, SinkCountsGapsAndOutOfOrderSamples) {
+  navbus::tool::SinkCount c;
+  for (std::uint64_t seq : {1, 2, 3, 6, 7, 5, 10})
+    c.take(seq, static_cast<std::int64_t>(seq) * 100);
+  EXPECT_EQ(c.taken, 7u);
+  EXPECT_EQ(c.missing, 2u + 2u);  // 4 and 5 before 6 (5 came late), 8 and 9
+  EXPECT_EQ(c.out_of_order, 1u);  // 5 after 7
+  EXPECT_EQ(c.last_seq, 10u);
+  EXPECT_EQ(c.first_ns, 100);
+  EXPECT_EQ(c.last_ns, 1000);
+}

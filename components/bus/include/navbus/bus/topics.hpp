@@ -16,7 +16,8 @@ inline constexpr const char* kFilterDiagnostics = "navbus/nav/diagnostics";
 inline constexpr const char* kFaultDecision = "navbus/fault/decision";
 inline constexpr const char* kFilterCommand = "navbus/filter/command";
 inline constexpr const char* kHealth = "navbus/health";
-// Latency probes of `navbus latency` (ImuIncrement samples, sensor stream profiles).
+// Latency and throughput probes of `navbus latency` (ImuIncrement samples, sensor stream
+// profiles unless the user names others).
 inline constexpr const char* kLatencyPing = "navbus/latency/ping";
 inline constexpr const char* kLatencyPong = "navbus/latency/pong";
 }  // namespace topic
@@ -26,10 +27,13 @@ namespace profile {
 inline constexpr const char* kParticipantLoopback = "navbus_participant_udp_loopback";
 // Writer / reader profiles per topic class.
 inline constexpr const char* kSensorWriter = "navbus_sensor_writer";
+/// The simulator's sensor writers in fast pacing (same QoS, asynchronous publishing).
+inline constexpr const char* kSensorWriterFastPacing = "navbus_sensor_writer_fast_pacing";
 inline constexpr const char* kSensorReader = "navbus_sensor_reader";
 inline constexpr const char* kSensorWatchdogReader = "navbus_sensor_watchdog_reader";
 inline constexpr const char* kRawImuMonitorReader = "navbus_raw_imu_monitor_reader";
 inline constexpr const char* kMeasurementWriter = "navbus_measurement_writer";
+inline constexpr const char* kMeasurementWriterFastPacing = "navbus_measurement_writer_fast_pacing";
 inline constexpr const char* kMeasurementReader = "navbus_measurement_reader";
 inline constexpr const char* kMeasurementWatchdogReader = "navbus_measurement_watchdog_reader";
 inline constexpr const char* kSolutionWriter = "navbus_solution_writer";
