@@ -47,7 +47,7 @@ filter=$!
 "$bin/navbus" -d "$((domain + 1))" --log-level warn latency imu --samples 4000 --warmup 200 \
   --rate 200 --csv "$dir/e2e.csv" >"$dir/e2e.txt" 2>&1 || true
 # Peak resident memory of the filter participant over the run.
-grep VmHWM "/proc/$filter/status" >"$dir/filter_rss.txt" 2>/dev/null || true
+grep -E "VmHWM|RssAnon|RssFile" "/proc/$filter/status" >"$dir/filter_rss.txt" 2>/dev/null || true
 kill -INT "$filter" 2>/dev/null || true
 wait "$filter" 2>/dev/null || true
 rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2>/dev/null || true
@@ -181,10 +181,15 @@ else:
     row("bus throughput, seed 001", "no result", f"see {d}/tp_sim.txt")
 
 try:
-    hwm_kib = int(open(f"{d}/filter_rss.txt").read().split()[1])
+    kib = {k: int(v.split()[0]) for k, v in
+           (line.split(":", 1) for line in open(f"{d}/filter_rss.txt").read().splitlines())}
+    hwm_kib = kib["VmHWM"]
     row("navbus-filter peak RSS (latency run, low-latency output on)", f"{hwm_kib / 1024:.1f} MiB",
         "target < 15 MB", "met" if hwm_kib * 1024 < 15e6 else "NOT met")
-except (OSError, IndexError, ValueError):
+    row("navbus-filter RSS at the end: private (anonymous) / shared-library pages",
+        f"{kib['RssAnon'] / 1024:.1f} / {kib['RssFile'] / 1024:.1f} MiB",
+        "library pages are shared by every Fast DDS process on the host")
+except (OSError, IndexError, ValueError, KeyError):
     row("navbus-filter peak RSS", "not read", f"see {d}/filter_rss.txt")
 
 w = [max(len(r[i]) for r in rows + [("figure", "value", "baseline / target", "")]) for i in range(4)]
