@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <unordered_map>
+#include <utility>
 
 #include <navbus_idl/ImuPubSubTypes.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
@@ -300,6 +302,71 @@ int runSink(bus::Participant& p, const LatencyOptions& o) {
   return count.taken > 0 && count.missing == 0 ? bus::kExitOk : bus::kExitRuntimeError;
 }
 
+std::int64_t systemNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+/// Passive end to end, against running participants (for example navbus-sensor-sim in real
+/// time, navbus-filter with the low-latency output, the fault manager): each IMU increment's
+/// source time stamp (the writer's system clock at its write, from the DDS sample info) to the
+/// reception of the low-latency output and of the deterministic solution of the same data time.
+/// Same host: both clocks are this host's system clock. Stops after --samples outputs or
+/// --duration seconds.
+int runObserve(bus::Participant& p, const LatencyOptions& o) {
+  std::unordered_map<std::uint64_t, std::int64_t> imu_written_ns, fast_rx_ns, det_rx_ns;
+  // Best effort (the watchdog profile): observing never back-pressures the sensor.
+  p.subscribe<ImuIncrementPubSubType>(
+      bus::topic::kImuIncrement, bus::profile::kSensorWatchdogReader,
+      [&](const ImuIncrement& m, const eprosima::fastdds::dds::SampleInfo& info) {
+        imu_written_ns.emplace(m.time_gps_ns(), info.source_timestamp.to_ns());
+      });
+  const auto receiver = [&](std::unordered_map<std::uint64_t, std::int64_t>& into) {
+    return [&, into_ptr = &into](const NavigationSolution& s, const auto&) {
+      into_ptr->emplace(s.time_gps_ns(), systemNowNs());
+    };
+  };
+  p.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolutionLowLatency,
+                                            bus::profile::kLowLatencySolutionReader,
+                                            receiver(fast_rx_ns));
+  p.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution, bus::profile::kSolutionReader,
+                                            receiver(det_rx_ns));
+  const auto total = static_cast<std::size_t>(o.warmup + o.samples);
+  spinUntil(p, o.pong_duration_s > 0 ? o.pong_duration_s : 1e9,
+            [&] { return fast_rx_ns.size() >= total; });
+  // Latencies of the outputs whose increment was seen, from the data time of the first output
+  // after the --warmup first ones.
+  std::vector<std::uint64_t> output_times;
+  for (const auto& entry : fast_rx_ns) output_times.push_back(entry.first);
+  std::sort(output_times.begin(), output_times.end());
+  const std::uint64_t from =
+      output_times.empty()
+          ? 0
+          : output_times[std::min(output_times.size() - 1, static_cast<std::size_t>(o.warmup))];
+  const auto latencies = [&](const std::unordered_map<std::uint64_t, std::int64_t>& rx) {
+    std::vector<std::int64_t> out;
+    for (const auto& [time, received_ns] : rx) {
+      const auto it = imu_written_ns.find(time);
+      if (time >= from && it != imu_written_ns.end()) out.push_back(received_ns - it->second);
+    }
+    return out;
+  };
+  const std::vector<std::int64_t> fast = latencies(fast_rx_ns), det = latencies(det_rx_ns);
+  std::printf("IMU written (source time stamp) -> received [us], %zu increments seen:\n",
+              imu_written_ns.size());
+  printOneWay("low-latency output", latencyStats(fast), fast_rx_ns.size());
+  printOneWay("deterministic solution", latencyStats(det), det_rx_ns.size());
+  if (!o.csv.empty()) {
+    std::ofstream csv(o.csv);
+    csv << "output,latency_ns\n";
+    for (const auto v : fast) csv << "low_latency," << v << '\n';
+    for (const auto v : det) csv << "solution," << v << '\n';
+  }
+  p.finish();
+  return fast.empty() ? bus::kExitRuntimeError : bus::kExitOk;
+}
+
 }  // namespace
 
 void SinkCount::take(std::uint64_t seq, std::int64_t now_ns) {
@@ -338,6 +405,7 @@ int runLatencyCommand(const bus::Participant::Options& participant, const Latenc
   if (o.role == "imu") return runImuSource(p, o);
   if (o.role == "flood") return runFlood(p, o);
   if (o.role == "sink") return runSink(p, o);
+  if (o.role == "observe") return runObserve(p, o);
   return runPing(p, o);
 }
 

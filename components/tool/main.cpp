@@ -193,12 +193,13 @@ int main(int argc, char** argv) {
       "latency",
       "latency over the bus: `ping` against a `pong` process (raw Fast DDS, navbus's message "
       "type), `imu` as the IMU of a running navbus-filter with the low-latency output "
-      "(config/filter_latency.yaml): increment written -> output received, or `flood` against "
+      "(config/filter_latency.yaml): increment written -> output received, `observe` the same "
+      "passively on a running bus (IMU source time stamp -> outputs received), or `flood` against "
       "a `sink` process: saturation throughput with zero loss checked (same domain, --profile, "
       "--qos)");
-  latency_cmd->add_option("role", latency.role, "ping, pong, imu, flood or sink")
+  latency_cmd->add_option("role", latency.role, "ping, pong, imu, observe, flood or sink")
       ->required()
-      ->check(CLI::IsMember({"ping", "pong", "imu", "flood", "sink"}));
+      ->check(CLI::IsMember({"ping", "pong", "imu", "observe", "flood", "sink"}));
   latency_cmd
       ->add_option("--samples", latency.samples, "pings (flood: samples) timed after the warm-up")
       ->check(CLI::Range(1, 10'000'000));
@@ -210,8 +211,9 @@ int main(int argc, char** argv) {
       ->add_option("--match-timeout", latency.match_timeout_s, "seconds to wait for the other side")
       ->check(CLI::Range(0.1, 600.0));
   latency_cmd->add_option("--duration", latency.pong_duration_s,
-                          "pong, sink: stop after this many seconds (0: until SIGINT; a sink "
-                          "also stops when the flood ends its stream)");
+                          "pong, sink, observe: stop after this many seconds (0: until SIGINT; "
+                          "a sink also stops when the flood ends its stream, observe after "
+                          "--warmup + --samples outputs)");
   latency_cmd->add_option("--writer-profile", latency.writer_profile,
                           "data writer profile of ping, pong, flood (default "
                           "navbus_sensor_writer; e.g. navbus_latency_best_effort_writer, or "
@@ -221,7 +223,7 @@ int main(int argc, char** argv) {
                           "navbus_sensor_reader; e.g. navbus_latency_best_effort_reader)");
   latency_cmd->add_option("--csv", latency.csv,
                           "ping: every round trip [ns]; imu: every increment's latencies [ns] "
-                          "(-1: not received)");
+                          "(-1: not received); observe: every output's latency [ns]");
 
   nb::tool::OfflineOptions offline;
   auto* offline_cmd = app.add_subcommand(

@@ -22,6 +22,15 @@ TEST(LowLatencyBus, EveryIncrementGetsItsOutputOverTheBus) {
           "domain_id: " + std::to_string(kDomain) + "\n");
   test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
   const std::string csv = (dir / "latency.csv").string();
+  // A passive observer on the same bus: IMU source time stamps -> outputs received. It stops
+  // after kObserved outputs past its warm-up (fewer than the tool sends: the first increments
+  // come before the filter's first solution, the anchor of the outputs).
+  constexpr int kObserved = kSamples / 2;
+  test::ChildProcess observer(
+      NAVBUS_TOOL_EXE,
+      {"-d", std::to_string(kDomain), "latency", "observe", "--samples", std::to_string(kObserved),
+       "--warmup", std::to_string(kWarmup), "--duration", "60"},
+      (dir / "observe.log").string());
   test::ChildProcess tool(
       NAVBUS_TOOL_EXE,
       {"-d", std::to_string(kDomain), "latency", "imu", "--samples", std::to_string(kSamples),
@@ -49,6 +58,23 @@ TEST(LowLatencyBus, EveryIncrementGetsItsOutputOverTheBus) {
   EXPECT_EQ(timed, kSamples);
   EXPECT_EQ(outputs, kSamples);
   EXPECT_GE(solutions, kSamples / 20 - 2);
+
+  // The observer timed the outputs whose increment it saw (its IMU reader is best effort):
+  // at least 90 % of them, and some deterministic solutions.
+  const auto observed = observer.wait(std::chrono::seconds(30));
+  ASSERT_TRUE(observed.has_value()) << test::readFile(dir / "observe.log");
+  EXPECT_EQ(*observed, 0) << test::readFile(dir / "observe.log");
+  const std::string observe_log = test::readFile(dir / "observe.log");
+  std::printf("%s", observe_log.c_str());
+  const auto fast_at = observe_log.find("low-latency output");
+  const auto det_at = observe_log.find("deterministic solution");
+  ASSERT_NE(fast_at, std::string::npos) << observe_log;
+  ASSERT_NE(det_at, std::string::npos) << observe_log;
+  const auto count_after = [&](std::size_t at) {
+    return std::atoi(observe_log.c_str() + observe_log.find('(', at) + 1);
+  };
+  EXPECT_GE(count_after(fast_at), kObserved * 9 / 10) << observe_log;
+  EXPECT_GE(count_after(det_at), 1) << observe_log;
 
   filter.signal(SIGINT);
   ASSERT_TRUE(filter.wait(std::chrono::seconds(20)).has_value());
