@@ -34,6 +34,11 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   watch<navbus::ImuIncrementPubSubType>(
       topic::kImuIncrement, profile::kSensorWatchdogReader, StreamKind::kImu,
       [](const auto& m) { return m.sensor_id(); }, [](const auto& m) { return m.time_gps_ns(); });
+  // Fast pacing's blocks of increments: each element is watched as one increment.
+  watch<navbus::ImuIncrementBlockPubSubType>(
+      topic::kImuIncrementBlock, profile::kSensorWatchdogReader, StreamKind::kImu,
+      [](const auto& m) { return m.sensor_id(); },
+      [](const auto&) { return std::uint64_t{0}; });  // per element
   watch<navbus::ImuRawBlockPubSubType>(
       topic::kImuRaw, profile::kRawImuMonitorReader, StreamKind::kImuRaw,
       [](const auto& m) { return m.sensor_id(); },
@@ -76,11 +81,11 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
       pipeline_.onWritersGone(kind, steadyNowNs());
   };
   bus::WriterGate& writers =
-      writers_.try_emplace(kind, topic, participant_.health().stream(topic)).first->second;
+      writers_.try_emplace(topic, topic, participant_.health().stream(topic)).first->second;
   auto* reader = participant_.subscribe<PubSubType>(
       topic, profile,
-      [this, kind, id, time, &writers](const typename PubSubType::type& m,
-                                       const eprosima::fastdds::dds::SampleInfo& info) {
+      [this, topic, kind, id, time, &writers](const typename PubSubType::type& m,
+                                              const eprosima::fastdds::dds::SampleInfo& info) {
         switch (writers.check(id(m), info)) {
           case bus::WriterPins::Verdict::kNewSecondWriter:
             pipeline_.onSecondWriter(kind, id(m), time(m));
@@ -91,7 +96,15 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
             break;
         }
         instances_[{kind, info.instance_handle}] = id(m);
-        pipeline_.onStreamSample(kind, id(m), m.seq(), time(m), steadyNowNs());
+        if constexpr (std::is_same_v<typename PubSubType::type, navbus::ImuIncrementBlock>) {
+          ++participant_.health().stream(topic).accepted;  // the block; its increments below
+          const std::int64_t now = steadyNowNs();
+          for (const navbus::ImuIncrement& increment : m.increments())
+            pipeline_.onStreamSample(kind, id(m), increment.seq(), increment.time_gps_ns(), now);
+          return;
+        } else {
+          pipeline_.onStreamSample(kind, id(m), m.seq(), time(m), steadyNowNs());
+        }
         if constexpr (std::is_same_v<typename PubSubType::type, navbus::ImuRawBlock>) {
           pipeline_.onRawBlock(m);
         }

@@ -34,7 +34,7 @@ class FaultManagerNode {
   std::map<std::pair<StreamKind, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>
       instances_;
   /// One writer per sensor id on each watched stream (bus::WriterGate).
-  std::map<StreamKind, bus::WriterGate> writers_;
+  std::map<std::string, bus::WriterGate> writers_;  ///< per topic
 };
 
 }  // namespace navbus::fault_manager

@@ -59,6 +59,8 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
       not_producing_ns_(
           std::max(kNotProducingMinNs, kNotProducingPeriods * config.engine.solution_period_ns)),
       imu_writers_(bus::topic::kImuIncrement, p.health().stream(bus::topic::kImuIncrement)),
+      imu_block_writers_(bus::topic::kImuIncrementBlock,
+                         p.health().stream(bus::topic::kImuIncrementBlock)),
       gnss_obs_writers_(bus::topic::kGnssObservations,
                         p.health().stream(bus::topic::kGnssObservations)),
       gnss_fix_writers_(bus::topic::kGnssFix, p.health().stream(bus::topic::kGnssFix)),
@@ -67,6 +69,10 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   subscribeSensor<navbus::ImuIncrementPubSubType>(
       topic::kImuIncrement, profile::kSensorReader, kRankImu, imu_writers_,
       [](const auto& m) { return m.sensor_id(); }, [this](const auto& m) { pipeline_.onImu(m); });
+  subscribeSensor<navbus::ImuIncrementBlockPubSubType>(
+      topic::kImuIncrementBlock, profile::kSensorReader, kRankImu, imu_block_writers_,
+      [](const auto& m) { return m.sensor_id(); },
+      [this](const auto& m) { pipeline_.onImuBlock(m); });
   subscribeSensor<navbus::GnssObservationEpochPubSubType>(
       topic::kGnssObservations, profile::kMeasurementReader, kRankGnssObs, gnss_obs_writers_,
       [](const auto& m) { return m.receiver_id(); },

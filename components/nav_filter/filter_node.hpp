@@ -50,7 +50,8 @@ class FilterNode {
   std::int64_t not_producing_ns_;      ///< silence of the solution output that is "not producing"
   std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)
   /// One writer per sensor id on each sensor stream (a second writer's samples are kept out).
-  bus::WriterGate imu_writers_, gnss_obs_writers_, gnss_fix_writers_, star_writers_;
+  bus::WriterGate imu_writers_, imu_block_writers_, gnss_obs_writers_, gnss_fix_writers_,
+      star_writers_;
   /// The sensor id of each stream instance seen (rank, instance handle): disposals carry only
   /// the handle.
   std::map<std::pair<StreamRank, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>

@@ -122,6 +122,9 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
       predictor_(config.engine.tuning.gravity, config.low_latency_max_buffered),
       imu_gate_(bus::topic::kImuIncrement, health.stream(bus::topic::kImuIncrement),
                 config.time_jump, &time_reference_),
+      imu_block_gate_(bus::topic::kImuIncrementBlock,
+                      health.stream(bus::topic::kImuIncrementBlock)),
+      imu_counters_(health.stream(bus::topic::kImuIncrement)),
       gnss_obs_gate_(bus::topic::kGnssObservations, health.stream(bus::topic::kGnssObservations),
                      config.time_jump, &time_reference_),
       gnss_fix_gate_(bus::topic::kGnssFix, health.stream(bus::topic::kGnssFix), config.time_jump,
@@ -185,6 +188,16 @@ void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
   const core::ImuIncrement inc = bus::toCore(msg);
   queue(imu_gate_, {kRankImu, msg.sensor_id()}, inc.time_ns, inc);
   if (config_.low_latency_output && sinks_.low_latency) publishLowLatency(inc);
+}
+
+void FilterPipeline::onImuBlock(const navbus::ImuIncrementBlock& msg) {
+  const auto& increments = msg.increments();
+  const std::uint64_t first_ns = increments.empty() ? 0 : increments.front().time_gps_ns();
+  if (!imu_block_gate_.admit(msg, msg.sensor_id(), msg.seq(), first_ns)) return;
+  for (const navbus::ImuIncrement& increment : increments) {
+    ++imu_counters_.received;
+    onImu(increment);
+  }
 }
 
 void FilterPipeline::publishLowLatency(const core::ImuIncrement& inc) {

@@ -67,6 +67,10 @@ class FilterPipeline {
   FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks);
 
   void onImu(const navbus::ImuIncrement& msg);
+  /// A block of increments (fast pacing): its structure and block sequence are checked under
+  /// the block topic, then every element goes through onImu as one increment sample (received,
+  /// validated and counted under the increment topic), in order.
+  void onImuBlock(const navbus::ImuIncrementBlock& msg);
   void onGnssObservations(const navbus::GnssObservationEpoch& msg);
   void onGnssFix(const navbus::GnssFix& msg);
   void onStarTracker(const navbus::StarTrackerAttitude& msg);
@@ -159,6 +163,8 @@ class FilterPipeline {
   bus::TimeReference
       time_reference_;  ///< latest data time accepted on any input (before the gates)
   bus::StreamGate imu_gate_;
+  bus::StreamGate imu_block_gate_;     ///< the block topic: structure and block sequence
+  bus::StreamCounters& imu_counters_;  ///< health of the increment topic (received per element)
   bus::StreamGate gnss_obs_gate_;
   bus::StreamGate gnss_fix_gate_;
   bus::StreamGate star_gate_;

@@ -84,7 +84,9 @@ navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_
 }
 
 FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& config)
-    : participant_(participant), config_(config) {
+    : participant_(participant),
+      config_(config),
+      increments_per_block_(sensor_sim::incrementsPerBlock(config)) {
   using namespace bus;
   // Fast pacing writes asynchronously (several samples per datagram); real time synchronously
   // (no thread hop in the latency). qos/navbus_qos.xml says what each measured.
@@ -92,8 +94,14 @@ FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& c
   const char* sensor_profile = fast ? profile::kSensorWriterFastPacing : profile::kSensorWriter;
   const char* measurement_profile =
       fast ? profile::kMeasurementWriterFastPacing : profile::kMeasurementWriter;
-  imu_ = participant.createWriter<navbus::ImuIncrementPubSubType>(topic::kImuIncrement,
-                                                                  sensor_profile);
+  if (increments_per_block_ > 0) {
+    batcher_.emplace(increments_per_block_);
+    imu_blocks_ = participant.createWriter<navbus::ImuIncrementBlockPubSubType>(
+        topic::kImuIncrementBlock, sensor_profile);
+  } else {
+    imu_ = participant.createWriter<navbus::ImuIncrementPubSubType>(topic::kImuIncrement,
+                                                                    sensor_profile);
+  }
   if (config.publish_raw) {
     raw_ = participant.createWriter<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, sensor_profile);
   }
@@ -121,17 +129,72 @@ bool FramePublisher::writeReliably(bus::Writer<Sample>& writer, const Sample& sa
   return true;
 }
 
+bool FramePublisher::writeIncrement(const navbus::ImuIncrement& increment) {
+  if (batcher_) {
+    batcher_->addIncrement(increment);  // written by writeBlocks when full
+    return true;
+  }
+  if (!writeReliably(imu_, increment)) return false;
+  ++written_.increments;
+  ++written_.increment_samples;
+  return true;
+}
+
+bool FramePublisher::writeRaw(const navbus::ImuRawBlock& raw) {
+  if (!writeReliably(raw_, raw)) return false;
+  written_.raw_samples += raw.samples().size();
+  ++written_.raw_blocks;
+  return true;
+}
+
+bool FramePublisher::batchRaw(const navbus::ImuRawBlock& raw) {
+  if (batcher_->addRaw(raw)) return true;
+  // Not a continuation of the pending block (or no room): that one goes first.
+  if (batcher_->hasRaw() && !writeRaw(batcher_->takeRaw())) return false;
+  if (batcher_->addRaw(raw)) return true;
+  return writeRaw(raw);  // longer than any block: as it is
+}
+
+bool FramePublisher::writeBlocks() {
+  if (batcher_->hasIncrements()) {
+    const navbus::ImuIncrementBlock block = batcher_->takeIncrements();
+    if (!writeReliably(imu_blocks_, block)) return false;
+    written_.increments += block.increments().size();
+    ++written_.increment_samples;
+  }
+  return !batcher_->hasRaw() || writeRaw(batcher_->takeRaw());
+}
+
 bool FramePublisher::publish(const sim::SensorFrame& f) {
-  return emitFrame(f, config_, counts_, [this](const auto& sample) {
+  const bool written = emitFrame(f, config_, sequence_, [this](const auto& sample) {
     using T = std::decay_t<decltype(sample)>;
-    if constexpr (std::is_same_v<T, navbus::ImuIncrement>) return writeReliably(imu_, sample);
-    if constexpr (std::is_same_v<T, navbus::ImuRawBlock>) return writeReliably(raw_, sample);
-    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
-      return writeReliably(gnss_, sample);
-    if constexpr (std::is_same_v<T, navbus::GnssFix>) return writeReliably(fix_, sample);
-    if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>)
-      return writeReliably(star_, sample);
+    if constexpr (std::is_same_v<T, navbus::ImuIncrement>) return writeIncrement(sample);
+    if constexpr (std::is_same_v<T, navbus::ImuRawBlock>)
+      return batcher_ ? batchRaw(sample) : writeRaw(sample);
+    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>) {
+      if (!writeReliably(gnss_, sample)) return false;
+      ++written_.gnss_epochs;
+      return true;
+    }
+    if constexpr (std::is_same_v<T, navbus::GnssFix>) {
+      if (!writeReliably(fix_, sample)) return false;
+      ++written_.gnss_fixes;
+      return true;
+    }
+    if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) {
+      if (!writeReliably(star_, sample)) return false;
+      ++written_.star_tracker;
+      return true;
+    }
   });
+  if (!written) return false;
+  // A full block of increments goes out with the raw samples of the same frames.
+  const bool full = batcher_ && sequence_.imu % increments_per_block_ == 0;
+  return !full || writeBlocks();
+}
+
+std::size_t FramePublisher::imuReaders() const {
+  return batcher_ ? imu_blocks_.matchedReaders() : imu_.matchedReaders();
 }
 
 bool FramePublisher::readersMatched() const {
@@ -139,14 +202,16 @@ bool FramePublisher::readersMatched() const {
   auto enough = [](const auto& writer, int wanted) {
     return writer.matchedReaders() >= static_cast<std::size_t>(wanted);
   };
-  return enough(imu_, m.imu) && (!config_.publish_raw || enough(raw_, m.raw_imu)) &&
+  return imuReaders() >= static_cast<std::size_t>(m.imu) &&
+         (!config_.publish_raw || enough(raw_, m.raw_imu)) &&
          (!config_.publish_gnss || (enough(gnss_, m.gnss) && enough(fix_, m.gnss))) &&
          (!config_.publish_star_tracker || enough(star_, m.star_tracker));
 }
 
 void FramePublisher::flush() {
   const eprosima::fastrtps::Duration_t timeout(5, 0);
-  for (auto* w : {imu_.raw(), raw_.raw(), gnss_.raw(), fix_.raw(), star_.raw()}) {
+  for (auto* w :
+       {imu_.raw(), imu_blocks_.raw(), raw_.raw(), gnss_.raw(), fix_.raw(), star_.raw()}) {
     if (w != nullptr && w->wait_for_acknowledgments(timeout) != ReturnCode_t::RETCODE_OK) {
       spdlog::warn("{}: not every reliable reader acknowledged the data within {} s",
                    w->get_topic()->get_name(), timeout.seconds);
@@ -163,21 +228,25 @@ void disposeIfPublished(bus::Writer<Sample>& writer, std::uint64_t published, co
 }  // namespace
 
 void FramePublisher::endStreams() {
+  if (batcher_ && !writeBlocks()) return;  // stopped meanwhile
   navbus::ImuIncrement imu;
   imu.sensor_id(config_.imu_sensor_id);
-  disposeIfPublished(imu_, counts_.imu, imu);
+  disposeIfPublished(imu_, batcher_ ? 0 : written_.increment_samples, imu);
+  navbus::ImuIncrementBlock imu_block;
+  imu_block.sensor_id(config_.imu_sensor_id);
+  disposeIfPublished(imu_blocks_, batcher_ ? written_.increment_samples : 0, imu_block);
   navbus::ImuRawBlock raw;
   raw.sensor_id(config_.imu_sensor_id);
-  disposeIfPublished(raw_, counts_.raw, raw);
+  disposeIfPublished(raw_, written_.raw_blocks, raw);
   navbus::GnssObservationEpoch gnss;
   gnss.receiver_id(config_.gnss_receiver_id);
-  disposeIfPublished(gnss_, counts_.gnss_epochs, gnss);
+  disposeIfPublished(gnss_, written_.gnss_epochs, gnss);
   navbus::GnssFix fix;
   fix.receiver_id(config_.gnss_receiver_id);
-  disposeIfPublished(fix_, counts_.gnss_fixes, fix);
+  disposeIfPublished(fix_, written_.gnss_fixes, fix);
   navbus::StarTrackerAttitude star;
   star.tracker_id(config_.star_tracker_id);
-  disposeIfPublished(star_, counts_.star_tracker, star);
+  disposeIfPublished(star_, written_.star_tracker, star);
 }
 
 }  // namespace navbus::sensor_sim

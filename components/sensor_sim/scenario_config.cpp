@@ -292,8 +292,8 @@ SimConfig parseSimConfig(const YAML::Node& root) {
 
   const YAML::Node timing = root["timing"];
   checkKeys(timing, "timing",
-            {"start", "duration_s", "pacing", "wait_for_readers_s", "min_readers", "imu_rate_hz",
-             "raw_rate_hz", "gnss_rate_hz", "star_tracker_rate_hz"});
+            {"start", "duration_s", "pacing", "fast_pacing_block_s", "wait_for_readers_s",
+             "min_readers", "imu_rate_hz", "raw_rate_hz", "gnss_rate_hz", "star_tracker_rate_hz"});
   const std::string start = get<std::string>(timing, "timing", "start", "now");
   if (start == "now") {
     c.start_now = true;
@@ -315,6 +315,8 @@ SimConfig parseSimConfig(const YAML::Node& root) {
     c.pacing = Pacing::kFast;
   else
     throw ConfigError("configuration timing.pacing = '" + pacing + "' is not realtime or fast");
+  c.fast_pacing_block_s =
+      get<double>(timing, "timing", "fast_pacing_block_s", SimConfig{}.fast_pacing_block_s);
   c.wait_for_readers_s = checkRange(get<double>(timing, "timing", "wait_for_readers_s", 10.0), 0,
                                     3600, "timing.wait_for_readers_s");
   const YAML::Node wait = child(timing, "min_readers");
@@ -494,6 +496,19 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   c.publish_star_tracker =
       get<bool>(pub, "publish", "star_tracker", s.star_tracker_every_n_increments > 0);
   return c;
+}
+
+std::size_t incrementsPerBlock(const SimConfig& c) {
+  if (c.pacing != Pacing::kFast || c.fast_pacing_block_s == 0.0) return 0;
+  const double rate_hz = 1e9 / static_cast<double>(c.scenario.imu_period_ns);
+  const double n = std::round(c.fast_pacing_block_s * rate_hz);
+  if (!(n >= 1.0 && n <= static_cast<double>(ImuBlockBatcher::kMaxIncrements))) {
+    throw ConfigError(
+        "configuration timing.fast_pacing_block_s = " + std::to_string(c.fast_pacing_block_s) +
+        " is " + std::to_string(n) + " increments at " + std::to_string(rate_hz) + " Hz, not 1.." +
+        std::to_string(ImuBlockBatcher::kMaxIncrements) + " (or 0: one per sample)");
+  }
+  return static_cast<std::size_t>(n);
 }
 
 }  // namespace navbus::sensor_sim

@@ -2,11 +2,13 @@
 // names and comments), converted to SI here, once. See scenarios/*.yaml and the README.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
 #include <yaml-cpp/yaml.h>
 
+#include "imu_block_batcher.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
 namespace navbus::sensor_sim {
@@ -18,6 +20,10 @@ struct SimConfig {
   bool start_now{true};    ///< start at the current GPS time (real time), else the configured time
   double duration_s{0.0};  ///< 0: until stopped (bus) or the end of the segments (files)
   Pacing pacing{Pacing::kRealTime};
+  /// [s] of IMU data per DDS sample in fast pacing: increments go out as ImuIncrementBlocks and
+  /// raw samples in blocks as long (bus throughput); 0: one ImuIncrement per sample, as in
+  /// real time, which always publishes each increment as it is due.
+  double fast_pacing_block_s{0.1};
   double wait_for_readers_s{10.0};  ///< wait this long for readers before publishing
   /// Readers to wait for before publishing, per topic.
   struct MinReaders {
@@ -33,5 +39,10 @@ struct SimConfig {
 
 /// Throws bus::ConfigError naming the key and value on any invalid entry.
 SimConfig parseSimConfig(const YAML::Node& root);
+
+/// Increments per ImuIncrementBlock (fast_pacing_block_s at the IMU rate), 0 when increments
+/// go out one per sample (real time, or a block of 0 s). Throws bus::ConfigError naming
+/// timing.fast_pacing_block_s when it is not 1..ImuBlockBatcher::kMaxIncrements increments.
+std::size_t incrementsPerBlock(const SimConfig& config);
 
 }  // namespace navbus::sensor_sim

@@ -46,6 +46,12 @@ void visitFields(const navbus::ImuIncrement& m, V& v) {
   v("status_flags", m.status_flags());
 }
 template <class V>
+void visitFields(const navbus::ImuIncrementBlock& m, V& v) {
+  v("sensor_id", m.sensor_id());
+  v("seq", m.seq());
+  v.rows("increments", m.increments());
+}
+template <class V>
 void visitFields(const navbus::ImuRawSample& m, V& v) {
   v("angular_rate_b_radps", m.angular_rate_b_radps());
   v("specific_force_b_mps2", m.specific_force_b_mps2());

@@ -32,6 +32,7 @@ const std::vector<TopicEntry>& topicRegistry() {
   using namespace bus;
   static const std::vector<TopicEntry> registry = {
       entry<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorReader),
+      entry<navbus::ImuIncrementBlockPubSubType>(topic::kImuIncrementBlock, profile::kSensorReader),
       entry<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, profile::kSensorReader),
       entry<navbus::GnssObservationEpochPubSubType>(topic::kGnssObservations,
                                                     profile::kMeasurementReader),

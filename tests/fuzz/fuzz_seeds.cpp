@@ -136,6 +136,10 @@ bool writeTopicSeeds(const std::string& dir) {
   health.inputs().resize(1);
   health.inputs()[0].topic("navbus/imu/increment");
   health.inputs()[0].rejected().resize(1);
+  navbus::ImuIncrementBlock block;
+  block.sensor_id(inc.sensor_id());
+  block.seq(1);
+  block.increments().assign(3, inc);
   // Selectors in the order of fuzz_topics.cpp's kTypes.
   return writeSample<navbus::ImuIncrementPubSubType>(dir, 0, inc) &&
          writeSample<navbus::ImuRawBlockPubSubType>(dir, 1, raw) &&
@@ -146,7 +150,8 @@ bool writeTopicSeeds(const std::string& dir) {
          writeSample<navbus::FilterDiagnosticsPubSubType>(dir, 6, diagnostics()) &&
          writeSample<navbus::FaultDecisionPubSubType>(dir, 7, dec) &&
          writeSample<navbus::FilterCommandPubSubType>(dir, 8, cmd) &&
-         writeSample<navbus::HealthPubSubType>(dir, 9, health);
+         writeSample<navbus::HealthPubSubType>(dir, 9, health) &&
+         writeSample<navbus::ImuIncrementBlockPubSubType>(dir, 10, block);
 }
 
 /// "kind:path": the file's text behind the selector of its parser (fuzz_config.cpp's order).

@@ -39,6 +39,10 @@ void check(bool condition) {
 void admit(const navbus::ImuIncrement& s, const ValidationLimits& l) {
   if (!navbus::bus::validate(s, l)) (void)navbus::bus::toCore(s);
 }
+void admit(const navbus::ImuIncrementBlock& s, const ValidationLimits& l) {
+  if (navbus::bus::validate(s, l)) return;
+  for (const navbus::ImuIncrement& increment : s.increments()) admit(increment, l);
+}
 void admit(const navbus::ImuRawBlock& s, const ValidationLimits& l) {
   (void)navbus::bus::validate(s, l);
 }
@@ -101,6 +105,7 @@ constexpr Fuzz kTypes[] = {
     fuzzType<navbus::FaultDecisionPubSubType>,
     fuzzType<navbus::FilterCommandPubSubType>,
     fuzzType<navbus::HealthPubSubType>,
+    fuzzType<navbus::ImuIncrementBlockPubSubType>,
 };
 
 }  // namespace

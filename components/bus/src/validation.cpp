@@ -85,6 +85,17 @@ std::optional<Rejection> validate(const navbus::ImuIncrement& s, const Validatio
   return std::nullopt;
 }
 
+std::optional<Rejection> validate(const navbus::ImuIncrementBlock& s, const ValidationLimits&) {
+  if (s.increments().empty()) return Rejection{navbus::REJECT_OUT_OF_RANGE, "increments.size", 0.0};
+  for (std::size_t i = 0; i < s.increments().size(); ++i) {
+    if (s.increments()[i].sensor_id() != s.sensor_id()) {
+      return Rejection{navbus::REJECT_INCONSISTENT, indexed("increments", i) + ".sensor_id",
+                       static_cast<double>(s.increments()[i].sensor_id())};
+    }
+  }
+  return std::nullopt;
+}
+
 std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const ValidationLimits& l) {
   if (s.samples().empty()) {
     return Rejection{navbus::REJECT_OUT_OF_RANGE, "samples.size", 0.0};

@@ -6,6 +6,8 @@ namespace navbus::bus {
 
 namespace topic {
 inline constexpr const char* kImuIncrement = "navbus/imu/increment";
+/// Blocks of increments (ImuIncrementBlock): the simulator's fast pacing.
+inline constexpr const char* kImuIncrementBlock = "navbus/imu/increment_block";
 inline constexpr const char* kImuRaw = "navbus/imu/raw";
 inline constexpr const char* kGnssObservations = "navbus/gnss/observations";
 inline constexpr const char* kGnssFix = "navbus/gnss/fix";

@@ -46,6 +46,9 @@ struct ValidationLimits {
 };
 
 std::optional<Rejection> validate(const navbus::ImuIncrement& s, const ValidationLimits& l);
+/// The block's structure only: at least one increment, each of the block's sensor. Each
+/// increment is then validated (and counted) as an ImuIncrement sample.
+std::optional<Rejection> validate(const navbus::ImuIncrementBlock& s, const ValidationLimits& l);
 std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const ValidationLimits& l);
 /// Epoch-level checks only (none today beyond the IDL bounds): a bad satellite costs that
 /// satellite, not the epoch; see screenSatellites.
