@@ -150,6 +150,9 @@ int runImuSource(bus::Participant& p, const LatencyOptions& o) {
                            period_ns) *
                           period_ns;
   std::vector<std::int64_t> sent_ns(total, 0), fast_ns(total, -1), solution_ns(total, -1);
+  // The filter's write time (the output's DDS source time stamp, system clock: same host)
+  // splits the low-latency path into hop 1 + the filter, and hop 2.
+  std::vector<std::int64_t> sent_system_ns(total, 0), fast_written_ns(total, -1);
   const auto index = [&](std::uint64_t time_gps_ns) -> std::int64_t {
     const std::int64_t k = (static_cast<std::int64_t>(time_gps_ns) - t0) / period_ns - 1;
     return k >= 0 && static_cast<std::size_t>(k) < total &&
@@ -157,19 +160,21 @@ int runImuSource(bus::Participant& p, const LatencyOptions& o) {
                ? k
                : -1;
   };
-  const auto receiver = [&](std::vector<std::int64_t>& into) {
-    return [&, into_ptr = &into](const NavigationSolution& s, const auto&) {
+  const auto receiver = [&](std::vector<std::int64_t>& into, std::vector<std::int64_t>* written) {
+    return [&, into_ptr = &into, written](const NavigationSolution& s, const auto& info) {
       const std::int64_t k = index(s.time_gps_ns());
-      if (k >= 0 && (*into_ptr)[static_cast<std::size_t>(k)] < 0 &&
-          sent_ns[static_cast<std::size_t>(k)] > 0)
-        (*into_ptr)[static_cast<std::size_t>(k)] = nowNs() - sent_ns[static_cast<std::size_t>(k)];
+      if (k < 0) return;
+      const auto i = static_cast<std::size_t>(k);
+      if ((*into_ptr)[i] >= 0 || sent_ns[i] <= 0) return;
+      (*into_ptr)[i] = nowNs() - sent_ns[i];
+      if (written) (*written)[i] = info.source_timestamp.to_ns() - sent_system_ns[i];
     };
   };
   auto* fast = p.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolutionLowLatency,
                                                          bus::profile::kLowLatencySolutionReader,
-                                                         receiver(fast_ns));
+                                                         receiver(fast_ns, &fast_written_ns));
   auto* det = p.subscribe<NavigationSolutionPubSubType>(
-      bus::topic::kNavSolution, bus::profile::kSolutionReader, receiver(solution_ns));
+      bus::topic::kNavSolution, bus::profile::kSolutionReader, receiver(solution_ns, nullptr));
   if (!spinUntil(p, o.match_timeout_s, [&] {
         return imu.matchedReaders() > 0 && matchedWriters(fast) > 0 && matchedWriters(det) > 0;
       })) {
@@ -190,6 +195,9 @@ int runImuSource(bus::Participant& p, const LatencyOptions& o) {
     while (Clock::now() < next) p.spinOnce(next - Clock::now());
     inc.time_ns = t0 + static_cast<std::int64_t>(k + 1) * period_ns;
     const ImuIncrement msg = bus::toIdl(inc, 1, k + 1);
+    sent_system_ns[k] = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
     sent_ns[k] = nowNs();
     imu.write(msg);
     next += period;
@@ -208,6 +216,14 @@ int runImuSource(bus::Participant& p, const LatencyOptions& o) {
   std::printf("IMU written -> received [us], %zu increments at %.1f Hz over %.1f s:\n",
               static_cast<std::size_t>(o.samples), o.rate_hz, elapsed_s);
   printOneWay("low-latency output", latencyStats(fast_t), static_cast<std::size_t>(o.samples));
+  std::vector<std::int64_t> hop1, hop2;  // where both are known
+  for (std::size_t k = static_cast<std::size_t>(o.warmup); k < total; ++k) {
+    if (fast_ns[k] < 0 || fast_written_ns[k] < 0) continue;
+    hop1.push_back(fast_written_ns[k]);
+    hop2.push_back(fast_ns[k] - fast_written_ns[k]);
+  }
+  printOneWay("  increment -> filter's write", latencyStats(hop1), fast_t.size());
+  printOneWay("  filter's write -> received", latencyStats(hop2), fast_t.size());
   printOneWay("deterministic solution", latencyStats(det_t), solutions_expected);
   if (!o.csv.empty()) {
     std::ofstream csv(o.csv);
