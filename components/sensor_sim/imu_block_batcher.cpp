@@ -1,5 +1,6 @@
 #include "imu_block_batcher.hpp"
 
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -29,10 +30,16 @@ bool ImuBlockBatcher::addRaw(const navbus::ImuRawBlock& raw) {
     raw_.sample_period_ns(raw.sample_period_ns());
   } else {
     const std::size_t n = raw_.samples().size();
-    const std::uint64_t next_ns =
-        raw_.first_sample_time_gps_ns() + static_cast<std::uint64_t>(n) * raw_.sample_period_ns();
+    // The period is whole nanoseconds (416667 ns at 2400 Hz), the samples' times are not: a
+    // continuation starts within half a period of where the block's times put it, a gap of a
+    // sample or more does not.
+    const auto next_ns =
+        static_cast<std::int64_t>(raw_.first_sample_time_gps_ns() + n * raw_.sample_period_ns());
+    const std::int64_t offset_ns =
+        static_cast<std::int64_t>(raw.first_sample_time_gps_ns()) - next_ns;
     if (raw.sensor_id() != raw_.sensor_id() || raw.sample_period_ns() != raw_.sample_period_ns() ||
-        raw.first_sample_time_gps_ns() != next_ns || n + raw.samples().size() > kMaxRawSamples) {
+        2 * std::llabs(offset_ns) >= static_cast<std::int64_t>(raw_.sample_period_ns()) ||
+        n + raw.samples().size() > kMaxRawSamples) {
       return false;
     }
   }

@@ -24,7 +24,8 @@ class ImuBlockBatcher {
   /// takeIncrements() (and takeRaw(), so that both blocks cover the same frames).
   bool addIncrement(const navbus::ImuIncrement& increment);
   /// Appends a raw block's samples to the pending raw block. False, adding nothing, when they
-  /// do not continue it (another sensor or rate, a gap in time, or beyond kMaxRawSamples):
+  /// do not continue it (another sensor or rate, a gap in time: a start more than half a
+  /// period off the block's sample times, or beyond kMaxRawSamples):
   /// write takeRaw() first, then add again.
   bool addRaw(const navbus::ImuRawBlock& raw);
 

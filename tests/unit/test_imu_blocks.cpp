@@ -110,6 +110,19 @@ TEST(ImuBlockBatcher, RawSamplesThatDoNotContinueTheBlockAreRefused) {
   EXPECT_FALSE(batcher.addRaw(big));  // beyond the IDL bound together
   EXPECT_TRUE(batcher.addRaw(f.raw[1]));
   EXPECT_EQ(batcher.takeRaw().samples().size(), 8u);
+  // 2400 Hz: the period rounded to whole nanoseconds, the times exact; consecutive blocks of
+  // 24 samples continue one another although 24 rounded periods miss the next time by 8 ns.
+  ImuRawBlock a, b;
+  a.sensor_id(1);
+  a.sample_period_ns(416'667);
+  a.first_sample_time_gps_ns(1'000'000'000);
+  a.samples().resize(24);
+  b = a;
+  b.first_sample_time_gps_ns(1'010'000'000);  // 10 ms later: 24 samples of 1/2400 s
+  ASSERT_TRUE(batcher.addRaw(a));
+  EXPECT_TRUE(batcher.addRaw(b));
+  b.first_sample_time_gps_ns(1'020'000'000 + 416'667);  // one sample missing
+  EXPECT_FALSE(batcher.addRaw(b));
   EXPECT_THROW(sensor_sim::ImuBlockBatcher(0), std::invalid_argument);
   EXPECT_THROW(sensor_sim::ImuBlockBatcher(65), std::invalid_argument);
 }
