@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every benchmark and prints one table: each figure beside the baseline measured in the
 # same run (or the absolute target), and the raw outputs under $BENCH_DIR.
-#   bash scripts/bench.sh            (builds first if needed; about 3 minutes on 2 cores)
+#   bash scripts/bench.sh            (builds first if needed; about 8 minutes on 2 cores)
 # Environment: BENCH_DIR (default: a new temporary directory), BENCH_DOMAIN (DDS domain of the
 # latency ping/pong, default 150), BENCH_RUNS (offline repetitions, default 3).
 set -euo pipefail
@@ -105,6 +105,10 @@ throughput() {  # tag, domain, simulator options...
 echo "bench: bus throughput, seed 001, 600 s of data, fast pacing, three processes, domain $((domain + 3))" >&2
 for i in 1 2 3; do throughput "$i" "$((domain + 3))"; done
 throughput single "$((domain + 3))" --fast-pacing-block 0
+
+echo "bench: raw latency and saturation per participant profile and stream QoS (scripts/latency_sweep.sh)" >&2
+SWEEP_DIR="$dir/sweep" SWEEP_DOMAIN="$((domain + 20))" NAVBUS_BIN="$bin" bash scripts/latency_sweep.sh 2000 \
+  >"$dir/sweep.txt" 2>/dev/null || echo "bench: latency sweep failed (see $dir/sweep)" >&2
 
 /usr/bin/python3 scripts/plot_navbus.py latency --raw "$dir/ping.csv" --e2e "$dir/e2e.csv" -o "$dir" \
   >/dev/null 2>&1 || echo "bench: no latency figure (see the CSV files in $dir)" >&2
@@ -272,5 +276,10 @@ fmt = "  ".join(f"{{:<{x}}}" for x in w)
 print(fmt.format("figure", "value", "baseline / target", ""))
 for r in rows:
     print(fmt.format(*r))
+print()
+try:
+    print(open(f"{d}/sweep.txt").read().rstrip())
+except OSError:
+    print("latency sweep: no result")
 print(f"raw outputs and the latency figure (latency.png): {d}")
 EOF
