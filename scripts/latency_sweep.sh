@@ -2,7 +2,7 @@
 # Raw Fast DDS latency and saturation throughput of navbus's IMU message, per participant
 # profile and per stream QoS, in one table (`navbus latency ping/pong` and `flood/sink`, two
 # processes each). Profiles: UDP loopback, shared memory, a discovery server (started here:
-# `fastdds discovery` on 127.0.0.1:11811) and UDP loopback under DDS Security (the build's
+# fast-discovery-server, Fast DDS's `fastdds discovery`, on 127.0.0.1:11811) and UDP loopback under DDS Security (the build's
 # test credentials). QoS: the sensor profiles (reliable, KEEP_ALL) and the best-effort probe
 # profiles (KEEP_LAST 100). The LAN profile needs a second host: tests/netns runs it.
 #   bash scripts/latency_sweep.sh [SAMPLES]      (default 2000 pings at 200 Hz per case)
@@ -21,13 +21,19 @@ mkdir -p "$dir"
 
 server=
 cleanup() {
-  [ -n "$server" ] && kill "$server" 2>/dev/null
+  if [ -n "$server" ]; then kill "$server" 2>/dev/null || true; fi
   rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2>/dev/null || true
 }
 trap cleanup EXIT
-fastdds discovery -i 0 -l 127.0.0.1 -p 11811 >"$dir/discovery_server.txt" 2>&1 &
+# The server binary itself (`fastdds discovery` is a wrapper that leaves it running when killed).
+fast-discovery-server -i 0 -l 127.0.0.1 -p 11811 >"$dir/discovery_server.txt" 2>&1 &
 server=$!
 sleep 1
+if ! kill -0 "$server" 2>/dev/null; then
+  echo "latency_sweep: the discovery server did not start on 127.0.0.1:11811 (port in use?):" >&2
+  cat "$dir/discovery_server.txt" >&2
+  exit 1
+fi
 
 profiles=(navbus_participant_udp_loopback navbus_participant_shm
           navbus_participant_discovery_client navbus_participant_udp_loopback_secure)
