@@ -113,7 +113,9 @@ def last_health(health_csv):
 
 
 def published_counts(sim_summary):
-    pattern = {"navbus/imu/increment": r"(\d+) IMU increments", "navbus/imu/raw": r"(\d+) raw blocks",
+    # "published N IMU increments in M samples, K raw samples in B blocks, ...": every
+    # increment is counted under navbus/imu/increment whether it came alone or in a block.
+    pattern = {"navbus/imu/increment": r"(\d+) IMU increments", "navbus/imu/raw": r"raw samples in (\d+) blocks",
                "navbus/gnss/observations": r"(\d+) GNSS epochs", "navbus/gnss/fix": r"(\d+) GNSS fixes"}
     counts = {}
     for topic, p in pattern.items():

@@ -97,10 +97,15 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
         }
         instances_[{kind, info.instance_handle}] = id(m);
         if constexpr (std::is_same_v<typename PubSubType::type, navbus::ImuIncrementBlock>) {
-          ++participant_.health().stream(topic).accepted;  // the block; its increments below
+          // The block is counted under its topic; each element is received (and watched) as
+          // one increment, under the increment topic, as the filter counts them.
+          ++participant_.health().stream(topic).accepted;
+          bus::StreamCounters& increments = participant_.health().stream(bus::topic::kImuIncrement);
           const std::int64_t now = steadyNowNs();
-          for (const navbus::ImuIncrement& increment : m.increments())
+          for (const navbus::ImuIncrement& increment : m.increments()) {
+            ++increments.received;
             pipeline_.onStreamSample(kind, id(m), increment.seq(), increment.time_gps_ns(), now);
+          }
           return;
         } else {
           pipeline_.onStreamSample(kind, id(m), m.seq(), time(m), steadyNowNs());
