@@ -23,7 +23,7 @@ struct Case {
 
 class FastPacing : public ::testing::TestWithParam<Case> {};
 
-constexpr int kSeconds = 60;  // 6000 increments, 6000 raw blocks of 24 samples, 600 solutions
+constexpr int kSeconds = 60;      // 6000 increments in 600 blocks, raw samples, 600 solutions
 constexpr double kStallS = 20.0;  // wall time of the simulator's run that counts as a stall
 }  // namespace
 
