@@ -38,7 +38,9 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   watch<navbus::ImuIncrementBlockPubSubType>(
       topic::kImuIncrementBlock, profile::kSensorWatchdogReader, StreamKind::kImu,
       [](const auto& m) { return m.sensor_id(); },
-      [](const auto&) { return std::uint64_t{0}; });  // per element
+      [](const auto& m) {  // its newest increment's (the watchdog takes every element's)
+        return m.increments().empty() ? std::uint64_t{0} : m.increments().back().time_gps_ns();
+      });
   watch<navbus::ImuRawBlockPubSubType>(
       topic::kImuRaw, profile::kRawImuMonitorReader, StreamKind::kImuRaw,
       [](const auto& m) { return m.sensor_id(); },

@@ -189,8 +189,7 @@ bool FramePublisher::publish(const sim::SensorFrame& f) {
   });
   if (!written) return false;
   // A full block of increments goes out with the raw samples of the same frames.
-  const bool full = batcher_ && sequence_.imu % increments_per_block_ == 0;
-  return !full || writeBlocks();
+  return !(batcher_ && batcher_->full()) || writeBlocks();
 }
 
 std::size_t FramePublisher::imuReaders() const {

@@ -16,10 +16,9 @@ ImuBlockBatcher::ImuBlockBatcher(std::size_t increments_per_block)
   increments_.increments().reserve(increments_per_block);
 }
 
-bool ImuBlockBatcher::addIncrement(const navbus::ImuIncrement& increment) {
+void ImuBlockBatcher::addIncrement(const navbus::ImuIncrement& increment) {
   if (!hasIncrements()) increments_.sensor_id(increment.sensor_id());
   increments_.increments().push_back(increment);
-  return increments_.increments().size() >= increments_per_block_;
 }
 
 bool ImuBlockBatcher::addRaw(const navbus::ImuRawBlock& raw) {

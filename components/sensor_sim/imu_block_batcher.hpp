@@ -20,9 +20,11 @@ class ImuBlockBatcher {
   /// `increments_per_block` in 1..kMaxIncrements.
   explicit ImuBlockBatcher(std::size_t increments_per_block);
 
-  /// Adds one increment (consecutive, one sensor). True when the block is full: write
-  /// takeIncrements() (and takeRaw(), so that both blocks cover the same frames).
-  bool addIncrement(const navbus::ImuIncrement& increment);
+  /// Adds one increment (consecutive, one sensor).
+  void addIncrement(const navbus::ImuIncrement& increment);
+  /// The increment block holds its length: write takeIncrements() (and takeRaw(), so that
+  /// both blocks cover the same frames).
+  bool full() const { return increments_.increments().size() >= increments_per_block_; }
   /// Appends a raw block's samples to the pending raw block. False, adding nothing, when they
   /// do not continue it (another sensor or rate, a gap in time: a start more than half a
   /// period off the block's sample times, or beyond kMaxRawSamples):

@@ -26,6 +26,13 @@ std::int64_t nowNs() {
       .count();
 }
 
+/// This host's system clock: the clock of DDS source time stamps.
+std::int64_t systemNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
 bool spinUntil(bus::Participant& p, double timeout_s, const std::function<bool()>& done) {
   const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
   while (!done() && !p.stopping() && Clock::now() < end) p.spinOnce(std::chrono::milliseconds(5));
@@ -195,9 +202,7 @@ int runImuSource(bus::Participant& p, const LatencyOptions& o) {
     while (Clock::now() < next) p.spinOnce(next - Clock::now());
     inc.time_ns = t0 + static_cast<std::int64_t>(k + 1) * period_ns;
     const ImuIncrement msg = bus::toIdl(inc, 1, k + 1);
-    sent_system_ns[k] = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                            std::chrono::system_clock::now().time_since_epoch())
-                            .count();
+    sent_system_ns[k] = systemNowNs();
     sent_ns[k] = nowNs();
     imu.write(msg);
     next += period;
@@ -316,12 +321,6 @@ int runSink(bus::Participant& p, const LatencyOptions& o) {
       ended ? "the flood ended its stream" : "stopped before the flood ended its stream");
   p.finish();
   return count.taken > 0 && count.missing == 0 ? bus::kExitOk : bus::kExitRuntimeError;
-}
-
-std::int64_t systemNowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
 }
 
 /// Passive end to end, against running participants (for example navbus-sensor-sim in real

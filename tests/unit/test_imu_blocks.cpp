@@ -59,7 +59,8 @@ TEST(ImuBlockBatcher, PacksConsecutiveIncrementsAndRawSamplesInOrder) {
   std::vector<ImuIncrementBlock> blocks;
   std::vector<ImuRawBlock> raw;
   for (std::size_t k = 0; k < f.increments.size(); ++k) {
-    const bool full = batcher.addIncrement(f.increments[k]);
+    batcher.addIncrement(f.increments[k]);
+    const bool full = batcher.full();
     ASSERT_TRUE(batcher.addRaw(f.raw[k]));
     EXPECT_EQ(full, (k + 1) % 20 == 0);
     if (full) {
@@ -160,7 +161,8 @@ TEST(FilterPipelineBlocks, BlocksGiveTheSameSolutionsAsSingleIncrements) {
   for (const ImuIncrement& inc : f.increments) {
     one.onImu(inc);
     one.pump(now += 10'000'000);
-    if (batcher.addIncrement(inc)) {
+    batcher.addIncrement(inc);
+    if (batcher.full()) {
       many.onImuBlock(batcher.takeIncrements());
       many.pump(now);
     }
