@@ -1,4 +1,4 @@
-#include "dither_detector.hpp"
+#include "navbus/fault_manager/dither_detector.hpp"
 
 #include <cmath>
 #include <sstream>

@@ -1,4 +1,4 @@
-#include "fault_config.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
 
 #include <string>
 

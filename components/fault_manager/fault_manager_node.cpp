@@ -1,4 +1,4 @@
-#include "fault_manager_node.hpp"
+#include "navbus/fault_manager/fault_manager_node.hpp"
 
 #include <chrono>
 #include <type_traits>

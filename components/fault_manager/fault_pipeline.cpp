@@ -1,4 +1,4 @@
-#include "fault_pipeline.hpp"
+#include "navbus/fault_manager/fault_pipeline.hpp"
 
 #include <sstream>
 

@@ -1,4 +1,4 @@
-#include "glr_detector.hpp"
+#include "navbus/fault_manager/glr_detector.hpp"
 
 #include <algorithm>
 #include <array>

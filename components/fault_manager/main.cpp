@@ -1,8 +1,8 @@
 // navbus-fault-manager: stream watchdogs and the GLR of seed 000 on the filter's diagnostics,
 // publishing decisions (facts) and filter commands (requests).
-#include "fault_config.hpp"
-#include "fault_manager_node.hpp"
 #include "navbus/bus/app.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/fault_manager/fault_manager_node.hpp"
 
 namespace nb = navbus;
 

@@ -1,4 +1,4 @@
-#include "stream_watchdog.hpp"
+#include "navbus/fault_manager/stream_watchdog.hpp"
 
 #include <algorithm>
 

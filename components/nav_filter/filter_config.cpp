@@ -1,4 +1,4 @@
-#include "filter_config.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
 
 #include <algorithm>
 

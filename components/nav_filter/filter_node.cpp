@@ -1,4 +1,4 @@
-#include "filter_node.hpp"
+#include "navbus/nav_filter/filter_node.hpp"
 
 #include <algorithm>
 #include <chrono>

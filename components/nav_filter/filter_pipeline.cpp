@@ -1,4 +1,4 @@
-#include "filter_pipeline.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
 
 #include <algorithm>
 #include <array>

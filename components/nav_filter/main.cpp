@@ -1,7 +1,7 @@
 // navbus-filter: the integrated navigation filter participant.
-#include "filter_config.hpp"
-#include "filter_node.hpp"
 #include "navbus/bus/app.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
+#include "navbus/nav_filter/filter_node.hpp"
 
 namespace nb = navbus;
 

@@ -14,13 +14,13 @@
 #include <spdlog/spdlog.h>
 #include <boost/math/distributions/chi_squared.hpp>
 
-#include "fault_config.hpp"
 #include "fault_evaluation.hpp"
 #include "formatters.hpp"
 #include "integrity_evaluation.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/rotation.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
 #include "offline_runner.hpp"
 
 namespace navbus::tool {

@@ -6,13 +6,13 @@
 
 #include <navbus_idl/Fault.h>
 
-#include "fault_pipeline.hpp"
-#include "filter_pipeline.hpp"
 #include "frame_prefetcher.hpp"
 #include "frame_publisher.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/core/rotation.hpp"
+#include "navbus/fault_manager/fault_pipeline.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
 namespace navbus::tool {

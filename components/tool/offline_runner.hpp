@@ -13,11 +13,11 @@
 #include <navbus_idl/Navigation.h>
 #include <Eigen/Core>
 
-#include "fault_config.hpp"
-#include "filter_config.hpp"
-#include "glr_detector.hpp"
 #include "navbus/core/initial_alignment.hpp"
 #include "navbus/core/strapdown.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/fault_manager/glr_detector.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
 #include "scenario_config.hpp"
 
 namespace navbus::tool {

@@ -9,13 +9,13 @@
 #include <spdlog/spdlog.h>
 
 #include "fault_evaluation.hpp"
-#include "fault_pipeline.hpp"
 #include "formatters.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/core/earth.hpp"
+#include "navbus/fault_manager/fault_pipeline.hpp"
 
 namespace navbus::tool {
 

@@ -15,10 +15,10 @@
 #include <navbus_idl/Fault.h>
 #include <Eigen/Core>
 
-#include "fault_config.hpp"
-#include "glr_detector.hpp"
 #include "navbus/core/single_point_positioning.hpp"
 #include "navbus/core/static_receiver_filter.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/fault_manager/glr_detector.hpp"
 #include "rinex2.hpp"
 
 namespace navbus::tool {

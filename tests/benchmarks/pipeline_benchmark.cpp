@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "allocation_counter.hpp"
-#include "filter_config.hpp"
-#include "filter_pipeline.hpp"
 #include "frame_publisher.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/health.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/sim/scenario_source.hpp"
 #include "scenario_config.hpp"
 
@@ -52,7 +52,8 @@ int main(int argc, char** argv) {
   const std::string root = argc > 1 ? argv[1] : ".";
   const int cycles = argc > 2 ? std::atoi(argv[2]) : 40000;
   const bool require_zero = argc > 3 && std::strcmp(argv[3], "--require-zero-allocations") == 0;
-  const auto sim = sensor_sim::parseSimConfig(bus::loadYamlFile(root + "/sim/scenarios/seed001_leo.yaml"));
+  const auto sim =
+      sensor_sim::parseSimConfig(bus::loadYamlFile(root + "/sim/scenarios/seed001_leo.yaml"));
   YAML::Node filter_yaml = bus::loadYamlFile(root + "/config/filter_seed001_lc.yaml");
   filter_yaml["low_latency_output"]["enabled"] = true;
   const nav_filter::FilterConfig cfg = nav_filter::parseFilterConfig(filter_yaml);
@@ -61,17 +62,16 @@ int main(int argc, char** argv) {
   bus::HealthCounters health("pipeline-benchmark");
   NavigationSolution last, last_fast;
   std::uint64_t solutions = 0, fast = 0;
-  nav_filter::FilterPipeline pipeline(
-      cfg, health,
-      {[&](const NavigationSolution& s) {
-         last = s;
-         ++solutions;
-       },
-       nullptr,
-       [&](const NavigationSolution& s) {
-         last_fast = s;
-         ++fast;
-       }});
+  nav_filter::FilterPipeline pipeline(cfg, health,
+                                      {[&](const NavigationSolution& s) {
+                                         last = s;
+                                         ++solutions;
+                                       },
+                                       nullptr,
+                                       [&](const NavigationSolution& s) {
+                                         last_fast = s;
+                                         ++fast;
+                                       }});
   // Warm-up: longer than the recovery history (cfg.recovery_history_ns), so its queues are at
   // their steady size.
   const auto warmup = static_cast<std::size_t>(

@@ -15,10 +15,10 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "fault_config.hpp"
-#include "filter_config.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
 #include "scenario_config.hpp"
 
 namespace {

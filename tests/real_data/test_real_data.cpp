@@ -8,9 +8,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "fault_config.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/earth.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
 #include "real_data.hpp"
 #include "rinex2.hpp"
 

@@ -3,13 +3,13 @@
 // about this run's data acts.
 #include <gtest/gtest.h>
 
-#include "filter_config.hpp"
-#include "filter_pipeline.hpp"
 #include "frame_publisher.hpp"
-#include "monitor_liveness.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/topics.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/nav_filter/monitor_liveness.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
 #include <map>

@@ -6,14 +6,14 @@
 #include <cstring>
 #include <vector>
 
-#include "filter_config.hpp"
-#include "filter_pipeline.hpp"
 #include "frame_publisher.hpp"
 #include "imu_block_batcher.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/topics.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/sim/scenario_source.hpp"
 #include "scenario_config.hpp"
 

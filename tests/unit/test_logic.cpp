@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "formatters.hpp"
-#include "input_sequencer.hpp"
-#include "stream_watchdog.hpp"
+#include "navbus/fault_manager/stream_watchdog.hpp"
+#include "navbus/nav_filter/input_sequencer.hpp"
 
 using navbus::nav_filter::InputSequencer;
 using navbus::nav_filter::StreamId;

@@ -14,8 +14,10 @@ void addCommonOptions(CLI::App& app, CommonOptions& o, bool config_required) {
   }
   app.add_option("-d,--domain", o.domain_id, "DDS domain id (overrides the configuration)")
       ->check(CLI::Range(0, 232));
-  app.add_option("--qos", o.qos_file,
-                 "Fast DDS QoS XML file (FASTRTPS_DEFAULT_PROFILES_FILE takes precedence)");
+  app.add_option(
+      "--qos", o.qos_file,
+      "your Fast DDS XML profiles: added to navbus's, overriding its profiles of the same "
+      "name (FASTRTPS_DEFAULT_PROFILES_FILE is read after both, as Fast DDS's defaults)");
   app.add_option(
       "--profile", o.participant_profile,
       "participant profile name in the QoS file (default: navbus_participant_udp_loopback)");

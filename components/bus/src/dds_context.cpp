@@ -1,54 +1,24 @@
 #include "navbus/bus/dds_context.hpp"
 
-#include <cstdlib>
-#include <fstream>
-#include <mutex>
-
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
+#include "navbus/bus/qos_files.hpp"
 #include "navbus/bus/security.hpp"
-
-#ifndef NAVBUS_QOS_FILE_DEFAULT
-#error "NAVBUS_QOS_FILE_DEFAULT must be defined by the build"
-#endif
 
 namespace navbus::bus {
 
 namespace dds = eprosima::fastdds::dds;
 
-std::string loadQosProfiles(const std::string& explicit_file) {
-  static std::mutex mutex;
-  static std::string loaded;
-  std::lock_guard<std::mutex> lock(mutex);
-  const char* env = std::getenv("FASTRTPS_DEFAULT_PROFILES_FILE");
-  const std::string file = (env != nullptr && *env != '\0')
-                               ? env
-                               : (explicit_file.empty() ? NAVBUS_QOS_FILE_DEFAULT : explicit_file);
-  if (loaded == file) {
-    return file;
-  }
-  if (!std::ifstream(file).good()) {
-    throw DdsError("QoS file '" + file + "' cannot be read");
-  }
-  // Fast DDS loads the environment's file by itself when the factory starts; loading it again
-  // is harmless and reports a parse error here instead of silently falling back to defaults.
-  if (dds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(file) !=
-      ReturnCode_t::RETCODE_OK) {
-    throw DdsError("QoS file '" + file + "' could not be parsed as Fast DDS XML profiles");
-  }
-  loaded = file;
-  return file;
-}
-
 DdsContext::DdsContext(const ParticipantOptions& options) : name_(options.name) {
-  loadQosProfiles(options.qos_file);
+  const QosFiles& files = loadQosProfiles(options.qos_file);
+  qos_files_ = files.describe();
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::DomainParticipantQos qos;
   if (factory->get_participant_qos_from_profile(options.participant_profile, qos) !=
       ReturnCode_t::RETCODE_OK) {
     throw DdsError("participant profile '" + options.participant_profile +
-                   "' is not defined in the QoS file");
+                   "' is not defined in the QoS files read (" + files.describe() + ")");
   }
   applySecurityIdentity(qos, options.participant_profile, options.security_identity);
   secure_ = securityEnabled(qos);
@@ -114,7 +84,9 @@ dds::DataWriter* DdsContext::createWriter(dds::Topic* topic, const std::string& 
   dds::DataWriter* writer = publisher_->create_datawriter_with_profile(topic, profile);
   if (writer == nullptr) {
     throw DdsError("cannot create writer on '" + topic->get_name() + "' with profile '" + profile +
-                   "' (missing profile, inconsistent QoS, or not permitted to this identity)");
+                   "' (missing profile, inconsistent QoS, or not permitted to this identity; QoS "
+                   "files read: " +
+                   qos_files_ + ")");
   }
   return writer;
 }
@@ -123,7 +95,9 @@ dds::DataReader* DdsContext::createReader(dds::Topic* topic, const std::string& 
   dds::DataReader* reader = subscriber_->create_datareader_with_profile(topic, profile);
   if (reader == nullptr) {
     throw DdsError("cannot create reader on '" + topic->get_name() + "' with profile '" + profile +
-                   "' (missing profile, inconsistent QoS, or not permitted to this identity)");
+                   "' (missing profile, inconsistent QoS, or not permitted to this identity; QoS "
+                   "files read: " +
+                   qos_files_ + ")");
   }
   return reader;
 }

@@ -27,16 +27,10 @@ class DdsError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Loads the QoS profiles once per process. Precedence: Fast DDS's standard environment
-/// variable FASTRTPS_DEFAULT_PROFILES_FILE (loaded by Fast DDS itself), else `explicit_file`,
-/// else the installed default. Throws DdsError if the chosen file cannot be loaded.
-/// Returns the file in force.
-std::string loadQosProfiles(const std::string& explicit_file);
-
 struct ParticipantOptions {
   int domain_id{0};
   std::string participant_profile;  ///< a <participant> profile name from the QoS file
-  std::string qos_file;             ///< empty: environment variable or installed default
+  std::string qos_file;             ///< the user's profiles (qos_files.hpp), empty for none
   std::string name;                 ///< participant name shown in discovery and health
   /// DDS Security credentials directory (see security.hpp); required by a secure profile,
   /// refused by any other.
@@ -80,6 +74,7 @@ class DdsContext {
                                               eprosima::fastdds::dds::TypeSupport type);
 
   std::string name_;
+  std::string qos_files_;  ///< the profile files read, for error messages
   bool secure_{false};
   PeerIdentities peers_;  ///< the participant's listener unless the options bring one
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};

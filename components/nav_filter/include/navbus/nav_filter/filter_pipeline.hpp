@@ -19,13 +19,13 @@
 #include <navbus_idl/Navigation.h>
 #include <navbus_idl/StarTracker.h>
 
-#include "filter_config.hpp"
-#include "input_history.hpp"
-#include "input_sequencer.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/navigation_engine.hpp"
 #include "navbus/core/output_predictor.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
+#include "navbus/nav_filter/input_history.hpp"
+#include "navbus/nav_filter/input_sequencer.hpp"
 
 namespace navbus::nav_filter {
 

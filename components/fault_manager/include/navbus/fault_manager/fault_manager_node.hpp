@@ -10,9 +10,9 @@
 #include <fastdds/rtps/common/InstanceHandle.h>
 #include <navbus_idl/FaultPubSubTypes.h>
 
-#include "fault_pipeline.hpp"
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/writer_gate.hpp"
+#include "navbus/fault_manager/fault_pipeline.hpp"
 
 namespace navbus::fault_manager {
 

@@ -13,9 +13,9 @@
 #include <navbus_idl/Fault.h>
 #include <navbus_idl/Navigation.h>
 
-#include "fault_config.hpp"
-#include "fault_output.hpp"
 #include "navbus/core/glr.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/fault_manager/fault_output.hpp"
 
 namespace navbus::fault_manager {
 

@@ -15,13 +15,13 @@
 #include <navbus_idl/Fault.h>
 #include <navbus_idl/Navigation.h>
 
-#include "dither_detector.hpp"
-#include "fault_config.hpp"
-#include "fault_output.hpp"
-#include "glr_detector.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/validation.hpp"
-#include "stream_watchdog.hpp"
+#include "navbus/fault_manager/dither_detector.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/fault_manager/fault_output.hpp"
+#include "navbus/fault_manager/glr_detector.hpp"
+#include "navbus/fault_manager/stream_watchdog.hpp"
 
 namespace navbus::fault_manager {
 

@@ -10,11 +10,11 @@
 
 #include <navbus_idl/NavigationPubSubTypes.h>
 
-#include "filter_config.hpp"
-#include "filter_pipeline.hpp"
-#include "monitor_liveness.hpp"
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/writer_gate.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/nav_filter/monitor_liveness.hpp"
 
 namespace navbus::nav_filter {
 

@@ -10,10 +10,10 @@
 
 #include <navbus_idl/Imu.h>
 
-#include "fault_config.hpp"
-#include "fault_output.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/dither_monitor.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/fault_manager/fault_output.hpp"
 
 namespace navbus::fault_manager {
 
