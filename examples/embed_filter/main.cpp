@@ -184,8 +184,8 @@ int main(int argc, char** argv) {
   std::printf("increments taken: %d of %d\n", taken, kIncrements);
   std::printf("solutions received by your subscriber: %d\n", received);
   std::printf(
-      "last solution: seq %llu, %d increments used, drift from the start N E D %.4f %.4f "
-      "%.4f m\n",
+      "last solution: seq %llu, %d increments used, drift from the start N E D %.3g %.3g "
+      "%.3g m\n",
       static_cast<unsigned long long>(last.seq()), static_cast<int>(last.imu_samples_used()),
       drift_ned_m.x(), drift_ned_m.y(), drift_ned_m.z());
   std::printf("pipeline: %s\n", pipeline.summary().c_str());

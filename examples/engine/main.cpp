@@ -42,9 +42,9 @@ int main() {
   const navbus::core::NavState& end = strapdown.state();
   const Eigen::Vector3d drift_ned_m = earth::differenceNed(end.position, start.position);
   std::printf("%d increments integrated over %.1f s\n", steps, kDuration_s);
-  std::printf("position drift N E D: %.4f %.4f %.4f m\n", drift_ned_m.x(), drift_ned_m.y(),
+  std::printf("position drift N E D: %.3g %.3g %.3g m\n", drift_ned_m.x(), drift_ned_m.y(),
               drift_ned_m.z());
-  std::printf("velocity N E D: %.5f %.5f %.5f m/s\n", end.vel_ned_mps.x(), end.vel_ned_mps.y(),
+  std::printf("velocity N E D: %.3g %.3g %.3g m/s\n", end.vel_ned_mps.x(), end.vel_ned_mps.y(),
               end.vel_ned_mps.z());
   // A wrong sign or frame anywhere shows as metres of drift in 10 s.
   return drift_ned_m.norm() < 0.05 ? 0 : 1;

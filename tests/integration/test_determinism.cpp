@@ -1,5 +1,5 @@
 // The same sensor input, delivered with two different interleavings and pacings, gives a
-// bit-identical solution stream (DESIGN.md, Determinism).
+// bit-identical solution stream (README, Architecture: Determinism).
 #include <gtest/gtest.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
