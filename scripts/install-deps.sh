@@ -7,6 +7,7 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools   # Fast DDS 2.9, Fast-CDR, code generator, CLI
   libeigen3-dev libfftw3-dev libboost-dev                  # math (Boost.Math: noncentral chi-square)
   libyaml-cpp-dev libcli11-dev libspdlog-dev               # configuration, command line, logging
+  libcsv-dev libtinyxml2-dev                               # CSV recordings (navbus replay), QoS files
   libgtest-dev libbenchmark-dev                            # tests and benchmarks
   cyclonedds-dev cyclonedds-tools                          # second DDS vendor for the interop test
   iproute2                                                 # network namespaces for the topology test

@@ -59,7 +59,8 @@ class CellCollector {
   void rows(const std::string& name, const std::vector<S>& seq) {
     rows_at_ = cells_.size();
     CellCollector names(prefix_ + name + ".");
-    visitFields(S{}, names);
+    const S empty{};
+    visitFields(empty, names);
     row_names_ = names.names_;
     for (const auto& element : seq) {
       CellCollector sub;
@@ -157,7 +158,8 @@ bool appendCsvLine(const T& msg, fmt::memory_buffer& out) {
 template <class T>
 std::string csvHeader() {
   CellCollector c;
-  visitFields(T{}, c);
+  const T empty{};
+  visitFields(empty, c);
   return joinCsv(c.header());
 }
 

@@ -14,6 +14,7 @@
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/core/earth.hpp"
+#include "spin.hpp"
 
 namespace navbus::tool {
 
@@ -31,12 +32,6 @@ std::int64_t systemNowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-bool spinUntil(bus::Participant& p, double timeout_s, const std::function<bool()>& done) {
-  const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
-  while (!done() && !p.stopping() && Clock::now() < end) p.spinOnce(std::chrono::milliseconds(5));
-  return done();
 }
 
 std::size_t matchedWriters(eprosima::fastdds::dds::DataReader* reader) {

@@ -10,11 +10,13 @@
 
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 
+#include "command.hpp"
 #include "evaluation.hpp"
 #include "latency.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
 #include "real_data.hpp"
+#include "replay.hpp"
 #include "topic_registry.hpp"
 
 namespace nb = navbus;
@@ -73,7 +75,8 @@ class EchoSink : public nb::tool::SampleSink {
   EchoSink(bool csv, const std::string& header, std::uint64_t limit) : csv_(csv), limit_(limit) {
     if (csv_) std::cout << header << "\n";
   }
-  void onSample(const std::string& topic, const std::function<std::string()>& text,
+  void onSample(const std::string& topic, const nb::tool::SampleTimes&,
+                const std::function<std::string()>& text,
                 const std::function<std::vector<std::string>()>& rows) override {
     if (limit_ > 0 && count_ >= limit_) return;  // one dispatch round may hold more samples
     ++count_;
@@ -92,23 +95,25 @@ class EchoSink : public nb::tool::SampleSink {
   std::uint64_t count_{0};
 };
 
-/// Writes one CSV file per topic.
+/// Writes one CSV file per topic: the message's columns, then when it was written (DDS source
+/// time stamp) and received [ns, system clocks], so that `navbus replay` can pace it.
 class RecordSink : public nb::tool::SampleSink {
  public:
   void open(const nb::tool::TopicEntry& e, const std::filesystem::path& dir) {
-    std::string file = e.name;
-    for (char& c : file)
-      if (c == '/') c = '_';
+    const std::filesystem::path path = dir / nb::tool::recordFileName(e.name);
     auto& f = files_[e.name];
-    f.stream = std::make_unique<std::ofstream>(dir / (file + ".csv"));
-    if (!*f.stream) throw std::runtime_error("cannot write " + (dir / (file + ".csv")).string());
-    *f.stream << e.csv_header << "\n";
+    f.stream = std::make_unique<std::ofstream>(path);
+    if (!*f.stream) throw std::runtime_error("cannot write " + path.string());
+    *f.stream << e.csv_header << ",source_timestamp_ns,reception_timestamp_ns\n";
   }
-  void onSample(const std::string& topic, const std::function<std::string()>&,
+  void onSample(const std::string& topic, const nb::tool::SampleTimes& times,
+                const std::function<std::string()>&,
                 const std::function<std::vector<std::string>()>& rows) override {
     auto& f = files_.at(topic);
     ++f.samples;
-    for (const auto& r : rows()) *f.stream << r << "\n";
+    for (const auto& r : rows()) {
+      *f.stream << r << ',' << times.source_ns << ',' << times.reception_ns << '\n';
+    }
   }
   void flush() {
     for (auto& [name, f] : files_) f.stream->flush();
@@ -181,12 +186,74 @@ int main(int argc, char** argv) {
   std::vector<std::string> record_topics;
   std::string out_dir;
   auto* record_cmd = app.add_subcommand("record", "record topics into CSV files, one per topic");
-  record_cmd->add_option("topics", record_topics, "topic names")->required();
+  bool record_all = false;
+  record_cmd->add_option("topics", record_topics, "topic names");
+  record_cmd->add_flag("--all", record_all, "every navbus topic");
   record_cmd->add_option("-o,--out", out_dir, "output directory (created)")->required();
   record_cmd->add_option("-n,--count", count,
                          "stop when every topic has this many samples (exit 1 if not reached)");
   record_cmd->add_option("--duration", duration_s,
                          "stop after this many seconds (0: until SIGINT)");
+
+  nb::tool::ReplayOptions replay;
+  auto* replay_cmd = app.add_subcommand(
+      "replay",
+      "publish a `navbus record` recording's sensor topics back onto the bus, content unchanged, "
+      "paced as recorded (source time stamps) and scaled by --speed; the streams are disposed "
+      "at the end");
+  replay_cmd->add_option("dir", replay.dir, "the recording's directory")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  replay_cmd
+      ->add_option("--speed", replay.speed, "1: as recorded, 10: ten times faster, 0: no pacing")
+      ->check(CLI::Range(0.0, 1e6));
+  replay_cmd->add_option("--topics", replay.topics,
+                         "only these topics (default: every sensor topic recorded)");
+  replay_cmd->add_option("--min-readers", replay.min_readers,
+                         "TOPIC=N: wait for N readers of TOPIC before the first sample (default "
+                         "1 each), e.g. navbus/imu/increment_block=2 for a filter and a fault "
+                         "manager");
+  replay_cmd
+      ->add_option("--match-timeout", replay.match_timeout_s,
+                   "seconds to wait for a reader of every replayed topic")
+      ->check(CLI::Range(0.1, 600.0));
+
+  nb::tool::CommandOptions command;
+  auto* command_cmd = app.add_subcommand(
+      "command",
+      "send one FilterCommand to navbus-filter and wait for its acknowledgment (enums by name, "
+      "with or without their IDL prefix; units as in idl/Fault.idl)");
+  command_cmd
+      ->add_option("kind", command.kind,
+                   "EXCLUDE_SATELLITE, READMIT_SATELLITE, COMPENSATE_BIAS, SELECT_FUSION, "
+                   "SELECT_MODE, RESET, EXCLUDE_STREAM, READMIT_STREAM, FAIL_SENSOR_AXIS, "
+                   "RESTORE_SENSOR_AXIS, RELEARN_BIAS")
+      ->required();
+  command_cmd->add_option("--vehicle", command.vehicle_id, "vehicle_id of the filter addressed");
+  command_cmd->add_option("--sv", command.sv_id, "GPS PRN (satellite commands)");
+  command_cmd->add_option("--scope", command.scope, "ALL, PSEUDORANGE or PSEUDORANGE_RATE");
+  command_cmd->add_option("--sensor", command.sensor,
+                          "ACCELEROMETER or GYRO (bias and axis commands); IMU_STREAM, "
+                          "GNSS_OBS_STREAM, ... (stream commands)");
+  command_cmd->add_option("--sensor-id", command.sensor_id, "the stream's sensor id");
+  command_cmd->add_option("--axis", command.axis, "body axis 0, 1 or 2");
+  command_cmd->add_option("--bias", command.bias, "bias to compensate [m/s^2 or rad/s, body]");
+  command_cmd->add_option("--bias-sigma", command.bias_sigma, "its 1-sigma [m/s^2 or rad/s]");
+  command_cmd->add_option("--fusion", command.fusion, "CENTRALIZED, FEDERATED or ADAPTIVE");
+  command_cmd->add_option("--mode", command.mode, "a FilterMode, e.g. TIGHTLY_COUPLED");
+  command_cmd->add_option("--time-gps-ns", command.time_gps_ns,
+                          "data time the command refers to [ns, GPS time] (0: at once)");
+  command_cmd->add_option("--onset-gps-ns", command.onset_time_gps_ns,
+                          "estimated onset of the fault it answers [ns, GPS time]");
+  command_cmd->add_option("--decision-id", command.decision_id,
+                          "the decision it follows (0: none)");
+  command_cmd->add_option("--issuer", command.issuer, "issuer (the filter obeys configured ones)");
+  command_cmd->add_option("--command-id", command.command_id,
+                          "unique per issuer, increasing (default: this run's start time [ns])");
+  command_cmd
+      ->add_option("--match-timeout", command.match_timeout_s,
+                   "seconds to wait for the filter's reader and its acknowledgment")
+      ->check(CLI::Range(0.1, 600.0));
 
   nb::tool::LatencyOptions latency;
   auto* latency_cmd = app.add_subcommand(
@@ -353,6 +420,14 @@ int main(int argc, char** argv) {
       options.dds.name = "navbus-latency-" + latency.role;
       return nb::tool::runLatencyCommand(options, latency, shutdown);
     }
+    if (*replay_cmd) {
+      options.dds.name = "navbus-replay";
+      return nb::tool::runReplayCommand(options, replay, shutdown);
+    }
+    if (*command_cmd) {
+      options.dds.name = "navbus-command";
+      return nb::tool::runCommandCommand(options, command, shutdown);
+    }
     if (*topics_cmd) {
       DiscoveryListener listener;
       options.dds.listener = &listener;
@@ -378,6 +453,12 @@ int main(int argc, char** argv) {
     nb::bus::Participant p(options, shutdown);
     RecordSink sink;
     std::vector<const nb::tool::TopicEntry*> entries;
+    if (record_all) {
+      for (const auto& t : nb::tool::topicRegistry()) record_topics.push_back(t.name);
+    }
+    if (record_topics.empty()) {
+      throw nb::bus::ConfigError("record: name the topics, or --all");
+    }
     for (const auto& t : record_topics) {
       entries.push_back(&requireTopic(t));
       sink.open(*entries.back(), out_dir);

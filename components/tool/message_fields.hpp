@@ -7,6 +7,7 @@
 
 #include <sstream>
 #include <string>
+#include <type_traits>
 
 #include <navbus_idl/Fault.h>
 #include <navbus_idl/Gnss.h>
@@ -18,6 +19,11 @@
 #include "navbus/bus/health.hpp"
 
 namespace navbus::tool {
+
+/// visitFields(m, v) exists for M = T and M = const T: the same field list reads a message
+/// (echo, record) and fills one (replay).
+template <class M, class T>
+using IfMessage = std::enable_if_t<std::is_same_v<std::remove_const_t<M>, T>>;
 
 const char* enumName(navbus::FilterMode v);
 const char* enumName(navbus::FusionStructure v);
@@ -35,8 +41,8 @@ inline const char* enumName(navbus::RejectReason v) {
   return bus::rejectReasonName(v);
 }
 
-template <class V>
-void visitFields(const navbus::ImuIncrement& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::ImuIncrement> visitFields(M& m, V& v) {
   v("sensor_id", m.sensor_id());
   v("seq", m.seq());
   v("time_gps_ns", m.time_gps_ns());
@@ -45,27 +51,27 @@ void visitFields(const navbus::ImuIncrement& m, V& v) {
   v("delta_angle_b_rad", m.delta_angle_b_rad());
   v("status_flags", m.status_flags());
 }
-template <class V>
-void visitFields(const navbus::ImuIncrementBlock& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::ImuIncrementBlock> visitFields(M& m, V& v) {
   v("sensor_id", m.sensor_id());
   v("seq", m.seq());
   v.rows("increments", m.increments());
 }
-template <class V>
-void visitFields(const navbus::ImuRawSample& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::ImuRawSample> visitFields(M& m, V& v) {
   v("angular_rate_b_radps", m.angular_rate_b_radps());
   v("specific_force_b_mps2", m.specific_force_b_mps2());
 }
-template <class V>
-void visitFields(const navbus::ImuRawBlock& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::ImuRawBlock> visitFields(M& m, V& v) {
   v("sensor_id", m.sensor_id());
   v("seq", m.seq());
   v("first_sample_time_gps_ns", m.first_sample_time_gps_ns());
   v("sample_period_ns", m.sample_period_ns());
   v.rows("samples", m.samples());
 }
-template <class V>
-void visitFields(const navbus::GnssSatelliteMeasurement& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::GnssSatelliteMeasurement> visitFields(M& m, V& v) {
   v("sv_id", m.sv_id());
   v("pseudorange_m", m.pseudorange_m());
   v("pseudorange_rate_mps", m.pseudorange_rate_mps());
@@ -78,15 +84,15 @@ void visitFields(const navbus::GnssSatelliteMeasurement& m, V& v) {
   v("pseudorange_rate_sigma_mps", m.pseudorange_rate_sigma_mps());
   v("valid", m.valid());
 }
-template <class V>
-void visitFields(const navbus::GnssObservationEpoch& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::GnssObservationEpoch> visitFields(M& m, V& v) {
   v("receiver_id", m.receiver_id());
   v("seq", m.seq());
   v("time_gps_ns", m.time_gps_ns());
   v.rows("satellites", m.satellites());
 }
-template <class V>
-void visitFields(const navbus::GnssFix& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::GnssFix> visitFields(M& m, V& v) {
   v("receiver_id", m.receiver_id());
   v("seq", m.seq());
   v("time_gps_ns", m.time_gps_ns());
@@ -100,8 +106,8 @@ void visitFields(const navbus::GnssFix& m, V& v) {
   v("num_satellites_used", m.num_satellites_used());
   v("valid", m.valid());
 }
-template <class V>
-void visitFields(const navbus::StarTrackerAttitude& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::StarTrackerAttitude> visitFields(M& m, V& v) {
   v("tracker_id", m.tracker_id());
   v("seq", m.seq());
   v("time_gps_ns", m.time_gps_ns());
@@ -109,8 +115,8 @@ void visitFields(const navbus::StarTrackerAttitude& m, V& v) {
   v("sigma_b_rad", m.sigma_b_rad());
   v("valid", m.valid());
 }
-template <class V>
-void visitFields(const navbus::NavigationSolution& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::NavigationSolution> visitFields(M& m, V& v) {
   v("vehicle_id", m.vehicle_id());
   v("seq", m.seq());
   v("time_gps_ns", m.time_gps_ns());
@@ -146,8 +152,8 @@ void visitFields(const navbus::NavigationSolution& m, V& v) {
   v("output", m.output());
   v("propagated_from_gps_ns", m.propagated_from_gps_ns());
 }
-template <class V>
-void visitFields(const navbus::FilterDiagnostics& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::FilterDiagnostics> visitFields(M& m, V& v) {
   v("vehicle_id", m.vehicle_id());
   v("seq", m.seq());
   v("time_gps_ns", m.time_gps_ns());
@@ -169,8 +175,8 @@ void visitFields(const navbus::FilterDiagnostics& m, V& v) {
   v("phi", m.phi());
   v("test_ratio", m.test_ratio());
 }
-template <class V>
-void visitFields(const navbus::FaultDecision& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::FaultDecision> visitFields(M& m, V& v) {
   v("decision_id", m.decision_id());
   v("time_gps_ns", m.time_gps_ns());
   v("event", m.event());
@@ -199,8 +205,8 @@ void visitFields(const navbus::FaultDecision& m, V& v) {
   v("dither_window_s", m.dither().window_s());
   v("run_id", m.run_id());
 }
-template <class V>
-void visitFields(const navbus::FilterCommand& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::FilterCommand> visitFields(M& m, V& v) {
   v("command_id", m.command_id());
   v("vehicle_id", m.vehicle_id());
   v("kind", m.kind());
@@ -219,8 +225,8 @@ void visitFields(const navbus::FilterCommand& m, V& v) {
   v("issuer", m.issuer());
   v("run_id", m.run_id());
 }
-template <class V>
-void visitFields(const navbus::StreamHealth& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::StreamHealth> visitFields(M& m, V& v) {
   v("topic", m.topic());
   v("received", m.received());
   v("accepted", m.accepted());
@@ -235,8 +241,8 @@ void visitFields(const navbus::StreamHealth& m, V& v) {
     elements << enumName(r.reason()) << "=" << r.count() << " ";
   v.text("elements_rejected", elements.str());
 }
-template <class V>
-void visitFields(const navbus::Health& m, V& v) {
+template <class M, class V>
+IfMessage<M, navbus::Health> visitFields(M& m, V& v) {
   v("participant", m.participant());
   v("seq", m.seq());
   v("wall_time_ns", m.wall_time_ns());

@@ -17,14 +17,15 @@ template <class PubSubType>
 TopicEntry entry(const char* topic, const char* profile) {
   using T = typename PubSubType::type;
   PubSubType type;
-  return TopicEntry{topic, type.getName(), profile, csvHeader<T>(),
-                    [topic, profile](bus::Participant& p, SampleSink& sink) {
-                      p.subscribe<PubSubType>(
-                          topic, profile, [topic, &sink](const T& m, const auto&) {
-                            sink.onSample(
-                                topic, [&m] { return textOf(m); }, [&m] { return csvRows(m); });
-                          });
-                    }};
+  return TopicEntry{
+      topic, type.getName(), profile, csvHeader<T>(),
+      [topic, profile](bus::Participant& p, SampleSink& sink) {
+        p.subscribe<PubSubType>(topic, profile, [topic, &sink](const T& m, const auto& info) {
+          const SampleTimes times{info.source_timestamp.to_ns(), info.reception_timestamp.to_ns()};
+          sink.onSample(
+              topic, times, [&m] { return textOf(m); }, [&m] { return csvRows(m); });
+        });
+      }};
 }
 }  // namespace
 
@@ -49,6 +50,14 @@ const std::vector<TopicEntry>& topicRegistry() {
       entry<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthReader),
   };
   return registry;
+}
+
+std::string recordFileName(const std::string& topic) {
+  std::string file = topic;
+  for (char& c : file) {
+    if (c == '/') c = '_';
+  }
+  return file + ".csv";
 }
 
 const TopicEntry* findTopic(const std::string& name) {

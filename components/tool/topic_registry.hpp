@@ -1,6 +1,7 @@
 // Every navbus topic the bus tool knows: its name, reader profile and formatters.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -9,10 +10,18 @@
 
 namespace navbus::tool {
 
+/// When a sample was written (the writer's DDS source time stamp) and received [ns, the
+/// writers' and this host's system clocks].
+struct SampleTimes {
+  std::int64_t source_ns{0};
+  std::int64_t reception_ns{0};
+};
+
 /// Receives samples as text and CSV rows, computed only when asked for.
 struct SampleSink {
   virtual ~SampleSink() = default;
-  virtual void onSample(const std::string& topic, const std::function<std::string()>& text,
+  virtual void onSample(const std::string& topic, const SampleTimes& times,
+                        const std::function<std::string()>& text,
                         const std::function<std::vector<std::string>()>& csv_rows) = 0;
 };
 
@@ -27,5 +36,7 @@ struct TopicEntry {
 const std::vector<TopicEntry>& topicRegistry();
 /// nullptr if the topic is not a navbus topic.
 const TopicEntry* findTopic(const std::string& name);
+/// The file `navbus record` writes a topic to (and `navbus replay` reads): "/" as "_", ".csv".
+std::string recordFileName(const std::string& topic);
 
 }  // namespace navbus::tool

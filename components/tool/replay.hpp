@@ -1,0 +1,38 @@
+// `navbus replay DIR`: a recording made by `navbus record` back onto the bus, so that a
+// recorded run can be re-run through a new filter. Every sensor topic with a file in DIR is
+// published with its recorded content (sequence numbers and data time stamps unchanged, bit for
+// bit: record writes shortest round-trip numbers), in the recorded order, paced like the
+// recording: by each sample's DDS source time stamp when the files have them (record's
+// source_timestamp_ns column), else by its data time, scaled by --speed (0: as fast as the
+// reliable writers take them). At the end each stream is disposed, as the simulator does, so a
+// filter knows the data ended rather than was lost.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "navbus/bus/participant.hpp"
+
+namespace navbus::tool {
+
+struct ReplayOptions {
+  std::string dir;                  ///< the recording: <topic with / as _>.csv per topic
+  double speed{1.0};                ///< 1: as recorded; 2: twice as fast; 0: no pacing
+  double match_timeout_s{10.0};     ///< wait this long for a reader of every replayed topic
+  std::vector<std::string> topics;  ///< empty: every sensor topic with a file in dir
+  /// "TOPIC=N": wait for N readers of TOPIC before the first sample (default 1 per topic), so
+  /// that no participant joins after the data began (the writers are volatile, as the
+  /// simulator's, whose timing.min_readers this mirrors).
+  std::vector<std::string> min_readers;
+};
+
+/// The topics replay publishes (the sensor inputs of a filter).
+const std::vector<std::string>& replayableTopics();
+
+/// Returns an exit code: 0, runtime error when a topic found no reader in time, configuration
+/// error (thrown as bus::ConfigError) for a missing or malformed file, naming file, line,
+/// column and value.
+int runReplayCommand(const bus::Participant::Options& participant, const ReplayOptions& options,
+                     bus::ShutdownSignal& shutdown);
+
+}  // namespace navbus::tool
