@@ -199,14 +199,19 @@ int main(int argc, char** argv) {
   auto* replay_cmd = app.add_subcommand(
       "replay",
       "publish a `navbus record` recording's sensor topics back onto the bus, content unchanged, "
-      "paced as recorded (source time stamps) and scaled by --speed; the streams are disposed "
-      "at the end");
+      "paced by their data times (or the recorded source time stamps) scaled by --speed; the "
+      "streams are disposed at the end");
   replay_cmd->add_option("dir", replay.dir, "the recording's directory")
       ->required()
       ->check(CLI::ExistingDirectory);
   replay_cmd
       ->add_option("--speed", replay.speed, "1: as recorded, 10: ten times faster, 0: no pacing")
       ->check(CLI::Range(0.0, 1e6));
+  replay_cmd
+      ->add_option("--pace", replay.pace,
+                   "data: by the samples' data times; source: by the recorded DDS source time "
+                   "stamps (the bus timing of the recording)")
+      ->check(CLI::IsMember({"data", "source"}));
   replay_cmd->add_option("--topics", replay.topics,
                          "only these topics (default: every sensor topic recorded)");
   replay_cmd->add_option("--min-readers", replay.min_readers,

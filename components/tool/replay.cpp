@@ -212,11 +212,18 @@ int runReplayCommand(const bus::Participant::Options& participant, const ReplayO
   }
   const std::map<std::string, std::size_t> min_readers = minReaders(o);
   auto streams = loadStreams(o);
-  const bool source_times = std::all_of(streams.begin(), streams.end(),
-                                        [](const auto& s) { return s->hasSourceTimes(); });
+  if (o.pace != "data" && o.pace != "source") {
+    throw bus::ConfigError("--pace '" + o.pace + "' must be data or source");
+  }
+  const bool source_times = o.pace == "source";
+  for (const auto& s : streams) {
+    if (source_times && !s->hasSourceTimes()) {
+      throw bus::ConfigError("--pace source: the recording of " + s->topic() + " has no " +
+                             kSourceTimeColumn + " column");
+    }
+  }
   spdlog::info("pacing by {} at speed {}",
-               source_times ? "the recorded source time stamps"
-                            : "the data times (no source time stamps recorded)",
+               source_times ? "the recorded source time stamps" : "the samples' data times",
                o.speed);
   const std::vector<Event> events = schedule(streams, source_times);
 

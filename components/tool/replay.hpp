@@ -1,11 +1,10 @@
 // `navbus replay DIR`: a recording made by `navbus record` back onto the bus, so that a
 // recorded run can be re-run through a new filter. Every sensor topic with a file in DIR is
 // published with its recorded content (sequence numbers and data time stamps unchanged, bit for
-// bit: record writes shortest round-trip numbers), in the recorded order, paced like the
-// recording: by each sample's DDS source time stamp when the files have them (record's
-// source_timestamp_ns column), else by its data time, scaled by --speed (0: as fast as the
-// reliable writers take them). At the end each stream is disposed, as the simulator does, so a
-// filter knows the data ended rather than was lost.
+// bit: record writes shortest round-trip numbers), paced by the samples' data times (or, with
+// --pace source, by the DDS source time stamps record wrote beside them) scaled by --speed
+// (0: as fast as the reliable writers take them). At the end each stream is disposed, as the
+// simulator does, so a filter knows the data ended rather than was lost.
 #pragma once
 
 #include <string>
@@ -16,8 +15,12 @@
 namespace navbus::tool {
 
 struct ReplayOptions {
-  std::string dir;                  ///< the recording: <topic with / as _>.csv per topic
-  double speed{1.0};                ///< 1: as recorded; 2: twice as fast; 0: no pacing
+  std::string dir;    ///< the recording: <topic with / as _>.csv per topic
+  double speed{1.0};  ///< 1: real time; 2: twice as fast; 0: no pacing
+  /// "data": paced by the samples' data times (a fast-paced recording plays at the speed of its
+  /// data); "source": by the recorded DDS source time stamps (the bus timing as recorded,
+  /// jitter included; needs record's source_timestamp_ns column).
+  std::string pace{"data"};
   double match_timeout_s{10.0};     ///< wait this long for a reader of every replayed topic
   std::vector<std::string> topics;  ///< empty: every sensor topic with a file in dir
   /// "TOPIC=N": wait for N readers of TOPIC before the first sample (default 1 per topic), so
