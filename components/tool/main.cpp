@@ -421,6 +421,8 @@ int main(int argc, char** argv) {
     }
     auto options = nb::bus::participantOptions(common, yaml, "navbus");
     options.publish_health = publish_health;  // an inspection tool is not part of what it inspects
+    // Under a discovery server, the inspection tools see every endpoint, not only their matches.
+    options.dds.discovery_super_client = *topics_cmd || *echo_cmd || *record_cmd;
     if (*latency_cmd) {
       options.dds.name = "navbus-latency-" + latency.role;
       return nb::tool::runLatencyCommand(options, latency, shutdown);

@@ -24,6 +24,9 @@ void addCommonOptions(CLI::App& app, CommonOptions& o, bool config_required) {
   app.add_option("--identity", o.security_identity,
                  "DDS Security credentials directory, for a *_secure profile "
                  "(scripts/make_credentials.sh makes test ones)");
+  app.add_option("--discovery-server", o.discovery_server,
+                 "IP[:PORT] of the discovery server (server id 0, port 11811 by default) for a "
+                 "discovery-client --profile");
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
 }
@@ -42,6 +45,9 @@ Participant::Options participantOptions(const CommonOptions& o, const YAML::Node
   p.dds.security_identity = !o.security_identity.empty()
                                 ? o.security_identity
                                 : get<std::string>(cfg, "", "security_identity", "");
+  p.dds.discovery_server = !o.discovery_server.empty()
+                               ? o.discovery_server
+                               : get<std::string>(cfg, "", "discovery_server", "");
   const double health_s =
       checkRange(get<double>(cfg, "", "health_period_s", 1.0), 0.05, 60.0, "health_period_s");
   p.health_period = std::chrono::milliseconds(static_cast<long>(health_s * 1000.0));

@@ -3,6 +3,7 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
+#include "navbus/bus/discovery_server.hpp"
 #include "navbus/bus/qos_files.hpp"
 #include "navbus/bus/security.hpp"
 
@@ -21,6 +22,8 @@ DdsContext::DdsContext(const ParticipantOptions& options) : name_(options.name) 
                    "' is not defined in the QoS files read (" + files.describe() + ")");
   }
   applySecurityIdentity(qos, options.participant_profile, options.security_identity);
+  applyDiscoveryServer(qos, options.participant_profile, options.discovery_server,
+                       options.discovery_super_client);
   secure_ = securityEnabled(qos);
   qos.name(options.name);
   // The listener hears discovery only (mask none): data and statuses go to the waitset.

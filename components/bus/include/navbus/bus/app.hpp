@@ -25,6 +25,7 @@ struct CommonOptions {
   std::string qos_file;             ///< empty: configuration, environment or installed default
   std::string participant_profile;  ///< empty: configuration or the loopback profile
   std::string security_identity;    ///< empty: configuration (none by default)
+  std::string discovery_server;     ///< empty: configuration, else the profile's server
   std::string log_level{"info"};
 };
 
@@ -32,7 +33,8 @@ struct CommonOptions {
 void addCommonOptions(CLI::App& app, CommonOptions& options, bool config_required);
 
 /// Participant options: command line first, then the configuration's keys domain_id,
-/// qos_file, participant_profile, security_identity and health_period_s, then defaults.
+/// qos_file, participant_profile, security_identity, discovery_server and health_period_s,
+/// then defaults.
 Participant::Options participantOptions(const CommonOptions& options, const YAML::Node& config,
                                         const std::string& name);
 

@@ -35,6 +35,11 @@ struct ParticipantOptions {
   /// DDS Security credentials directory (see security.hpp); required by a secure profile,
   /// refused by any other.
   std::string security_identity;
+  /// Discovery server "IP[:PORT]" for a discovery-client profile (discovery_server.hpp); empty:
+  /// the profile's.
+  std::string discovery_server;
+  /// Take the SUPER_CLIENT role under a discovery server (inspection tools: see every endpoint).
+  bool discovery_super_client{false};
   /// Optional listener installed at creation, so that no discovery event is missed.
   eprosima::fastdds::dds::DomainParticipantListener* listener{nullptr};
 };
