@@ -46,20 +46,4 @@ kill -TERM $rec
 wait $rec 2>/dev/null || true
 trap - EXIT
 
-# The same scenario without DDS: its truth (the simulator is deterministic), and the same data
-# without the fault manager, to show what the loop saves. --start config: the filter starts as
-# its file says, as navbus-filter did on the bus.
-"$bin/navbus" offline --scenario "$scenario" --filter "$filter_cfg" --fault-manager "$fm_cfg" \
-  --start config -o "$out/offline" > "$out/offline.log" 2>&1
-"$bin/navbus" offline --scenario "$scenario" --filter "$filter_cfg" --start config \
-  -o "$out/offline_without_fault_manager" > "$out/offline_without_fault_manager.log" 2>&1
-
-echo
-echo "================ navbus demo summary ================"
-grep -h "summary" "$out/sensor_sim.log" | sed 's/.*summary: /sensor-sim:    /'
-grep -h "summary" "$out/filter.log" | sed 's/.*summary: /filter:        /'
-grep -h "summary" "$out/fault_manager.log" | sed 's/.*summary: /fault-manager: /'
-/usr/bin/python3 scripts/demo_summary.py "$scenario" "$out/record" "$out/offline" \
-  "$out/offline_without_fault_manager"
-/usr/bin/python3 scripts/plot_navbus.py demo "$scenario" "$out" -o "$out/figures"
-echo "logs and CSV files: $out; figures: $out/figures"
+bash scripts/demo_report.sh "$bin" scripts "$scenario" "$filter_cfg" "$fm_cfg" "$out"

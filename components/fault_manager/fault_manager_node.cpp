@@ -75,7 +75,9 @@ void FaultManagerNode::watch(const std::string& topic, const std::string& profil
   };
   callbacks.on_disposed = [this, kind](const eprosima::fastrtps::rtps::InstanceHandle_t& h) {
     auto it = instances_.find({kind, h});
-    if (it != instances_.end()) pipeline_.onStreamEnded(kind, it->second);
+    if (it == instances_.end()) return;
+    pipeline_.onStreamEnded(kind, it->second);
+    if (kind == StreamKind::kImu && on_imu_ended_) on_imu_ended_();
   };
   callbacks.on_liveliness = [this,
                              kind](const eprosima::fastdds::dds::LivelinessChangedStatus& st) {

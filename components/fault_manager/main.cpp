@@ -1,6 +1,9 @@
 // navbus-fault-manager: stream watchdogs and the GLR of seed 000 on the filter's diagnostics,
 // publishing decisions (facts) and filter commands (requests).
+#include <optional>
+
 #include "navbus/bus/app.hpp"
+#include "navbus/bus/stop_after_end.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/fault_manager/fault_manager_node.hpp"
 
@@ -13,9 +16,14 @@ int main(int argc, char** argv) {
       "on the navbus DDS bus; publishes fault decisions and filter commands",
       "navbus-fault-manager"};
   nb::bus::CommonOptions common;
+  bool exit_when_ended = false;
+  app.add_flag("--exit-when-ended", exit_when_ended,
+               "stop by itself 2 s after the IMU stream's writer announced the end of its data "
+               "(the simulator and navbus replay do), e.g. in the compose demo");
   nb::bus::addCommonOptions(app, common, false);
   app.footer(
-      "Exit codes: 0 stopped by SIGINT/SIGTERM, 1 runtime error, 2 configuration error, 3 DDS "
+      "Exit codes: 0 stopped by SIGINT/SIGTERM (or --exit-when-ended), 1 runtime error, 2 "
+      "configuration error, 3 DDS "
       "error.");
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) {
     const nb::fault_manager::FaultManagerConfig config =
@@ -25,6 +33,11 @@ int main(int argc, char** argv) {
     nb::fault_manager::FaultManagerNode node(participant, config);
     spdlog::info("running: watching IMU, raw IMU, GNSS and star-tracker streams; GLR {}",
                  config.glr.enabled ? "on navbus/nav/diagnostics" : "disabled");
+    std::optional<nb::bus::StopAfterEnd> stop_after_end;
+    if (exit_when_ended) {
+      stop_after_end.emplace(participant, nb::bus::kStopAfterEndGrace);
+      node.setOnImuEnded([&] { stop_after_end->ended(); });
+    }
     participant.run();
     spdlog::info("summary: {}\n{}", node.summary(), participant.health().summary());
     return static_cast<int>(nb::bus::kExitOk);

@@ -115,7 +115,9 @@ void FilterNode::subscribeSensor(const std::string& topic, const std::string& pr
   bus::ReaderCallbacks callbacks;
   callbacks.on_disposed = [this, rank](const eprosima::fastrtps::rtps::InstanceHandle_t& h) {
     auto it = sensor_instances_.find({rank, h});
-    if (it != sensor_instances_.end()) pipeline_.onStreamEnded(rank, it->second);
+    if (it == sensor_instances_.end()) return;
+    pipeline_.onStreamEnded(rank, it->second);
+    if (rank == kRankImu && on_imu_ended_) on_imu_ended_();
   };
   participant_.subscribe<PubSubType>(
       topic, profile,

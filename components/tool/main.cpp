@@ -6,12 +6,14 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 
 #include "command.hpp"
 #include "evaluation.hpp"
+#include "health_check.hpp"
 #include "latency.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
@@ -111,6 +113,7 @@ class RecordSink : public nb::tool::SampleSink {
                 const std::function<std::vector<std::string>()>& rows) override {
     auto& f = files_.at(topic);
     ++f.samples;
+    last_sample_ = std::chrono::steady_clock::now();
     for (const auto& r : rows()) {
       *f.stream << r << ',' << times.source_ns << ',' << times.reception_ns << '\n';
     }
@@ -119,6 +122,11 @@ class RecordSink : public nb::tool::SampleSink {
     for (auto& [name, f] : files_) f.stream->flush();
   }
   std::uint64_t samples(const std::string& topic) const { return files_.at(topic).samples; }
+  /// Seconds since the last sample of any topic; negative before the first.
+  double idleSeconds() const {
+    if (!last_sample_) return -1.0;
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - *last_sample_).count();
+  }
 
  private:
   struct File {
@@ -126,6 +134,7 @@ class RecordSink : public nb::tool::SampleSink {
     std::uint64_t samples{0};
   };
   std::map<std::string, File> files_;
+  std::optional<std::chrono::steady_clock::time_point> last_sample_;
 };
 
 const nb::tool::TopicEntry& requireTopic(const std::string& name) {
@@ -192,6 +201,12 @@ int main(int argc, char** argv) {
   record_cmd->add_option("-o,--out", out_dir, "output directory (created)")->required();
   record_cmd->add_option("-n,--count", count,
                          "stop when every topic has this many samples (exit 1 if not reached)");
+  double idle_s = 0.0;
+  record_cmd
+      ->add_option("--idle", idle_s,
+                   "stop once no sample of any topic came for this many seconds after the "
+                   "first (0: never)")
+      ->check(CLI::Range(0.0, 3600.0));
   record_cmd->add_option("--duration", duration_s,
                          "stop after this many seconds (0: until SIGINT)");
 
@@ -221,6 +236,15 @@ int main(int argc, char** argv) {
   replay_cmd
       ->add_option("--match-timeout", replay.match_timeout_s,
                    "seconds to wait for a reader of every replayed topic")
+      ->check(CLI::Range(0.1, 600.0));
+
+  nb::tool::HealthCheckOptions health;
+  auto* health_cmd = app.add_subcommand(
+      "health",
+      "exit 0 if PARTICIPANT's own health reports say RUNNING or DEGRADED within --timeout, 1 "
+      "otherwise (no report, STARTING, STOPPING); for container healthchecks and scripts");
+  health_cmd->add_option("participant", health.participant, "e.g. navbus-filter")->required();
+  health_cmd->add_option("--timeout", health.timeout_s, "seconds to wait for a working report")
       ->check(CLI::Range(0.1, 600.0));
 
   nb::tool::CommandOptions command;
@@ -431,6 +455,10 @@ int main(int argc, char** argv) {
       options.dds.name = "navbus-replay";
       return nb::tool::runReplayCommand(options, replay, shutdown);
     }
+    if (*health_cmd) {
+      options.dds.name = "navbus-health";
+      return nb::tool::runHealthCommand(options, health, shutdown);
+    }
     if (*command_cmd) {
       options.dds.name = "navbus-command";
       return nb::tool::runCommandCommand(options, command, shutdown);
@@ -472,6 +500,7 @@ int main(int argc, char** argv) {
       entries.back()->subscribe(p, sink);
     }
     auto all_counted = [&] {
+      if (idle_s > 0.0 && sink.idleSeconds() >= idle_s) return true;
       if (count == 0) return false;
       for (const auto* e : entries)
         if (sink.samples(e->name) < count) return false;

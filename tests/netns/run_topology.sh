@@ -13,12 +13,9 @@ bin=$1
 mode=${2:-plain}
 creds=${3:-}
 id=$$
-probe="nbprobe$id"
-if ! ip netns add "$probe" 2>/dev/null; then
-  echo "SKIP: network namespaces are not permitted here (ip netns add failed)"
-  exit 77
-fi
-ip netns del "$probe"
+# shellcheck source=namespaces.sh
+source "$(dirname "$0")/namespaces.sh"
+netns_available
 
 hosts=(sim filter fm obs)
 subnet=77
@@ -27,38 +24,18 @@ profile=navbus_participant_udp_lan
 if [ "$mode" = secure ]; then subnet=78; domain=78; profile=navbus_participant_udp_lan_secure; fi
 # identity NAME: the credentials option of a participant (none on the plain profile)
 identity() { [ "$mode" = secure ] && echo "--identity $creds/$1" || true; }
-sw="nbsw$id"
 work=$(mktemp -d)
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
   sleep 0.5
   for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
-  for h in "${hosts[@]}"; do ip netns del "nb$h$id" 2>/dev/null || true; done
-  ip netns del "$sw" 2>/dev/null || true
+  netns_delete "$id" "${hosts[@]}"
   rm -rf "$work"
 }
 trap cleanup EXIT
 
-ip netns add "$sw"
-ip netns exec "$sw" ip link add br0 type bridge mcast_snooping 0
-ip netns exec "$sw" ip link set br0 up
-n=1
-for h in "${hosts[@]}"; do
-  ns="nb$h$id"
-  ip netns add "$ns"
-  ip link add "v$h$id" type veth peer name "s$h$id"
-  ip link set "v$h$id" netns "$ns"
-  ip link set "s$h$id" netns "$sw"
-  ip netns exec "$sw" ip link set "s$h$id" master br0 up
-  ip netns exec "$ns" ip link set "v$h$id" name eth0
-  ip netns exec "$ns" ip addr add "10.254.$subnet.$n/24" dev eth0
-  ip netns exec "$ns" ip link set eth0 up
-  ip netns exec "$ns" ip link set lo up
-  # Multicast (SPDP discovery) leaves through eth0; the bridge is the whole network.
-  ip netns exec "$ns" ip route add 224.0.0.0/4 dev eth0
-  n=$((n + 1))
-done
+netns_create "$id" "$subnet" "${hosts[@]}"
 echo "namespaces: ${hosts[*]} on bridge br0 (10.254.$subnet.0/24), profile $profile"
 
 common=(--domain $domain --profile $profile)

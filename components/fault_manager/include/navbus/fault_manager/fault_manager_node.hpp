@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 
@@ -20,6 +21,8 @@ class FaultManagerNode {
  public:
   FaultManagerNode(bus::Participant& participant, const FaultManagerConfig& config);
   std::string summary() const { return pipeline_.summary(); }
+  /// Called once the IMU stream's writer announced the end of its data.
+  void setOnImuEnded(std::function<void()> fn) { on_imu_ended_ = std::move(fn); }
 
  private:
   template <class PubSubType, class IdFn, class TimeFn>
@@ -27,6 +30,7 @@ class FaultManagerNode {
              TimeFn time);
 
   bus::Participant& participant_;
+  std::function<void()> on_imu_ended_;
   bus::Writer<navbus::FaultDecision> decision_writer_;
   bus::Writer<navbus::FilterCommand> command_writer_;
   FaultPipeline pipeline_;

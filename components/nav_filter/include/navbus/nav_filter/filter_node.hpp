@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <utility>
@@ -25,6 +26,9 @@ class FilterNode {
   /// Releases ready inputs (after every reader dispatch and periodically).
   void pump();
   std::string summary() const { return pipeline_.summary(); }
+  /// Called once the IMU stream's writer announced the end of its data (after the pipeline
+  /// was told).
+  void setOnImuEnded(std::function<void()> fn) { on_imu_ended_ = std::move(fn); }
 
  private:
   /// STARTING until the first solution; DEGRADED while a stream is lost or no solution has
@@ -43,6 +47,7 @@ class FilterNode {
   static constexpr std::int64_t kNotProducingMinNs = 1'000'000'000;
 
   bus::Participant& participant_;
+  std::function<void()> on_imu_ended_;
   bus::Writer<navbus::NavigationSolution> solution_writer_;
   bus::Writer<navbus::FilterDiagnostics> diagnostics_writer_;
   bus::Writer<navbus::NavigationSolution> low_latency_writer_;  ///< when configured
