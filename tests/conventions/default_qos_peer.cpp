@@ -1,10 +1,13 @@
 // A DDS application with Fast DDS's library defaults (participant, topic and reader QoS, no XML
 // profile at all), built only on the navbus IDL types: it reads navbus/imu/increment and exits
-// 0 once it has received N samples within the time limit, 1 otherwise.
-// Usage: navbus_default_qos_peer DOMAIN N TIMEOUT_S
+// 0 once it has received N samples within the time limit, 1 otherwise. With TOPIC and TYPE it
+// reads that topic with the type registered under that name (the ROS 2 names:
+// rt/navbus/imu/increment, navbus::msg::dds_::ImuIncrement_), as a ROS 2 node's rmw would.
+// Usage: navbus_default_qos_peer DOMAIN N TIMEOUT_S [TOPIC TYPE]
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <thread>
 
 #include <navbus_idl/ImuPubSubTypes.h>
@@ -18,8 +21,8 @@
 namespace fdds = eprosima::fastdds::dds;
 
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::fprintf(stderr, "usage: %s DOMAIN N TIMEOUT_S\n", argv[0]);
+  if (argc != 4 && argc != 6) {
+    std::fprintf(stderr, "usage: %s DOMAIN N TIMEOUT_S [TOPIC TYPE]\n", argv[0]);
     return 2;
   }
   const int domain = std::atoi(argv[1]);
@@ -30,10 +33,11 @@ int main(int argc, char** argv) {
   fdds::DomainParticipant* participant = factory->create_participant(
       static_cast<fdds::DomainId_t>(domain), fdds::PARTICIPANT_QOS_DEFAULT);
   if (participant == nullptr) return 3;
+  const std::string topic_name = argc == 6 ? argv[4] : "navbus/imu/increment";
   fdds::TypeSupport type(new navbus::ImuIncrementPubSubType());
-  type.register_type(participant);
-  fdds::Topic* topic = participant->create_topic("navbus/imu/increment", type.get_type_name(),
-                                                 fdds::TOPIC_QOS_DEFAULT);
+  const std::string type_name = argc == 6 ? argv[5] : type.get_type_name();
+  type.register_type(participant, type_name);
+  fdds::Topic* topic = participant->create_topic(topic_name, type_name, fdds::TOPIC_QOS_DEFAULT);
   fdds::DataReader* reader = participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT)
                                  ->create_datareader(topic, fdds::DATAREADER_QOS_DEFAULT);
   int received = 0;
@@ -45,7 +49,8 @@ int main(int argc, char** argv) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  std::printf("default-QoS application received %d navbus/imu/increment samples\n", received);
+  std::printf("default-QoS application received %d samples of %s (type %s)\n", received,
+              topic_name.c_str(), type_name.c_str());
   participant->delete_contained_entities();
   factory->delete_participant(participant);
   return received >= wanted ? 0 : 1;

@@ -27,6 +27,8 @@ void addCommonOptions(CLI::App& app, CommonOptions& o, bool config_required) {
   app.add_option("--discovery-server", o.discovery_server,
                  "IP[:PORT] of the discovery server (server id 0, port 11811 by default) for a "
                  "discovery-client --profile");
+  app.add_flag("--ros2", o.ros2_names,
+               "ROS 2 naming: topics rt/<name>, types navbus::msg::dds_::<Type>_ (README)");
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
 }
@@ -48,6 +50,7 @@ Participant::Options participantOptions(const CommonOptions& o, const YAML::Node
   p.dds.discovery_server = !o.discovery_server.empty()
                                ? o.discovery_server
                                : get<std::string>(cfg, "", "discovery_server", "");
+  p.dds.ros2_names = o.ros2_names || get<bool>(cfg, "", "ros2_names", false);
   const double health_s =
       checkRange(get<double>(cfg, "", "health_period_s", 1.0), 0.05, 60.0, "health_period_s");
   p.health_period = std::chrono::milliseconds(static_cast<long>(health_s * 1000.0));

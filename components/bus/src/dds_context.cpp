@@ -11,7 +11,19 @@ namespace navbus::bus {
 
 namespace dds = eprosima::fastdds::dds;
 
-DdsContext::DdsContext(const ParticipantOptions& options) : name_(options.name) {
+std::string ros2TopicName(const std::string& topic) {
+  return "rt/" + topic;
+}
+
+std::string ros2TypeName(const std::string& type) {
+  const std::size_t last = type.rfind("::");
+  const std::string module = last == std::string::npos ? "" : type.substr(0, last + 2);
+  const std::string name = last == std::string::npos ? type : type.substr(last + 2);
+  return module + "msg::dds_::" + name + "_";
+}
+
+DdsContext::DdsContext(const ParticipantOptions& options)
+    : name_(options.name), ros2_names_(options.ros2_names) {
   const QosFiles& files = loadQosProfiles(options.qos_file);
   qos_files_ = files.describe();
   auto* factory = dds::DomainParticipantFactory::get_instance();
@@ -65,15 +77,21 @@ dds::Topic* DdsContext::topicForType(const std::string& name, dds::TypeSupport t
   if (it != topics_.end()) {
     return it->second;
   }
-  const std::string type_name = type.get_type_name();
+  const std::string type_name =
+      ros2_names_ ? ros2TypeName(type.get_type_name()) : type.get_type_name();
   if (participant_->find_type(type_name).empty()) {
-    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+    // The type object (NAVBUS_TYPE_OBJECTS) is announced for dynamic tools, the XTypes type
+    // information is not: Fast DDS 2.9 compares it with a remote endpoint's own and refused
+    // Cyclone DDS 0.10's writers with it (interop_cyclone; README, Type information).
+    type->auto_fill_type_information(false);
+    if (type.register_type(participant_, type_name) != ReturnCode_t::RETCODE_OK) {
       throw DdsError("cannot register type '" + type_name + "'");
     }
   }
-  dds::Topic* topic = participant_->create_topic(name, type_name, dds::TOPIC_QOS_DEFAULT);
+  const std::string dds_name = ros2_names_ ? ros2TopicName(name) : name;
+  dds::Topic* topic = participant_->create_topic(dds_name, type_name, dds::TOPIC_QOS_DEFAULT);
   if (topic == nullptr) {
-    throw DdsError("cannot create topic '" + name + "' of type '" + type_name + "'");
+    throw DdsError("cannot create topic '" + dds_name + "' of type '" + type_name + "'");
   }
   topics_.emplace(name, topic);
   return topic;

@@ -26,6 +26,7 @@ struct CommonOptions {
   std::string participant_profile;  ///< empty: configuration or the loopback profile
   std::string security_identity;    ///< empty: configuration (none by default)
   std::string discovery_server;     ///< empty: configuration, else the profile's server
+  bool ros2_names{false};           ///< --ros2 (or the configuration's ros2_names)
   std::string log_level{"info"};
 };
 

@@ -40,9 +40,17 @@ struct ParticipantOptions {
   std::string discovery_server;
   /// Take the SUPER_CLIENT role under a discovery server (inspection tools: see every endpoint).
   bool discovery_super_client{false};
+  /// ROS 2 naming (ros2Names()): topics "rt/<name>", types "<module>::msg::dds_::<Type>_".
+  bool ros2_names{false};
   /// Optional listener installed at creation, so that no discovery event is missed.
   eprosima::fastdds::dds::DomainParticipantListener* listener{nullptr};
 };
+
+/// A topic's and a type's DDS names under ROS 2's conventions (the rmw_fastrtps mapping):
+/// topic "navbus/imu/increment" -> "rt/navbus/imu/increment"; type "navbus::ImuIncrement" ->
+/// "navbus::msg::dds_::ImuIncrement_".
+std::string ros2TopicName(const std::string& topic);
+std::string ros2TypeName(const std::string& type);
 
 class DdsContext {
  public:
@@ -54,6 +62,10 @@ class DdsContext {
   /// Registers PubSubType (once) and returns the topic, created on first use.
   template <class PubSubType>
   eprosima::fastdds::dds::Topic* topic(const std::string& name) {
+    // With NAVBUS_TYPE_OBJECTS the generated constructors register the type objects
+    // (register<File>Types()); one sample constructed before the entities makes sure the type
+    // object exists when discovery announces the endpoint.
+    [[maybe_unused]] const typename PubSubType::type registers_type_object{};
     eprosima::fastdds::dds::TypeSupport type(new GuardedType<PubSubType>());
     return topicForType(name, type);
   }
@@ -80,6 +92,7 @@ class DdsContext {
 
   std::string name_;
   std::string qos_files_;  ///< the profile files read, for error messages
+  bool ros2_names_{false};
   bool secure_{false};
   PeerIdentities peers_;  ///< the participant's listener unless the options bring one
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
