@@ -13,9 +13,7 @@ int main(int argc, char** argv) {
   CLI::App app{"navbus-filter: strapdown navigation filter on the navbus DDS bus", "navbus-filter"};
   nb::bus::CommonOptions common;
   bool exit_when_ended = false;
-  app.add_flag("--exit-when-ended", exit_when_ended,
-               "stop by itself 2 s after the IMU stream's writer announced the end of its data "
-               "(the simulator and navbus replay do), e.g. in the compose demo");
+  nb::bus::addExitWhenEndedOption(app, exit_when_ended);
   nb::bus::addCommonOptions(app, common, true);
   app.footer(
       "Exit codes: 0 stopped by SIGINT/SIGTERM (or --exit-when-ended), 1 runtime error, 2 "

@@ -113,6 +113,16 @@ inline std::string readFile(const std::filesystem::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
+/// The lines of a CSV file after its header.
+inline std::vector<std::string> csvDataRows(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> rows;
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) rows.push_back(line);
+  return rows;
+}
+
 /// The test's own participant on the bus.
 inline bus::Participant::Options testParticipant(int domain, const std::string& name) {
   bus::Participant::Options o;

@@ -1,7 +1,7 @@
 // The offline runner (`navbus offline`, no DDS) and the three participants over the bus give
 // bit-identical solutions for the same scenario, seed and filter configuration (README,
-// Architecture: Determinism). Two scenarios: the seed-004 land vehicle with the multi-dimensional filter
-// (ZUPT, NHC, stage switches, resets) and 40 s of the seed-001 LEO with GNSS fixes and the
+// Architecture: Determinism). Two scenarios: the seed-004 land vehicle with the multi-dimensional
+// filter (ZUPT, NHC, stage switches, resets) and 40 s of the seed-001 LEO with GNSS fixes and the
 // star tracker in the federated structure.
 #include <algorithm>
 #include <cmath>
@@ -19,15 +19,6 @@ using namespace navbus;
 using namespace std::chrono_literals;
 
 namespace {
-
-std::vector<std::string> readCsvRows(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::vector<std::string> rows;
-  std::string line;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) rows.push_back(line);
-  return rows;
-}
 
 /// Rows that differ between the bus and offline runs; the first three are reported.
 std::size_t countDiffering(const std::vector<std::string>& bus,
@@ -79,7 +70,7 @@ void runCase(const Case& c) {
        std::to_string(c.seed), "-o", (dir / "offline").string()},
       (dir / "offline.log").string());
   ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
-  const std::vector<std::string> expected = readCsvRows(dir / "offline" / "solution.csv");
+  const std::vector<std::string> expected = test::csvDataRows(dir / "offline" / "solution.csv");
   ASSERT_GT(expected.size(), 100u);
 
   // The same over the bus: simulator, filter and fault manager as separate processes.
@@ -224,7 +215,7 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
        "--start", "config", "-o", (dir / "offline").string()},
       (dir / "offline.log").string());
   ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
-  const std::vector<std::string> expected = readCsvRows(dir / "offline" / "solution.csv");
+  const std::vector<std::string> expected = test::csvDataRows(dir / "offline" / "solution.csv");
   ASSERT_EQ(expected.size(), 350u);
 
   bus::ShutdownSignal shutdown;

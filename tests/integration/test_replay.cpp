@@ -16,17 +16,8 @@ using namespace std::chrono_literals;
 
 namespace {
 
-std::vector<std::string> solutionRows(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::vector<std::string> rows;
-  std::string line;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) rows.push_back(line);
-  return rows;
-}
-
 std::size_t dataRows(const std::filesystem::path& file) {
-  return solutionRows(file).size();
+  return test::csvDataRows(file).size();
 }
 
 }  // namespace
@@ -52,7 +43,7 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
                               "config", "--seed", "5", "-o", (dir / "offline").string()},
                              (dir / "offline.log").string());
   ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
-  const std::vector<std::string> expected = solutionRows(dir / "offline" / "solution.csv");
+  const std::vector<std::string> expected = test::csvDataRows(dir / "offline" / "solution.csv");
   ASSERT_GT(expected.size(), 500u);
 
   // 1. The simulator's run, recorded from the bus (the recorder is its only reader).
@@ -119,7 +110,7 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
     }
   }
   EXPECT_EQ(differing, 0u) << test::readFile(dir / "filter.log") << test::readFile(dir / "fm.log")
-                          << replay_log;
+                           << replay_log;
   std::printf("replay of a recording: %zu solutions, bit-identical to offline: %s\n", rows.size(),
               differing == 0 ? "yes" : "NO");
   test::cleanSharedMemory();

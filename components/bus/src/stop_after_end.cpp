@@ -11,6 +11,12 @@ StopAfterEnd::StopAfterEnd(Participant& participant, std::chrono::nanoseconds gr
   });
 }
 
+void addExitWhenEndedOption(CLI::App& app, bool& exit_when_ended) {
+  app.add_flag("--exit-when-ended", exit_when_ended,
+               "stop by itself 2 s after the IMU stream's writer announced the end of its data "
+               "(the simulator and navbus replay do), e.g. in the compose demo");
+}
+
 void StopAfterEnd::ended() {
   if (ended_at_) return;
   ended_at_ = std::chrono::steady_clock::now();

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <optional>
 
+#include <CLI/CLI.hpp>
+
 #include "navbus/bus/participant.hpp"
 
 namespace navbus::bus {
@@ -25,5 +27,8 @@ class StopAfterEnd {
 
 /// The grace period of --exit-when-ended.
 inline constexpr std::chrono::seconds kStopAfterEndGrace{2};
+
+/// Adds --exit-when-ended to a participant's command line.
+void addExitWhenEndedOption(CLI::App& app, bool& exit_when_ended);
 
 }  // namespace navbus::bus
