@@ -123,11 +123,12 @@ class CellParser {
 /// sequence columns (names with a '.') are equal: the scalar fields repeated on each row.
 std::vector<std::pair<std::size_t, std::size_t>> messageRowRanges(const CsvTable& table);
 
-/// Every message of a recorded file, in file order.
+/// Every message of a recorded file, in file order, from its rows' ranges (messageRowRanges).
 template <class T>
-std::vector<T> parseMessages(const CsvTable& table) {
+std::vector<T> parseMessages(const CsvTable& table,
+                             const std::vector<std::pair<std::size_t, std::size_t>>& ranges) {
   std::vector<T> messages;
-  for (const auto& [first, count] : messageRowRanges(table)) {
+  for (const auto& [first, count] : ranges) {
     CellParser parser(table, first, count);
     T message;
     visitFields(message, parser);

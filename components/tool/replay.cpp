@@ -63,10 +63,11 @@ class TypedStream : public Stream {
   using T = typename PubSubType::type;
   TypedStream(std::string topic, std::string profile, const CsvTable& table)
       : topic_(std::move(topic)), profile_(std::move(profile)) {
-    messages_ = parseMessages<T>(table);
+    const auto ranges = messageRowRanges(table);
+    messages_ = parseMessages<T>(table, ranges);
     if (table.has(kSourceTimeColumn)) {
       const std::size_t column = table.column(kSourceTimeColumn);
-      for (const auto& [first, count] : messageRowRanges(table)) {
+      for (const auto& [first, count] : ranges) {
         const std::string& cell = table.rows[first][column];
         std::int64_t ns = 0;
         const auto [ptr, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), ns);

@@ -18,6 +18,8 @@
 #include <thread>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include <navbus_idl/GnssPubSubTypes.h>
 #include <navbus_idl/ImuPubSubTypes.h>
 #include <navbus_idl/StarTrackerPubSubTypes.h>
@@ -111,6 +113,20 @@ inline std::string writeFile(const std::filesystem::path& path, const std::strin
 inline std::string readFile(const std::filesystem::path& path) {
   std::ifstream in(path);
   return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// Solution rows that differ between a bus run and the offline run; the first three are
+/// reported as failures.
+inline std::size_t countDiffering(const std::vector<std::string>& bus,
+                                  const std::vector<std::string>& offline) {
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < bus.size() && i < offline.size(); ++i) {
+    if (bus[i] != offline[i] && differing++ < 3) {
+      ADD_FAILURE() << "solution " << i << " differs:\n bus:     " << bus[i]
+                    << "\n offline: " << offline[i];
+    }
+  }
+  return differing;
 }
 
 /// The lines of a CSV file after its header.

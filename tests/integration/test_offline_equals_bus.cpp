@@ -20,19 +20,6 @@ using namespace std::chrono_literals;
 
 namespace {
 
-/// Rows that differ between the bus and offline runs; the first three are reported.
-std::size_t countDiffering(const std::vector<std::string>& bus,
-                           const std::vector<std::string>& offline) {
-  std::size_t differing = 0;
-  for (std::size_t i = 0; i < bus.size() && i < offline.size(); ++i) {
-    if (bus[i] != offline[i] && differing++ < 3) {
-      ADD_FAILURE() << "solution " << i << " differs:\n bus:     " << bus[i]
-                    << "\n offline: " << offline[i];
-    }
-  }
-  return differing;
-}
-
 struct Case {
   int domain;
   std::string scenario;  ///< file under sim/scenarios
@@ -99,7 +86,7 @@ void runCase(const Case& c) {
   EXPECT_EQ(fm.wait(10s), 0);
 
   ASSERT_EQ(rows.size(), expected.size()) << test::readFile(dir / "filter.log");
-  const std::size_t differing = countDiffering(rows, expected);
+  const std::size_t differing = test::countDiffering(rows, expected);
   EXPECT_EQ(differing, 0u);
   std::printf("%s: %zu solutions, bus and offline bit-identical (17-digit CSV rows): %s\n",
               c.scenario.c_str(), rows.size(), differing == 0 ? "yes" : "NO");
@@ -297,7 +284,7 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
   }
   // Bus and offline: the same loop, the same bits.
   ASSERT_EQ(rows.size(), expected.size()) << filter_log;
-  const std::size_t differing = countDiffering(rows, expected);
+  const std::size_t differing = test::countDiffering(rows, expected);
   EXPECT_EQ(differing, 0u);
   std::printf("fault loop: decision at %.1f s (onset %.1f s), %zu solutions bit-identical: %s\n",
               decided_s, onset_s, rows.size(), differing == 0 ? "yes" : "NO");

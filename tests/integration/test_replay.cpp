@@ -102,13 +102,7 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
   EXPECT_EQ(fm.wait(10s), 0);
 
   ASSERT_EQ(rows.size(), expected.size()) << test::readFile(dir / "filter.log");
-  std::size_t differing = 0;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (rows[i] != expected[i] && differing++ < 3) {
-      ADD_FAILURE() << "solution " << i << " differs:\n replay:  " << rows[i]
-                    << "\n offline: " << expected[i];
-    }
-  }
+  const std::size_t differing = test::countDiffering(rows, expected);
   EXPECT_EQ(differing, 0u) << test::readFile(dir / "filter.log") << test::readFile(dir / "fm.log")
                            << replay_log;
   std::printf("replay of a recording: %zu solutions, bit-identical to offline: %s\n", rows.size(),
