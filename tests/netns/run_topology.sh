@@ -57,15 +57,22 @@ pids+=($!)
 ip netns exec "nbfm$id" "$bin/navbus-fault-manager" "${common[@]}" $(identity fault-manager) > "$work/fm.log" 2>&1 &
 pids+=($!)
 ip netns exec "nbobs$id" "$bin/navbus" "${common[@]}" $(identity tool) record navbus/nav/solution navbus/fault/decision \
-  -o "$work/rec" --duration 25 > "$work/rec.log" 2>&1 &
+  -o "$work/rec" --duration 90 > "$work/rec.log" 2>&1 &
 rec_pid=$!
 pids+=($rec_pid)
 sleep 1
 ip netns exec "nbsim$id" "$bin/navbus-sensor-sim" -c "$work/sim.yaml" "${common[@]}" $(identity simulator) > "$work/sim.log" 2>&1 &
 sim_pid=$!
 # A clean end of data is announced (no loss); a crash is not: kill the simulator after 4 s of
-# data or more so that the watchdog's decision has to cross the namespaces.
-sleep 7
+# data so that the watchdog's decision has to cross the namespaces. The data starts once the
+# simulator's readers matched ("publishing"): under DDS Security and the sanitizers that took
+# more than the 6 s this test used to allow in 2 of about 10 runs (0 solutions recorded).
+for _ in $(seq 1 400); do
+  grep -q "publishing" "$work/sim.log" 2>/dev/null && break
+  sleep 0.1
+done
+grep -q "publishing" "$work/sim.log" || echo "the simulator did not start publishing within 40 s"
+sleep 4
 kill -KILL $sim_pid 2>/dev/null || true
 wait $sim_pid 2>/dev/null || true
 sleep 3
