@@ -294,7 +294,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
        "initial_position_sigma_m", "initial_velocity_sigma_mps", "initial_level_sigma_mrad",
        "initial_heading_sigma_mrad", "accel_bias_sigma_ug", "gyro_bias_sigma_deg_per_h",
        "initial_clock_bias_sigma_m", "initial_clock_drift_sigma_mps", "gate_sigma",
-       "initial_clock_bias_m", "initial_clock_drift_mps"});
+       "initial_clock_bias_m", "initial_clock_drift_mps", "star_tracker_bias_sigma_arcsec",
+       "star_tracker_bias_correlation_time_s"});
   using units::kArcsec;
   using units::kDeg;
   using units::kMicroG;
@@ -336,6 +337,20 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                              " must be positive and finite (covariance), got " +
                              std::to_string(value));
     }
+  }
+  // The star tracker's Gauss-Markov bias, modelled as states when its sigma is positive.
+  t.star_tracker_bias_sigma_rad =
+      bus::checkRange(bus::get<double>(tc, w, "star_tracker_bias_sigma_arcsec",
+                                       t.star_tracker_bias_sigma_rad / kArcsec),
+                      0.0, 3600.0, "ekf.star_tracker_bias_sigma_arcsec (0: not modelled)") *
+      kArcsec;
+  t.star_tracker_bias_correlation_time_s =
+      bus::checkRange(bus::get<double>(tc, w, "star_tracker_bias_correlation_time_s",
+                                       t.star_tracker_bias_correlation_time_s),
+                      1.0, 1e7, "ekf.star_tracker_bias_correlation_time_s");
+  if (t.star_tracker_bias_sigma_rad > 0.0 && !e.use_star_tracker) {
+    throw bus::ConfigError(
+        "configuration ekf.star_tracker_bias_sigma_arcsec needs star_tracker_updates = true");
   }
   e.initial_clock_bias_m = bus::get<double>(tc, w, "initial_clock_bias_m", 0.0);
   e.initial_clock_drift_mps = bus::get<double>(tc, w, "initial_clock_drift_mps", 0.0);

@@ -322,20 +322,21 @@ void FilterPipeline::publishSolution() {
   sol.seq(++solution_seq_);
   bus::fillSolution(engine_.state(), sol);
   // Sigmas from the filter covariance: propagated only (inertial-only mode) or updated.
-  const core::Matrix17& P = engine_.covariance();
+  const core::StateMatrix& P = engine_.covariance();
   auto sigma3 = [&P](const core::StateBlock& b) {
     return bus::toArray(P.block<3, 3>(b.index, b.index).diagonal().cwiseSqrt());
   };
-  sol.pos_sigma_ned_m(sigma3(core::tc17::kPos));
-  sol.vel_sigma_ned_mps(sigma3(core::tc17::kVel));
-  sol.att_sigma_ned_rad(sigma3(core::tc17::kAtt));
-  sol.accel_bias_sigma_b_mps2(sigma3(core::tc17::kAccelBias));
-  sol.gyro_bias_sigma_b_radps(sigma3(core::tc17::kGyroBias));
+  sol.pos_sigma_ned_m(sigma3(core::layout::kPos));
+  sol.vel_sigma_ned_mps(sigma3(core::layout::kVel));
+  sol.att_sigma_ned_rad(sigma3(core::layout::kAtt));
+  sol.accel_bias_sigma_b_mps2(sigma3(core::layout::kAccelBias));
+  sol.gyro_bias_sigma_b_radps(sigma3(core::layout::kGyroBias));
   sol.clock_bias_m(engine_.clockBias());
   sol.clock_drift_mps(engine_.clockDrift());
-  sol.clock_bias_sigma_m(std::sqrt(P(core::tc17::kClockBias.index, core::tc17::kClockBias.index)));
+  sol.clock_bias_sigma_m(
+      std::sqrt(P(core::layout::kClockBias.index, core::layout::kClockBias.index)));
   sol.clock_drift_sigma_mps(
-      std::sqrt(P(core::tc17::kClockDrift.index, core::tc17::kClockDrift.index)));
+      std::sqrt(P(core::layout::kClockDrift.index, core::layout::kClockDrift.index)));
   sol.covariance_valid(true);
   // Biases: estimated plus those compensated by command.
   sol.accel_bias_b_mps2(bus::toArray(engine_.accelBias()));

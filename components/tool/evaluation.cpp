@@ -109,7 +109,8 @@ struct Stats {
   std::size_t n{0};
   // NEES: per epoch index, summed over runs.
   std::vector<double> nees_sum;
-  std::vector<Eigen::Vector3d> nees_blocks_sum;  ///< position, velocity, attitude
+  using Blocks = Eigen::Matrix<double, kNeesBlocks, 1>;
+  std::vector<Blocks> nees_blocks_sum;  ///< as EpochError::nees_blocks
   std::vector<int> nees_runs;
   std::vector<double> nees_time_s;  ///< of epoch index k, from the start (the first run's)
   std::vector<double> recovery_s;   ///< per run and instant; NaN when not converged
@@ -130,7 +131,7 @@ void accumulate(Stats& st, const OfflineResult& r, std::int64_t from_ns, const M
     ++st.n;
     if (st.nees_sum.size() <= k) {
       st.nees_sum.resize(k + 1, 0.0);
-      st.nees_blocks_sum.resize(k + 1, Eigen::Vector3d::Zero());
+      st.nees_blocks_sum.resize(k + 1, Stats::Blocks::Zero());
       st.nees_runs.resize(k + 1, 0);
       st.nees_time_s.push_back(1e-9 * static_cast<double>(e.time_ns - start_ns));
     }
@@ -223,9 +224,10 @@ void printBlockNees(const Rows& rows, int runs) {
   const double hi = chiSquareQuantile(0.975, 3.0 * runs) / runs;
   std::printf("\naverage NEES per block (3 degrees of freedom each, 95%% band [%.2f, %.2f])\n", lo,
               hi);
-  std::printf("%-34s %10s %10s %10s\n", "configuration", "position", "velocity", "attitude");
+  std::printf("%-34s %10s %10s %10s %10s %10s %10s\n", "configuration", "position", "velocity",
+              "attitude", "accel bias", "gyro bias", "star bias");
   for (const auto& r : rows) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Stats::Blocks mean = Stats::Blocks::Zero();
     int epochs = 0;
     for (std::size_t k = 0; k < r.st.nees_blocks_sum.size(); ++k) {
       if (r.st.nees_runs[k] != runs) continue;
@@ -233,7 +235,15 @@ void printBlockNees(const Rows& rows, int runs) {
       ++epochs;
     }
     mean /= std::max(epochs, 1);
-    std::printf("%-34s %10.2f %10.2f %10.2f\n", r.label.c_str(), mean.x(), mean.y(), mean.z());
+    std::printf("%-34s", r.label.c_str());
+    // "-": a block the filter does not estimate.
+    for (int b = 0; b < kNeesBlocks; ++b) {
+      if (std::isnan(mean[b]))
+        std::printf(" %10s", "-");
+      else
+        std::printf(" %10.2f", mean[b]);
+    }
+    std::printf("\n");
   }
 }
 

@@ -1,5 +1,6 @@
 #include "offline_runner.hpp"
 
+#include <cmath>
 #include <deque>
 #include <random>
 #include <type_traits>
@@ -48,12 +49,29 @@ EpochError epochError(const core::NavState& e, const core::NavState& t) {
 }
 
 namespace {
+/// The truth of one frame: navigation state and sensor biases.
+struct Truth {
+  core::NavState state;
+  Eigen::Vector3d accel_bias_b_mps2;
+  Eigen::Vector3d gyro_bias_b_radps;
+  Eigen::Vector3d star_tracker_bias_b_rad;
+};
+
+/// NEES of one 3-state block of the error (estimate minus truth) against its covariance
+/// block; NaN when the filter does not estimate the block.
+double blockNees(const core::StateMatrix& P, const core::StateMask& active,
+                 const core::StateBlock& b, const Eigen::Vector3d& error) {
+  if (!active[static_cast<std::size_t>(b.index)]) return std::nan("");
+  return error.dot(P.block<3, 3>(b.index, b.index).ldlt().solve(error));
+}
+
 /// Once, when the engine has just aligned: its start against the truth at the start's time.
-void recordAlignedStart(const core::NavigationEngine& engine,
-                        const std::deque<core::NavState>& truths, OfflineResult& result) {
+void recordAlignedStart(const core::NavigationEngine& engine, const std::deque<Truth>& truths,
+                        OfflineResult& result) {
   if (result.aligned || !engine.aligner().aligned()) return;
   const core::AlignedStart& a = engine.aligner().start();
-  for (const core::NavState& t : truths) {
+  for (const Truth& truth : truths) {
+    const core::NavState& t = truth.state;
     if (t.time_ns != a.state.time_ns) continue;
     result.aligned = true;
     result.aligned_start = a;
@@ -72,20 +90,21 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   const sensor_sim::SimConfig& sim = setup.sim;
   sim::ScenarioSource source(sim.scenario);
   bus::HealthCounters health("navbus-offline");
-  std::deque<core::NavState> truths;
+  std::deque<Truth> truths;
   const nav_filter::FilterPipeline* pipeline_ptr = nullptr;
   auto on_solution = [&](const navbus::NavigationSolution& sol) {
     ++result.solutions;
     const auto t = static_cast<std::int64_t>(sol.time_gps_ns());
-    while (!truths.empty() && truths.front().time_ns < t) truths.pop_front();
-    if (truths.empty() || truths.front().time_ns != t) {
+    while (!truths.empty() && truths.front().state.time_ns < t) truths.pop_front();
+    if (truths.empty() || truths.front().state.time_ns != t) {
       ++result.solutions_without_truth;
       return;
     }
     const core::NavigationEngine& engine = pipeline_ptr->engine();
-    EpochError err = epochError(engine.state(), truths.front());
-    const core::Matrix17& P = engine.covariance();
-    using namespace core::tc17;
+    const Truth& truth = truths.front();
+    EpochError err = epochError(engine.state(), truth.state);
+    const core::StateMatrix& P = engine.covariance();
+    using namespace core::layout;
     err.pos_sigma_ned_m = P.block<3, 3>(kPos.index, kPos.index).diagonal().cwiseSqrt();
     err.vel_sigma_ned_mps = P.block<3, 3>(kVel.index, kVel.index).diagonal().cwiseSqrt();
     err.att_sigma_ned_rad = P.block<3, 3>(kAtt.index, kAtt.index).diagonal().cwiseSqrt();
@@ -93,16 +112,19 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     d << err.pos_ned_m, err.vel_ned_mps, err.att_ned_rad;
     const Eigen::Matrix<double, 9, 9> P9 = P.topLeftCorner<9, 9>();
     err.nees9 = d.dot(P9.ldlt().solve(d));
-    for (int b = 0; b < 3; ++b) {
-      const Eigen::Vector3d db = d.segment<3>(3 * b);
-      err.nees_blocks[b] = db.dot(P9.block<3, 3>(3 * b, 3 * b).ldlt().solve(db));
-    }
+    const core::StateMask& active = engine.filter().active();
+    err.nees_blocks << blockNees(P, active, kPos, err.pos_ned_m),
+        blockNees(P, active, kVel, err.vel_ned_mps), blockNees(P, active, kAtt, err.att_ned_rad),
+        blockNees(P, active, kAccelBias, engine.accelBias() - truth.accel_bias_b_mps2),
+        blockNees(P, active, kGyroBias, engine.gyroBias() - truth.gyro_bias_b_radps),
+        blockNees(P, active, kStarTrackerBias,
+                  engine.filter().starTrackerBias() - truth.star_tracker_bias_b_rad);
     err.mode = static_cast<int>(sol.mode());
     err.integrity = static_cast<int>(sol.integrity());
     err.hpl_m = sol.horizontal_protection_level_m();
     err.vpl_m = sol.vertical_protection_level_m();
     result.errors.push_back(err);
-    if (hook) hook(sol, truths.front(), err);
+    if (hook) hook(sol, truth.state, err);
   };
   // The fault manager's pipeline, when configured, sees every diagnostics sample as the
   // filter emits it and its commands go back to the filter at once.
@@ -151,7 +173,8 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   FramePrefetcher frames(source, total);
   while (const std::optional<sim::SensorFrame> next = frames.next()) {
     const sim::SensorFrame& f = *next;
-    truths.push_back(f.truth);
+    truths.push_back({f.truth, f.truth_accel_bias_b_mps2, f.truth_gyro_bias_b_radps,
+                      f.truth_star_tracker_bias_b_rad});
     // The same samples, in the same order and with the same sequence numbers as the
     // simulator participant publishes them.
     sensor_sim::emitFrame(f, emitted, seq, feed);

@@ -23,6 +23,8 @@
 namespace navbus::tool {
 
 /// Estimate minus truth at one solution epoch, with the filter's own uncertainty.
+inline constexpr int kNeesBlocks = 6;
+
 struct EpochError {
   std::int64_t time_ns{0};
   Eigen::Vector3d pos_ned_m{Eigen::Vector3d::Zero()};
@@ -32,8 +34,10 @@ struct EpochError {
   Eigen::Vector3d vel_sigma_ned_mps{Eigen::Vector3d::Zero()};
   Eigen::Vector3d att_sigma_ned_rad{Eigen::Vector3d::Zero()};
   double nees9{0.0};  ///< position, velocity, attitude against the full 9x9 covariance
-  /// NEES of the position, velocity and attitude blocks, each against its own 3x3 block.
-  Eigen::Vector3d nees_blocks{Eigen::Vector3d::Zero()};
+  /// NEES of each 3-state block against its own 3x3 covariance: position, velocity, attitude,
+  /// accelerometer bias, gyro bias, star-tracker bias (NaN: a block the filter does not have).
+  /// A bias's truth is the simulator's bias (scale factors and misalignments are not in it).
+  Eigen::Matrix<double, kNeesBlocks, 1> nees_blocks{Eigen::Matrix<double, kNeesBlocks, 1>::Zero()};
   int mode{0};        ///< navbus::FilterMode of the solution
   int integrity{0};   ///< navbus::IntegrityState of the solution
   double hpl_m{0.0};  ///< its horizontal protection level [m]

@@ -131,6 +131,7 @@ SensorFrame ScenarioSource::next() {
     const Eigen::Quaterniond q_true(C_e_i * C_n_e * f.truth.q_b_to_n.toRotationMatrix());
     const double dt_st = T * config_.star_tracker_every_n_increments;
     const auto q = star_.measure(q_true, dt_st);
+    star_bias_b_rad_ = star_.bias() + config_.faults.starTrackerBias(t_s);
     if (q && !config_.faults.starTrackerOut(t_s)) {
       f.has_star_tracker = true;
       f.star_tracker.time_ns = t_end;
@@ -141,6 +142,7 @@ SensorFrame ScenarioSource::next() {
           std::hypot(config_.star_tracker.noise_rad, config_.star_tracker.bias_rad));
     }
   }
+  f.truth_star_tracker_bias_b_rad = star_bias_b_rad_;
   return f;
 }
 

@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
       seconds, raw.size(), static_cast<unsigned long long>(windows));
   std::printf("  monitor       %8.4f s  = %.3f %% of one core in real time (target < 1 %%)\n", d,
               100.0 * d / seconds);
-  std::printf("  mechanization %8.4f s  (100 Hz increments + 17-state covariance, same data)\n",
+  std::printf("  mechanization %8.4f s  (100 Hz increments + error-state covariance, same data)\n",
               mech);
   std::printf(
       "  ratio monitor / mechanization = %.2f; heap allocations per window %.3f "

@@ -66,7 +66,7 @@ navbus::FilterDiagnostics diagnostics() {
   d.vehicle_id(1);
   d.seq(3);
   d.time_gps_ns(1'400'000'001'000'000'000ULL);
-  navbus::bus::fillTc17Layout(d);
+  navbus::bus::fillStateLayout(d);
   const std::size_t n = d.n(), m = 4;
   d.m(static_cast<std::uint16_t>(m));
   for (std::size_t r = 0; r < m; ++r) {

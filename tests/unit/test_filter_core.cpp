@@ -13,9 +13,9 @@
 #include "navbus/sim/constellation.hpp"
 
 namespace earth = navbus::core::earth;
-namespace tc17 = navbus::core::tc17;
-using Vec17 = Eigen::Matrix<double, tc17::kSize, 1>;
-using Mat17 = Eigen::Matrix<double, tc17::kSize, tc17::kSize>;
+namespace layout = navbus::core::layout;
+using StateVec = Eigen::Matrix<double, layout::kSize, 1>;
+using StateMat = Eigen::Matrix<double, layout::kSize, layout::kSize>;
 
 namespace {
 navbus::core::NavState ins() {
@@ -63,15 +63,15 @@ TEST(TightlyCoupledModel, JacobiansMatchNumericalDifferences) {
     const auto p0 = navbus::core::predictRange(s, 100.0, 2.0, sat);
     for (int axis = 0; axis < 3; ++axis) {
       // Position: +1 m along each NED axis (the estimate moves, so the error grows by +1 m).
-      Vec17 dx = Vec17::Zero();
-      dx[tc17::kPos.index + axis] = 1.0;
+      StateVec dx = StateVec::Zero();
+      dx[layout::kPos.index + axis] = 1.0;
       const auto pp = navbus::core::predictRange(
           perturbed(s, Eigen::Vector3d::Unit(axis), Eigen::Vector3d::Zero()), 100.0, 2.0, sat);
       EXPECT_NEAR(pp.pseudorange_m - p0.pseudorange_m, (p0.h_range * dx)(0, 0), 1e-6)
           << "sv " << sat.sv_id;
       // Velocity: +0.1 m/s along each axis.
       dx.setZero();
-      dx[tc17::kVel.index + axis] = 0.1;
+      dx[layout::kVel.index + axis] = 0.1;
       const auto pv = navbus::core::predictRange(
           perturbed(s, Eigen::Vector3d::Zero(), 0.1 * Eigen::Vector3d::Unit(axis)), 100.0, 2.0,
           sat);
@@ -80,10 +80,10 @@ TEST(TightlyCoupledModel, JacobiansMatchNumericalDifferences) {
     // Clock bias and drift enter with unit coefficients.
     EXPECT_DOUBLE_EQ(
         navbus::core::predictRange(s, 101.0, 2.0, sat).pseudorange_m - p0.pseudorange_m,
-        p0.h_range(0, tc17::kClockBias.index));
+        p0.h_range(0, layout::kClockBias.index));
     EXPECT_DOUBLE_EQ(navbus::core::predictRange(s, 100.0, 2.5, sat).pseudorange_rate_mps -
                          p0.pseudorange_rate_mps,
-                     0.5 * p0.h_rate(0, tc17::kClockDrift.index));
+                     0.5 * p0.h_rate(0, layout::kClockDrift.index));
   }
 }
 
@@ -91,18 +91,18 @@ TEST(JosephUpdate, PseudorangesReduceAConstructedPositionAndClockError) {
   // Given an estimate 30 m off in position and 200 m in clock bias, with a matching covariance,
   const auto truth = ins();
   const auto sats = satellites(truth);
-  Vec17 err_true = Vec17::Zero();
-  err_true.segment<3>(tc17::kPos.index) << 20.0, -15.0, 16.0;
-  err_true[tc17::kClockBias.index] = 200.0;
-  Mat17 P = Mat17::Identity() * 1e-2;
-  P.block<3, 3>(tc17::kPos.index, tc17::kPos.index) *= 1e5;  // 30 m sigma
-  P(tc17::kClockBias.index, tc17::kClockBias.index) = 300.0 * 300.0;
-  Vec17 x = Vec17::Zero();
+  StateVec err_true = StateVec::Zero();
+  err_true.segment<3>(layout::kPos.index) << 20.0, -15.0, 16.0;
+  err_true[layout::kClockBias.index] = 200.0;
+  StateMat P = StateMat::Identity() * 1e-2;
+  P.block<3, 3>(layout::kPos.index, layout::kPos.index) *= 1e5;  // 30 m sigma
+  P(layout::kClockBias.index, layout::kClockBias.index) = 300.0 * 300.0;
+  StateVec x = StateVec::Zero();
   const double before = (x - err_true).segment<4>(0).norm() + std::abs(x[15] - err_true[15]);
   // when noise-free pseudoranges (innovations H dx) of every satellite are processed,
   for (const auto& sat : sats) {
     const auto p = navbus::core::predictRange(truth, 0.0, 0.0, sat);
-    const auto res = navbus::core::scalarUpdate<tc17::kSize>(
+    const auto res = navbus::core::scalarUpdate<layout::kSize>(
         x, P, p.h_range, (p.h_range * err_true)(0, 0), 1.0, 5.0);
     EXPECT_TRUE(res.accepted);
   }
@@ -112,30 +112,30 @@ TEST(JosephUpdate, PseudorangesReduceAConstructedPositionAndClockError) {
               before, after, sats.size());
   EXPECT_LT(after, 0.05 * before);
   EXPECT_LT((P - P.transpose()).norm(), 1e-9);
-  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat17>(P).eigenvalues().minCoeff(), 0.0);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<StateMat>(P).eigenvalues().minCoeff(), 0.0);
 }
 
 TEST(JosephUpdate, StaysSymmetricPositiveDefiniteAndGatesOutliers) {
   std::mt19937_64 rng(3);
   std::normal_distribution<double> n(0.0, 1.0);
-  Mat17 A;
-  for (int i = 0; i < 17; ++i)
-    for (int j = 0; j < 17; ++j) A(i, j) = n(rng);
-  Mat17 P = A * A.transpose() + Mat17::Identity();
-  Vec17 x = Vec17::Zero();
+  StateMat A;
+  for (int i = 0; i < layout::kSize; ++i)
+    for (int j = 0; j < layout::kSize; ++j) A(i, j) = n(rng);
+  StateMat P = A * A.transpose() + StateMat::Identity();
+  StateVec x = StateVec::Zero();
   for (int k = 0; k < 500; ++k) {
-    Eigen::Matrix<double, 1, 17> h;
-    for (int j = 0; j < 17; ++j) h(0, j) = n(rng);
-    navbus::core::scalarUpdate<17>(x, P, h, n(rng), 1e-4, 1e6);
+    Eigen::Matrix<double, 1, layout::kSize> h;
+    for (int j = 0; j < layout::kSize; ++j) h(0, j) = n(rng);
+    navbus::core::scalarUpdate<layout::kSize>(x, P, h, n(rng), 1e-4, 1e6);
   }
   EXPECT_LT((P - P.transpose()).norm(), 1e-9 * P.norm());
-  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat17>(P).eigenvalues().minCoeff(), 0.0);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<StateMat>(P).eigenvalues().minCoeff(), 0.0);
   // An outlier far outside the gate is rejected, reported with its ratio, and changes nothing.
-  const Vec17 x0 = x;
-  const Mat17 P0 = P;
-  Eigen::Matrix<double, 1, 17> h = Eigen::Matrix<double, 1, 17>::Zero();
+  const StateVec x0 = x;
+  const StateMat P0 = P;
+  Eigen::Matrix<double, 1, layout::kSize> h = Eigen::Matrix<double, 1, layout::kSize>::Zero();
   h(0, 0) = 1.0;
-  const auto res = navbus::core::scalarUpdate<17>(x, P, h, 1e6, 1.0, 5.0);
+  const auto res = navbus::core::scalarUpdate<layout::kSize>(x, P, h, 1e6, 1.0, 5.0);
   EXPECT_FALSE(res.accepted);
   EXPECT_GT(res.test_ratio, 1.0);
   EXPECT_EQ(x, x0);
@@ -147,21 +147,21 @@ TEST(JosephUpdate, StaysSymmetricPositiveDefiniteAndGatesOutliers) {
 #include "navbus/sim/trajectory.hpp"
 
 namespace {
-/// Error of `est` relative to `truth` in the 17-state convention (position NED m, velocity,
+/// Error of `est` relative to `truth` in the state layout's convention (position NED m, velocity,
 /// phi with C_est = (I - [phi x]) C_true).
-Vec17 errorOf(const navbus::core::NavState& est, const navbus::core::NavState& truth) {
-  Vec17 e = Vec17::Zero();
+StateVec errorOf(const navbus::core::NavState& est, const navbus::core::NavState& truth) {
+  StateVec e = StateVec::Zero();
   const earth::Radii r = earth::radiiOfCurvature(truth.position.latitude_rad);
-  e[tc17::kPos.index] = (est.position.latitude_rad - truth.position.latitude_rad) *
-                        (r.meridian_m + truth.position.height_m);
-  e[tc17::kPos.index + 1] = (est.position.longitude_rad - truth.position.longitude_rad) *
-                            (r.prime_vertical_m + truth.position.height_m) *
-                            std::cos(truth.position.latitude_rad);
-  e[tc17::kPos.index + 2] = -(est.position.height_m - truth.position.height_m);
-  e.segment<3>(tc17::kVel.index) = est.vel_ned_mps - truth.vel_ned_mps;
+  e[layout::kPos.index] = (est.position.latitude_rad - truth.position.latitude_rad) *
+                          (r.meridian_m + truth.position.height_m);
+  e[layout::kPos.index + 1] = (est.position.longitude_rad - truth.position.longitude_rad) *
+                              (r.prime_vertical_m + truth.position.height_m) *
+                              std::cos(truth.position.latitude_rad);
+  e[layout::kPos.index + 2] = -(est.position.height_m - truth.position.height_m);
+  e.segment<3>(layout::kVel.index) = est.vel_ned_mps - truth.vel_ned_mps;
   const Eigen::Matrix3d M =
       est.q_b_to_n.toRotationMatrix() * truth.q_b_to_n.toRotationMatrix().transpose();
-  e.segment<3>(tc17::kAtt.index) =
+  e.segment<3>(layout::kAtt.index) =
       Eigen::Vector3d(M(1, 2) - M(2, 1), M(2, 0) - M(0, 2), M(0, 1) - M(1, 0)) / 2.0;
   return e;
 }
@@ -181,18 +181,18 @@ TEST(InsErrorModel, TransitionMatrixPredictsTheNonlinearErrorGrowth) {
   navbus::sim::VehicleTrajectory traj(start, segs, earth::GravityModel::kWgs84Normal);
   navbus::core::StrapdownNed truth, est;
   truth.initialize(traj.state());
-  Vec17 dx0 = Vec17::Zero();
-  dx0.segment<3>(tc17::kPos.index) << 10.0, -5.0, 3.0;
-  dx0.segment<3>(tc17::kVel.index) << 0.1, -0.05, 0.02;
-  dx0.segment<3>(tc17::kAtt.index) << 1e-4, -2e-4, 5e-4;
-  dx0.segment<3>(tc17::kAccelBias.index) << 1e-3, -5e-4, 2e-3;
-  dx0.segment<3>(tc17::kGyroBias.index) << 1e-6, -2e-6, 3e-6;
-  navbus::core::NavState s0 =
-      perturbed(traj.state(), dx0.segment<3>(tc17::kPos.index), dx0.segment<3>(tc17::kVel.index));
+  StateVec dx0 = StateVec::Zero();
+  dx0.segment<3>(layout::kPos.index) << 10.0, -5.0, 3.0;
+  dx0.segment<3>(layout::kVel.index) << 0.1, -0.05, 0.02;
+  dx0.segment<3>(layout::kAtt.index) << 1e-4, -2e-4, 5e-4;
+  dx0.segment<3>(layout::kAccelBias.index) << 1e-3, -5e-4, 2e-3;
+  dx0.segment<3>(layout::kGyroBias.index) << 1e-6, -2e-6, 3e-6;
+  navbus::core::NavState s0 = perturbed(traj.state(), dx0.segment<3>(layout::kPos.index),
+                                        dx0.segment<3>(layout::kVel.index));
   s0.q_b_to_n =
-      navbus::core::quaternionFromRotationVector(-dx0.segment<3>(tc17::kAtt.index)) * s0.q_b_to_n;
+      navbus::core::quaternionFromRotationVector(-dx0.segment<3>(layout::kAtt.index)) * s0.q_b_to_n;
   est.initialize(s0);
-  Mat17 Phi = Mat17::Identity();
+  StateMat Phi = StateMat::Identity();
   const double dt = 0.01;
   for (int k = 1; k <= 3000; ++k) {
     const auto inc = traj.advance(dt);
@@ -206,14 +206,14 @@ TEST(InsErrorModel, TransitionMatrixPredictsTheNonlinearErrorGrowth) {
           Phi;
     truth.propagate(m);
     // The estimate corrects its increments with its bias estimates (truth + error).
-    m.delta_vel_b_mps -= dx0.segment<3>(tc17::kAccelBias.index) * dt;
-    m.delta_angle_b_rad -= dx0.segment<3>(tc17::kGyroBias.index) * dt;
+    m.delta_vel_b_mps -= dx0.segment<3>(layout::kAccelBias.index) * dt;
+    m.delta_angle_b_rad -= dx0.segment<3>(layout::kGyroBias.index) * dt;
     est.propagate(m);
   }
   // then the linear prediction Phi dx0 matches the nonlinear difference within a few percent.
-  const Vec17 actual = errorOf(est.state(), truth.state());
-  const Vec17 predicted = Phi * dx0;
-  for (const auto& b : {tc17::kPos, tc17::kVel, tc17::kAtt}) {
+  const StateVec actual = errorOf(est.state(), truth.state());
+  const StateVec predicted = Phi * dx0;
+  for (const auto& b : {layout::kPos, layout::kVel, layout::kAtt}) {
     const double rel = (predicted.segment<3>(b.index) - actual.segment<3>(b.index)).norm() /
                        actual.segment<3>(b.index).norm();
     std::printf(
@@ -234,31 +234,32 @@ TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
     s.vel_ned_mps = 200.0 * Eigen::Vector3d(u(rng), u(rng), u(rng));
     s.q_b_to_n =
         navbus::core::quaternionFromRotationVector(Eigen::Vector3d(u(rng), u(rng), u(rng)));
-    const Mat17 F = navbus::core::errorDynamics(s, Eigen::Vector3d(u(rng), u(rng), -9.8),
-                                                earth::GravityModel::kWgs84Normal);
-    Mat17 Phi = navbus::core::transitionMatrix(F, 0.005);
+    const StateMat F = navbus::core::errorDynamics(s, Eigen::Vector3d(u(rng), u(rng), -9.8),
+                                                   earth::GravityModel::kWgs84Normal);
+    StateMat Phi = navbus::core::transitionMatrix(F, 0.005);
     if (trial % 2 == 1) {
-      Phi.row(tc17::kClockBias.index).setZero();
-      Phi.col(tc17::kClockBias.index).setZero();
+      Phi.row(layout::kClockBias.index).setZero();
+      Phi.col(layout::kClockBias.index).setZero();
     }
-    const Mat17 A = Mat17::Random();
-    const Mat17 P = A * A.transpose();
-    const navbus::core::SparseRows<tc17::kSize> sparse(Phi);
+    const StateMat A = StateMat::Random();
+    const StateMat P = A * A.transpose();
+    const navbus::core::SparseRows<layout::kSize> sparse(Phi);
     // then Phi P Phi^T, Phi P, Phi x and Phi Phi agree with the dense products to rounding,
-    const Mat17 dense = Phi * P * Phi.transpose();
-    const Mat17 sandwich = sparse.sandwich(P);
+    const StateMat dense = Phi * P * Phi.transpose();
+    const StateMat sandwich = sparse.sandwich(P);
     EXPECT_LT((sandwich - dense).cwiseAbs().maxCoeff(), 1e-12 * dense.cwiseAbs().maxCoeff());
     EXPECT_LT((sparse.times(P) - Phi * P).cwiseAbs().maxCoeff(), 1e-12 * P.cwiseAbs().maxCoeff());
-    const Vec17 x = Vec17::Random();
+    const StateVec x = StateVec::Random();
     EXPECT_LT((sparse.times(x) - Phi * x).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((sparse.times(sparse) - Phi * Phi).cwiseAbs().maxCoeff(), 1e-12);
     // the covariance is exactly symmetric, and most of Phi is skipped;
     EXPECT_EQ(sandwich, sandwich.transpose());
-    EXPECT_LT(sparse.nonZeros(), tc17::kSize * tc17::kSize / 2);
+    EXPECT_LT(sparse.nonZeros(), layout::kSize * layout::kSize / 2);
     // the structural patterns cover F and Phi, and give the same products.
     EXPECT_TRUE(navbus::core::errorDynamicsPattern().covers(F));
     EXPECT_TRUE(navbus::core::transitionPattern().covers(Phi));
-    const navbus::core::SparseRows<tc17::kSize> structural(Phi, navbus::core::transitionPattern());
+    const navbus::core::SparseRows<layout::kSize> structural(Phi,
+                                                             navbus::core::transitionPattern());
     EXPECT_EQ(structural.sandwich(P), sandwich);
   }
 }

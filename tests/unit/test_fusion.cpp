@@ -14,7 +14,7 @@
 
 namespace core = navbus::core;
 namespace earth = navbus::core::earth;
-namespace tc17 = navbus::core::tc17;
+namespace layout = navbus::core::layout;
 
 namespace {
 
@@ -28,12 +28,12 @@ core::NavState movingTruth(const Eigen::Vector3d& rpy, const Eigen::Vector3d& ve
 }
 
 /// The INS state with the error dx (estimate minus truth) applied to the truth.
-core::NavState withError(const core::NavState& truth, const core::Vector17& dx) {
+core::NavState withError(const core::NavState& truth, const core::StateVector& dx) {
   core::NavState s = truth;
-  s.position = earth::offsetNed(truth.position, dx.segment<3>(tc17::kPos.index));
-  s.vel_ned_mps += dx.segment<3>(tc17::kVel.index);
+  s.position = earth::offsetNed(truth.position, dx.segment<3>(layout::kPos.index));
+  s.vel_ned_mps += dx.segment<3>(layout::kVel.index);
   s.q_b_to_n =
-      core::quaternionFromRotationVector(-dx.segment<3>(tc17::kAtt.index)) * truth.q_b_to_n;
+      core::quaternionFromRotationVector(-dx.segment<3>(layout::kAtt.index)) * truth.q_b_to_n;
   return s;
 }
 
@@ -47,7 +47,7 @@ core::FilterTuning tuning() {
 }
 
 const core::StateMask kFifteen =
-    core::maskOf({tc17::kPos, tc17::kVel, tc17::kAtt, tc17::kAccelBias, tc17::kGyroBias});
+    core::maskOf({layout::kPos, layout::kVel, layout::kAtt, layout::kAccelBias, layout::kGyroBias});
 
 double attitudeError(const core::NavState& e, const core::NavState& t) {
   return Eigen::AngleAxisd(e.q_b_to_n * t.q_b_to_n.conjugate()).angle();
@@ -59,9 +59,9 @@ TEST(AidingMeasurements, NonHolonomicAndZeroVelocityInnovationsEqualHTimesTheErr
   // Given a vehicle driving along its body x axis with a velocity and attitude error,
   const core::NavState truth = movingTruth(
       {0.05, -0.03, 0.8}, core::dcmFromEuler({0.05, -0.03, 0.8}) * Eigen::Vector3d(12.0, 0.0, 0.0));
-  core::Vector17 dx = core::Vector17::Zero();
-  dx.segment<3>(tc17::kVel.index) << 0.05, -0.04, 0.02;
-  dx.segment<3>(tc17::kAtt.index) << 2e-3, -1e-3, 3e-3;
+  core::StateVector dx = core::StateVector::Zero();
+  dx.segment<3>(layout::kVel.index) << 0.05, -0.04, 0.02;
+  dx.segment<3>(layout::kAtt.index) << 2e-3, -1e-3, 3e-3;
   const core::NavState ins = withError(truth, dx);
   // when the constraints are predicted from the erroneous state, then z = H dx to first order.
   const auto nhc = core::nonHolonomicMeasurement(ins, 0.1);
@@ -76,10 +76,10 @@ TEST(IntegratedFilter, EveryUpdateTypeReducesAConstructedError) {
   const Eigen::Vector3d rpy(0.1, -0.05, 2.0);
   const core::NavState truth =
       movingTruth(rpy, core::dcmFromEuler(rpy) * Eigen::Vector3d(15, 0, 0));
-  core::Vector17 dx = core::Vector17::Zero();
-  dx.segment<3>(tc17::kPos.index) << 8.0, -6.0, 4.0;
-  dx.segment<3>(tc17::kVel.index) << 0.6, -0.5, 0.3;
-  dx.segment<3>(tc17::kAtt.index) << 0.01, -0.012, 0.015;
+  core::StateVector dx = core::StateVector::Zero();
+  dx.segment<3>(layout::kPos.index) << 8.0, -6.0, 4.0;
+  dx.segment<3>(layout::kVel.index) << 0.6, -0.5, 0.3;
+  dx.segment<3>(layout::kAtt.index) << 0.01, -0.012, 0.015;
   struct Case {
     const char* name;
     std::function<void(core::IntegratedFilter&)> update;
@@ -108,7 +108,8 @@ TEST(IntegratedFilter, EveryUpdateTypeReducesAConstructedError) {
              earth::C_i_e(t_s).transpose() *
              earth::C_n_e(truth.position.latitude_rad, truth.position.longitude_rad) *
              truth.q_b_to_n.toRotationMatrix());
-         f.update(core::attitudeMeasurement(f.state(), q_b_i, Eigen::Vector3d::Constant(1e-4)),
+         f.update(core::attitudeMeasurement(f.state(), q_b_i, Eigen::Vector3d::Constant(1e-4),
+                                            Eigen::Vector3d::Zero()),
                   core::AidingKind::kAttitude);
        },
        [&](const core::NavState& s) { return attitudeError(s, truth); }},
@@ -128,7 +129,8 @@ TEST(IntegratedFilter, EveryUpdateTypeReducesAConstructedError) {
   for (const Case& c : cases) {
     // Given an INS with a known error and a filter whose prior covers it,
     core::NavState start = withError(truth, dx);
-    if (std::string(c.name) == "zero velocity") start.vel_ned_mps = dx.segment<3>(tc17::kVel.index);
+    if (std::string(c.name) == "zero velocity")
+      start.vel_ned_mps = dx.segment<3>(layout::kVel.index);
     core::IntegratedFilter f;
     f.initialize(start, 0, 0, tuning(), kFifteen);
     const double before = c.error(f.state());
@@ -138,9 +140,9 @@ TEST(IntegratedFilter, EveryUpdateTypeReducesAConstructedError) {
     const double after = c.error(f.state());
     std::printf("%-22s error %.4g -> %.4g\n", c.name, before, after);
     EXPECT_LT(after, 0.5 * before) << c.name;
-    const core::Matrix17& P = f.covariance();
+    const core::StateMatrix& P = f.covariance();
     EXPECT_LT((P - P.transpose()).norm(), 1e-12 * P.norm()) << c.name;
-    EXPECT_GT(Eigen::SelfAdjointEigenSolver<core::Matrix17>(P).eigenvalues().minCoeff(), 0.0);
+    EXPECT_GT(Eigen::SelfAdjointEigenSolver<core::StateMatrix>(P).eigenvalues().minCoeff(), 0.0);
   }
 }
 
@@ -167,9 +169,9 @@ TEST(IntegratedFilter, CovarianceStaysSymmetricPositiveDefiniteAcrossAttitudes) 
             core::AidingKind::kVelocity);
       }
     }
-    const core::Matrix17& P = f.covariance();
+    const core::StateMatrix& P = f.covariance();
     EXPECT_LT((P - P.transpose()).norm(), 1e-12 * P.norm());
-    EXPECT_GT(Eigen::SelfAdjointEigenSolver<core::Matrix17>(P).eigenvalues().minCoeff(), 0.0)
+    EXPECT_GT(Eigen::SelfAdjointEigenSolver<core::StateMatrix>(P).eigenvalues().minCoeff(), 0.0)
         << "rpy " << rpy.transpose();
   }
 }
@@ -177,9 +179,9 @@ TEST(IntegratedFilter, CovarianceStaysSymmetricPositiveDefiniteAcrossAttitudes) 
 TEST(IntegratedFilter, FederatedNoResetFusionEqualsCentralizedForIndependentSensors) {
   // Given the same INS error and two independent sensors (GNSS position, star tracker),
   const core::NavState truth = movingTruth({0.02, 0.01, 1.0}, {20, 5, 0});
-  core::Vector17 dx = core::Vector17::Zero();
-  dx.segment<3>(tc17::kPos.index) << 5.0, -4.0, 3.0;
-  dx.segment<3>(tc17::kAtt.index) << 2e-3, -1e-3, 4e-3;
+  core::StateVector dx = core::StateVector::Zero();
+  dx.segment<3>(layout::kPos.index) << 5.0, -4.0, 3.0;
+  dx.segment<3>(layout::kAtt.index) << 2e-3, -1e-3, 4e-3;
   const double t_s = 1e-9 * static_cast<double>(truth.time_ns);
   const Eigen::Quaterniond q_b_i(
       earth::C_i_e(t_s).transpose() *
@@ -190,7 +192,8 @@ TEST(IntegratedFilter, FederatedNoResetFusionEqualsCentralizedForIndependentSens
     f.initialize(withError(truth, dx), 0, 0, tuning(), kFifteen, s);
     f.update(core::positionMeasurement(f.state(), truth.position, Eigen::Vector3d::Ones()),
              core::AidingKind::kPosition);
-    f.update(core::attitudeMeasurement(f.state(), q_b_i, Eigen::Vector3d::Constant(1e-4)),
+    f.update(core::attitudeMeasurement(f.state(), q_b_i, Eigen::Vector3d::Constant(1e-4),
+                                       Eigen::Vector3d::Zero()),
              core::AidingKind::kAttitude);
     return f;
   };

@@ -19,8 +19,10 @@
 namespace nc = navbus::core;
 using nc::GlrFault;
 using nc::GlrHypothesis;
-using nc::Matrix17;
-using Vector17 = Eigen::Matrix<double, 17, 1>;
+using nc::StateMatrix;
+using StateVector = Eigen::Matrix<double, nc::layout::kSize, 1>;
+constexpr int kClock = nc::layout::kClockBias.index;
+constexpr int kDrift = nc::layout::kClockDrift.index;
 
 namespace {
 
@@ -29,13 +31,13 @@ constexpr int kRows = 2 * kSats;
 constexpr std::int64_t kSecond = 1'000'000'000;
 const int kSvIds[kSats] = {3, 6, 9, 13};
 
-/// A linear system with the 17-state layout: random but fixed Phi (biases and clock as random
+/// A linear system with the filter's state layout: random but fixed Phi (biases and clock as random
 /// constants / random walk), pseudorange-like and rate-like rows, a Kalman filter's gains.
 class ClosedLoop {
  public:
   explicit ClosedLoop(std::uint64_t seed) : rng_(seed) {
     std::normal_distribution<double> n(0.0, 1.0);
-    phi_ = Matrix17::Identity();
+    phi_ = StateMatrix::Identity();
     // Position <- velocity, velocity <- attitude and accelerometer bias, attitude <- gyro
     // bias, clock <- drift, plus small random couplings among the navigation states.
     for (int i = 0; i < 3; ++i) {
@@ -45,14 +47,14 @@ class ClosedLoop {
     }
     phi_(3, 7) = -9.8;
     phi_(4, 6) = 9.8;
-    phi_(15, 16) = 1.0;
+    phi_(kClock, kDrift) = 1.0;
     for (int i = 0; i < 9; ++i)
       for (int j = 0; j < 9; ++j) phi_(i, j) += 0.01 * n(rng_);
-    q_ = Vector17::Constant(1e-6).asDiagonal();
+    q_ = StateVector::Constant(1e-6).asDiagonal();
     for (int i = 0; i < 3; ++i) q_(3 + i, 3 + i) = 1e-4;
-    q_(15, 15) = 0.01;
-    q_(16, 16) = 1e-4;
-    p_ = Vector17::Constant(1.0).asDiagonal();
+    q_(kClock, kClock) = 0.01;
+    q_(kDrift, kDrift) = 1e-4;
+    p_ = StateVector::Constant(1.0).asDiagonal();
     for (int s = 0; s < kSats; ++s) {
       Eigen::Vector3d los(n(rng_), n(rng_), n(rng_));
       los_[s] = los.normalized();
@@ -62,34 +64,34 @@ class ClosedLoop {
   /// One epoch: propagate the covariance, compute H, V, K for this epoch.
   void nextEpoch() {
     p_ = phi_ * p_ * phi_.transpose() + q_;
-    h_.setZero(kRows, 17);
+    h_.setZero(kRows, nc::layout::kSize);
     for (int s = 0; s < kSats; ++s) {
       h_.block<1, 3>(2 * s, 0) = -los_[s].transpose();
-      h_(2 * s, 15) = 1.0;
+      h_(2 * s, kClock) = 1.0;
       h_.block<1, 3>(2 * s + 1, 3) = -los_[s].transpose();
-      h_(2 * s + 1, 16) = 1.0;
+      h_(2 * s + 1, kDrift) = 1.0;
     }
     r_ = Eigen::VectorXd::Constant(kRows, 1.0).asDiagonal();
     for (int s = 0; s < kSats; ++s) r_(2 * s + 1, 2 * s + 1) = 0.01;
     v_ = h_ * p_ * h_.transpose() + r_;
     k_ = p_ * h_.transpose() * v_.inverse();
-    const Matrix17 a = Matrix17::Identity() - k_ * h_;
+    const StateMatrix a = StateMatrix::Identity() - k_ * h_;
     p_ = a * p_ * a.transpose() + k_ * r_ * k_.transpose();
     // Slowly rotating geometry, so that the gains change from epoch to epoch.
     for (auto& l : los_) l = (l + 0.01 * Eigen::Vector3d(l.y(), -l.x(), 0.0)).normalized();
   }
 
-  const Matrix17& phi() const { return phi_; }
+  const StateMatrix& phi() const { return phi_; }
   const Eigen::MatrixXd& h() const { return h_; }
   const Eigen::MatrixXd& k() const { return k_; }
   const Eigen::MatrixXd& v() const { return v_; }
   const Eigen::MatrixXd& r() const { return r_; }
-  const Matrix17& q() const { return q_; }
+  const StateMatrix& q() const { return q_; }
   std::mt19937_64& rng() { return rng_; }
 
  private:
   std::mt19937_64 rng_;
-  Matrix17 phi_, q_, p_;
+  StateMatrix phi_, q_, p_;
   Eigen::MatrixXd h_, k_, v_, r_;
   Eigen::Vector3d los_[kSats];
 };
@@ -103,7 +105,7 @@ struct Fault {
 /// Error state of the closed loop with its epoch matrices, simulated forward.
 struct LoopRun {
   std::vector<Eigen::VectorXd> innovations;
-  std::vector<Vector17> corrected;  ///< dx after each epoch's update
+  std::vector<StateVector> corrected;  ///< dx after each epoch's update
   std::vector<nc::GlrEpoch> epochs;
 };
 
@@ -124,18 +126,18 @@ LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& fault
   ClosedLoop loop(seed);
   std::mt19937_64 rng(seed * 7 + 1);
   std::normal_distribution<double> n(0.0, noise ? 1.0 : 0.0);
-  Vector17 dx = Vector17::Zero();
+  StateVector dx = StateVector::Zero();
   LoopRun run;
   for (int k = 0; k < epochs; ++k) {
     loop.nextEpoch();
     // Interval (k-1, k]: a state fault starting at epoch `onset` enters at its start.
-    Vector17 w;
-    for (int i = 0; i < 17; ++i) w[i] = std::sqrt(loop.q()(i, i)) * n(rng);
-    Vector17 before = dx;
+    StateVector w;
+    for (int i = 0; i < nc::layout::kSize; ++i) w[i] = std::sqrt(loop.q()(i, i)) * n(rng);
+    StateVector before = dx;
     for (const Fault& f : faults) {
       if (f.h.isImu() && k == f.onset_epoch) before[biasState(f.h)] -= f.magnitude;
     }
-    dx = loop.phi() * before + (k > 0 ? w : Vector17::Zero());
+    dx = loop.phi() * before + (k > 0 ? w : StateVector::Zero());
     Eigen::VectorXd eps = loop.h() * dx;
     for (int r = 0; r < kRows; ++r) eps[r] += std::sqrt(loop.r()(r, r)) * n(rng);
     for (const Fault& f : faults) {

@@ -10,7 +10,7 @@
 #include "scenario_config.hpp"
 
 namespace earth = navbus::core::earth;
-namespace tc17 = navbus::core::tc17;
+namespace layout = navbus::core::layout;
 
 namespace {
 struct RunResult {
@@ -128,19 +128,19 @@ TEST(AidingMeasurements, InnovationsEqualHTimesTheConstructedError) {
   truth.position = {34.0 * M_PI / 180, 128.0 * M_PI / 180, 500e3};
   truth.vel_ned_mps = Eigen::Vector3d(6000.0, 4000.0, 10.0);
   truth.q_b_to_n = Eigen::Quaterniond(navbus::core::dcmFromEuler(Eigen::Vector3d(0.3, -0.2, 1.1)));
-  Eigen::Matrix<double, tc17::kSize, 1> dx = Eigen::Matrix<double, tc17::kSize, 1>::Zero();
-  dx.segment<3>(tc17::kPos.index) << 12.0, -7.0, 4.0;
-  dx.segment<3>(tc17::kVel.index) << 0.2, -0.1, 0.05;
-  dx.segment<3>(tc17::kAtt.index) << 2e-5, -3e-5, 5e-5;
+  Eigen::Matrix<double, layout::kSize, 1> dx = Eigen::Matrix<double, layout::kSize, 1>::Zero();
+  dx.segment<3>(layout::kPos.index) << 12.0, -7.0, 4.0;
+  dx.segment<3>(layout::kVel.index) << 0.2, -0.1, 0.05;
+  dx.segment<3>(layout::kAtt.index) << 2e-5, -3e-5, 5e-5;
   navbus::core::NavState ins = truth;
   const earth::Radii r = earth::radiiOfCurvature(truth.position.latitude_rad);
   ins.position.latitude_rad += dx[0] / (r.meridian_m + truth.position.height_m);
   ins.position.longitude_rad += dx[1] / ((r.prime_vertical_m + truth.position.height_m) *
                                          std::cos(truth.position.latitude_rad));
   ins.position.height_m -= dx[2];
-  ins.vel_ned_mps += dx.segment<3>(tc17::kVel.index);
-  ins.q_b_to_n =
-      navbus::core::quaternionFromRotationVector(-dx.segment<3>(tc17::kAtt.index)) * truth.q_b_to_n;
+  ins.vel_ned_mps += dx.segment<3>(layout::kVel.index);
+  ins.q_b_to_n = navbus::core::quaternionFromRotationVector(-dx.segment<3>(layout::kAtt.index)) *
+                 truth.q_b_to_n;
   const Eigen::Vector3d one(1, 1, 1);
   const auto p = navbus::core::positionMeasurement(ins, truth.position, one);
   // Second order: the INS's radii and latitude differ from the truth's by the error itself.
@@ -154,9 +154,20 @@ TEST(AidingMeasurements, InnovationsEqualHTimesTheConstructedError) {
       truth.q_b_to_n.toRotationMatrix());
   navbus::core::NavState ins_att = truth;
   ins_att.q_b_to_n = ins.q_b_to_n;
-  const auto a = navbus::core::attitudeMeasurement(ins_att, q_b_i, one * 1e-6);
+  const auto a =
+      navbus::core::attitudeMeasurement(ins_att, q_b_i, one * 1e-6, Eigen::Vector3d::Zero());
   EXPECT_LT((a.z - a.h * dx).norm(), 1e-9);
   EXPECT_NEAR(a.r.trace(), 3e-12, 1e-20);  // a rotation keeps the total variance
+  // A tracker with bias b (measuring q_true exp(b), as the simulator's does) and a filter
+  // estimate b^: the bias error state b^ - b enters through H as well.
+  const Eigen::Vector3d b(2e-5, -3e-5, 1.5e-5);
+  const Eigen::Vector3d b_est(0.5e-5, 1e-5, -1e-5);
+  const Eigen::Quaterniond q_biased = q_b_i * navbus::core::quaternionFromRotationVector(b);
+  const auto ab = navbus::core::attitudeMeasurement(ins_att, q_biased, one * 1e-6, b_est);
+  Eigen::Matrix<double, layout::kSize, 1> dxb = dx;
+  dxb.segment<3>(layout::kStarTrackerBias.index) = b_est - b;
+  EXPECT_LT((ab.z - ab.h * dxb).norm(), 1e-8);  // second order in the 3e-5 rad rotations
+  EXPECT_GT((ab.z - ab.h * dx).norm(), 1e-5);   // the bias term matters
 }
 
 TEST(IntegratedFilter, Seed001LooselyCoupledWithStarTrackerConverges) {
@@ -182,8 +193,8 @@ TEST(IntegratedFilter, Seed001LooselyCoupledWithStarTrackerConverges) {
       navbus::core::quaternionFromRotationVector(Eigen::Vector3d(5e-5, -5e-5, 8e-5)) * s0.q_b_to_n;
   navbus::core::IntegratedFilter ekf;
   ekf.initialize(s0, 0.0, 0.0, cfg,
-                 navbus::core::maskOf(
-                     {tc17::kPos, tc17::kVel, tc17::kAtt, tc17::kAccelBias, tc17::kGyroBias}));
+                 navbus::core::maskOf({layout::kPos, layout::kVel, layout::kAtt, layout::kAccelBias,
+                                       layout::kGyroBias}));
   double sum_pos = 0, sum_vel = 0, sum_att = 0;
   int n = 0;
   for (int k = 1; k < 200 * 600; ++k) {
@@ -198,9 +209,10 @@ TEST(IntegratedFilter, Seed001LooselyCoupledWithStarTrackerConverges) {
                  navbus::core::AidingKind::kVelocity);
     }
     if (f.has_star_tracker) {
-      ekf.update(navbus::core::attitudeMeasurement(ekf.state(), f.star_tracker.q_b_to_i,
-                                                   f.star_tracker.sigma_b_rad),
-                 navbus::core::AidingKind::kAttitude);
+      ekf.update(
+          navbus::core::attitudeMeasurement(ekf.state(), f.star_tracker.q_b_to_i,
+                                            f.star_tracker.sigma_b_rad, ekf.starTrackerBias()),
+          navbus::core::AidingKind::kAttitude);
     }
     if (k % 200 == 0 && k > 200 * 100) {  // RMS after 100 s of convergence, once per second
       const auto& e = ekf.state();

@@ -89,19 +89,21 @@ struct LayoutEntry {
   core::StateBlock block;
   const char* unit;
 };
-constexpr LayoutEntry kTc17Layout[] = {{"pos_ned", core::tc17::kPos, "m"},
-                                       {"vel_ned", core::tc17::kVel, "m/s"},
-                                       {"phi_ned", core::tc17::kAtt, "rad"},
-                                       {"accel_bias", core::tc17::kAccelBias, "m/s^2"},
-                                       {"gyro_bias", core::tc17::kGyroBias, "rad/s"},
-                                       {"clock_bias", core::tc17::kClockBias, "m"},
-                                       {"clock_drift", core::tc17::kClockDrift, "m/s"}};
+constexpr LayoutEntry kStateLayout[] = {
+    {"pos_ned", core::layout::kPos, "m"},
+    {"vel_ned", core::layout::kVel, "m/s"},
+    {"phi_ned", core::layout::kAtt, "rad"},
+    {"accel_bias", core::layout::kAccelBias, "m/s^2"},
+    {"gyro_bias", core::layout::kGyroBias, "rad/s"},
+    {"star_tracker_bias", core::layout::kStarTrackerBias, "rad"},
+    {"clock_bias", core::layout::kClockBias, "m"},
+    {"clock_drift", core::layout::kClockDrift, "m/s"}};
 }  // namespace
 
-void fillTc17Layout(navbus::FilterDiagnostics& msg) {
-  msg.n(static_cast<std::uint16_t>(core::tc17::kSize));
+void fillStateLayout(navbus::FilterDiagnostics& msg) {
+  msg.n(static_cast<std::uint16_t>(core::layout::kSize));
   msg.state_layout().clear();
-  for (const LayoutEntry& e : kTc17Layout) {
+  for (const LayoutEntry& e : kStateLayout) {
     navbus::StateBlock b;
     b.name(e.name);
     b.index(static_cast<std::uint16_t>(e.block.index));
@@ -118,7 +120,7 @@ navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t v
   msg.seq(seq);
   msg.time_gps_ns(static_cast<std::uint64_t>(time_ns));
   const auto m = static_cast<std::uint16_t>(d.h.rows());
-  fillTc17Layout(msg);
+  fillStateLayout(msg);
   msg.m(m);
   for (std::size_t r = 0; r < m; ++r) {
     navbus::MeasurementRow row;
@@ -141,15 +143,15 @@ navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t v
 }
 
 std::optional<Rejection> toGlrEpoch(const navbus::FilterDiagnostics& msg, core::GlrEpoch& out) {
-  constexpr std::size_t n = core::tc17::kSize;
+  constexpr std::size_t n = core::layout::kSize;
   if (msg.n() != n)
     return Rejection{navbus::REJECT_INCONSISTENT, "n", static_cast<double>(msg.n())};
   const auto& layout = msg.state_layout();
-  if (layout.size() != std::size(kTc17Layout))
+  if (layout.size() != std::size(kStateLayout))
     return Rejection{navbus::REJECT_INCONSISTENT, "state_layout.size()",
                      static_cast<double>(layout.size())};
   for (std::size_t i = 0; i < layout.size(); ++i) {
-    const LayoutEntry& e = kTc17Layout[i];
+    const LayoutEntry& e = kStateLayout[i];
     if (layout[i].name() != e.name || layout[i].index() != e.block.index ||
         layout[i].dof() != e.block.dof)
       return Rejection{navbus::REJECT_INCONSISTENT, "state_layout[" + std::to_string(i) + "]",

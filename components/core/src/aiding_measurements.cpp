@@ -6,7 +6,7 @@
 
 namespace navbus::core {
 
-using namespace tc17;
+using namespace layout;
 
 VectorMeasurement positionMeasurement(const NavState& ins, const earth::Geodetic& fix,
                                       const Eigen::Vector3d& sigma) {
@@ -29,7 +29,8 @@ VectorMeasurement velocityMeasurement(const NavState& ins, const Eigen::Vector3d
 }
 
 VectorMeasurement attitudeMeasurement(const NavState& ins, const Eigen::Quaterniond& q_b_to_i,
-                                      const Eigen::Vector3d& sigma_b) {
+                                      const Eigen::Vector3d& sigma_b,
+                                      const Eigen::Vector3d& bias_estimate_b) {
   VectorMeasurement m;
   const double t_s = 1e-9 * static_cast<double>(ins.time_ns);
   const Eigen::Matrix3d C_n_e = earth::C_n_e(ins.position.latitude_rad, ins.position.longitude_rad);
@@ -40,9 +41,11 @@ VectorMeasurement attitudeMeasurement(const NavState& ins, const Eigen::Quaterni
   // C_ins C_meas^T = (I - [phi x]) (I + [eps x]) ~ I - [(phi - eps) x]: z = vee of the negated
   // antisymmetric part.
   const Eigen::Matrix3d A = C_ins * C_meas.transpose();
-  m.z = Eigen::Vector3d(A(1, 2) - A(2, 1), A(2, 0) - A(0, 2), A(0, 1) - A(1, 0)) / 2.0;
+  m.z = Eigen::Vector3d(A(1, 2) - A(2, 1), A(2, 0) - A(0, 2), A(0, 1) - A(1, 0)) / 2.0 -
+        C_ins * bias_estimate_b;
   m.h.setZero();
   m.h.block<3, 3>(0, kAtt.index).setIdentity();
+  m.h.block<3, 3>(0, kStarTrackerBias.index) = -C_ins;
   const Eigen::Matrix3d R_b = sigma_b.array().square().matrix().asDiagonal();
   m.r = C_ins * R_b * C_ins.transpose();
   return m;

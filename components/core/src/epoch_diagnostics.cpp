@@ -2,7 +2,7 @@
 
 namespace navbus::core {
 
-void AppliedGain::compute(EpochDiagnostics& d, const Matrix17& prior_P) {
+void AppliedGain::compute(EpochDiagnostics& d, const StateMatrix& prior_P) {
   const Eigen::Index m = d.h.rows();
   cov_ = d.innovation_cov;
   for (Eigen::Index i = 0; i < m; ++i) {

@@ -14,39 +14,56 @@ StateMask maskOf(std::initializer_list<StateBlock> blocks) {
   return m;
 }
 
-void ErrorState::initialize(const Matrix17& P0, const StateMask& active) {
+void ErrorState::initialize(const StateMatrix& P0, const StateMask& active) {
   x_.setZero();
   P_ = P0;
   active_ = active;
   removeInactiveCoupling();
 }
 
-void ErrorState::predict(const Matrix17& Phi_full, const Vector17& q_diagonal) {
-  Vector17 q = q_diagonal;
-  const bool all_active = active_.all();
-  Matrix17 Phi_reduced;
-  if (!all_active) {
+namespace {
+/// Whether Phi leaves state i alone: row i and column i are those of the identity.
+bool leavesAlone(const StateMatrix& Phi, int i) {
+  for (int k = 0; k < layout::kSize; ++k) {
+    const double unit = k == i ? 1.0 : 0.0;
+    if (Phi(i, k) != unit || Phi(k, i) != unit) return false;
+  }
+  return true;
+}
+}  // namespace
+
+void ErrorState::predict(const StateMatrix& Phi_full, const StateVector& q_diagonal) {
+  StateVector q = q_diagonal;
+  // Inactive states are cut out of Phi; those it already leaves alone (a block no sensor of
+  // the configuration drives, such as the star-tracker bias of a GNSS/INS filter) need no copy.
+  bool reduce = false;
+  for (int i = 0; i < layout::kSize; ++i) {
+    if (active_[static_cast<std::size_t>(i)]) continue;
+    q[i] = 0.0;
+    reduce = reduce || !leavesAlone(Phi_full, i);
+  }
+  StateMatrix Phi_reduced;
+  if (reduce) {
     Phi_reduced = Phi_full;
-    for (int i = 0; i < tc17::kSize; ++i) {
+    for (int i = 0; i < layout::kSize; ++i) {
       if (active_[static_cast<std::size_t>(i)]) continue;
       Phi_reduced.row(i).setZero();
       Phi_reduced.col(i).setZero();
       Phi_reduced(i, i) = 1.0;
-      q[i] = 0.0;
     }
   }
   // Phi is sparse, within the error model's transition pattern (sparse_rows.hpp,
   // ins_error_model.hpp); the product is symmetric by construction.
-  const Matrix17& Phi = all_active ? Phi_full : Phi_reduced;
+  const StateMatrix& Phi = reduce ? Phi_reduced : Phi_full;
   assert(transitionPattern().covers(Phi));
-  const SparseRows<tc17::kSize> phi(Phi, transitionPattern());
+  const SparseRows<layout::kSize> phi(Phi, transitionPattern());
   x_ = phi.times(x_);
   P_ = phi.sandwich(P_);
   P_.diagonal() += q;
 }
 
 void ErrorState::zeroOffDiagonal() {
-  P_ = Matrix17(P_.diagonal().asDiagonal());
+  P_ = StateMatrix(P_.diagonal().asDiagonal());
 }
 
 void ErrorState::setVariances(const StateBlock& block, double sigma) {
@@ -59,7 +76,7 @@ void ErrorState::setActive(const StateMask& active) {
 }
 
 void ErrorState::removeInactiveCoupling() {
-  for (int i = 0; i < tc17::kSize; ++i) {
+  for (int i = 0; i < layout::kSize; ++i) {
     if (active_[static_cast<std::size_t>(i)]) continue;
     const double v = P_(i, i);
     P_.row(i).setZero();

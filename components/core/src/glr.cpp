@@ -20,11 +20,14 @@ constexpr int kRangeRamp = 1;
 constexpr double kStepInput = -1.0;
 constexpr int kRateStep = 2;
 
-/// The accelerometer and gyro bias states, adjacent in tc17.
-constexpr int kBiasIndex = tc17::kAccelBias.index;
-constexpr int kBiasStates = tc17::kAccelBias.dof + tc17::kGyroBias.dof;
-static_assert(tc17::kGyroBias.index == tc17::kAccelBias.end() && tc17::kAtt.end() == kBiasIndex &&
-              tc17::kGyroBias.end() == kSupportTail.index);
+/// The sensor bias states between attitude and clock: accelerometer, gyro and star tracker
+/// (random constants, or an inactive star-tracker bias, in the filters the GLR watches).
+constexpr int kBiasIndex = layout::kAccelBias.index;
+constexpr int kBiasStates = kSupportTail.index - kBiasIndex;
+static_assert(layout::kGyroBias.index == layout::kAccelBias.end() &&
+              layout::kAtt.end() == kBiasIndex &&
+              layout::kStarTrackerBias.index == layout::kGyroBias.end() &&
+              layout::kStarTrackerBias.end() == kSupportTail.index);
 
 /// Index of a satellite slot's direction in f (three per slot).
 constexpr int satColumn(int slot, int direction) {
@@ -40,7 +43,7 @@ constexpr int muColumn(int slot, int direction) {
 
 /// The bias state a column-j IMU direction steps: accelerometer x y z, gyro x y z.
 constexpr int imuState(int j) {
-  return j < 3 ? tc17::kAccelBias.index + j : tc17::kGyroBias.index + (j - 3);
+  return j < 3 ? layout::kAccelBias.index + j : layout::kGyroBias.index + (j - 3);
 }
 
 struct GroupFit {
@@ -241,7 +244,7 @@ bool GlrMonitor::validate(const GlrEpoch& e) const {
     const int sv = e.sv_id[static_cast<std::size_t>(r)];
     if (sv < 1 || sv > 32) return false;
   }
-  // H must stay on the support (the pseudorange and rate model of the tc17 layout).
+  // H must stay on the support (the pseudorange and rate model of the layout).
   if (!e.h.middleCols<kSupportTail.index - kSupportHead.end()>(kSupportHead.end()).isZero(0.0))
     return false;
   return e.innovation.allFinite() && e.innovation_cov.allFinite() && e.h.allFinite() &&
@@ -302,7 +305,7 @@ void GlrMonitor::prepareEpoch(const GlrEpoch& e) {
   llt_.matrixL().solveInPlace(l_inv_);
   w_ = llt_.solve(e.innovation);
   // The statistics see the state only through H: everything below lives on H's support
-  // (position, velocity and clock), which makes S mu an 8 x 8 product instead of 17 x 17.
+  // (position, velocity and clock), which makes S mu an 8 x 8 product instead of n x n.
   h_support_.resize(m, kSupport);
   h_support_.leftCols<kSupportHead.dof>() = e.h.middleCols<kSupportHead.dof>(kSupportHead.index);
   h_support_.rightCols<kSupportTail.dof>() = e.h.middleCols<kSupportTail.dof>(kSupportTail.index);
@@ -320,11 +323,11 @@ double GlrMonitor::vInv(int i, int j) const {
 }
 
 bool GlrMonitor::biasAndClockRowsSparse() const {
-  // Random-constant biases and a clock that only the clock drives (the tc17 error model)
+  // Random-constant biases and a clock that only the clock drives (the layout's error model)
   // make the bias and clock rows of Phi [0 I 0] and [0 0 Phi_clock] exactly, and G H only
   // adds support columns.
-  constexpr int kNav = tc17::kAtt.end();
-  return b_.block<kStates - kNav, tc17::kAtt.dof>(kNav, tc17::kAtt.index).isZero(0.0) &&
+  constexpr int kNav = layout::kAtt.end();
+  return b_.block<kStates - kNav, layout::kAtt.dof>(kNav, layout::kAtt.index).isZero(0.0) &&
          b_.block<kBiasStates, kBiasStates>(kBiasIndex, kBiasIndex).isIdentity(0.0) &&
          b_.block<kSupportTail.dof, kBiasStates>(kSupportTail.index, kBiasIndex).isZero(0.0);
 }
@@ -336,9 +339,9 @@ void GlrMonitor::propagate() {
   const auto in = mu_.leftCols(columns);
   auto out = mu_next_.leftCols(columns);
   if (biasAndClockRowsSparse()) {
-    // Bias and clock rows: B = [0 I 0] + B(:, support): 8 x 8 per column instead of 8 x 17.
-    constexpr int kNav = tc17::kAtt.end();  // position, velocity, attitude rows
-    constexpr int kLower = kStates - kNav;  // bias and clock rows
+    // Bias and clock rows: B = [0 I 0] + B(:, support): 8 x 8 per column instead of 8 x n.
+    constexpr int kNav = layout::kAtt.end();  // position, velocity, attitude rows
+    constexpr int kLower = kStates - kNav;    // bias and clock rows
     // (Eigen's kernels work on blocks of 4 rows: 8 rows as a product, the 9th alone.)
     out.topRows<kNav - 1>().noalias() = b_.topRows<kNav - 1>() * in;
     out.row(kNav - 1).noalias() = b_.row(kNav - 1) * in;
@@ -569,7 +572,7 @@ void GlrMonitor::positionSignatures(std::vector<PositionSignature>& out) const {
   out.clear();
   if (!have_previous_ || onset_count_ == 0) return;
   // mu+ = mu - K (H mu + D) on the position rows (doc eqs. C1, C3), with this epoch's K and H.
-  constexpr int kPos = tc17::kPos.index;
+  constexpr int kPos = layout::kPos.index;
   const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxRows> k_pos =
       prev_k_.middleRows<3>(kPos);
   const Eigen::Matrix<double, 3, kSupport> kh = k_pos * prev_h_support_;

@@ -4,7 +4,7 @@ namespace navbus::core {
 
 RangePrediction predictRange(const NavState& ins, double clock_bias_m, double clock_drift_mps,
                              const SatelliteObservation& sat) {
-  using namespace tc17;
+  using namespace layout;
   const Eigen::Vector3d r = earth::geodeticToEcef(ins.position);
   const Eigen::Matrix3d C_n_e = earth::C_n_e(ins.position.latitude_rad, ins.position.longitude_rad);
   const Eigen::Vector3d v_e = C_n_e * ins.vel_ned_mps;

@@ -7,8 +7,9 @@
 
 namespace navbus::core {
 
-Matrix17 errorDynamics(const NavState& s, const Eigen::Vector3d& f_b, earth::GravityModel gravity) {
-  using namespace tc17;
+StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
+                          earth::GravityModel gravity) {
+  using namespace layout;
   const Eigen::Matrix3d C_b_n = s.q_b_to_n.toRotationMatrix();
   const Eigen::Vector3d f_n = C_b_n * f_b;
   const Eigen::Vector3d w_ie = earth::omegaIeNed(s.position.latitude_rad);
@@ -19,7 +20,7 @@ Matrix17 errorDynamics(const NavState& s, const Eigen::Vector3d& f_b, earth::Gra
   const double g = earth::gravityNed(gravity, s.position).z();
   const double radius = std::sqrt(rm * rn);
 
-  Matrix17 F = Matrix17::Zero();
+  StateMatrix F = StateMatrix::Zero();
   F.block<3, 3>(kPos.index, kPos.index) = -skew(w_en);
   F.block<3, 3>(kPos.index, kVel.index) = Eigen::Matrix3d::Identity();
   F.block<3, 3>(kVel.index, kAtt.index) = skew(f_n);
@@ -38,17 +39,17 @@ Matrix17 errorDynamics(const NavState& s, const Eigen::Vector3d& f_b, earth::Gra
   return F;
 }
 
-Matrix17 transitionMatrix(const Matrix17& F, double dt) {
-  const Matrix17 Fdt = F * dt;
-  const SparseRows<tc17::kSize> sparse(Fdt, errorDynamicsPattern());
-  return Matrix17::Identity() + Fdt + 0.5 * sparse.times(sparse);
+StateMatrix transitionMatrix(const StateMatrix& F, double dt) {
+  const StateMatrix Fdt = F * dt;
+  const SparseRows<layout::kSize> sparse(Fdt, errorDynamicsPattern());
+  return StateMatrix::Identity() + Fdt + 0.5 * sparse.times(sparse);
 }
 
 namespace {
 /// F at a state where every term of errorDynamics() is nonzero: off the equator and the
 /// meridians, moving in all three axes, rotated about a skew axis, a specific force with
 /// three components.
-Matrix17 genericErrorDynamics() {
+StateMatrix genericErrorDynamics() {
   NavState s;
   s.position = {0.6, 2.2, 1000.0};
   s.vel_ned_mps = Eigen::Vector3d(120.0, -80.0, 15.0);
@@ -57,16 +58,16 @@ Matrix17 genericErrorDynamics() {
 }
 }  // namespace
 
-const SparsityPattern<tc17::kSize>& errorDynamicsPattern() {
-  static const auto pattern = SparsityPattern<tc17::kSize>::of(genericErrorDynamics());
+const SparsityPattern<layout::kSize>& errorDynamicsPattern() {
+  static const auto pattern = SparsityPattern<layout::kSize>::of(genericErrorDynamics());
   return pattern;
 }
 
-const SparsityPattern<tc17::kSize>& transitionPattern() {
+const SparsityPattern<layout::kSize>& transitionPattern() {
   // Magnitudes, so that no sum cancels to an accidental zero.
   static const auto pattern = [] {
-    const Matrix17 A = genericErrorDynamics().cwiseAbs();
-    return SparsityPattern<tc17::kSize>::of(Matrix17::Identity() + A + A * A);
+    const StateMatrix A = genericErrorDynamics().cwiseAbs();
+    return SparsityPattern<layout::kSize>::of(StateMatrix::Identity() + A + A * A);
   }();
   return pattern;
 }

@@ -11,21 +11,25 @@
 
 namespace navbus::core {
 
-using namespace tc17;
+using namespace layout;
 
 namespace {
 constexpr std::size_t kGnssLocal = 0;
 constexpr std::size_t kStarLocal = 1;
 }  // namespace
 
-Vector17 IntegratedFilter::initialSigma(const FilterTuning& tuning) {
-  Vector17 sigma;
+StateVector IntegratedFilter::initialSigma(const FilterTuning& tuning) {
+  StateVector sigma;
   sigma.segment<3>(kPos.index).setConstant(tuning.pos_sigma_m);
   sigma.segment<3>(kVel.index).setConstant(tuning.vel_sigma_mps);
   sigma.segment<3>(kAtt.index) << tuning.level_sigma_rad, tuning.level_sigma_rad,
       tuning.heading_sigma_rad;
   sigma.segment<3>(kAccelBias.index).setConstant(tuning.accel_bias_sigma_mps2);
   sigma.segment<3>(kGyroBias.index).setConstant(tuning.gyro_bias_sigma_radps);
+  // Not modelled: inactive states, whose variance only has to keep P invertible.
+  sigma.segment<3>(kStarTrackerBias.index)
+      .setConstant(tuning.star_tracker_bias_sigma_rad > 0.0 ? tuning.star_tracker_bias_sigma_rad
+                                                            : 1.0);
   sigma[kClockBias.index] = tuning.clock_bias_sigma_m;
   sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
   return sigma;
@@ -34,7 +38,7 @@ Vector17 IntegratedFilter::initialSigma(const FilterTuning& tuning) {
 void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
                                   double clock_drift_mps, const FilterTuning& tuning,
                                   const StateMask& active, FusionStructure structure) {
-  const Vector17 sigma = initialSigma(tuning);
+  const StateVector sigma = initialSigma(tuning);
   initialize(state, clock_bias_m, clock_drift_mps, tuning, active, structure,
              sigma.array().square().matrix().asDiagonal());
 }
@@ -42,7 +46,7 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
 void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
                                   double clock_drift_mps, const FilterTuning& tuning,
                                   const StateMask& active, FusionStructure structure,
-                                  const Matrix17& initial_covariance) {
+                                  const StateMatrix& initial_covariance) {
   tuning_ = tuning;
   ins_ = StrapdownNed(tuning.gravity);
   ins_.initialize(state);
@@ -50,6 +54,7 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   clock_drift_mps_ = clock_drift_mps;
   accel_bias_.setZero();
   gyro_bias_.setZero();
+  star_tracker_bias_.setZero();
   central_.initialize(initial_covariance, active);
   const Eigen::Vector3d floor_pos = Eigen::Vector3d::Constant(tuning.adaptive_floor_position_m);
   windows_[0].configure(tuning.adaptive_window, floor_pos);
@@ -83,18 +88,28 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   inc.delta_angle_b_rad -= gyro_bias_ * inc.interval_s;
   const double dt = inc.interval_s;
   // F at the state at the start of the interval (first-order hold of the error dynamics).
-  const Matrix17 Phi =
+  StateMatrix Phi =
       transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, tuning_.gravity), dt);
   ins_.propagate(inc);
   clock_bias_m_ += clock_drift_mps_ * dt;
   if (suspend_filter) return;
   // Discrete process noise: white specific force / rate noise into velocity / attitude
   // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3).
-  Vector17 q = Vector17::Zero();
+  StateVector q = StateVector::Zero();
   q.segment<3>(kVel.index).setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt);
   q.segment<3>(kAtt.index).setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt);
   q[kClockBias.index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
   q[kClockDrift.index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
+  if (central_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
+    // First-order Gauss-Markov: decay exp(-dt / tau), driving noise that keeps the variance
+    // at sigma^2 (exact discretization).
+    const double decay = std::exp(-dt / tuning_.star_tracker_bias_correlation_time_s);
+    const double sigma = tuning_.star_tracker_bias_sigma_rad;
+    for (int i = kStarTrackerBias.index; i < kStarTrackerBias.end(); ++i) {
+      Phi(i, i) = decay;
+      q[i] = sigma * sigma * (1.0 - decay * decay);
+    }
+  }
   for (int a = 0; a < 3; ++a) {
     if (axis_failed_[static_cast<std::size_t>(a)])
       q[kAccelBias.index + a] = std::pow(tuning_.failed_accel_bias_rw_mps2_per_sqrts, 2) * dt;
@@ -107,7 +122,8 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   // The master (federated) covariance is propagated too, so that it is valid between updates.
   central_.predict(Phi, q);
   if (keep_transition_)
-    phi_since_update_ = SparseRows<tc17::kSize>(Phi, transitionPattern()).times(phi_since_update_);
+    phi_since_update_ =
+        SparseRows<layout::kSize>(Phi, transitionPattern()).times(phi_since_update_);
 }
 
 ErrorState& IntegratedFilter::target(AidingKind kind) {
@@ -195,10 +211,10 @@ void IntegratedFilter::closeUpdate() {
     // Master fusion (eqs. 28-29) of the shared states; the clock comes from the GNSS local.
     const FusedEstimate<kFusedStates> f =
         fuseInformation<kFusedStates>(local_[kGnssLocal], local_[kStarLocal]);
-    Vector17 dx = Vector17::Zero();
+    StateVector dx = StateVector::Zero();
     dx.head<kFusedStates>() = f.x;
     dx.tail<kSize - kFusedStates>() = local_[kGnssLocal].x().tail<kSize - kFusedStates>();
-    Matrix17 P = Matrix17::Zero();
+    StateMatrix P = StateMatrix::Zero();
     P.topLeftCorner<kFusedStates, kFusedStates>() = f.P;
     P.bottomRightCorner<kSize - kFusedStates, kSize - kFusedStates>() =
         local_[kGnssLocal].P().bottomRightCorner<kSize - kFusedStates, kSize - kFusedStates>();
@@ -214,7 +230,7 @@ void IntegratedFilter::closeUpdate() {
   phi_since_update_.setIdentity();
 }
 
-void IntegratedFilter::feedback(const Vector17& dx) {
+void IntegratedFilter::feedback(const StateVector& dx) {
   // Errors are estimate minus truth: subtract them from the estimate, then the error state is 0.
   NavState s = ins_.state();
   s.position = earth::offsetNed(s.position, -dx.segment<3>(kPos.index));
@@ -224,6 +240,7 @@ void IntegratedFilter::feedback(const Vector17& dx) {
   ins_.correct(s);
   accel_bias_ -= dx.segment<3>(kAccelBias.index);
   gyro_bias_ -= dx.segment<3>(kGyroBias.index);
+  star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);
   clock_bias_m_ -= dx[kClockBias.index];
   clock_drift_mps_ -= dx[kClockDrift.index];
 }

@@ -4,7 +4,7 @@
 
 namespace navbus::core {
 
-using namespace tc17;
+using namespace layout;
 
 StateMask stageMask(MdfStage stage) {
   switch (stage) {

@@ -4,7 +4,7 @@
 
 namespace navbus::core {
 
-using namespace tc17;
+using namespace layout;
 
 namespace {
 EngineMode stageMode(MdfStage s) {
@@ -49,6 +49,9 @@ StateMask NavigationEngine::baseMask() const {
   // The receiver clock is a state only when pseudoranges are used.
   if (config_.aiding == AidingMode::kTightlyCoupled || config_.aiding == AidingMode::kInertialOnly)
     return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift});
+  // The star tracker's bias where it is modelled and the tracker used.
+  if (config_.use_star_tracker && config_.tuning.star_tracker_bias_sigma_rad > 0.0)
+    return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kStarTrackerBias});
   return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias});
 }
 
@@ -80,7 +83,7 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
   if (!filter_.initialized()) {
     NavState s = config_.initial_state;
     s.time_ns = start_ns;
-    const Vector17 sigma = IntegratedFilter::initialSigma(config_.tuning);
+    const StateVector sigma = IntegratedFilter::initialSigma(config_.tuning);
     start(s, config_.initial_clock_bias_m, config_.initial_clock_drift_mps,
           sigma.array().square().matrix().asDiagonal());
   } else if (start_ns - filter_.state().time_ns > interval_ns / 2) {
@@ -122,7 +125,7 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
 }
 
 void NavigationEngine::start(const NavState& state, double clock_bias_m, double clock_drift_mps,
-                             const Matrix17& initial_covariance) {
+                             const StateMatrix& initial_covariance) {
   filter_.initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
                      config_.fusion, initial_covariance);
   filter_.keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled);
@@ -135,7 +138,7 @@ void NavigationEngine::start(const NavState& state, double clock_bias_m, double 
   next_constraint_ns_ = state.time_ns;
 }
 
-Matrix17 NavigationEngine::alignedCovariance(const AlignedStart& a) const {
+StateMatrix NavigationEngine::alignedCovariance(const AlignedStart& a) const {
   // Position, velocity and clock with the alignment's sigmas; the sensor biases keep the
   // tuning's. The alignment read those biases as tilt and heading (static_alignment.cpp step
   // 8), so the attitude errors are correlated with them: with phi = S_a b_a + S_g b_g + n and
@@ -143,14 +146,14 @@ Matrix17 NavigationEngine::alignedCovariance(const AlignedStart& a) const {
   //   P_phi,phi = S_a Sa S_a^T + S_g Sg S_g^T + N,  P_phi,e_a = -S_a Sa,  P_phi,e_g = -S_g Sg,
   // with Sa, Sg the tuning's bias variances and N the rest of the alignment's own budget
   // (noise; at least 0 per axis).
-  Vector17 sigma = IntegratedFilter::initialSigma(config_.tuning);
+  StateVector sigma = IntegratedFilter::initialSigma(config_.tuning);
   sigma.segment<3>(kPos.index) = a.pos_sigma_ned_m;
   sigma.segment<3>(kVel.index) = a.vel_sigma_ned_mps;
   if (a.has_clock) {
     sigma[kClockBias.index] = a.clock_bias_sigma_m;
     sigma[kClockDrift.index] = a.clock_drift_sigma_mps;
   }
-  Matrix17 P = sigma.array().square().matrix().asDiagonal();
+  StateMatrix P = sigma.array().square().matrix().asDiagonal();
   const Eigen::Matrix3d& S_a = a.sensitivity.d_att_d_accel_bias_b;
   const Eigen::Matrix3d& S_g = a.sensitivity.d_att_d_gyro_bias_b;
   const double var_a = config_.tuning.accel_bias_sigma_mps2 * config_.tuning.accel_bias_sigma_mps2;
@@ -163,6 +166,18 @@ Matrix17 NavigationEngine::alignedCovariance(const AlignedStart& a) const {
   P.block<3, 3>(kAtt.index, kGyroBias.index) = -var_g * S_g;
   P.block<3, 3>(kAccelBias.index, kAtt.index) = -var_a * S_a.transpose();
   P.block<3, 3>(kGyroBias.index, kAtt.index) = -var_g * S_g.transpose();
+  if (a.attitude_source == AttitudeSource::kStarTracker &&
+      baseMask()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
+    // The start took the tracker's attitude with its bias b: phi = -C_b_n (b + v), and the
+    // bias error state starts at -b, so P_phi,phi gains C Sb C^T = Sb I (isotropic) and
+    // P_phi,e_st = C_b_n Sb.
+    const double var_st =
+        config_.tuning.star_tracker_bias_sigma_rad * config_.tuning.star_tracker_bias_sigma_rad;
+    const Eigen::Matrix3d C_b_n = a.state.q_b_to_n.toRotationMatrix();
+    P.block<3, 3>(kAtt.index, kAtt.index) += var_st * Eigen::Matrix3d::Identity();
+    P.block<3, 3>(kAtt.index, kStarTrackerBias.index) = var_st * C_b_n;
+    P.block<3, 3>(kStarTrackerBias.index, kAtt.index) = var_st * C_b_n.transpose();
+  }
   return P;
 }
 
@@ -329,11 +344,24 @@ void NavigationEngine::addStarAttitude(const StarAttitudeMeasurement& st) {
       config_.aiding == AidingMode::kInertialOnly ||
       config_.aiding == AidingMode::kMultiDimensional)
     return;
-  const auto a = filter_.update(attitudeMeasurement(filter_.state(), st.q_b_to_i, st.sigma_b_rad),
-                                AidingKind::kAttitude);
+  const auto a = filter_.update(
+      attitudeMeasurement(filter_.state(), st.q_b_to_i, starTrackerWhiteSigma(st.sigma_b_rad),
+                          filter_.starTrackerBias()),
+      AidingKind::kAttitude);
   countGated(a.data(), 3);
   ++counters_.star_fused;
   mode_ = aidedMode();
+}
+
+Eigen::Vector3d NavigationEngine::starTrackerWhiteSigma(const Eigen::Vector3d& sigma_b_rad) const {
+  // The message's sigma is the tracker's whole error per sample (bias and noise). Where the
+  // bias is a state, R keeps the rest: sigma^2 - sigma_bias^2, at least 1 % of sigma^2 (a
+  // tracker reporting less than the configured bias is taken as mostly bias).
+  if (!filter_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) return sigma_b_rad;
+  const double var_bias =
+      config_.tuning.star_tracker_bias_sigma_rad * config_.tuning.star_tracker_bias_sigma_rad;
+  const Eigen::Vector3d var = sigma_b_rad.cwiseAbs2();
+  return (var.array() - var_bias).max(0.01 * var.array()).sqrt().matrix();
 }
 
 void NavigationEngine::excludeSatellite(int sv_id, SatelliteScope scope) {

@@ -7,7 +7,7 @@
 
 namespace navbus::core {
 
-using namespace tc17;
+using namespace layout;
 
 void StaticReceiverFilter::initialize(const Eigen::Vector3d& pos_ecef_m, double clock_bias_m,
                                       double time_s, const StaticReceiverTuning& tuning) {
@@ -17,7 +17,7 @@ void StaticReceiverFilter::initialize(const Eigen::Vector3d& pos_ecef_m, double 
   state_.position = earth::ecefToGeodetic(pos_ecef_m);
   clock_bias_m_ = clock_bias_m;
   clock_drift_mps_ = 0.0;
-  Matrix17 P0 = Matrix17::Zero();
+  StateMatrix P0 = StateMatrix::Zero();
   P0.block<3, 3>(kPos.index, kPos.index)
       .diagonal()
       .setConstant(tuning.pos_sigma_m * tuning.pos_sigma_m);
@@ -30,16 +30,16 @@ void StaticReceiverFilter::initialize(const Eigen::Vector3d& pos_ecef_m, double 
 
 void StaticReceiverFilter::propagate(double dt_s) {
   // Position constant; clock bias integrates the drift (seed 000 eq. 3).
-  Matrix17 Phi = Matrix17::Identity();
+  StateMatrix Phi = StateMatrix::Identity();
   Phi(kClockBias.index, kClockDrift.index) = dt_s;
-  Vector17 q = Vector17::Zero();
+  StateVector q = StateVector::Zero();
   q[kClockBias.index] =
       tuning_.clock_bias_noise_m_per_sqrts * tuning_.clock_bias_noise_m_per_sqrts * dt_s;
   q[kClockDrift.index] =
       tuning_.clock_drift_noise_mps_per_sqrts * tuning_.clock_drift_noise_mps_per_sqrts * dt_s;
   error_.predict(Phi, q);
   clock_bias_m_ += clock_drift_mps_ * dt_s;
-  phi_ = SparseRows<tc17::kSize>(Phi, transitionPattern()).times(phi_);
+  phi_ = SparseRows<layout::kSize>(Phi, transitionPattern()).times(phi_);
 }
 
 const EpochDiagnostics& StaticReceiverFilter::update(
@@ -90,7 +90,7 @@ const EpochDiagnostics& StaticReceiverFilter::update(
 }
 
 void StaticReceiverFilter::feedback() {
-  const Vector17& dx = error_.x();
+  const StateVector& dx = error_.x();
   state_.position = earth::offsetNed(state_.position, -dx.segment<3>(kPos.index));
   clock_bias_m_ -= dx[kClockBias.index];
   clock_drift_mps_ -= dx[kClockDrift.index];

@@ -73,6 +73,8 @@ struct SensorFrame {
   core::NavState truth;
   Eigen::Vector3d truth_accel_bias_b_mps2{Eigen::Vector3d::Zero()};  ///< model + injected faults
   Eigen::Vector3d truth_gyro_bias_b_radps{Eigen::Vector3d::Zero()};
+  /// The star tracker's bias at its latest sample [rad, tracker axes]: model + injected faults.
+  Eigen::Vector3d truth_star_tracker_bias_b_rad{Eigen::Vector3d::Zero()};
 };
 
 }  // namespace navbus::sim

@@ -64,6 +64,7 @@ class ScenarioSource {
   Constellation constellation_;
   GnssReceiverModel receiver_;
   StarTrackerModel star_;
+  Eigen::Vector3d star_bias_b_rad_{Eigen::Vector3d::Zero()};  ///< at the latest tracker sample
   std::mt19937_64 rng_;
   std::int64_t index_{0};
   Eigen::Vector3d last_accel_{Eigen::Vector3d::Zero()};  ///< last raw outputs (for stuck axes)

@@ -40,15 +40,15 @@ std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoc
 std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& msg,
                                                const std::vector<SatelliteRejection>& dropped);
 
-/// The tightly coupled filter's state layout (core::tc17) as the diagnostics declare it.
-void fillTc17Layout(navbus::FilterDiagnostics& msg);
+/// The tightly coupled filter's state layout (core::layout) as the diagnostics declare it.
+void fillStateLayout(navbus::FilterDiagnostics& msg);
 
-/// A GNSS epoch's diagnostics over the tc17 layout as the message (matrices row-major).
+/// A GNSS epoch's diagnostics over core::layout as the message (matrices row-major).
 navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t vehicle_id,
                                 std::uint64_t seq, std::int64_t time_ns);
 
 /// A validated diagnostics sample (validate() passed) as the GLR's epoch; a rejection when
-/// its state layout is not core::tc17's or it has more rows than the GLR supports.
+/// its state layout is not core::layout's or it has more rows than the GLR supports.
 std::optional<Rejection> toGlrEpoch(const navbus::FilterDiagnostics& msg, core::GlrEpoch& out);
 
 /// Fills time, position, velocity and attitude fields of a solution from a navigation state.

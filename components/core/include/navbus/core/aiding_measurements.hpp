@@ -1,4 +1,4 @@
-// Loosely coupled aiding measurements over the 17-state layout: GNSS position and velocity
+// Loosely coupled aiding measurements over the state layout: GNSS position and velocity
 // (seed 004 eq. 5, seed 001) and star-tracker attitude (seed 001 eq. 17). Each returns the
 // innovation z = predicted - measured in error-state form (z = H dx + v), H and R.
 #pragma once
@@ -15,9 +15,9 @@ namespace navbus::core {
 template <int M>
 struct AidingMeasurement {
   static constexpr int kRows = M;
-  Eigen::Matrix<double, M, 1> z;            ///< innovation, predicted minus measured
-  Eigen::Matrix<double, M, tc17::kSize> h;  ///< d z / d dx
-  Eigen::Matrix<double, M, M> r;            ///< measurement noise covariance
+  Eigen::Matrix<double, M, 1> z;              ///< innovation, predicted minus measured
+  Eigen::Matrix<double, M, layout::kSize> h;  ///< d z / d dx
+  Eigen::Matrix<double, M, M> r;              ///< measurement noise covariance
 };
 using VectorMeasurement = AidingMeasurement<3>;
 
@@ -31,10 +31,14 @@ VectorMeasurement velocityMeasurement(const NavState& ins, const Eigen::Vector3d
 
 /// Star tracker: the measured body-to-ECI attitude brought into NED at the INS position and
 /// time; z = phi_INS - phi_ST (seed 001 eq. 17) as the small rotation between the INS attitude
-/// and the measured one, so that H selects phi. Body-axis sigmas are rotated into NED.
+/// and the measured one. Body-axis sigmas are rotated into NED. The tracker's bias b (a small
+/// rotation about its axes, which are the body axes: C_meas = C_true exp([b + v] x)) appears
+/// in NED as C_b_n b: with the estimate b^ subtracted, z = phi - C_b_n (b^ - b) + C_b_n v, so
+/// H selects phi and gives -C_b_n on the bias error states.
 VectorMeasurement attitudeMeasurement(const NavState& ins,
                                       const Eigen::Quaterniond& q_b_to_i_measured,
-                                      const Eigen::Vector3d& sigma_b_rad);
+                                      const Eigen::Vector3d& sigma_b_rad,
+                                      const Eigen::Vector3d& bias_estimate_b_rad);
 
 /// Zero-velocity update while the vehicle stands still (seed 004 eq. 4): z = V_INS - 0 [m/s,
 /// NED], H selects the velocity error.

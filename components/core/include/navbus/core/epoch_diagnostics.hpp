@@ -1,4 +1,4 @@
-// What a GNSS measurement epoch of a filter over the 17-state layout publishes for an
+// What a GNSS measurement epoch of a filter over the state layout publishes for an
 // independent fault monitor (the GLR of seed 000 eqs. 6-16): innovations, their covariance
 // from the prior, H, the gain actually applied and the transition since the previous epoch.
 // Shared by the tightly coupled filter and the static receiver filter.
@@ -20,10 +20,10 @@ struct EpochDiagnostics {
   std::vector<bool> used;          ///< per row: fused (false: gated, or monitored only)
   Eigen::VectorXd innovation;      ///< predicted minus measured, m rows
   Eigen::MatrixXd innovation_cov;  ///< V = H P- H^T + R, m x m
-  Eigen::MatrixXd h;               ///< m x 17
-  Eigen::MatrixXd k;  ///< 17 x m: the gain applied, P- H_u^T V_uu^-1 on the used rows, 0 elsewhere
-  Matrix17 phi{Matrix17::Identity()};  ///< transition accumulated since the previous epoch
-  std::vector<double> test_ratio;      ///< per row, from the sequential gated update
+  Eigen::MatrixXd h;               ///< m x n (n = layout::kSize)
+  Eigen::MatrixXd k;  ///< n x m: the gain applied, P- H_u^T V_uu^-1 on the used rows, 0 elsewhere
+  StateMatrix phi{StateMatrix::Identity()};  ///< transition accumulated since the previous epoch
+  std::vector<double> test_ratio;            ///< per row, from the sequential gated update
 };
 
 /// Sets d.k to the gain a sequence of scalar updates applied in total: for the accepted rows a
@@ -31,7 +31,7 @@ struct EpochDiagnostics {
 /// rows in V (identity block) gives it in one solve. Keeps its storage between epochs.
 class AppliedGain {
  public:
-  void compute(EpochDiagnostics& d, const Matrix17& prior_P);
+  void compute(EpochDiagnostics& d, const StateMatrix& prior_P);
 
  private:
   Eigen::MatrixXd cov_;

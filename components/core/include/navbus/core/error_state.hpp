@@ -1,6 +1,6 @@
-// An error-state Kalman filter over the 17-state layout: the error estimate x, its covariance
-// P and the set of active states. It knows nothing of the navigation state it corrects; the
-// integrated filter (integrated_filter.hpp) owns the mechanization and applies the feedback.
+// An error-state Kalman filter over the state layout (state_layout.hpp): the error estimate x, its
+// covariance P and the set of active states. It knows nothing of the navigation state it corrects;
+// the integrated filter (integrated_filter.hpp) owns the mechanization and applies the feedback.
 #pragma once
 
 #include <array>
@@ -15,15 +15,15 @@
 
 namespace navbus::core {
 
-using Vector17 = Eigen::Matrix<double, tc17::kSize, 1>;
-using StateMask = std::bitset<tc17::kSize>;
+using StateVector = Eigen::Matrix<double, layout::kSize, 1>;
+using StateMask = std::bitset<layout::kSize>;
 
 /// The mask with the given blocks active.
 StateMask maskOf(std::initializer_list<StateBlock> blocks);
 
 class ErrorState {
  public:
-  void initialize(const Matrix17& P0, const StateMask& active);
+  void initialize(const StateMatrix& P0, const StateMask& active);
 
   /// x = Phi x, P = Phi P Phi^T + Q, Q = diag(q_diagonal) (the process noises of every
   /// configuration are uncorrelated), on the active states only: an inactive state keeps its
@@ -31,7 +31,7 @@ class ErrorState {
   /// reduced filter uses its region of the 15-state system matrix). Phi's nonzero elements
   /// must lie within transitionPattern() (ins_error_model.hpp), as every transitionMatrix()
   /// does (asserted in builds without NDEBUG).
-  void predict(const Matrix17& Phi, const Vector17& q_diagonal);
+  void predict(const StateMatrix& Phi, const StateVector& q_diagonal);
 
   /// Sequential Joseph-form update, rows decorrelated by the Cholesky factor of R, inactive
   /// columns of H ignored. gate_sigma <= 0 disables gating. Returns one result per row.
@@ -47,36 +47,36 @@ class ErrorState {
   void setActive(const StateMask& active);
 
   /// The navigation state was corrected by dx: the error estimate becomes x - dx.
-  void shift(const Vector17& dx) { x_ -= dx; }
+  void shift(const StateVector& dx) { x_ -= dx; }
 
-  Vector17& x() { return x_; }
-  const Vector17& x() const { return x_; }
-  Matrix17& P() { return P_; }
-  const Matrix17& P() const { return P_; }
+  StateVector& x() { return x_; }
+  const StateVector& x() const { return x_; }
+  StateMatrix& P() { return P_; }
+  const StateMatrix& P() const { return P_; }
   const StateMask& active() const { return active_; }
 
  private:
   void removeInactiveCoupling();
 
-  Vector17 x_{Vector17::Zero()};
-  Matrix17 P_{Matrix17::Zero()};
+  StateVector x_{StateVector::Zero()};
+  StateMatrix P_{StateMatrix::Zero()};
   StateMask active_;
 };
 
 template <int M>
 std::array<ScalarUpdateResult, M> ErrorState::update(const AidingMeasurement<M>& m,
                                                      double gate_sigma) {
-  using RowMatrix = Eigen::Matrix<double, M, tc17::kSize>;
+  using RowMatrix = Eigen::Matrix<double, M, layout::kSize>;
   const Eigen::Matrix<double, M, M> L = m.r.llt().matrixL();
   const Eigen::Matrix<double, M, 1> z = L.template triangularView<Eigen::Lower>().solve(m.z);
   RowMatrix H = L.template triangularView<Eigen::Lower>().solve(m.h);
-  for (int j = 0; j < tc17::kSize; ++j) {
+  for (int j = 0; j < layout::kSize; ++j) {
     if (!active_[static_cast<std::size_t>(j)]) H.col(j).setZero();
   }
   std::array<ScalarUpdateResult, M> out;
   for (int i = 0; i < M; ++i) {
     out[static_cast<std::size_t>(i)] =
-        scalarUpdate<tc17::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma);
+        scalarUpdate<layout::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma);
   }
   return out;
 }

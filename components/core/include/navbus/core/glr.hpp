@@ -38,7 +38,7 @@
 namespace navbus::core {
 
 namespace glr {
-inline constexpr int kStates = tc17::kSize;
+inline constexpr int kStates = layout::kSize;
 inline constexpr int kMaxSatellites = kMaxEpochSatellites;
 inline constexpr int kMaxRows = 2 * kMaxSatellites;
 inline constexpr int kImuDirections = 6;  ///< accelerometer x y z, gyro x y z
@@ -51,12 +51,12 @@ inline constexpr int kMaxWindow = 100;  ///< largest configurable window M [epoc
 /// The states pseudorange and rate rows measure: position and velocity (the first six) and the
 /// clock bias and drift (the last two). f and R see a signature only through H, so they are
 /// accumulated on these eight states; an epoch whose H reaches others is refused.
-inline constexpr StateBlock kSupportHead{tc17::kPos.index, tc17::kPos.dof + tc17::kVel.dof};
-inline constexpr StateBlock kSupportTail{tc17::kClockBias.index,
-                                         tc17::kClockBias.dof + tc17::kClockDrift.dof};
+inline constexpr StateBlock kSupportHead{layout::kPos.index, layout::kPos.dof + layout::kVel.dof};
+inline constexpr StateBlock kSupportTail{layout::kClockBias.index,
+                                         layout::kClockBias.dof + layout::kClockDrift.dof};
 inline constexpr int kSupport = kSupportHead.dof + kSupportTail.dof;
-static_assert(kSupportHead.index == 0 && tc17::kVel.index == tc17::kPos.end() &&
-                  tc17::kClockDrift.index == tc17::kClockBias.end() &&
+static_assert(kSupportHead.index == 0 && layout::kVel.index == layout::kPos.end() &&
+                  layout::kClockDrift.index == layout::kClockBias.end() &&
                   kSupportTail.end() == kStates,
               "the GLR's support is position, velocity (leading) and clock (trailing)");
 
@@ -106,9 +106,9 @@ struct GlrEpoch {
   std::array<bool, glr::kMaxRows> is_rate{};  ///< false: pseudorange row
   glr::RowVector innovation;                  ///< eps = predicted - measured [m, m/s]
   glr::RowMatrix innovation_cov;              ///< V = H P- H^T + R
-  glr::HMatrix h;                             ///< rows x 17
-  glr::KMatrix k;                      ///< 17 x rows: the gain applied (0 columns for unused rows)
-  Matrix17 phi{Matrix17::Identity()};  ///< transition from the previous epoch to this one
+  glr::HMatrix h;                             ///< rows x n
+  glr::KMatrix k;  ///< n x rows: the gain applied (0 columns for unused rows)
+  StateMatrix phi{StateMatrix::Identity()};  ///< transition from the previous epoch to this one
 };
 
 struct GlrCandidate {
@@ -288,7 +288,7 @@ class GlrMonitor {
       prev_h_support_;  ///< the previous epoch's H on the support
   SupportMatrix s_;     ///< H^T V^-1 H on the support
   SupportVector a_;     ///< H^T V^-1 eps on the support
-  Matrix17 b_;          ///< Phi_k (I - K_{k-1} H_{k-1})
+  StateMatrix b_;       ///< Phi_k (I - K_{k-1} H_{k-1})
   glr::KMatrix g_;      ///< Phi_k K_{k-1}
 
   GlrResult result_;

@@ -1,6 +1,6 @@
 // Pseudorange and pseudorange-rate measurement model of the tightly coupled filter
 // (seed 000 eq. 5): predictions from the INS state and clock estimates, and the rows of H
-// over the 17-state error vector of state_layout.hpp.
+// over the error vector of state_layout.hpp.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,8 +32,8 @@ struct RangePrediction {
   double pseudorange_m;
   double pseudorange_rate_mps;
   Eigen::Vector3d los_ned;  ///< unit line of sight receiver -> satellite, NED at the receiver
-  Eigen::Matrix<double, 1, tc17::kSize> h_range;  ///< d(predicted - measured)/d(error state)
-  Eigen::Matrix<double, 1, tc17::kSize> h_rate;
+  Eigen::Matrix<double, 1, layout::kSize> h_range;  ///< d(predicted - measured)/d(error state)
+  Eigen::Matrix<double, 1, layout::kSize> h_rate;
 };
 
 /// Predicts the measurements of `sat` from the INS state and the clock estimates. With

@@ -1,4 +1,4 @@
-// Continuous-time error dynamics of the strapdown INS and the receiver clock over the 17-state
+// Continuous-time error dynamics of the strapdown INS and the receiver clock over the state
 // layout of state_layout.hpp (phi-angle attitude error, NED position error in metres), and the
 // transition matrix of one propagation step.
 #pragma once
@@ -11,7 +11,7 @@
 
 namespace navbus::core {
 
-using Matrix17 = Eigen::Matrix<double, tc17::kSize, tc17::kSize>;
+using StateMatrix = Eigen::Matrix<double, layout::kSize, layout::kSize>;
 
 /// F of dx/dt = F dx at `state`, with the specific force in the body frame `f_b`:
 ///   d(dr)/dt  = -[w_en x] dr + dv
@@ -20,16 +20,16 @@ using Matrix17 = Eigen::Matrix<double, tc17::kSize, tc17::kSize>;
 ///   d(cb)/dt  = cd,  d(cd)/dt = 0           (seed 000 eq. 3)
 /// Errors are estimate minus truth; biases are random constants (seed 000 eq. 1). The small
 /// couplings of position error into the Earth and transport rates are neglected.
-Matrix17 errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
-                       earth::GravityModel gravity);
+StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
+                          earth::GravityModel gravity);
 
 /// Transition matrix over dt: I + F dt + (F dt)^2 / 2.
-Matrix17 transitionMatrix(const Matrix17& F, double dt);
+StateMatrix transitionMatrix(const StateMatrix& F, double dt);
 
 /// The elements errorDynamics() can fill (read once from a state where all of them are
 /// nonzero), and those of a transitionMatrix() built from such an F (I + F + F^2). Every
 /// transition matrix of the filters lies within the latter (tested at random states).
-const SparsityPattern<tc17::kSize>& errorDynamicsPattern();
-const SparsityPattern<tc17::kSize>& transitionPattern();
+const SparsityPattern<layout::kSize>& errorDynamicsPattern();
+const SparsityPattern<layout::kSize>& transitionPattern();
 
 }  // namespace navbus::core

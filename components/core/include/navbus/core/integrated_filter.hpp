@@ -1,5 +1,5 @@
 // The integrated navigation filter: strapdown mechanization with error-state feedback and the
-// fusion structures of seed 001 over the 17-state layout of seed 000.
+// fusion structures of seed 001 over the state layout of state_layout.hpp.
 //  - centralized: one error-state EKF takes every measurement (seed 001 eqs. 22-23 in
 //    sequential Joseph form);
 //  - federated, no-reset mode: a GNSS/INS and a star-tracker/INS local filter, each with its own
@@ -50,6 +50,11 @@ struct FilterTuning {
   double clock_bias_sigma_m{3000.0};
   double clock_drift_sigma_mps{1.0};
   double gate_sigma{5.0};  ///< innovation gate in standard deviations; <= 0: no gate
+  // Star-tracker bias (seed 001): a first-order Gauss-Markov rotation about each star-tracker
+  // axis, modelled as the layout's kStarTrackerBias states when its sigma is positive (0: not
+  // modelled, the states stay inactive).
+  double star_tracker_bias_sigma_rad{0.0};             ///< stationary 1 sigma per axis [rad]
+  double star_tracker_bias_correlation_time_s{300.0};  ///< [s]
   // Adaptive structure (seed 001 eqs. 30-34).
   int adaptive_window{50};                ///< innovations per estimate [epochs]
   double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]
@@ -78,7 +83,8 @@ class IntegratedFilter {
  public:
   /// Number of leading states the federated master fuses: all but the receiver clock, which
   /// only the GNSS local filter observes.
-  static constexpr int kFusedStates = tc17::kClockBias.index;
+  static constexpr int kFusedStates = layout::kClockBias.index;
+  static_assert(layout::kClockDrift.end() == layout::kSize, "the clock must trail the layout");
 
   /// Starts from `state` with the tuning's initial sigmas (initialSigma).
   void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
@@ -88,9 +94,9 @@ class IntegratedFilter {
   /// its attitude-bias correlations), in the units of the state layout.
   void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
                   const FilterTuning& tuning, const StateMask& active, FusionStructure structure,
-                  const Matrix17& initial_covariance);
+                  const StateMatrix& initial_covariance);
   /// The tuning's initial 1-sigma of every state (the configured start).
-  static Vector17 initialSigma(const FilterTuning& tuning);
+  static StateVector initialSigma(const FilterTuning& tuning);
   /// Mechanizes one increment (bias-corrected) and propagates the clock and, unless
   /// `suspend_filter` (the filter is not run: seed 004's case I during an outage), the
   /// covariance(s).
@@ -121,10 +127,13 @@ class IntegratedFilter {
 
   const NavState& state() const { return ins_.state(); }
   /// The covariance of the estimate: the centralized one, or the master's (federated).
-  const Matrix17& covariance() const { return central_.P(); }
+  const StateMatrix& covariance() const { return central_.P(); }
   const ErrorState& local(int i) const { return local_[static_cast<std::size_t>(i)]; }
   const Eigen::Vector3d& accelBias() const { return accel_bias_; }
   const Eigen::Vector3d& gyroBias() const { return gyro_bias_; }
+  /// The star tracker's estimated bias [rad, star-tracker axes], subtracted from its
+  /// measurements (attitudeMeasurement()); 0 while the bias is not modelled.
+  const Eigen::Vector3d& starTrackerBias() const { return star_tracker_bias_; }
   double clockBias() const { return clock_bias_m_; }
   double clockDrift() const { return clock_drift_mps_; }
   /// Whether the transition since the last update is kept for the pseudorange epochs'
@@ -141,7 +150,7 @@ class IntegratedFilter {
   ErrorState& target(AidingKind kind);
   /// Applies the estimate after an update: centralized feedback, or master fusion + feedback.
   void closeUpdate();
-  void feedback(const Vector17& dx);
+  void feedback(const StateVector& dx);
   InnovationWindow<3>* window(AidingKind kind);
 
   FilterTuning tuning_;
@@ -151,14 +160,15 @@ class IntegratedFilter {
   ErrorState central_;               ///< centralized/adaptive filter; master result (federated)
   std::array<ErrorState, 2> local_;  ///< federated: [0] GNSS/INS, [1] star tracker/INS
   std::array<InnovationWindow<3>, 3> windows_;  ///< adaptive: position, velocity, attitude
-  Matrix17 phi_since_update_{Matrix17::Identity()};
+  StateMatrix phi_since_update_{StateMatrix::Identity()};
   bool keep_transition_{true};
   EpochDiagnostics last_epoch_;
-  Matrix17 prior_P_{Matrix17::Zero()};  ///< P- of the latest GNSS epoch
-  AppliedGain applied_gain_;            ///< the diagnostics' K from the sequential updates
+  StateMatrix prior_P_{StateMatrix::Zero()};  ///< P- of the latest GNSS epoch
+  AppliedGain applied_gain_;                  ///< the diagnostics' K from the sequential updates
   std::vector<MeasurementReport> reports_;
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d star_tracker_bias_{Eigen::Vector3d::Zero()};
   double clock_bias_m_{0.0};
   double clock_drift_mps_{0.0};
 };

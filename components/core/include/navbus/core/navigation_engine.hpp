@@ -122,7 +122,7 @@ class NavigationEngine {
 
   bool initialized() const { return filter_.initialized(); }
   const NavState& state() const { return filter_.state(); }
-  const Matrix17& covariance() const { return filter_.covariance(); }
+  const StateMatrix& covariance() const { return filter_.covariance(); }
   Eigen::Vector3d accelBias() const { return filter_.accelBias() + accel_compensation_; }
   Eigen::Vector3d gyroBias() const { return filter_.gyroBias() + gyro_compensation_; }
   double clockBias() const { return filter_.clockBias(); }
@@ -144,14 +144,16 @@ class NavigationEngine {
 
  private:
   StateMask baseMask() const;
+  /// The white part of a star-tracker sample's sigma, per body axis [rad].
+  Eigen::Vector3d starTrackerWhiteSigma(const Eigen::Vector3d& sigma_b_rad) const;
   EngineMode aidedMode() const;
   void applyStage(const StageDecision& d);
   void constraintUpdate();
   void countGated(const ScalarUpdateResult* results, int n);
   void start(const NavState& state, double clock_bias_m, double clock_drift_mps,
-             const Matrix17& initial_covariance);
+             const StateMatrix& initial_covariance);
   void startFromAlignment();
-  Matrix17 alignedCovariance(const AlignedStart& a) const;
+  StateMatrix alignedCovariance(const AlignedStart& a) const;
   bool aligning() const { return config_.start == StartSource::kAligned && !filter_.initialized(); }
 
   EngineConfig config_;

@@ -10,26 +10,31 @@ struct StateBlock {
   constexpr int end() const { return index + dof; }
 };
 
-/// The 17-state tightly coupled error state of seed 000 (eqs. 1 and 3), in NED:
+/// The error state of every filter (seed 000 eqs. 1 and 3, seed 001 eq. 17), in NED:
 /// position error [m, N E D], velocity error [m/s, NED], attitude error phi [rad, NED; the
 /// computed body-to-NED rotation is (I - [phi x]) times the true one], accelerometer bias
-/// [m/s^2, body], gyro bias [rad/s, body], receiver clock bias c*b [m] and drift c*f [m/s].
-/// All errors are estimate minus truth. Seed 000 orders dV, dR, Psi, ...; the order here is
-/// position first, which only permutes the matrices.
-namespace tc17 {
+/// [m/s^2, body], gyro bias [rad/s, body], star-tracker bias [rad, star-tracker body axes: a
+/// small rotation of the measured attitude, first-order Gauss-Markov], receiver clock bias c*b
+/// [m] and drift c*f [m/s]. All errors are estimate minus truth. Seed 000 orders dV, dR, Psi,
+/// ...; the order here is position first, which only permutes the matrices. A configuration
+/// uses the blocks it has sensors for (the others are inactive, error_state.hpp): the 17
+/// states of seed 000 without the star-tracker bias, seed 001 without the clock.
+namespace layout {
 inline constexpr StateBlock kPos{0, 3};
 inline constexpr StateBlock kVel{3, 3};
 inline constexpr StateBlock kAtt{6, 3};
 inline constexpr StateBlock kAccelBias{9, 3};
 inline constexpr StateBlock kGyroBias{12, 3};
-inline constexpr StateBlock kClockBias{15, 1};
-inline constexpr StateBlock kClockDrift{16, 1};
-inline constexpr int kSize = 17;
+inline constexpr StateBlock kStarTrackerBias{15, 3};
+inline constexpr StateBlock kClockBias{18, 1};
+inline constexpr StateBlock kClockDrift{19, 1};
+inline constexpr int kSize = 20;
 static_assert(kPos.end() == kVel.index && kVel.end() == kAtt.index &&
                   kAtt.end() == kAccelBias.index && kAccelBias.end() == kGyroBias.index &&
-                  kGyroBias.end() == kClockBias.index && kClockBias.end() == kClockDrift.index &&
-                  kClockDrift.end() == kSize,
-              "tc17 blocks must tile the state vector");
-}  // namespace tc17
+                  kGyroBias.end() == kStarTrackerBias.index &&
+                  kStarTrackerBias.end() == kClockBias.index &&
+                  kClockBias.end() == kClockDrift.index && kClockDrift.end() == kSize,
+              "the layout's blocks must tile the state vector");
+}  // namespace layout
 
 }  // namespace navbus::core

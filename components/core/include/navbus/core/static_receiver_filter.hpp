@@ -1,5 +1,5 @@
 // GNSS-only filter of a receiver at rest (a surveyed antenna, a parked vehicle), for real
-// pseudorange data without an IMU. It runs over the 17-state layout of the tightly coupled
+// pseudorange data without an IMU. It runs over the state layout of the tightly coupled
 // filter (state_layout.hpp) with the position and clock blocks active: the position is
 // constant, the receiver clock bias and drift are random walks as in seed 000 eq. 3; velocity,
 // attitude and IMU biases are inactive (zero, no variance). Pseudorange rows only. Its epochs
@@ -59,8 +59,8 @@ class StaticReceiverFilter {
   double clock_bias_m_{0.0};
   double clock_drift_mps_{0.0};
   ErrorState error_;
-  Matrix17 phi_{Matrix17::Identity()};
-  Matrix17 prior_P_{Matrix17::Zero()};
+  StateMatrix phi_{StateMatrix::Identity()};
+  StateMatrix prior_P_{StateMatrix::Zero()};
   EpochDiagnostics last_epoch_;
   AppliedGain applied_gain_;
 };
