@@ -18,6 +18,7 @@ void ErrorState::initialize(const StateMatrix& P0, const StateMask& active) {
   x_.setZero();
   P_ = P0;
   active_ = active;
+  estimated_.set();
   removeInactiveCoupling();
 }
 

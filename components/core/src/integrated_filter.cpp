@@ -250,6 +250,11 @@ void IntegratedFilter::setActive(const StateMask& active) {
   for (ErrorState& l : local_) l.setActive(active);
 }
 
+void IntegratedFilter::setEstimated(const StateMask& estimated) {
+  central_.setEstimated(estimated);
+  for (ErrorState& l : local_) l.setEstimated(estimated);
+}
+
 void IntegratedFilter::zeroOffDiagonal() {
   central_.zeroOffDiagonal();
   for (ErrorState& l : local_) l.zeroOffDiagonal();

@@ -200,7 +200,10 @@ void NavigationEngine::applyStage(const StageDecision& d) {
   ++counters_.stage_switches;
   const FilterTuning& t = config_.tuning;
   if (config_.mdf.policy == MdfPolicy::kMultiDimensional) {
-    filter_.setActive(stageMask(d.stage));
+    if (config_.mdf.unestimated == ReducedStates::kConsidered)
+      filter_.setEstimated(stageMask(d.stage));
+    else
+      filter_.setActive(stageMask(d.stage));
   }
   const StateBlock horizontal_att{kAtt.index, 2};
   const StateBlock heading{kAtt.index + 2, 1};

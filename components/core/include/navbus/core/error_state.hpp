@@ -45,6 +45,9 @@ class ErrorState {
 
   /// Changes the active set (inactive states keep their variance, cross terms removed).
   void setActive(const StateMask& active);
+  /// Which active states updates correct; the other active ones are consider states
+  /// (kalman_update.hpp): propagated and correlated, never corrected. Default: all.
+  void setEstimated(const StateMask& estimated) { estimated_ = estimated; }
 
   /// The navigation state was corrected by dx: the error estimate becomes x - dx.
   void shift(const StateVector& dx) { x_ -= dx; }
@@ -61,6 +64,7 @@ class ErrorState {
   StateVector x_{StateVector::Zero()};
   StateMatrix P_{StateMatrix::Zero()};
   StateMask active_;
+  StateMask estimated_{StateMask().set()};
 };
 
 template <int M>
@@ -76,7 +80,7 @@ std::array<ScalarUpdateResult, M> ErrorState::update(const AidingMeasurement<M>&
   std::array<ScalarUpdateResult, M> out;
   for (int i = 0; i < M; ++i) {
     out[static_cast<std::size_t>(i)] =
-        scalarUpdate<layout::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma);
+        scalarUpdate<layout::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma, &estimated_);
   }
   return out;
 }

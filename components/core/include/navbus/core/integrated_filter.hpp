@@ -116,6 +116,8 @@ class IntegratedFilter {
 
   /// Covariance management for the multi-dimensional filter (seed 004).
   void setActive(const StateMask& active);
+  /// Which states the updates correct; the others are consider states (error_state.hpp).
+  void setEstimated(const StateMask& estimated);
   void zeroOffDiagonal();
   void resetVariances(const StateBlock& block, double sigma);
   /// Adds `variance` to one state's variance (a correction of uncertain size was applied).

@@ -3,6 +3,7 @@
 // is data); a measurement with ratio > 1 is rejected and leaves the state untouched.
 #pragma once
 
+#include <bitset>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -19,11 +20,14 @@ struct ScalarUpdateResult {
 /// Updates the error state x and covariance P with the scalar measurement z = h x + v,
 /// var(v) = r. `gate_sigma` is the gate in standard deviations (e.g. 5); <= 0 disables it.
 /// Joseph form P = (I - K h) P (I - K h)^T + K r K^T (expanded, see below) keeps P symmetric
-/// positive definite even with rounding; the result is symmetrized.
+/// positive definite even with rounding; the result is symmetrized. States outside
+/// `estimated` (when given) are consider states (Schmidt-Kalman): their gain is zero, so they
+/// are not corrected, but their covariance and correlations are updated and keep counting in
+/// the gains of the others.
 template <int N>
 ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P,
                                 const Eigen::Matrix<double, 1, N>& h, double z, double r,
-                                double gate_sigma) {
+                                double gate_sigma, const std::bitset<N>* estimated = nullptr) {
   ScalarUpdateResult out;
   const Eigen::Matrix<double, N, 1> Ph = P * h.transpose();
   out.innovation = z - (h * x)(0, 0);
@@ -33,7 +37,12 @@ ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<do
   out.test_ratio = out.innovation * out.innovation / (gate2 * out.innovation_var);
   if (!(out.innovation_var > 0.0) || !std::isfinite(out.test_ratio)) return out;
   if (gate_sigma > 0.0 && !(out.test_ratio <= 1.0)) return out;
-  const Eigen::Matrix<double, N, 1> K = Ph / out.innovation_var;
+  Eigen::Matrix<double, N, 1> K = Ph / out.innovation_var;
+  if (estimated != nullptr) {
+    for (int i = 0; i < N; ++i) {
+      if (!(*estimated)[static_cast<std::size_t>(i)]) K[i] = 0.0;
+    }
+  }
   x += K * out.innovation;
   // Joseph form expanded for one row, O(N^2) instead of two N^3 products: with Ph = P h^T and
   // h P h^T + r = V, (I - K h) P (I - K h)^T + K r K^T = P - K Ph^T - Ph K^T + V K K^T, an

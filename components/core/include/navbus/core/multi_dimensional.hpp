@@ -29,6 +29,14 @@ enum class MdfStage { kF1ZeroVelocity, kF2Gnss, kF3Recovery, kF4Constraint };
 /// I: resumes as it was; II: resumes with its whole covariance re-initialized.
 enum class MdfPolicy { kMultiDimensional, kContinue, kResetAll };
 
+/// What a reduced filter does with the states it does not estimate: seed 004 drops them (they
+/// keep their variance, lose their correlations and are not propagated), which makes the
+/// reduced filters overconfident: standing still, the tilt absorbs the horizontal accelerometer
+/// biases F1 leaves out, and F4's frozen position variance stops growing while the position
+/// error does. As consider states (Schmidt-Kalman) they are propagated and correlated like the
+/// 15-state filter's but never corrected, so each stage still estimates only its own states.
+enum class ReducedStates { kDropped, kConsidered };
+
 enum class CovarianceReset { kNone, kFs, kFsA, kFsI, kAll };
 
 /// The active states of each reduced filter (clock states never: this filter is loosely
@@ -66,6 +74,7 @@ class StationarityDetector {
 
 struct MdfConfig {
   MdfPolicy policy{MdfPolicy::kMultiDimensional};
+  ReducedStates unestimated{ReducedStates::kConsidered};
   StationarityConfig stationarity;
   double recovery_s{5.0};           ///< F3 duration after GNSS returns (seed 004: 5 s)
   double gnss_timeout_s{1.5};       ///< GNSS counts as lost after this long without a fix
