@@ -1,5 +1,6 @@
 // Issue 4 groundwork: the tightly coupled measurement model's Jacobians against numerical
 // differences, and the Joseph-form gated update.
+#include <bitset>
 #include <cmath>
 #include <random>
 
@@ -113,6 +114,29 @@ TEST(JosephUpdate, PseudorangesReduceAConstructedPositionAndClockError) {
   EXPECT_LT(after, 0.05 * before);
   EXPECT_LT((P - P.transpose()).norm(), 1e-9);
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<StateMat>(P).eigenvalues().minCoeff(), 0.0);
+}
+
+TEST(JosephUpdate, ConsiderStatesAreNotCorrectedButKeepTheirCorrelations) {
+  // Given two correlated states, the second a consider state (Schmidt-Kalman), and a
+  // measurement of their sum,
+  Eigen::Matrix<double, 2, 1> x = Eigen::Matrix<double, 2, 1>::Zero();
+  Eigen::Matrix2d P;
+  P << 4.0, 1.0, 1.0, 2.0;
+  const Eigen::Matrix<double, 1, 2> h(1.0, 1.0);
+  const std::bitset<2> estimated("01");
+  const Eigen::Matrix2d P0 = P;
+  navbus::core::scalarUpdate<2>(x, P, h, 3.0, 1.0, 0.0, &estimated);
+  // then only the first state is corrected, with the gain of a filter that sees the second
+  // one's uncertainty: K = [P h^T]_0 / V, V = h P h^T + r = 9,
+  EXPECT_DOUBLE_EQ(x[1], 0.0);
+  EXPECT_DOUBLE_EQ(x[0], 5.0 / 9.0 * 3.0);
+  // the consider state's variance is unchanged (nothing corrects it), and the covariance is
+  // that of the Joseph form with this gain.
+  const Eigen::Vector2d K(5.0 / 9.0, 0.0);
+  const Eigen::Matrix2d A = Eigen::Matrix2d::Identity() - K * h;
+  const Eigen::Matrix2d expected = A * P0 * A.transpose() + K * K.transpose();
+  EXPECT_NEAR(P(1, 1), 2.0, 1e-15);
+  EXPECT_LT((P - expected).cwiseAbs().maxCoeff(), 1e-14);
 }
 
 TEST(JosephUpdate, StaysSymmetricPositiveDefiniteAndGatesOutliers) {
