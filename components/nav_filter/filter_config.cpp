@@ -386,7 +386,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
 
   const YAML::Node ad = root["adaptive"];
   bus::checkKeys(ad, "adaptive",
-                 {"window", "floor_position_m", "floor_velocity_mps", "floor_attitude_arcsec"});
+                 {"window", "floor_position_m", "floor_velocity_mps", "floor_attitude_arcsec",
+                  "floor_at_reported"});
   bus::checkKeys(root["federated"], "federated", {"share"});
   const std::string wa = "adaptive";
   t.adaptive_window =
@@ -395,6 +396,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   t.adaptive_floor_position_m = bus::get<double>(ad, wa, "floor_position_m", 0.3);
   t.adaptive_floor_velocity_mps = bus::get<double>(ad, wa, "floor_velocity_mps", 0.01);
   t.adaptive_floor_attitude_rad = bus::get<double>(ad, wa, "floor_attitude_arcsec", 0.2) * kArcsec;
+  t.adaptive_floor_at_reported =
+      bus::get<bool>(ad, wa, "floor_at_reported", t.adaptive_floor_at_reported);
   t.federated_share =
       bus::checkRange(bus::get<double>(root["federated"], "federated", "share", 2.0), 1.0, 100.0,
                       "federated.share");

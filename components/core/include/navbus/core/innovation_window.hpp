@@ -3,6 +3,9 @@
 //   C_k = 1/N sum dz_i dz_i^T                      (eq. 31 over the last N epochs),
 //   R_k = C_k - H P- H^T                           (eqs. 32, 34),
 // and every variance that comes out at or below the floor xi is replaced by xi (eq. 33).
+// Optionally the floor is also the measurement's own reported variance: R then only grows
+// (a sensor noisier than it says, or a fault), and a window of 20 innovations, whose sample
+// variance scatters by +-30 %, never makes the filter trust a sensor more than its report.
 // The paper accumulates from the start (1/k); a window lets R fall back after a fault ends.
 // Only the diagonal of R is estimated: off-diagonal sample covariances of a short window are
 // noise, and a diagonal R keeps the update's row decorrelation exact.
@@ -40,8 +43,9 @@ class InnovationWindow {
   /// True once the window holds N innovations; before that the nominal R is used.
   bool full() const { return count_ == length_; }
 
-  /// The adapted R given H P- H^T (eqs. 31-34), diagonal.
-  Matrix adaptedR(const Matrix& hpht) const {
+  /// The adapted R given H P- H^T (eqs. 31-34), diagonal; `reported` (the measurement's own
+  /// R), when given, is a floor too.
+  Matrix adaptedR(const Matrix& hpht, const Matrix* reported = nullptr) const {
     Vector c = Vector::Zero();
     for (int i = 0; i < count_; ++i) {
       c += samples_[static_cast<std::size_t>(i)].array().square().matrix();
@@ -50,7 +54,9 @@ class InnovationWindow {
     Matrix r = Matrix::Zero();
     for (int j = 0; j < M; ++j) {
       const double v = c[j] - hpht(j, j);
-      r(j, j) = v > floor_var_[j] ? v : floor_var_[j];
+      double floor = floor_var_[j];
+      if (reported != nullptr && (*reported)(j, j) > floor) floor = (*reported)(j, j);
+      r(j, j) = v > floor ? v : floor;
     }
     return r;
   }

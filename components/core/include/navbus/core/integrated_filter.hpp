@@ -60,6 +60,7 @@ struct FilterTuning {
   double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]
   double adaptive_floor_velocity_mps{0.01};
   double adaptive_floor_attitude_rad{1e-6};
+  bool adaptive_floor_at_reported{true};  ///< R never below the measurement's own R
   // A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its output error (a stuck value minus the true
   // specific force or rate) is modelled as a bias with this random walk, and its variance grows
   // by the sigma at the failure. The walk must cover the vehicle's manoeuvres on that axis.
@@ -186,7 +187,8 @@ std::array<ScalarUpdateResult, M> IntegratedFilter::update(const AidingMeasureme
       const Eigen::Vector3d dz = m.z - m.h * es.x();
       const Eigen::Matrix3d hpht = m.h * es.P() * m.h.transpose();
       w->push(dz);
-      if (w->full()) used.r = w->adaptedR(hpht);
+      if (w->full())
+        used.r = w->adaptedR(hpht, tuning_.adaptive_floor_at_reported ? &m.r : nullptr);
     }
   }
   const std::array<ScalarUpdateResult, M> out = es.update(used, tuning_.gate_sigma);
