@@ -99,7 +99,11 @@ void writeErrorHeader(std::ofstream& f) {
        "vel_err_ned_mps[1],vel_err_ned_mps[2],att_err_ned_rad[0],att_err_ned_rad[1],"
        "att_err_ned_rad[2],pos_sigma_ned_m[0],pos_sigma_ned_m[1],pos_sigma_ned_m[2],"
        "vel_sigma_ned_mps[0],vel_sigma_ned_mps[1],vel_sigma_ned_mps[2],att_sigma_ned_rad[0],"
-       "att_sigma_ned_rad[1],att_sigma_ned_rad[2],nees9\n";
+       "att_sigma_ned_rad[1],att_sigma_ned_rad[2],nees9,accel_bias_err_b_mps2[0],"
+       "accel_bias_err_b_mps2[1],accel_bias_err_b_mps2[2],gyro_bias_err_b_radps[0],"
+       "gyro_bias_err_b_radps[1],gyro_bias_err_b_radps[2],star_tracker_bias_err_b_rad[0],"
+       "star_tracker_bias_err_b_rad[1],star_tracker_bias_err_b_rad[2],nees_pos,nees_vel,nees_att,"
+       "nees_accel_bias,nees_gyro_bias,nees_star_tracker_bias\n";
 }
 
 /// Statistics of a set of runs of one configuration.
@@ -346,7 +350,19 @@ int runOfflineCommand(const OfflineOptions& o) {
           &e.att_sigma_ned_rad}) {
       fmt::format_to(out(err_b), ",{},{},{}", v->x(), v->y(), v->z());
     }
-    fmt::format_to(out(err_b), ",{}\n", e.nees9);
+    fmt::format_to(out(err_b), ",{}", e.nees9);
+    for (const Eigen::Vector3d* v :
+         {&e.accel_bias_err_b_mps2, &e.gyro_bias_err_b_radps, &e.star_tracker_bias_err_b_rad}) {
+      fmt::format_to(out(err_b), ",{},{},{}", v->x(), v->y(), v->z());
+    }
+    // Empty: a block the filter does not estimate.
+    for (int b = 0; b < kNeesBlocks; ++b) {
+      if (std::isnan(e.nees_blocks[b]))
+        fmt::format_to(out(err_b), ",");
+      else
+        fmt::format_to(out(err_b), ",{}", e.nees_blocks[b]);
+    }
+    fmt::format_to(out(err_b), "\n");
     flush(1 << 20);
   });
   flush(0);

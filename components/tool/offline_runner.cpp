@@ -113,12 +113,15 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     const Eigen::Matrix<double, 9, 9> P9 = P.topLeftCorner<9, 9>();
     err.nees9 = d.dot(P9.ldlt().solve(d));
     const core::StateMask& active = engine.filter().active();
+    err.accel_bias_err_b_mps2 = engine.accelBias() - truth.accel_bias_b_mps2;
+    err.gyro_bias_err_b_radps = engine.gyroBias() - truth.gyro_bias_b_radps;
+    err.star_tracker_bias_err_b_rad =
+        engine.filter().starTrackerBias() - truth.star_tracker_bias_b_rad;
     err.nees_blocks << blockNees(P, active, kPos, err.pos_ned_m),
         blockNees(P, active, kVel, err.vel_ned_mps), blockNees(P, active, kAtt, err.att_ned_rad),
-        blockNees(P, active, kAccelBias, engine.accelBias() - truth.accel_bias_b_mps2),
-        blockNees(P, active, kGyroBias, engine.gyroBias() - truth.gyro_bias_b_radps),
-        blockNees(P, active, kStarTrackerBias,
-                  engine.filter().starTrackerBias() - truth.star_tracker_bias_b_rad);
+        blockNees(P, active, kAccelBias, err.accel_bias_err_b_mps2),
+        blockNees(P, active, kGyroBias, err.gyro_bias_err_b_radps),
+        blockNees(P, active, kStarTrackerBias, err.star_tracker_bias_err_b_rad);
     err.mode = static_cast<int>(sol.mode());
     err.integrity = static_cast<int>(sol.integrity());
     err.hpl_m = sol.horizontal_protection_level_m();

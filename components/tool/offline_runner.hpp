@@ -33,6 +33,10 @@ struct EpochError {
   Eigen::Vector3d pos_sigma_ned_m{Eigen::Vector3d::Zero()};
   Eigen::Vector3d vel_sigma_ned_mps{Eigen::Vector3d::Zero()};
   Eigen::Vector3d att_sigma_ned_rad{Eigen::Vector3d::Zero()};
+  /// Bias estimates minus the simulator's biases [m/s^2, rad/s, rad; body / tracker axes].
+  Eigen::Vector3d accel_bias_err_b_mps2{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d gyro_bias_err_b_radps{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d star_tracker_bias_err_b_rad{Eigen::Vector3d::Zero()};
   double nees9{0.0};  ///< position, velocity, attitude against the full 9x9 covariance
   /// NEES of each 3-state block against its own 3x3 covariance: position, velocity, attitude,
   /// accelerometer bias, gyro bias, star-tracker bias (NaN: a block the filter does not have).
