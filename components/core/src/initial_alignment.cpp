@@ -222,10 +222,15 @@ void InitialAligner::tryCourse() {
   const Eigen::Matrix3d C_at_levelling =
       Eigen::AngleAxisd(course_rad - yaw_rad, Eigen::Vector3d::UnitZ()) *
       q_at_levelling_b_to_n_.toRotationMatrix();
+  // The gyro bias integrated since the levelling tilts the attitude too: d(phi)/dt = C_b_n e_g
+  // with the bias error e_g = -b (the estimate starts at 0), so phi_tilt gains -C_b_n b dt and
+  // the tilt rows of d(phi)/d(b) gain -C_b_n dt (the heading came from the course since).
+  AlignmentSensitivity sensitivity = alignmentSensitivity(
+      C_at_levelling, fix_.measurement.position.latitude_rad, gravity(), false);
+  sensitivity.d_att_d_gyro_bias_b.topRows<2>() =
+      -q.toRotationMatrix().topRows<2>() * levelled_for_s_;
   finish(q.normalized(), Eigen::Vector3d(level_sigma_rad, level_sigma_rad, heading_sigma_rad),
-         AttitudeSource::kGnssCourse,
-         alignmentSensitivity(C_at_levelling, fix_.measurement.position.latitude_rad, gravity(),
-                              false));
+         AttitudeSource::kGnssCourse, sensitivity);
 }
 
 void InitialAligner::finish(const Eigen::Quaterniond& q_b_to_n,
