@@ -169,12 +169,15 @@ StateMatrix NavigationEngine::alignedCovariance(const AlignedStart& a) const {
   if (a.attitude_source == AttitudeSource::kStarTracker &&
       baseMask()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
     // The start took the tracker's attitude with its bias b: phi = -C_b_n (b + v), and the
-    // bias error state starts at -b, so P_phi,phi gains C Sb C^T = Sb I (isotropic) and
+    // bias error state starts at -b. The tracker's sigma (the alignment's) holds both, so
+    // P_phi,phi = Sb I (C Sb C^T, isotropic) + the rest of the alignment's budget, and
     // P_phi,e_st = C_b_n Sb.
     const double var_st =
         config_.tuning.star_tracker_bias_sigma_rad * config_.tuning.star_tracker_bias_sigma_rad;
     const Eigen::Matrix3d C_b_n = a.state.q_b_to_n.toRotationMatrix();
-    P.block<3, 3>(kAtt.index, kAtt.index) += var_st * Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d noise = (a.att_sigma_ned_rad.cwiseAbs2().array() - var_st).max(0.0);
+    P.block<3, 3>(kAtt.index, kAtt.index) =
+        var_st * Eigen::Matrix3d::Identity() + Eigen::Matrix3d(noise.asDiagonal());
     P.block<3, 3>(kAtt.index, kStarTrackerBias.index) = var_st * C_b_n;
     P.block<3, 3>(kStarTrackerBias.index, kAtt.index) = var_st * C_b_n.transpose();
   }
