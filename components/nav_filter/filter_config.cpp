@@ -405,7 +405,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   const YAML::Node md = root["multi_dimensional"];
   bus::checkKeys(md, "multi_dimensional",
                  {"policy", "recovery_s", "gnss_timeout_s", "constraint_rate_hz", "zupt_sigma_mps",
-                  "nhc_sigma_mps", "stationary", "unestimated_states"});
+                  "nhc_sigma_mps", "stationary", "unestimated_states", "resets"});
   const std::string wm = "multi_dimensional";
   auto& m = e.mdf;
   m.policy = choice<core::MdfPolicy>(md, wm, "policy", "mdf",
@@ -415,6 +415,9 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   m.unestimated = choice<core::ReducedStates>(
       md, wm, "unestimated_states", "consider",
       {{"consider", core::ReducedStates::kConsidered}, {"drop", core::ReducedStates::kDropped}});
+  m.reset_form = choice<core::ResetForm>(
+      md, wm, "resets", "inflate",
+      {{"inflate", core::ResetForm::kInflate}, {"paper", core::ResetForm::kPaper}});
   m.recovery_s = bus::checkRange(bus::get<double>(md, wm, "recovery_s", 5.0), 0.0, 600.0,
                                  "multi_dimensional.recovery_s");
   m.gnss_timeout_s = bus::checkRange(bus::get<double>(md, wm, "gnss_timeout_s", 1.5), 0.01, 600.0,

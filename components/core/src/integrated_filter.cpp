@@ -275,6 +275,13 @@ void IntegratedFilter::addVariance(int state, double variance) {
   for (ErrorState& l : local_) l.P()(state, state) += variance * tuning_.federated_share;
 }
 
+void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
+  for (int i = block.index; i < block.end(); ++i) {
+    const double v = central_.P()(i, i);
+    if (v < sigma * sigma) addVariance(i, sigma * sigma - v);
+  }
+}
+
 void IntegratedFilter::resetVariances(const StateBlock& block, double sigma) {
   central_.setVariances(block, sigma);
   for (ErrorState& l : local_) l.setVariances(block, sigma * std::sqrt(tuning_.federated_share));

@@ -210,27 +210,33 @@ void NavigationEngine::applyStage(const StageDecision& d) {
   }
   const StateBlock horizontal_att{kAtt.index, 2};
   const StateBlock heading{kAtt.index + 2, 1};
+  // Cases I and II are the paper's comparison: always its resets.
+  const bool paper = config_.mdf.reset_form == ResetForm::kPaper ||
+                     config_.mdf.policy != MdfPolicy::kMultiDimensional;
+  const auto reset = [&](const StateBlock& b, double sigma) {
+    if (paper)
+      filter_.resetVariances(b, sigma);
+    else
+      filter_.inflateVariances(b, sigma);
+  };
+  if (paper && d.reset != CovarianceReset::kNone) filter_.zeroOffDiagonal();  // FS
   switch (d.reset) {
     case CovarianceReset::kNone:
-      break;
     case CovarianceReset::kFs:
-      filter_.zeroOffDiagonal();
       break;
     case CovarianceReset::kFsA:
-      filter_.zeroOffDiagonal();
-      filter_.resetVariances(horizontal_att, t.level_sigma_rad);
-      filter_.resetVariances(kVel, t.vel_sigma_mps);
+      reset(horizontal_att, t.level_sigma_rad);
+      reset(kVel, t.vel_sigma_mps);
       break;
     case CovarianceReset::kAll:
-      filter_.resetVariances(kAccelBias, t.accel_bias_sigma_mps2);
-      filter_.resetVariances(kGyroBias, t.gyro_bias_sigma_radps);
+      reset(kAccelBias, t.accel_bias_sigma_mps2);
+      reset(kGyroBias, t.gyro_bias_sigma_radps);
       [[fallthrough]];
     case CovarianceReset::kFsI:
-      filter_.zeroOffDiagonal();
-      filter_.resetVariances(kPos, t.pos_sigma_m);
-      filter_.resetVariances(kVel, t.vel_sigma_mps);
-      filter_.resetVariances(horizontal_att, t.level_sigma_rad);
-      filter_.resetVariances(heading, t.heading_sigma_rad);
+      reset(kPos, t.pos_sigma_m);
+      reset(kVel, t.vel_sigma_mps);
+      reset(horizontal_att, t.level_sigma_rad);
+      reset(heading, t.heading_sigma_rad);
       break;
   }
 }

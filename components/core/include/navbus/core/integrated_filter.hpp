@@ -121,6 +121,9 @@ class IntegratedFilter {
   void setEstimated(const StateMask& estimated);
   void zeroOffDiagonal();
   void resetVariances(const StateBlock& block, double sigma);
+  /// Raises each variance of the block to at least sigma^2, correlations kept (adding a
+  /// nonnegative diagonal keeps P positive definite).
+  void inflateVariances(const StateBlock& block, double sigma);
   /// Adds `variance` to one state's variance (a correction of uncertain size was applied).
   void addVariance(int state, double variance);
   /// Marks an IMU axis failed (or trusted again): while failed, its bias state is a random
