@@ -175,6 +175,19 @@ const char* attitudeSourceName(core::AttitudeSource s) {
   return "none";
 }
 
+/// What gyrocompassing would reach with this IMU here (the aligner's formula), or why it
+/// does not apply (beyond 0.5 rad its small-angle formula has no meaning).
+std::string gyrocompassingLimitText(double limit_rad) {
+  if (!(limit_rad > 0.0)) return "gyrocompassing limit not computed (no static window)";
+  if (limit_rad > 0.5) {
+    return fmt::format(
+        "gyrocompassing not possible with this gyro grade (its formula gives {:.0f} "
+        "mrad)",
+        1e3 * limit_rad);
+  }
+  return fmt::format("gyrocompassing limit with this IMU here {:.2f} mrad", 1e3 * limit_rad);
+}
+
 /// The alignment's starts of one configuration: how long they took, where the attitude came
 /// from, and whether the start's error is inside 3 of its own sigmas (tilt N, tilt E, heading).
 void printAlignment(const std::string& label, const std::vector<AlignmentOutcome>& runs) {
@@ -202,12 +215,12 @@ void printAlignment(const std::string& label, const std::vector<AlignmentOutcome
   std::printf(
       "\nalignment, %s: %d of %zu runs aligned (attitude from %s); time to align median %.1f s,"
       " max %.1f s\n  attitude error of the start: tilt RMS %.3f mrad, heading RMS %.2f mrad "
-      "against a reported heading sigma of %.2f mrad (median); gyrocompassing limit with this "
-      "IMU here %.2f mrad (median);\n  every axis within 3 of its own sigmas in %d of %d runs\n",
+      "against a reported heading sigma of %.2f mrad (median); %s (median);\n  every axis within "
+      "3 of its own sigmas in %d of %d runs\n",
       label.c_str(), aligned, runs.size(), from.empty() ? "-" : from.c_str(), median(times),
       times.empty() ? 0.0 : *std::max_element(times.begin(), times.end()),
       1e3 * std::sqrt(tilt2 / n), 1e3 * std::sqrt(heading2 / n), 1e3 * median(heading_sigma),
-      1e3 * median(limit), inside, aligned);
+      gyrocompassingLimitText(median(limit)).c_str(), inside, aligned);
 }
 
 /// Median with runs that never converged counted as infinitely slow.
