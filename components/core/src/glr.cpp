@@ -339,7 +339,7 @@ void GlrMonitor::propagate() {
   const auto in = mu_.leftCols(columns);
   auto out = mu_next_.leftCols(columns);
   if (biasAndClockRowsSparse()) {
-    // Bias and clock rows: B = [0 I 0] + B(:, support): 8 x 8 per column instead of 8 x n.
+    // Bias and clock rows: B = [0 I 0] + B(:, support): 11 x 8 per column instead of 11 x n.
     constexpr int kNav = layout::kAtt.end();  // position, velocity, attitude rows
     constexpr int kLower = kStates - kNav;    // bias and clock rows
     // (Eigen's kernels work on blocks of 4 rows: 8 rows as a product, the 9th alone.)
