@@ -346,36 +346,36 @@ int runOfflineCommand(const OfflineOptions& o) {
       buf->clear();
     }
   };
-  const auto out = [](fmt::memory_buffer& b) { return std::back_inserter(b); };
+  const auto out = [](fmt::memory_buffer& b) { return fmt::appender(b); };
   const OfflineResult r = runOffline(setup, [&](const navbus::NavigationSolution& s,
                                                 const core::NavState& t, const EpochError& e) {
     if (!appendCsvLine(s, sol_b)) {
-      for (const auto& row : csvRows(s)) fmt::format_to(out(sol_b), "{}\n", row);
+      for (const auto& row : csvRows(s)) fmt::format_to(out(sol_b), FMT_COMPILE("{}\n"), row);
     }
     const Eigen::Vector3d rpy = core::eulerFromDcm(t.q_b_to_n.toRotationMatrix());
-    fmt::format_to(out(truth_b), "{},{},{},{},{},{},{},{},{},{}\n", t.time_ns,
+    fmt::format_to(out(truth_b), FMT_COMPILE("{},{},{},{},{},{},{},{},{},{}\n"), t.time_ns,
                    t.position.latitude_rad, t.position.longitude_rad, t.position.height_m,
                    t.vel_ned_mps.x(), t.vel_ned_mps.y(), t.vel_ned_mps.z(), rpy.x(), rpy.y(),
                    rpy.z());
-    fmt::format_to(out(err_b), "{},{}", e.time_ns, e.mode);
+    fmt::format_to(out(err_b), FMT_COMPILE("{},{}"), e.time_ns, e.mode);
     for (const Eigen::Vector3d* v :
          {&e.pos_ned_m, &e.vel_ned_mps, &e.att_ned_rad, &e.pos_sigma_ned_m, &e.vel_sigma_ned_mps,
           &e.att_sigma_ned_rad}) {
-      fmt::format_to(out(err_b), ",{},{},{}", v->x(), v->y(), v->z());
+      fmt::format_to(out(err_b), FMT_COMPILE(",{},{},{}"), v->x(), v->y(), v->z());
     }
-    fmt::format_to(out(err_b), ",{}", e.nees9);
+    fmt::format_to(out(err_b), FMT_COMPILE(",{}"), e.nees9);
     for (const Eigen::Vector3d* v :
          {&e.accel_bias_err_b_mps2, &e.gyro_bias_err_b_radps, &e.star_tracker_bias_err_b_rad}) {
-      fmt::format_to(out(err_b), ",{},{},{}", v->x(), v->y(), v->z());
+      fmt::format_to(out(err_b), FMT_COMPILE(",{},{},{}"), v->x(), v->y(), v->z());
     }
     // Empty: a block the filter does not estimate.
     for (int b = 0; b < kNeesBlocks; ++b) {
       if (std::isnan(e.nees_blocks[b]))
-        fmt::format_to(out(err_b), ",");
+        fmt::format_to(out(err_b), FMT_COMPILE(","));
       else
-        fmt::format_to(out(err_b), ",{}", e.nees_blocks[b]);
+        fmt::format_to(out(err_b), FMT_COMPILE(",{}"), e.nees_blocks[b]);
     }
-    fmt::format_to(out(err_b), "\n");
+    fmt::format_to(out(err_b), FMT_COMPILE("\n"));
     flush(1 << 20);
   });
   flush(0);

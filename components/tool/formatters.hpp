@@ -9,6 +9,7 @@
 #include <type_traits>
 #include <vector>
 
+#include <fmt/compile.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <fastrtps/utils/fixed_size_string.hpp>
@@ -105,13 +106,13 @@ class CsvCellWriter {
     } else if constexpr (std::is_same_v<T, bool>) {
       append(value ? "1" : "0");
     } else if constexpr (std::is_arithmetic_v<T>) {
-      fmt::format_to(std::back_inserter(out_), "{}", value);  // as formatNumber / to_string
+      number(value);  // as formatNumber / to_string
     } else if constexpr (std::is_same_v<T, std::string>) {
       append(csvQuote(value));
     } else if constexpr (std::is_same_v<T, std::vector<double>>) {
-      fmt::format_to(std::back_inserter(out_), "{}", fmt::join(value, ";"));
+      numbers(value, ';');
     } else {  // std::array<double, N>: a cell each
-      fmt::format_to(std::back_inserter(out_), "{}", fmt::join(value, ","));
+      numbers(value, ',');
     }
   }
   template <std::size_t N>
@@ -135,6 +136,21 @@ class CsvCellWriter {
     first_ = false;
   }
   void append(std::string_view s) { out_.append(s.data(), s.data() + s.size()); }
+  /// Shortest round-trip text ("{}"), the format compiled and written straight into the buffer
+  /// (the runtime-parsed form through a back_inserter cost a third of the offline run's CSV time).
+  template <class T>
+  void number(T value) {
+    fmt::format_to(fmt::appender(out_), FMT_COMPILE("{}"), value);
+  }
+  template <class Range>
+  void numbers(const Range& values, char separator) {
+    bool first = true;
+    for (const auto v : values) {
+      if (!first) out_.push_back(separator);
+      first = false;
+      number(v);
+    }
+  }
   fmt::memory_buffer& out_;
   bool first_{true};
   bool complete_{true};

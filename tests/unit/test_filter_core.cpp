@@ -1,5 +1,5 @@
 // Issue 4 groundwork: the tightly coupled measurement model's Jacobians against numerical
-// differences, and the Joseph-form gated update.
+// differences, the Joseph-form gated update, and the covariance propagation.
 #include <bitset>
 #include <cmath>
 #include <random>
@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
+#include "navbus/core/error_state.hpp"
 #include "navbus/core/gnss_measurement.hpp"
 #include "navbus/core/kalman_update.hpp"
 #include "navbus/core/rotation.hpp"
@@ -285,5 +286,62 @@ TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
     const navbus::core::SparseRows<layout::kSize> structural(Phi,
                                                              navbus::core::transitionPattern());
     EXPECT_EQ(structural.sandwich(P), sandwich);
+    // Phi is block upper triangular (no navigation error drives a bias or the clock), and the
+    // block-triangular sandwich gives the general one's result to the last bit.
+    EXPECT_TRUE(navbus::core::transitionPattern().isBlockUpperTriangular(layout::kCoupledSize));
+    EXPECT_FALSE(
+        navbus::core::transitionPattern().isBlockUpperTriangular(layout::kCoupledSize - 1));
+    EXPECT_EQ(structural.sandwichBlockTriangular<layout::kCoupledSize>(P), sandwich);
+  }
+}
+
+TEST(ErrorState, InactiveStatesKeepTheirVarianceAndStayOutOfTheCoupling) {
+  // Given an error state whose clock and star-tracker bias are inactive, a covariance with
+  // cross terms everywhere, and a transition that couples the clock (bias from drift) and
+  // decays the star-tracker bias,
+  namespace core = navbus::core;
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  core::NavState s = ins();
+  s.q_b_to_n = core::quaternionFromRotationVector(Eigen::Vector3d(0.3, -0.2, 1.1));
+  StateMat Phi = core::transitionMatrix(
+      core::errorDynamics(s, Eigen::Vector3d(0.2, 0.1, -9.8), earth::GravityModel::kWgs84Normal),
+      0.01);
+  for (int i = layout::kStarTrackerBias.index; i < layout::kStarTrackerBias.end(); ++i)
+    Phi(i, i) = 0.9;
+  const StateMat A = StateMat::Random();
+  const StateMat P0 = A * A.transpose() + StateMat::Identity();
+  const core::StateMask active = core::maskOf(
+      {layout::kPos, layout::kVel, layout::kAtt, layout::kAccelBias, layout::kGyroBias});
+  core::ErrorState es;
+  es.initialize(P0, active);
+  StateVec x0;
+  for (int i = 0; i < layout::kSize; ++i) x0[i] = active[static_cast<std::size_t>(i)] ? u(rng) : 0;
+  es.x() = x0;
+  const StateVec q = StateVec::Constant(1e-3);
+  // when it predicts,
+  const StateMat P_before = es.P();
+  es.predict(Phi, q);
+  // then it is the dense prediction with the inactive states cut out of Phi (rows and columns
+  // zeroed, a unit diagonal) and no process noise on them:
+  StateMat Phi_reduced = Phi;
+  StateVec q_reduced = q;
+  for (int i = 0; i < layout::kSize; ++i) {
+    if (active[static_cast<std::size_t>(i)]) continue;
+    Phi_reduced.row(i).setZero();
+    Phi_reduced.col(i).setZero();
+    Phi_reduced(i, i) = 1.0;
+    q_reduced[i] = 0.0;
+  }
+  StateMat expected = Phi_reduced * P_before * Phi_reduced.transpose();
+  expected.diagonal() += q_reduced;
+  EXPECT_LT((es.P() - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+  EXPECT_LT((es.x() - Phi_reduced * x0).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(es.P(), es.P().transpose());
+  // the inactive variances are exactly those before, and no cross term reaches them.
+  for (int i = 0; i < layout::kSize; ++i) {
+    if (active[static_cast<std::size_t>(i)]) continue;
+    EXPECT_EQ(es.P()(i, i), P_before(i, i)) << "state " << i;
+    EXPECT_EQ(es.P().row(i).cwiseAbs().sum(), std::abs(P_before(i, i))) << "state " << i;
   }
 }

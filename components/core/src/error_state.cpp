@@ -22,45 +22,24 @@ void ErrorState::initialize(const StateMatrix& P0, const StateMask& active) {
   removeInactiveCoupling();
 }
 
-namespace {
-/// Whether Phi leaves state i alone: row i and column i are those of the identity.
-bool leavesAlone(const StateMatrix& Phi, int i) {
-  for (int k = 0; k < layout::kSize; ++k) {
-    const double unit = k == i ? 1.0 : 0.0;
-    if (Phi(i, k) != unit || Phi(k, i) != unit) return false;
-  }
-  return true;
-}
-}  // namespace
-
-void ErrorState::predict(const StateMatrix& Phi_full, const StateVector& q_diagonal) {
-  StateVector q = q_diagonal;
-  // Inactive states are cut out of Phi; those it already leaves alone (a block no sensor of
-  // the configuration drives, such as the star-tracker bias of a GNSS/INS filter) need no copy.
-  bool reduce = false;
+void ErrorState::predict(const StateMatrix& Phi, const StateVector& q_diagonal) {
+  // Phi is sparse, within the error model's transition pattern (sparse_rows.hpp,
+  // ins_error_model.hpp), and block upper triangular: no navigation error drives the biases or
+  // the clock. The pattern used here leaves the inactive states out of the coupling, so
+  // whatever Phi holds for them, they neither drive the active states nor are driven.
+  assert(transitionPattern().covers(Phi));
+  const SparseRows<layout::kSize> phi(Phi, pattern_);
+  const StateVector variance_before = P_.diagonal();
+  x_ = phi.times(x_);
+  P_ = phi.sandwichBlockTriangular<layout::kCoupledSize>(P_);
   for (int i = 0; i < layout::kSize; ++i) {
-    if (active_[static_cast<std::size_t>(i)]) continue;
-    q[i] = 0.0;
-    reduce = reduce || !leavesAlone(Phi_full, i);
-  }
-  StateMatrix Phi_reduced;
-  if (reduce) {
-    Phi_reduced = Phi_full;
-    for (int i = 0; i < layout::kSize; ++i) {
-      if (active_[static_cast<std::size_t>(i)]) continue;
-      Phi_reduced.row(i).setZero();
-      Phi_reduced.col(i).setZero();
-      Phi_reduced(i, i) = 1.0;
+    if (active_[static_cast<std::size_t>(i)]) {
+      P_(i, i) += q_diagonal[i];
+    } else {
+      P_(i, i) = variance_before[i];  // kept as it was, whatever Phi(i, i) is
+      x_[i] = 0.0;
     }
   }
-  // Phi is sparse, within the error model's transition pattern (sparse_rows.hpp,
-  // ins_error_model.hpp); the product is symmetric by construction.
-  const StateMatrix& Phi = reduce ? Phi_reduced : Phi_full;
-  assert(transitionPattern().covers(Phi));
-  const SparseRows<layout::kSize> phi(Phi, transitionPattern());
-  x_ = phi.times(x_);
-  P_ = phi.sandwich(P_);
-  P_.diagonal() += q;
 }
 
 void ErrorState::zeroOffDiagonal() {
@@ -77,6 +56,7 @@ void ErrorState::setActive(const StateMask& active) {
 }
 
 void ErrorState::removeInactiveCoupling() {
+  pattern_ = transitionPattern();
   for (int i = 0; i < layout::kSize; ++i) {
     if (active_[static_cast<std::size_t>(i)]) continue;
     const double v = P_(i, i);
@@ -84,6 +64,7 @@ void ErrorState::removeInactiveCoupling() {
     P_.col(i).setZero();
     P_(i, i) = v;
     x_[i] = 0.0;
+    pattern_.decouple(i);
   }
 }
 

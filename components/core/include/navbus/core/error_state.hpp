@@ -64,6 +64,8 @@ class ErrorState {
   StateVector x_{StateVector::Zero()};
   StateMatrix P_{StateMatrix::Zero()};
   StateMask active_;
+  /// transitionPattern() without the inactive states' coupling.
+  SparsityPattern<layout::kSize> pattern_{transitionPattern()};
   StateMask estimated_{StateMask().set()};
 };
 

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -42,6 +43,32 @@ class SparsityPattern {
     for (int i = 0; i < N; ++i)
       for (int n = 0; n < count(i); ++n) mask(i, col(i, n)) = 1.0;
     return ((A.array() != 0.0) && (mask.array() == 0.0)).count() == 0;
+  }
+
+  /// Removes every element of row i and column i except the diagonal one, which it keeps (or
+  /// adds): the pattern of a matrix whose state i is cut out of the coupling.
+  void decouple(int i) {
+    for (int r = 0; r < N; ++r) {
+      if (r == i) {
+        cols_[idx(r)][0] = static_cast<std::uint8_t>(i);
+        count_[idx(r)] = 1;
+        continue;
+      }
+      int kept = 0;
+      for (int n = 0; n < count(r); ++n) {
+        if (col(r, n) != i) cols_[idx(r)][idx(kept++)] = cols_[idx(r)][idx(n)];
+      }
+      count_[idx(r)] = kept;
+    }
+  }
+
+  /// Whether no element lies below the leading `lead` x `lead` block's columns: rows from
+  /// `lead` on reach no column before it (A = [A11 A12; 0 A22]).
+  bool isBlockUpperTriangular(int lead) const {
+    for (int i = lead; i < N; ++i)
+      for (int n = 0; n < count(i); ++n)
+        if (col(i, n) < lead) return false;
+    return true;
   }
 
   int count(int row) const { return count_[idx(row)]; }
@@ -112,16 +139,41 @@ class SparseRows {
     return out;
   }
 
+  /// A P A^T for a symmetric P and a block upper triangular A = [A11 A12; 0 A22], with A11
+  /// Lead x Lead (the pattern says so: isBlockUpperTriangular(Lead)). The same sums as
+  /// sandwich(), in the same order, so the same result to the last bit; only the products
+  /// the block structure makes zero or redundant are skipped:
+  ///   W = A(0:Lead, :) P                       (the leading rows of A P)
+  ///   out(0:Lead, j) = W A(j, :)^T             (every column j: the leading rows of A P A^T)
+  ///   out(Lead:, Lead:) = A22 P22 A22^T        (A's trailing rows reach trailing columns only)
+  /// and the rest mirrored.
+  template <int Lead>
+  Square sandwichBlockTriangular(const Square& P) const {
+    static_assert(Lead > 0 && Lead < N, "the leading block must be a proper one");
+    constexpr int Trail = N - Lead;
+    assert(p_->isBlockUpperTriangular(Lead));
+    Eigen::Matrix<double, N, Lead> Wt;  // W^T = P A(0:Lead, :)^T
+    for (int i = 0; i < Lead; ++i) Wt.col(i) = sumOfColumns(i, P);
+    const Eigen::Matrix<double, Lead, N> W = Wt.transpose();
+    Square out;
+    for (int j = 0; j < N; ++j) out.col(j).template head<Lead>() = sumOfColumns(j, W);
+    Eigen::Matrix<double, Trail, Trail> Tt;  // P22 A22^T
+    const auto P22 = P.template bottomRightCorner<Trail, Trail>();
+    for (int i = Lead; i < N; ++i) Tt.col(i - Lead) = sumOfColumns(i, P22, Lead);
+    const Eigen::Matrix<double, Trail, Trail> T = Tt.transpose();
+    for (int j = Lead; j < N; ++j) out.col(j).template tail<Trail>() = sumOfColumns(j, T, Lead);
+    out.template bottomLeftCorner<Trail, Lead>() =
+        out.template topRightCorner<Lead, Trail>().transpose();
+    for (int j = 0; j < N; ++j) {
+      for (int i = j + 1; i < (j < Lead ? Lead : N); ++i) out(i, j) = out(j, i);
+    }
+    return out;
+  }
+
   /// B A^T: column i = sum_k A(i, k) B(:, k).
   Square timesTransposed(const Square& B) const {
     Square out;
-    for (int i = 0; i < N; ++i) {
-      out.col(i).setZero();
-      for (int n = 0; n < p_->count(i); ++n) {
-        const int k = p_->col(i, n);
-        out.col(i) += a_(i, k) * B.col(k);
-      }
-    }
+    for (int i = 0; i < N; ++i) out.col(i) = sumOfColumns(i, B);
     return out;
   }
 
@@ -130,6 +182,20 @@ class SparseRows {
 
  private:
   static std::size_t idx(int i) { return static_cast<std::size_t>(i); }
+
+  /// sum_k A(i, k) B(:, k - offset) over row i's elements: column i of B A^T, for a B whose
+  /// columns start at state `offset`.
+  template <class Matrix>
+  Eigen::Matrix<double, Matrix::RowsAtCompileTime, 1> sumOfColumns(int i, const Matrix& B,
+                                                                   int offset = 0) const {
+    Eigen::Matrix<double, Matrix::RowsAtCompileTime, 1> c;
+    c.setZero();
+    for (int n = 0; n < p_->count(i); ++n) {
+      const int k = p_->col(i, n);
+      c += a_(i, k) * B.col(k - offset);
+    }
+    return c;
+  }
 
   double rowDot(int i, const double* v) const {
     double s = 0.0;

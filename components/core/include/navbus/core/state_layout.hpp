@@ -29,6 +29,10 @@ inline constexpr StateBlock kStarTrackerBias{15, 3};
 inline constexpr StateBlock kClockBias{18, 1};
 inline constexpr StateBlock kClockDrift{19, 1};
 inline constexpr int kSize = 20;
+/// The leading states the error dynamics couple (position, velocity, attitude). No navigation
+/// error drives the trailing ones (biases, clock), so every transition matrix is block upper
+/// triangular at this size (ins_error_model.hpp, tested).
+inline constexpr int kCoupledSize = kAtt.end();
 static_assert(kPos.end() == kVel.index && kVel.end() == kAtt.index &&
                   kAtt.end() == kAccelBias.index && kAccelBias.end() == kGyroBias.index &&
                   kGyroBias.end() == kStarTrackerBias.index &&
