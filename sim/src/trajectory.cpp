@@ -166,24 +166,21 @@ CircularOrbitTrajectory::CircularOrbitTrajectory(const OrbitStart& s) : start_(s
   const double ra_offset = std::atan2(std::cos(s.inclination_rad) * std::sin(u0_), std::cos(u0_));
   // Right ascension of the start = start longitude + Earth rotation angle at the start time.
   raan_ = s.longitude_rad + earth::kRotationRate_radps * s.start_gps_s - ra_offset;
+  C_orbit_i_ = (Eigen::AngleAxisd(raan_, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(start_.inclination_rad, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
 }
 
 Eigen::Vector3d CircularOrbitTrajectory::positionEci() const {
   const double u = u0_ + n_ * t_;
   const Eigen::Vector3d p_orbit(radius_m_ * std::cos(u), radius_m_ * std::sin(u), 0.0);
-  return (Eigen::AngleAxisd(raan_, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(start_.inclination_rad, Eigen::Vector3d::UnitX()))
-             .toRotationMatrix() *
-         p_orbit;
+  return C_orbit_i_ * p_orbit;
 }
 
 Eigen::Vector3d CircularOrbitTrajectory::velocityEci() const {
   const double u = u0_ + n_ * t_;
   const Eigen::Vector3d v_orbit(-radius_m_ * n_ * std::sin(u), radius_m_ * n_ * std::cos(u), 0.0);
-  return (Eigen::AngleAxisd(raan_, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(start_.inclination_rad, Eigen::Vector3d::UnitX()))
-             .toRotationMatrix() *
-         v_orbit;
+  return C_orbit_i_ * v_orbit;
 }
 
 core::NavState CircularOrbitTrajectory::state() const {

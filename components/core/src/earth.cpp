@@ -6,11 +6,41 @@
 
 namespace navbus::core::earth {
 
-Radii radiiOfCurvature(double latitude_rad) {
-  const double s = std::sin(latitude_rad);
+namespace {
+/// The sines and cosines of a position's latitude (l) and longitude (o), for the functions that
+/// need several of them: computed once, the same values as where each is used.
+struct SinCos {
+  double sl, cl, so, co;
+};
+SinCos sinCosOf(double latitude_rad, double longitude_rad) {
+  return {std::sin(latitude_rad), std::cos(latitude_rad), std::sin(longitude_rad),
+          std::cos(longitude_rad)};
+}
+
+Radii radiiFromSinLatitude(double s) {
   const double w2 = 1.0 - kEccentricitySq * s * s;
   const double w = std::sqrt(w2);
   return {kSemiMajorAxis_m * (1.0 - kEccentricitySq) / (w2 * w), kSemiMajorAxis_m / w};
+}
+
+Eigen::Vector3d ecefOf(const SinCos& t, double height_m) {
+  const double n = radiiFromSinLatitude(t.sl).prime_vertical_m;
+  return {(n + height_m) * t.cl * t.co, (n + height_m) * t.cl * t.so,
+          (n * (1.0 - kEccentricitySq) + height_m) * t.sl};
+}
+
+Eigen::Matrix3d nedToEcef(const SinCos& t) {
+  Eigen::Matrix3d c;
+  // Columns are the N, E, D unit vectors expressed in ECEF.
+  c << -t.sl * t.co, -t.so, -t.cl * t.co,  //
+      -t.sl * t.so, t.co, -t.cl * t.so,    //
+      t.cl, 0.0, -t.sl;
+  return c;
+}
+}  // namespace
+
+Radii radiiOfCurvature(double latitude_rad) {
+  return radiiFromSinLatitude(std::sin(latitude_rad));
 }
 
 double normalGravity(double latitude_rad, double height_m) {
@@ -40,10 +70,11 @@ Eigen::Vector3d gravityNed(GravityModel model, const Geodetic& position) {
   if (model == GravityModel::kWgs84Normal) {
     return gravityNed(position.latitude_rad, position.height_m);
   }
-  const Eigen::Vector3d r = geodeticToEcef(position);
+  const SinCos t = sinCosOf(position.latitude_rad, position.longitude_rad);
+  const Eigen::Vector3d r = ecefOf(t, position.height_m);
   const Eigen::Vector3d w(0.0, 0.0, kRotationRate_radps);
   const Eigen::Vector3d g_e = pointMassGravitationEcef(r) - w.cross(w.cross(r));
-  return C_n_e(position.latitude_rad, position.longitude_rad).transpose() * g_e;
+  return nedToEcef(t).transpose() * g_e;
 }
 
 Geodetic offsetNed(const Geodetic& p, const Eigen::Vector3d& d) {
@@ -64,13 +95,7 @@ Eigen::Vector3d differenceNed(const Geodetic& a, const Geodetic& b) {
 }
 
 Eigen::Vector3d geodeticToEcef(const Geodetic& p) {
-  const Radii r = radiiOfCurvature(p.latitude_rad);
-  const double cl = std::cos(p.latitude_rad);
-  const double sl = std::sin(p.latitude_rad);
-  const double n = r.prime_vertical_m;
-  return {(n + p.height_m) * cl * std::cos(p.longitude_rad),
-          (n + p.height_m) * cl * std::sin(p.longitude_rad),
-          (n * (1.0 - kEccentricitySq) + p.height_m) * sl};
+  return ecefOf(sinCosOf(p.latitude_rad, p.longitude_rad), p.height_m);
 }
 
 Geodetic ecefToGeodetic(const Eigen::Vector3d& r) {
@@ -102,16 +127,7 @@ Geodetic ecefToGeodetic(const Eigen::Vector3d& r) {
 }
 
 Eigen::Matrix3d C_n_e(double latitude_rad, double longitude_rad) {
-  const double sl = std::sin(latitude_rad);
-  const double cl = std::cos(latitude_rad);
-  const double so = std::sin(longitude_rad);
-  const double co = std::cos(longitude_rad);
-  Eigen::Matrix3d c;
-  // Columns are the N, E, D unit vectors expressed in ECEF.
-  c << -sl * co, -so, -cl * co,  //
-      -sl * so, co, -cl * so,    //
-      cl, 0.0, -sl;
-  return c;
+  return nedToEcef(sinCosOf(latitude_rad, longitude_rad));
 }
 
 Eigen::Vector3d omegaIeNed(double latitude_rad) {
@@ -120,7 +136,10 @@ Eigen::Vector3d omegaIeNed(double latitude_rad) {
 }
 
 Eigen::Vector3d omegaEnNed(const Geodetic& p, const Eigen::Vector3d& v) {
-  const Radii r = radiiOfCurvature(p.latitude_rad);
+  return omegaEnNed(p, v, radiiOfCurvature(p.latitude_rad));
+}
+
+Eigen::Vector3d omegaEnNed(const Geodetic& p, const Eigen::Vector3d& v, const Radii& r) {
   const double rn = r.prime_vertical_m + p.height_m;
   const double rm = r.meridian_m + p.height_m;
   return {v.y() / rn, -v.x() / rm, -v.y() * std::tan(p.latitude_rad) / rn};

@@ -38,6 +38,8 @@ void StrapdownNed::propagate(const ImuIncrement& inc) {
 
   // Mid-interval extrapolation of position and velocity, refined once with the new velocity.
   Eigen::Vector3d vel1 = vel0;
+  const earth::Radii r0 = earth::radiiOfCurvature(pos0.latitude_rad);
+  const double cos_lat0 = std::cos(pos0.latitude_rad);
   earth::Geodetic pos_mid = pos0;
   Eigen::Vector3d vel_mid = vel0;
   for (int pass = 0; pass < 2; ++pass) {
@@ -51,12 +53,11 @@ void StrapdownNed::propagate(const ImuIncrement& inc) {
     vel1 = vel0 + dv_sf_n + dv_cor_n;
     vel_mid = 0.5 * (vel0 + vel1);
     // Position at mid-interval for the next pass (half step with the mid velocity).
-    const earth::Radii r = earth::radiiOfCurvature(pos0.latitude_rad);
     pos_mid.latitude_rad =
-        pos0.latitude_rad + 0.5 * dt * vel_mid.x() / (r.meridian_m + pos0.height_m);
-    pos_mid.longitude_rad = pos0.longitude_rad + 0.5 * dt * vel_mid.y() /
-                                                     ((r.prime_vertical_m + pos0.height_m) *
-                                                      std::cos(pos0.latitude_rad));
+        pos0.latitude_rad + 0.5 * dt * vel_mid.x() / (r0.meridian_m + pos0.height_m);
+    pos_mid.longitude_rad =
+        pos0.longitude_rad +
+        0.5 * dt * vel_mid.y() / ((r0.prime_vertical_m + pos0.height_m) * cos_lat0);
     pos_mid.height_m = pos0.height_m - 0.5 * dt * vel_mid.z();
   }
 

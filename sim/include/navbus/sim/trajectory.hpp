@@ -112,6 +112,9 @@ class CircularOrbitTrajectory : public Trajectory {
   double radius_m_;
   double n_;  ///< mean motion
   double raan_;
+  /// Orbit plane to ECI: rotation about z by the right ascension of the ascending node, then
+  /// about x by the inclination (constant; computed once).
+  Eigen::Matrix3d C_orbit_i_;
   double u0_;  ///< argument of latitude at the start
   double t_{0.0};
 };

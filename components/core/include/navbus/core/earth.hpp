@@ -74,6 +74,9 @@ Eigen::Vector3d omegaIeNed(double latitude_rad);
 
 /// Transport rate (rotation of NED w.r.t. ECEF) for a velocity w.r.t. Earth in NED.
 Eigen::Vector3d omegaEnNed(const Geodetic& position, const Eigen::Vector3d& vel_ned_mps);
+/// The same with the radii of curvature at the position's latitude already computed.
+Eigen::Vector3d omegaEnNed(const Geodetic& position, const Eigen::Vector3d& vel_ned_mps,
+                           const Radii& radii);
 
 /// Rotation from ECI (coinciding with ECEF at GPS time 0) into ECEF at GPS time t.
 Eigen::Matrix3d C_i_e(double gps_time_s);
