@@ -1,5 +1,7 @@
 #include "frame_prefetcher.hpp"
 
+#include <algorithm>
+
 namespace navbus::tool {
 
 FramePrefetcher::FramePrefetcher(sim::ScenarioSource& source, std::int64_t total)
@@ -18,8 +20,17 @@ void FramePrefetcher::produce(sim::ScenarioSource& source, std::int64_t total) {
   try {
     while (source.index() < total) {
       std::vector<sim::SensorFrame> batch;
-      batch.reserve(kBatch);
-      while (batch.size() < kBatch && source.index() < total) batch.push_back(source.next());
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!spare_.empty()) {
+          batch = std::move(spare_.back());
+          spare_.pop_back();
+        }
+      }
+      const auto frames = static_cast<std::size_t>(
+          std::min<std::int64_t>(static_cast<std::int64_t>(kBatch), total - source.index()));
+      batch.resize(frames);
+      for (sim::SensorFrame& f : batch) source.next(f);
       std::unique_lock<std::mutex> lock(mutex_);
       changed_.wait(lock, [this] { return ready_.size() < kMaxBatches || stopping_; });
       if (stopping_) return;
@@ -38,13 +49,15 @@ void FramePrefetcher::produce(sim::ScenarioSource& source, std::int64_t total) {
   changed_.notify_all();
 }
 
-std::optional<sim::SensorFrame> FramePrefetcher::next() {
+const sim::SensorFrame* FramePrefetcher::next() {
   if (position_ == current_.size()) {
     std::unique_lock<std::mutex> lock(mutex_);
+    if (!current_.empty()) spare_.push_back(std::move(current_));
+    current_.clear();
     changed_.wait(lock, [this] { return !ready_.empty() || done_; });
     if (ready_.empty()) {
       if (error_) std::rethrow_exception(error_);
-      return std::nullopt;
+      return nullptr;
     }
     current_ = std::move(ready_.front());
     ready_.pop_front();
@@ -52,7 +65,7 @@ std::optional<sim::SensorFrame> FramePrefetcher::next() {
     lock.unlock();
     changed_.notify_all();
   }
-  return std::move(current_[position_++]);
+  return &current_[position_++];
 }
 
 }  // namespace navbus::tool

@@ -174,7 +174,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   // Raw blocks only feed the fault manager's dither monitor.
   emitted.publish_raw = sim.publish_raw && faults && faults->dither().has_value();
   FramePrefetcher frames(source, total);
-  while (const std::optional<sim::SensorFrame> next = frames.next()) {
+  while (const sim::SensorFrame* next = frames.next()) {
     const sim::SensorFrame& f = *next;
     truths.push_back({f.truth, f.truth_accel_bias_b_mps2, f.truth_gyro_bias_b_radps,
                       f.truth_star_tracker_bias_b_rad});

@@ -52,9 +52,28 @@ Eigen::Vector3d ScenarioSource::frozen(SensorKind sensor, const Eigen::Vector3d&
   return out;
 }
 
+namespace {
+/// A default frame that keeps the capacity of its sample buffers.
+void clearKeepingBuffers(SensorFrame& f) {
+  std::vector<RawImuSample> raw = std::move(f.raw.samples);
+  std::vector<SatelliteMeasurement> satellites = std::move(f.gnss.satellites);
+  f = SensorFrame{};
+  raw.clear();
+  satellites.clear();
+  f.raw.samples = std::move(raw);
+  f.gnss.satellites = std::move(satellites);
+}
+}  // namespace
+
 SensorFrame ScenarioSource::next() {
-  ++index_;
   SensorFrame f;
+  next(f);
+  return f;
+}
+
+void ScenarioSource::next(SensorFrame& f) {
+  ++index_;
+  clearKeepingBuffers(f);
   const std::int64_t t_end = config_.start_time_ns + index_ * config_.imu_period_ns;
   const std::int64_t t_begin = t_end - config_.imu_period_ns;
   f.time_ns = t_end;
@@ -143,7 +162,6 @@ SensorFrame ScenarioSource::next() {
     }
   }
   f.truth_star_tracker_bias_b_rad = star_bias_b_rad_;
-  return f;
 }
 
 }  // namespace navbus::sim

@@ -145,6 +145,15 @@ Eigen::Vector3d omegaEnNed(const Geodetic& p, const Eigen::Vector3d& v, const Ra
   return {v.y() / rn, -v.x() / rm, -v.y() * std::tan(p.latitude_rad) / rn};
 }
 
+LocalEarth localEarth(GravityModel model, const Geodetic& p, const Eigen::Vector3d& v) {
+  LocalEarth e;
+  e.radii = radiiOfCurvature(p.latitude_rad);
+  e.w_ie_ned = omegaIeNed(p.latitude_rad);
+  e.w_en_ned = omegaEnNed(p, v, e.radii);
+  e.g_ned = gravityNed(model, p);
+  return e;
+}
+
 Eigen::Matrix3d C_i_e(double gps_time_s) {
   const double a = kRotationRate_radps * gps_time_s;
   const double c = std::cos(a);

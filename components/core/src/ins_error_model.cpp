@@ -9,15 +9,20 @@ namespace navbus::core {
 
 StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
                           earth::GravityModel gravity) {
+  return errorDynamics(s, f_b, earth::localEarth(gravity, s.position, s.vel_ned_mps));
+}
+
+StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
+                          const earth::LocalEarth& at_state) {
   using namespace layout;
   const Eigen::Matrix3d C_b_n = s.q_b_to_n.toRotationMatrix();
   const Eigen::Vector3d f_n = C_b_n * f_b;
-  const Eigen::Vector3d w_ie = earth::omegaIeNed(s.position.latitude_rad);
-  const earth::Radii r = earth::radiiOfCurvature(s.position.latitude_rad);
-  const Eigen::Vector3d w_en = earth::omegaEnNed(s.position, s.vel_ned_mps, r);
+  const Eigen::Vector3d& w_ie = at_state.w_ie_ned;
+  const earth::Radii& r = at_state.radii;
+  const Eigen::Vector3d& w_en = at_state.w_en_ned;
   const double rn = r.prime_vertical_m + s.position.height_m;
   const double rm = r.meridian_m + s.position.height_m;
-  const double g = earth::gravityNed(gravity, s.position).z();
+  const double g = at_state.g_ned.z();
   const double radius = std::sqrt(rm * rn);
 
   StateMatrix F = StateMatrix::Zero();

@@ -88,9 +88,10 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   inc.delta_angle_b_rad -= gyro_bias_ * inc.interval_s;
   const double dt = inc.interval_s;
   // F at the state at the start of the interval (first-order hold of the error dynamics).
+  const earth::LocalEarth at_state = ins_.earthAtState();
   StateMatrix Phi =
-      transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, tuning_.gravity), dt);
-  ins_.propagate(inc);
+      transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, at_state), dt);
+  ins_.propagate(inc, at_state);
   clock_bias_m_ += clock_drift_mps_ * dt;
   if (suspend_filter) return;
   // Discrete process noise: white specific force / rate noise into velocity / attitude

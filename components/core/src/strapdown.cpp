@@ -18,7 +18,7 @@ void StrapdownNed::restartAt(std::int64_t time_ns) {
   has_previous_ = false;
 }
 
-void StrapdownNed::propagate(const ImuIncrement& inc) {
+void StrapdownNed::propagate(const ImuIncrement& inc, const earth::LocalEarth& at_state) {
   const double dt = inc.interval_s;
   const Eigen::Vector3d& dth = inc.delta_angle_b_rad;
   const Eigen::Vector3d& dv = inc.delta_vel_b_mps;
@@ -38,17 +38,20 @@ void StrapdownNed::propagate(const ImuIncrement& inc) {
 
   // Mid-interval extrapolation of position and velocity, refined once with the new velocity.
   Eigen::Vector3d vel1 = vel0;
-  const earth::Radii r0 = earth::radiiOfCurvature(pos0.latitude_rad);
+  const earth::Radii& r0 = at_state.radii;
   const double cos_lat0 = std::cos(pos0.latitude_rad);
   earth::Geodetic pos_mid = pos0;
   Eigen::Vector3d vel_mid = vel0;
   for (int pass = 0; pass < 2; ++pass) {
-    const Eigen::Vector3d w_ie = earth::omegaIeNed(pos_mid.latitude_rad);
-    const Eigen::Vector3d w_en = earth::omegaEnNed(pos_mid, vel_mid);
+    // The first pass is at the state itself.
+    const Eigen::Vector3d w_ie =
+        pass == 0 ? at_state.w_ie_ned : earth::omegaIeNed(pos_mid.latitude_rad);
+    const Eigen::Vector3d w_en =
+        pass == 0 ? at_state.w_en_ned : earth::omegaEnNed(pos_mid, vel_mid);
     const Eigen::Vector3d zeta = (w_ie + w_en) * dt;  // NED rotation over the interval
     const Eigen::Vector3d dv_sf_n =
         (Eigen::Matrix3d::Identity() - 0.5 * skew(zeta)) * C_b_n0 * dv_sf_b;
-    const Eigen::Vector3d g_n = earth::gravityNed(gravity_, pos_mid);
+    const Eigen::Vector3d g_n = pass == 0 ? at_state.g_ned : earth::gravityNed(gravity_, pos_mid);
     const Eigen::Vector3d dv_cor_n = (g_n - (2.0 * w_ie + w_en).cross(vel_mid)) * dt;
     vel1 = vel0 + dv_sf_n + dv_cor_n;
     vel_mid = 0.5 * (vel0 + vel1);

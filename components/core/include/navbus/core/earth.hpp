@@ -78,6 +78,17 @@ Eigen::Vector3d omegaEnNed(const Geodetic& position, const Eigen::Vector3d& vel_
 Eigen::Vector3d omegaEnNed(const Geodetic& position, const Eigen::Vector3d& vel_ned_mps,
                            const Radii& radii);
 
+/// The Earth at one position and velocity, as the mechanization and the error model both use
+/// it at the start of a step: computed once per step.
+struct LocalEarth {
+  Radii radii;
+  Eigen::Vector3d w_ie_ned;  ///< omegaIeNed
+  Eigen::Vector3d w_en_ned;  ///< omegaEnNed
+  Eigen::Vector3d g_ned;     ///< gravityNed
+};
+LocalEarth localEarth(GravityModel model, const Geodetic& position,
+                      const Eigen::Vector3d& vel_ned_mps);
+
 /// Rotation from ECI (coinciding with ECEF at GPS time 0) into ECEF at GPS time t.
 Eigen::Matrix3d C_i_e(double gps_time_s);
 

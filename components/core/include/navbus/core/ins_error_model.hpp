@@ -22,6 +22,9 @@ using StateMatrix = Eigen::Matrix<double, layout::kSize, layout::kSize>;
 /// couplings of position error into the Earth and transport rates are neglected.
 StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
                           earth::GravityModel gravity);
+/// The same with the Earth at the state already computed (earth::localEarth).
+StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
+                          const earth::LocalEarth& at_state);
 
 /// Transition matrix over dt: I + F dt + (F dt)^2 / 2.
 StateMatrix transitionMatrix(const StateMatrix& F, double dt);

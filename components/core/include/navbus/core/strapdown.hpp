@@ -39,7 +39,14 @@ class StrapdownNed {
   void initialize(const NavState& state);
 
   /// Integrates one increment whose interval ends at inc.time_ns and starts at state time.
-  void propagate(const ImuIncrement& inc);
+  void propagate(const ImuIncrement& inc) { propagate(inc, earthAtState()); }
+  /// The same, with the Earth at the state (earthAtState()) already computed for the error
+  /// model of the same step.
+  void propagate(const ImuIncrement& inc, const earth::LocalEarth& at_state);
+  /// The Earth rates, radii and gravity at the current position and velocity.
+  earth::LocalEarth earthAtState() const {
+    return earth::localEarth(gravity_, state_.position, state_.vel_ned_mps);
+  }
 
   /// Restarts the integration at a new time without propagating across a gap
   /// (the vehicle state cannot be known across missing inertial data).
