@@ -30,7 +30,8 @@ class ErrorState {
   /// variance, is not driven by the active ones and does not drive them (seed 004 fig. 9: each
   /// reduced filter uses its region of the 15-state system matrix). Phi's nonzero elements
   /// must lie within transitionPattern() (ins_error_model.hpp), as every transitionMatrix()
-  /// does (asserted in builds without NDEBUG).
+  /// does (asserted in builds without NDEBUG); that pattern is block upper triangular at
+  /// layout::kCoupledSize, which the product exploits (sparse_rows.hpp).
   void predict(const StateMatrix& Phi, const StateVector& q_diagonal);
 
   /// Sequential Joseph-form update, rows decorrelated by the Cholesky factor of R, inactive
