@@ -578,9 +578,12 @@ std::optional<std::string> FilterPipeline::checkCommand(const navbus::FilterComm
                            static_cast<int>(c.sensor()));
       if (c.axis() > 2) return fmt::format("axis {} outside 0..2", c.axis());
       const bool accel = c.sensor() == navbus::SOURCE_ACCELEROMETER;
-      const double limit =
-          accel ? config_.max_accel_compensation_mps2 : config_.max_gyro_compensation_radps;
-      if (!std::isfinite(c.bias_sigma()) || c.bias_sigma() < 0.0 || c.bias_sigma() > limit)
+      const double limit = compensationLimit(accel);
+      // A re-learned bias is unknown up to bias_sigma; one beyond the limit is re-learned up to
+      // the limit (relearnSigma), the largest bias the filter is configured to take.
+      const bool sigma_clamped = c.kind() == navbus::CMD_RELEARN_BIAS;
+      if (!std::isfinite(c.bias_sigma()) || c.bias_sigma() < 0.0 ||
+          (c.bias_sigma() > limit && !sigma_clamped))
         return fmt::format("bias_sigma {} outside 0..{}", c.bias_sigma(), limit);
       if (!std::isfinite(c.bias()) || std::abs(c.bias()) > limit)
         return fmt::format(
@@ -593,6 +596,22 @@ std::optional<std::string> FilterPipeline::checkCommand(const navbus::FilterComm
   }
 }
 
+double FilterPipeline::compensationLimit(bool accel) const {
+  return accel ? config_.max_accel_compensation_mps2 : config_.max_gyro_compensation_radps;
+}
+
+double FilterPipeline::relearnSigma(const navbus::FilterCommand& c) {
+  const double limit = compensationLimit(c.sensor() == navbus::SOURCE_ACCELEROMETER);
+  if (c.bias_sigma() <= limit) return c.bias_sigma();
+  ++relearn_sigmas_clamped_;
+  spdlog::warn(
+      "command {} from '{}': re-learn bias_sigma {} beyond the compensation limit {} (recovery."
+      "max_{}_compensation): re-learned up to the limit; {} clamped so far",
+      c.command_id(), c.issuer(), c.bias_sigma(), limit,
+      c.sensor() == navbus::SOURCE_ACCELEROMETER ? "accel" : "gyro", relearn_sigmas_clamped_);
+  return limit;
+}
+
 bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
   switch (c.kind()) {
     case navbus::CMD_EXCLUDE_SATELLITE:
@@ -602,7 +621,7 @@ bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
       engine_.readmitSatellite(c.sv_id(), toCore(c.scope()));
       return true;
     case navbus::CMD_RELEARN_BIAS:
-      engine_.relearnBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias_sigma());
+      engine_.relearnBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), relearnSigma(c));
       return true;
     case navbus::CMD_COMPENSATE_BIAS:
       engine_.compensateBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias(),
@@ -667,6 +686,7 @@ std::string FilterPipeline::summary() const {
       << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
       << ", stage switches " << n.stage_switches << ", decisions seen " << decisions_seen_
       << ", commands applied " << commands_applied_ << " refused " << commands_refused_
+      << " (re-learn sigmas clamped to the compensation limit " << relearn_sigmas_clamped_ << ")"
       << " (unauthorized issuer " << commands_unauthorized_ << ", issuer not the writer's identity "
       << commands_impersonated_ << ", stale " << commands_stale_ << ") late " << commands_late_
       << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending()

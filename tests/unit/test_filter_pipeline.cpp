@@ -4,13 +4,16 @@
 #include <gtest/gtest.h>
 
 #include "frame_publisher.hpp"
+#include "navbus/bus/config.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/topics.hpp"
+#include "navbus/core/state_layout.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/nav_filter/monitor_liveness.hpp"
 #include "navbus/sim/scenario_source.hpp"
+#include "scenario_config.hpp"
 
 #include <map>
 
@@ -134,6 +137,73 @@ TEST(FilterPipelineRestart, SourceRestartingAtAnEarlierTimeStartsANewRun) {
     EXPECT_EQ(a.q_b_to_n(), b.q_b_to_n());
   }
   EXPECT_NE(pipeline.summary().find("new runs after a source restart 1"), std::string::npos)
+      << pipeline.summary();
+}
+
+// A fault manager's re-learn whose sigma exceeds the filter's compensation limit (an ambiguous
+// isolation with a poorly known magnitude) is applied up to the limit and counted; a
+// compensation beyond the limit is still refused.
+TEST(FilterPipelineCommands, RelearnBeyondTheCompensationLimitRelearnsUpToTheLimit) {
+  // Given seed 001's loosely coupled filter fed by its scenario for 2 s,
+  const std::string dir = NAVBUS_SCENARIO_DIR;
+  auto cfg = nav_filter::parseFilterConfig(
+      bus::loadYamlFile(dir + "/../../config/filter_seed001_lc.yaml"));
+  cfg.fault_monitor.reset();
+  const sensor_sim::SimConfig sim =
+      sensor_sim::parseSimConfig(bus::loadYamlFile(dir + "/seed001_leo.yaml"));
+  bus::HealthCounters health("test");
+  std::vector<NavigationSolution> solutions;
+  nav_filter::FilterPipeline pipeline(
+      cfg, health, {[&](const NavigationSolution& s) { solutions.push_back(s); }, nullptr});
+  sim::ScenarioSource src(sim.scenario);
+  sensor_sim::FrameSequence seq;
+  auto feed = [&](int frames) {
+    for (int k = 0; k < frames; ++k) {
+      const sim::SensorFrame f = src.next();
+      sensor_sim::emitFrame(f, sim, seq, [&](const auto& sample) {
+        using T = std::decay_t<decltype(sample)>;
+        if constexpr (std::is_same_v<T, ImuIncrement>) pipeline.onImu(sample);
+        if constexpr (std::is_same_v<T, GnssFix>) pipeline.onGnssFix(sample);
+        if constexpr (std::is_same_v<T, StarTrackerAttitude>) pipeline.onStarTracker(sample);
+        return true;
+      });
+      pipeline.pump(f.increment.time_ns);
+    }
+  };
+  feed(400);
+  ASSERT_FALSE(solutions.empty());
+  const double limit = cfg.max_gyro_compensation_radps;
+  constexpr int kGyroY = core::layout::kGyroBias.index + 1;
+  const double before = pipeline.engine().covariance()(kGyroY, kGyroY);
+
+  // when a fault manager asks it to re-learn the y gyro's bias with twice the limit as sigma,
+  FilterCommand c;
+  c.command_id(1);
+  c.vehicle_id(cfg.vehicle_id);
+  c.issuer("fault-manager");
+  c.time_gps_ns(solutions.back().time_gps_ns());
+  c.kind(CMD_RELEARN_BIAS);
+  c.sensor(SOURCE_GYRO);
+  c.axis(1);
+  c.bias(0.0);
+  c.bias_sigma(2.0 * limit);
+  pipeline.onCommand(c);
+  feed(1);  // released in data-time order (no aiding in this IMU step, no bias noise)
+
+  // then the bias variance grows by the limit squared, the command counts as applied and the
+  // clamp is counted;
+  EXPECT_DOUBLE_EQ(pipeline.engine().covariance()(kGyroY, kGyroY), before + limit * limit);
+  EXPECT_NE(pipeline.summary().find("commands applied 1 refused 0 (re-learn sigmas clamped to "
+                                    "the compensation limit 1)"),
+            std::string::npos)
+      << pipeline.summary();
+
+  // a compensation beyond the limit is still refused.
+  c.command_id(2);
+  c.kind(CMD_COMPENSATE_BIAS);
+  pipeline.onCommand(c);
+  feed(1);
+  EXPECT_NE(pipeline.summary().find("commands applied 1 refused 1"), std::string::npos)
       << pipeline.summary();
 }
 

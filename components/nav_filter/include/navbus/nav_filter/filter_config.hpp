@@ -43,7 +43,8 @@ struct FilterConfig {
   std::int64_t recovery_snapshot_period_ns{1'000'000'000};
   /// A satellite is excluded from this long before the estimated onset [ns].
   std::int64_t recovery_onset_margin_ns{5'000'000'000};
-  /// Largest bias a CMD_COMPENSATE_BIAS may add [m/s^2, rad/s]; beyond, refused.
+  /// Largest bias a CMD_COMPENSATE_BIAS may add [m/s^2, rad/s]; beyond, refused. A
+  /// CMD_RELEARN_BIAS whose bias_sigma exceeds it re-learns up to it (counted).
   double max_accel_compensation_mps2{0.5};
   double max_gyro_compensation_radps{1e-3};
   /// QoS profile of the solution writer (qos/navbus_qos.xml): navbus_solution_writer, or

@@ -135,6 +135,10 @@ class FilterPipeline {
   /// Why a command cannot be applied (field and value), or nothing.
   std::optional<std::string> checkCommand(const navbus::FilterCommand& c) const;
   bool applyToEngine(const navbus::FilterCommand& c);
+  /// recovery.max_*_compensation of the accelerometers or the gyros [m/s^2, rad/s].
+  double compensationLimit(bool accel) const;
+  /// A re-learn's bias_sigma, at most the compensation limit (counted and logged when clamped).
+  double relearnSigma(const navbus::FilterCommand& c);
   void executeCommand(const navbus::FilterCommand& c);
   bool recoversFromOnset(const navbus::FilterCommand& c) const;
   std::int64_t restorePoint(const navbus::FilterCommand& c) const;
@@ -174,8 +178,9 @@ class FilterPipeline {
   std::uint64_t decisions_seen_{0};
   std::uint64_t commands_applied_{0};
   std::uint64_t commands_refused_{0};
-  std::uint64_t commands_unauthorized_{0};  ///< of those refused: not from a configured issuer
-  std::uint64_t commands_impersonated_{0};  ///< of those refused: issuer not the writer's identity
+  std::uint64_t relearn_sigmas_clamped_{0};  ///< CMD_RELEARN_BIAS applied at the limit
+  std::uint64_t commands_unauthorized_{0};   ///< of those refused: not from a configured issuer
+  std::uint64_t commands_impersonated_{0};   ///< of those refused: issuer not the writer's identity
   std::uint64_t commands_stale_{0};  ///< of those refused: about data before this run's first input
   std::int64_t first_input_ns_{-1};  ///< data time of the first input processed (-1: none yet)
   bus::StreamCounters& command_counters_;  ///< health of the command topic
