@@ -686,9 +686,9 @@ std::string FilterPipeline::summary() const {
       << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
       << ", stage switches " << n.stage_switches << ", decisions seen " << decisions_seen_
       << ", commands applied " << commands_applied_ << " refused " << commands_refused_
-      << " (re-learn sigmas clamped to the compensation limit " << relearn_sigmas_clamped_ << ")"
       << " (unauthorized issuer " << commands_unauthorized_ << ", issuer not the writer's identity "
       << commands_impersonated_ << ", stale " << commands_stale_ << ") late " << commands_late_
+      << ", re-learn sigmas clamped to the compensation limit " << relearn_sigmas_clamped_
       << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending()
       << ", recoveries from onset " << history_.rollbacks() << " (onset beyond history "
       << history_.outOfReach() << ")";
