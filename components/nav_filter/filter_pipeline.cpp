@@ -581,9 +581,9 @@ std::optional<std::string> FilterPipeline::checkCommand(const navbus::FilterComm
       const double limit = compensationLimit(accel);
       // A re-learned bias is unknown up to bias_sigma; one beyond the limit is re-learned up to
       // the limit (relearnSigma), the largest bias the filter is configured to take.
-      const bool sigma_clamped = c.kind() == navbus::CMD_RELEARN_BIAS;
+      const bool relearn = c.kind() == navbus::CMD_RELEARN_BIAS;
       if (!std::isfinite(c.bias_sigma()) || c.bias_sigma() < 0.0 ||
-          (c.bias_sigma() > limit && !sigma_clamped))
+          (c.bias_sigma() > limit && !relearn))
         return fmt::format("bias_sigma {} outside 0..{}", c.bias_sigma(), limit);
       if (!std::isfinite(c.bias()) || std::abs(c.bias()) > limit)
         return fmt::format(

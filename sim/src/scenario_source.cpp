@@ -53,15 +53,13 @@ Eigen::Vector3d ScenarioSource::frozen(SensorKind sensor, const Eigen::Vector3d&
 }
 
 namespace {
-/// A default frame that keeps the capacity of its sample buffers.
-void clearKeepingBuffers(SensorFrame& f) {
+/// A default frame that keeps the capacity of its raw-sample buffer (one per IMU frame; a GNSS
+/// epoch's satellites come as a new vector from the receiver model, 10 Hz at most).
+void clearKeepingRawBuffer(SensorFrame& f) {
   std::vector<RawImuSample> raw = std::move(f.raw.samples);
-  std::vector<SatelliteMeasurement> satellites = std::move(f.gnss.satellites);
   f = SensorFrame{};
   raw.clear();
-  satellites.clear();
   f.raw.samples = std::move(raw);
-  f.gnss.satellites = std::move(satellites);
 }
 }  // namespace
 
@@ -73,7 +71,7 @@ SensorFrame ScenarioSource::next() {
 
 void ScenarioSource::next(SensorFrame& f) {
   ++index_;
-  clearKeepingBuffers(f);
+  clearKeepingRawBuffer(f);
   const std::int64_t t_end = config_.start_time_ns + index_ * config_.imu_period_ns;
   const std::int64_t t_begin = t_end - config_.imu_period_ns;
   f.time_ns = t_end;

@@ -44,15 +44,14 @@ void StrapdownNed::propagate(const ImuIncrement& inc, const earth::LocalEarth& a
   Eigen::Vector3d vel_mid = vel0;
   for (int pass = 0; pass < 2; ++pass) {
     // The first pass is at the state itself.
-    const Eigen::Vector3d w_ie =
-        pass == 0 ? at_state.w_ie_ned : earth::omegaIeNed(pos_mid.latitude_rad);
-    const Eigen::Vector3d w_en =
-        pass == 0 ? at_state.w_en_ned : earth::omegaEnNed(pos_mid, vel_mid);
+    const earth::LocalEarth e =
+        pass == 0 ? at_state : earth::localEarth(gravity_, pos_mid, vel_mid);
+    const Eigen::Vector3d& w_ie = e.w_ie_ned;
+    const Eigen::Vector3d& w_en = e.w_en_ned;
     const Eigen::Vector3d zeta = (w_ie + w_en) * dt;  // NED rotation over the interval
     const Eigen::Vector3d dv_sf_n =
         (Eigen::Matrix3d::Identity() - 0.5 * skew(zeta)) * C_b_n0 * dv_sf_b;
-    const Eigen::Vector3d g_n = pass == 0 ? at_state.g_ned : earth::gravityNed(gravity_, pos_mid);
-    const Eigen::Vector3d dv_cor_n = (g_n - (2.0 * w_ie + w_en).cross(vel_mid)) * dt;
+    const Eigen::Vector3d dv_cor_n = (e.g_ned - (2.0 * w_ie + w_en).cross(vel_mid)) * dt;
     vel1 = vel0 + dv_sf_n + dv_cor_n;
     vel_mid = 0.5 * (vel0 + vel1);
     // Position at mid-interval for the next pass (half step with the mid velocity).

@@ -48,8 +48,8 @@ class ScenarioSource {
  public:
   explicit ScenarioSource(const ScenarioConfig& config);
   SensorFrame next();
-  /// The same frame written into `frame`, whose buffers it reuses: no allocation once they have
-  /// grown to the scenario's sizes (the offline runner recycles its frames).
+  /// The same frame written into `frame`, whose raw-sample buffer it reuses: no allocation per
+  /// IMU frame once it has grown (the offline runner recycles its frames).
   void next(SensorFrame& frame);
   std::int64_t index() const { return index_; }
   /// The truth at the current time (before the first next(): the initial state).

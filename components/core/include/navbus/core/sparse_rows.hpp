@@ -125,28 +125,14 @@ class SparseRows {
     return out;
   }
 
-  /// A P A^T for a symmetric P; the result is symmetric to the last bit (the upper triangle is
-  /// computed, the lower one mirrored).
-  Square sandwich(const Square& P) const {
-    // T = P A^T: column i = sum_k A(i, k) P(:, k). A P A^T = A T = (T^T A^T)^T, and for a
-    // symmetric result that is T^T A^T. Both steps are sums of contiguous columns (vectorized
-    // axpys); the upper triangle is then mirrored, so the result is exactly symmetric.
-    const Square Tt = timesTransposed(P).transpose();
-    Square out = timesTransposed(Tt);
-    for (int j = 0; j < N; ++j) {
-      for (int i = 0; i < j; ++i) out(j, i) = out(i, j);
-    }
-    return out;
-  }
-
   /// A P A^T for a symmetric P and a block upper triangular A = [A11 A12; 0 A22], with A11
-  /// Lead x Lead (the pattern says so: isBlockUpperTriangular(Lead)). The same sums as
-  /// sandwich(), in the same order, so the same result to the last bit; only the products
-  /// the block structure makes zero or redundant are skipped:
+  /// Lead x Lead (the pattern says so: isBlockUpperTriangular(Lead)). Each step is a sum of
+  /// contiguous columns (vectorized axpys), and only the products the block structure does not
+  /// make zero or redundant are formed:
   ///   W = A(0:Lead, :) P                       (the leading rows of A P)
   ///   out(0:Lead, j) = W A(j, :)^T             (every column j: the leading rows of A P A^T)
   ///   out(Lead:, Lead:) = A22 P22 A22^T        (A's trailing rows reach trailing columns only)
-  /// and the rest mirrored.
+  /// and the rest mirrored, so the result is symmetric to the last bit.
   template <int Lead>
   Square sandwichBlockTriangular(const Square& P) const {
     static_assert(Lead > 0 && Lead < N, "the leading block must be a proper one");
