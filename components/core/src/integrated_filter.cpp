@@ -103,9 +103,11 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   q[kClockDrift.index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
   if (central_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
     // First-order Gauss-Markov: decay exp(-dt / tau), driving noise that keeps the variance
-    // at sigma^2 (exact discretization).
+    // at sigma^2 (exact discretization). The estimate is the process's expected value and
+    // decays with it; held constant, its error would gain the unmodelled (1 - decay) b_est.
     const double decay = std::exp(-dt / tuning_.star_tracker_bias_correlation_time_s);
     const double sigma = tuning_.star_tracker_bias_sigma_rad;
+    star_tracker_bias_ *= decay;
     for (int i = kStarTrackerBias.index; i < kStarTrackerBias.end(); ++i) {
       Phi(i, i) = decay;
       q[i] = sigma * sigma * (1.0 - decay * decay);
