@@ -249,6 +249,53 @@ TEST(InsErrorModel, TransitionMatrixPredictsTheNonlinearErrorGrowth) {
   }
 }
 
+TEST(InsErrorModel, TransitionMatrixPredictsTheErrorGrowthInOrbit) {
+  // Given seed 001's circular orbit (7.6 km/s: the transport rate and its dependence on the
+  // position and velocity errors are 50 times an aircraft's) and an estimate with position,
+  // velocity and attitude errors, both mechanized from the same perfect increments for 600 s,
+  navbus::sim::CircularOrbitTrajectory traj{navbus::sim::OrbitStart{}};
+  navbus::core::StrapdownNed truth(earth::GravityModel::kPointMass);
+  navbus::core::StrapdownNed est(earth::GravityModel::kPointMass);
+  truth.initialize(traj.state());
+  StateVec dx0 = StateVec::Zero();
+  dx0.segment<3>(layout::kPos.index) << 10.0, -5.0, 3.0;
+  dx0.segment<3>(layout::kVel.index) << 0.01, -0.005, 0.002;
+  dx0.segment<3>(layout::kAtt.index) << 1e-4, -2e-4, 5e-4;
+  navbus::core::NavState s0 = perturbed(traj.state(), dx0.segment<3>(layout::kPos.index),
+                                        dx0.segment<3>(layout::kVel.index));
+  s0.q_b_to_n =
+      navbus::core::quaternionFromRotationVector(-dx0.segment<3>(layout::kAtt.index)) * s0.q_b_to_n;
+  est.initialize(s0);
+  StateMat Phi = StateMat::Identity();
+  const double dt = 0.01;
+  for (int k = 1; k <= 60000; ++k) {
+    const auto inc = traj.advance(dt);
+    const navbus::core::ImuIncrement m{static_cast<std::int64_t>(k) * 10'000'000, dt,
+                                       inc.delta_vel_b_mps, inc.delta_angle_b_rad};
+    Phi = navbus::core::transitionMatrix(
+              navbus::core::errorDynamics(truth.state(), inc.delta_vel_b_mps / dt,
+                                          earth::GravityModel::kPointMass),
+              dt) *
+          Phi;
+    truth.propagate(m);
+    est.propagate(m);
+  }
+  // then the linear prediction Phi dx0 matches the nonlinear difference within a few percent
+  // in every navigation block.
+  const StateVec actual = errorOf(est.state(), truth.state());
+  const StateVec predicted = Phi * dx0;
+  for (const auto& b : {layout::kPos, layout::kVel, layout::kAtt}) {
+    const double rel = (predicted.segment<3>(b.index) - actual.segment<3>(b.index)).norm() /
+                       actual.segment<3>(b.index).norm();
+    std::printf(
+        "orbit, error model block at %d: actual %.4e, predicted %.4e, relative difference %.2f "
+        "%%\n",
+        b.index, actual.segment<3>(b.index).norm(), predicted.segment<3>(b.index).norm(),
+        100 * rel);
+    EXPECT_LT(rel, 0.03) << "block at " << b.index;
+  }
+}
+
 TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
   // Given transition matrices of the error model at random states (and one with states switched
   // off, rows and columns of Phi zeroed as the error state does) and a random covariance,
