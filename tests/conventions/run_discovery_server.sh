@@ -12,7 +12,9 @@ trap 'kill $(jobs -p) 2>/dev/null || true; wait 2>/dev/null || true; rm -rf "$wo
 fail() { echo "FAIL: $*" >&2; cat "$work"/*.log >&2; exit 1; }
 client=(-d "$domain" --profile navbus_participant_discovery_client --discovery-server "127.0.0.1:$port")
 
-fastdds discovery -i 0 -l 127.0.0.1 -p "$port" > "$work/server.log" 2>&1 &
+# The server binary itself: `fastdds discovery` is a launcher whose server survived the kill
+# of the launcher and stayed after the test.
+fast-discovery-server -i 0 -l 127.0.0.1 -p "$port" > "$work/server.log" 2>&1 &
 cat > "$work/sim.yaml" <<YAML
 extends: $scenarios/default.yaml
 timing: {min_readers: {imu: 1, raw_imu: 0, gnss: 0, star_tracker: 0}}
