@@ -26,10 +26,10 @@ StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
   const double radius = std::sqrt(rm * rn);
 
   const Eigen::Vector3d& v = s.vel_ned_mps;
-  const double tan_lat = std::tan(s.position.latitude_rad);
-  const double sec2_lat = 1.0 + tan_lat * tan_lat;
   const double w_ie_n = w_ie.x();  // Omega cos(lat)
   const double w_ie_d = w_ie.z();  // -Omega sin(lat)
+  const double tan_lat = -w_ie_d / w_ie_n;
+  const double sec2_lat = 1.0 + tan_lat * tan_lat;
   // The position error is in NED metres of the curvilinear position: dN = (R_M + h) dlat,
   // dE = (R_N + h) cos(lat) dlon, dD = -dh. The Earth and transport rates depend on the
   // position through lat and h:
@@ -77,13 +77,14 @@ StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
 }
 
 StateMatrix transitionMatrix(const StateMatrix& F, double dt) {
-  const StateMatrix Fdt = F * dt;
-  const SparseRows<layout::kSize> sparse(Fdt, errorDynamicsPattern());
-  // I + F dt + (F dt)^2 / 2, the identity added on the diagonal: Eigen's StateMatrix::Identity()
-  // expression tests i == j for each of the 400 elements, which cost as much as the product.
-  StateMatrix Phi = Fdt;
+  // I + F dt + (F dt)^2 / 2 = I + dt (F + (dt / 2) F F): the sparse product accumulates into
+  // a copy of F, and the identity is added on the diagonal (Eigen's StateMatrix::Identity()
+  // expression tests i == j for each of the 400 elements, which cost as much as the product).
+  const SparseRows<layout::kSize> sparse(F, errorDynamicsPattern());
+  StateMatrix Phi = F;
+  sparse.addProductTo(sparse, 0.5 * dt, Phi);
+  Phi *= dt;
   Phi.diagonal().array() += 1.0;
-  Phi += 0.5 * sparse.times(sparse);
   return Phi;
 }
 

@@ -113,16 +113,22 @@ class SparseRows {
   /// A B for a sparse B: only the products of nonzero elements.
   Square times(const SparseRows& B) const {
     Square out = Square::Zero();
+    addProductTo(B, 1.0, out);
+    return out;
+  }
+
+  /// out += scale A B for a sparse B, in place (no temporary to zero and add).
+  void addProductTo(const SparseRows& B, double scale, Square& out) const {
     for (int i = 0; i < N; ++i) {
       for (int n = 0; n < p_->count(i); ++n) {
         const int k = p_->col(i, n);
+        const double a = scale * a_(i, k);
         for (int m = 0; m < B.p_->count(k); ++m) {
           const int j = B.p_->col(k, m);
-          out(i, j) += a_(i, k) * B.a_(k, j);
+          out(i, j) += a * B.a_(k, j);
         }
       }
     }
-    return out;
   }
 
   /// A P A^T for a symmetric P and a block upper triangular A = [A11 A12; 0 A22], with A11
