@@ -43,8 +43,10 @@ Radii radiiOfCurvature(double latitude_rad) {
   return radiiFromSinLatitude(std::sin(latitude_rad));
 }
 
-double normalGravity(double latitude_rad, double height_m) {
-  const double s2 = std::pow(std::sin(latitude_rad), 2);
+namespace {
+/// Normal gravity from the sine of the latitude (normalGravity()).
+double normalGravityFromSin(double sin_lat, double height_m) {
+  const double s2 = std::pow(sin_lat, 2);
   // Somigliana closed formula, TR8350.2 eq. 4-1.
   const double k =
       (kSemiMinorAxis_m * kGravityPole_mps2) / (kSemiMajorAxis_m * kGravityEquator_mps2) - 1.0;
@@ -56,6 +58,11 @@ double normalGravity(double latitude_rad, double height_m) {
   return g0 * (1.0 - 2.0 / a * (1.0 + kFlattening + m - 2.0 * kFlattening * s2) * height_m +
                3.0 / (a * a) * height_m * height_m);
 }
+}  // namespace
+
+double normalGravity(double latitude_rad, double height_m) {
+  return normalGravityFromSin(std::sin(latitude_rad), height_m);
+}
 
 Eigen::Vector3d gravityNed(double latitude_rad, double height_m) {
   return {0.0, 0.0, normalGravity(latitude_rad, height_m)};
@@ -66,15 +73,23 @@ Eigen::Vector3d pointMassGravitationEcef(const Eigen::Vector3d& r) {
   return -kGm_m3ps2 / (n * n * n) * r;
 }
 
+namespace {
+/// Gravity in NED with the position's sines and cosines already computed.
+Eigen::Vector3d gravityNed(GravityModel model, const SinCos& t, double height_m) {
+  if (model == GravityModel::kWgs84Normal) return {0.0, 0.0, normalGravityFromSin(t.sl, height_m)};
+  const Eigen::Vector3d r = ecefOf(t, height_m);
+  const Eigen::Vector3d w(0.0, 0.0, kRotationRate_radps);
+  const Eigen::Vector3d g_e = pointMassGravitationEcef(r) - w.cross(w.cross(r));
+  return nedToEcef(t).transpose() * g_e;
+}
+}  // namespace
+
 Eigen::Vector3d gravityNed(GravityModel model, const Geodetic& position) {
   if (model == GravityModel::kWgs84Normal) {
     return gravityNed(position.latitude_rad, position.height_m);
   }
-  const SinCos t = sinCosOf(position.latitude_rad, position.longitude_rad);
-  const Eigen::Vector3d r = ecefOf(t, position.height_m);
-  const Eigen::Vector3d w(0.0, 0.0, kRotationRate_radps);
-  const Eigen::Vector3d g_e = pointMassGravitationEcef(r) - w.cross(w.cross(r));
-  return nedToEcef(t).transpose() * g_e;
+  return gravityNed(model, sinCosOf(position.latitude_rad, position.longitude_rad),
+                    position.height_m);
 }
 
 Geodetic offsetNed(const Geodetic& p, const Eigen::Vector3d& d) {
@@ -146,11 +161,15 @@ Eigen::Vector3d omegaEnNed(const Geodetic& p, const Eigen::Vector3d& v, const Ra
 }
 
 LocalEarth localEarth(GravityModel model, const Geodetic& p, const Eigen::Vector3d& v) {
+  // One sine and cosine of each angle for the radii, the rates and the gravity.
+  const SinCos t = sinCosOf(p.latitude_rad, p.longitude_rad);
   LocalEarth e;
-  e.radii = radiiOfCurvature(p.latitude_rad);
-  e.w_ie_ned = omegaIeNed(p.latitude_rad);
-  e.w_en_ned = omegaEnNed(p, v, e.radii);
-  e.g_ned = gravityNed(model, p);
+  e.radii = radiiFromSinLatitude(t.sl);
+  e.w_ie_ned = {kRotationRate_radps * t.cl, 0.0, -kRotationRate_radps * t.sl};
+  const double rn = e.radii.prime_vertical_m + p.height_m;
+  const double rm = e.radii.meridian_m + p.height_m;
+  e.w_en_ned = {v.y() / rn, -v.x() / rm, -v.y() * (t.sl / t.cl) / rn};
+  e.g_ned = gravityNed(model, t, p.height_m);
   return e;
 }
 
