@@ -1,6 +1,9 @@
 // Continuous-time error dynamics of the strapdown INS and the receiver clock over the state
-// layout of state_layout.hpp (phi-angle attitude error, NED position error in metres), and the
-// transition matrix of one propagation step.
+// layout of state_layout.hpp (phi-angle attitude error, NED position error in metres of the
+// curvilinear position), and the transition matrix of one propagation step. The model is the
+// full local-level one (Titterton & Weston, Strapdown Inertial Navigation Technology, ch. 12;
+// Shin, EKF-based adaptive INS/GNSS, 2005, ch. 2): the Earth and transport rates' dependence on
+// the position and velocity errors is kept, which matters in orbit (seed 001, 7.6 km/s).
 #pragma once
 
 #include <Eigen/Core>
