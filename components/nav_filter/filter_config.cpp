@@ -64,7 +64,7 @@ void parseAlignment(const YAML::Node& node, core::EngineConfig& e) {
   const std::string w = "alignment";
   bus::checkKeys(node, w,
                  {"static_window_s", "min_static_window_s", "max_heading_sigma_deg",
-                  "course_min_speed_mps", "course_sigma_deg"});
+                  "course_min_speed_mps", "course_sigma_deg", "course_check_heading_sigma_deg"});
   core::InitialAlignmentConfig& a = e.alignment;
   const core::FilterTuning& t = e.tuning;
   a.budget.accel_bias_sigma_mps2 = t.accel_bias_sigma_mps2;
@@ -90,6 +90,11 @@ void parseAlignment(const YAML::Node& node, core::EngineConfig& e) {
                                                         a.course_sigma_rad / units::kDeg),
                                        1e-3, 90.0, "alignment.course_sigma_deg") *
                        units::kDeg;
+  a.course_check_heading_sigma_rad =
+      bus::checkRange(bus::get<double>(node, w, "course_check_heading_sigma_deg",
+                                       a.course_check_heading_sigma_rad / units::kDeg),
+                      0.0, 180.0, "alignment.course_check_heading_sigma_deg") *
+      units::kDeg;
 }
 
 /// Protection levels (tightly coupled): the risks, the alert limits and the GLR the fault

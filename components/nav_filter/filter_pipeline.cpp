@@ -673,6 +673,9 @@ std::string FilterPipeline::alignmentSummary() const {
         << " mrad)";
   }
   if (a.failedSolutions() > 0) out << ", pseudorange solutions failed " << a.failedSolutions();
+  if (engine_.counters().course_heading_checks > 0)
+    out << ", heading measured again from the GNSS course "
+        << engine_.counters().course_heading_checks << " time(s)";
   return out.str();
 }
 

@@ -302,6 +302,33 @@ TEST(Alignment, Seed000GyrocompassesAtRestWithinItsOwnSigmas) {
   EXPECT_LT(normalized, tool::chiSquareQuantile(0.999, 3.0 * runs));
 }
 
+TEST(Alignment, Seed000MeasuresTheHeadingAgainFromTheCourseAtTakeoff) {
+  // Given seed 000's seed 22, whose east gyro bias (3.3 sigma) gyrocompassing turns into a
+  // heading error of 0.27 rad, and the takeoff at 501 s (20 m/s^2 for 10 s),
+  const AlignedRun run = alignedRun("seed000_aircraft.yaml", "filter_seed000_tc.yaml", 22, 520);
+  const tool::OfflineResult& r = run.result;
+  ASSERT_TRUE(r.aligned) << r.summary;
+  ASSERT_GT(std::abs(r.aligned_start_error.att_ned_rad.z()), 0.2);
+  // when the filter starts from that alignment, it measures the heading again from the GNSS
+  // course once, at the first pseudorange epoch faster than 5 m/s,
+  EXPECT_NE(r.summary.find("heading measured again from the GNSS course 1 time(s)"),
+            std::string::npos)
+      << r.summary;
+  // and from there on the heading error is a few mrad and the tilt errors within 3 mrad
+  // (without the check the first-order update turned the takeoff's (1 - cos psi) f into tilt:
+  // 6.9 mrad against a sigma of 0.33). Not yet within 3 of their sigmas (README,
+  // "Consistency").
+  int checked = 0;
+  for (const auto& e : r.errors) {
+    const double t = 1e-9 * static_cast<double>(e.time_ns - kStart);
+    if (t < 505.0) continue;
+    ++checked;
+    EXPECT_LT(std::abs(e.att_ned_rad.z()), 0.005) << "at " << t << " s";
+    EXPECT_LT(e.att_ned_rad.head<2>().cwiseAbs().maxCoeff(), 0.003) << "at " << t << " s";
+  }
+  EXPECT_GT(checked, 100);
+}
+
 TEST(Alignment, Seed001TakesTheAttitudeFromTheFirstStarTrackerSampleAfterTheFirstFix) {
   // Given the LEO orbit, GNSS fixes at 10 Hz and a 5 Hz star tracker, no configured state,
   const AlignedRun run = alignedRun("seed001_leo.yaml", "filter_seed001_lc.yaml", 1, 5);

@@ -70,41 +70,55 @@ void InitialAligner::onMotion() {
   window_.reset();
 }
 
-void InitialAligner::addPseudoranges(std::int64_t time_ns,
-                                     const std::vector<SatelliteObservation>& sats) {
-  if (aligned()) return;
+PseudorangeFix pseudorangeFix(std::int64_t time_ns, const std::vector<SatelliteObservation>& sats,
+                              const Eigen::Vector3d& guess_ecef_m) {
   std::vector<RangeObservation> obs;
   obs.reserve(sats.size());
   for (const auto& s : sats) {
     if (!s.use_range) continue;
     obs.push_back({s.sat_pos_ecef_m, s.sat_vel_ecef_mps, s.pseudorange_m, s.pseudorange_rate_mps});
   }
-  const Eigen::Vector3d guess_ecef =
-      hasFix() ? earth::geodeticToEcef(fix_.measurement.position) : Eigen::Vector3d::Zero();
-  const LeastSquaresFix ls = leastSquaresFix(obs, guess_ecef);
-  if (!ls.valid) {
-    ++failed_solutions_;
-    return;
-  }
+  const LeastSquaresFix ls = leastSquaresFix(obs, guess_ecef_m);
+  PseudorangeFix f;
+  if (!ls.valid) return f;
   // Equal-weight least squares: each estimate's sigma is its DOP times the measurement sigma.
   // Each horizontal axis gets the whole HDOP (an upper bound: the split is not known).
   const double range_sigma_m = rmsSigma(sats, [](const auto& s) { return s.pseudorange_sigma_m; });
   const double rate_sigma_mps =
       rmsSigma(sats, [](const auto& s) { return s.pseudorange_rate_sigma_mps; });
-  Fix f;
-  f.time_ns = time_ns;
-  f.source = PositionSource::kPseudoranges;
-  f.measurement.time_ns = time_ns;
-  f.measurement.position = earth::ecefToGeodetic(ls.pos_ecef_m);
+  f.valid = true;
+  f.fix.time_ns = time_ns;
+  f.fix.position = earth::ecefToGeodetic(ls.pos_ecef_m);
   const Eigen::Matrix3d C_n_e =
-      earth::C_n_e(f.measurement.position.latitude_rad, f.measurement.position.longitude_rad);
-  f.measurement.vel_ned_mps = C_n_e.transpose() * ls.vel_ecef_mps;
-  f.measurement.pos_sigma_ned_m = Eigen::Vector3d(ls.hdop, ls.hdop, ls.vdop) * range_sigma_m;
-  f.measurement.vel_sigma_ned_mps = Eigen::Vector3d(ls.hdop, ls.hdop, ls.vdop) * rate_sigma_mps;
+      earth::C_n_e(f.fix.position.latitude_rad, f.fix.position.longitude_rad);
+  f.fix.vel_ned_mps = C_n_e.transpose() * ls.vel_ecef_mps;
+  f.fix.pos_sigma_ned_m = Eigen::Vector3d(ls.hdop, ls.hdop, ls.vdop) * range_sigma_m;
+  f.fix.vel_sigma_ned_mps = Eigen::Vector3d(ls.hdop, ls.hdop, ls.vdop) * rate_sigma_mps;
   f.clock_bias_m = ls.clock_bias_m;
   f.clock_drift_mps = ls.clock_drift_mps;
   f.clock_bias_sigma_m = ls.tdop * range_sigma_m;
   f.clock_drift_sigma_mps = ls.tdop * rate_sigma_mps;
+  return f;
+}
+
+void InitialAligner::addPseudoranges(std::int64_t time_ns,
+                                     const std::vector<SatelliteObservation>& sats) {
+  if (aligned()) return;
+  const Eigen::Vector3d guess_ecef =
+      hasFix() ? earth::geodeticToEcef(fix_.measurement.position) : Eigen::Vector3d::Zero();
+  const PseudorangeFix pf = pseudorangeFix(time_ns, sats, guess_ecef);
+  if (!pf.valid) {
+    ++failed_solutions_;
+    return;
+  }
+  Fix f;
+  f.time_ns = time_ns;
+  f.source = PositionSource::kPseudoranges;
+  f.measurement = pf.fix;
+  f.clock_bias_m = pf.clock_bias_m;
+  f.clock_drift_mps = pf.clock_drift_mps;
+  f.clock_bias_sigma_m = pf.clock_bias_sigma_m;
+  f.clock_drift_sigma_mps = pf.clock_drift_sigma_mps;
   takeFix(f);
 }
 

@@ -278,6 +278,30 @@ void IntegratedFilter::addVariance(int state, double variance) {
   for (ErrorState& l : local_) l.P()(state, state) += variance * tuning_.federated_share;
 }
 
+bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, double course_rad,
+                                                double speed_mps) {
+  if (structure_ == FusionStructure::kFederated || speed_mps <= 0.0) return false;
+  constexpr int kHeading = kAtt.index + 2;
+  // z observes the cross-track velocity error; the heading follows through its correlation
+  // with it (the velocity gained through the heading error).
+  StateVector h = StateVector::Zero();
+  h[kVel.index] = std::sin(course_rad) / speed_mps;  // -u_c / speed, u_c = (-sin c, cos c, 0)
+  h[kVel.index + 1] = -std::cos(course_rad) / speed_mps;
+  StateMatrix& P = central_.P();
+  const StateVector Ph = P * h;
+  const StateVector k = Ph / (h.dot(Ph) + sigma_rad * sigma_rad);
+  P -= k * Ph.transpose();
+  P = (0.5 * (P + P.transpose())).eval();
+  StateVector dx = k * z_rad;
+  // The horizontal velocity turns with the heading: v - dx_v = R_D(dx_psi) v.
+  const double a = dx[kHeading];
+  const Eigen::Vector3d& v = ins_.state().vel_ned_mps;
+  dx[kVel.index] = v.x() - (std::cos(a) * v.x() - std::sin(a) * v.y());
+  dx[kVel.index + 1] = v.y() - (std::sin(a) * v.x() + std::cos(a) * v.y());
+  feedback(dx);
+  return true;
+}
+
 void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
   for (int i = block.index; i < block.end(); ++i) {
     const double v = central_.P()(i, i);

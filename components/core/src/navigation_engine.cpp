@@ -40,6 +40,7 @@ void NavigationEngine::reset() {
   accel_compensation_.setZero();
   gyro_compensation_.setZero();
   last_fix_ns_ = -1;
+  course_check_armed_ = false;
   stationarity_.configure(config_.mdf.stationarity, config_.imu_period_s);
   stages_.configure(config_.mdf);
   stages_.restart();
@@ -195,6 +196,38 @@ void NavigationEngine::startFromAlignment() {
   }
   start(a.state, clock_bias_m, clock_drift_mps, alignedCovariance(a));
   mode_ = EngineMode::kInertialOnly;  // aided modes with the next measurement
+  const double limit = config_.alignment.course_check_heading_sigma_rad;
+  course_check_armed_ = a.attitude_source == AttitudeSource::kGyrocompass && limit > 0.0 &&
+                        a.att_sigma_ned_rad.z() > limit;
+}
+
+void NavigationEngine::checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
+                                              double cross_track_sigma_mps) {
+  const StateMatrix& P = filter_.covariance();
+  if (std::sqrt(P(kAtt.index + 2, kAtt.index + 2)) <=
+      config_.alignment.course_check_heading_sigma_rad) {
+    course_check_armed_ = false;  // the filter has found the heading by itself
+    return;
+  }
+  const double min_speed = config_.alignment.course_min_speed_mps;
+  const Eigen::Vector3d& v_ins = filter_.state().vel_ned_mps;
+  const double speed_mps = gnss_vel_ned_mps.head<2>().norm();
+  if (speed_mps < min_speed || v_ins.head<2>().norm() < min_speed) return;
+  const double course_rad = std::atan2(gnss_vel_ned_mps.y(), gnss_vel_ned_mps.x());
+  const double z_rad = std::remainder(course_rad - std::atan2(v_ins.y(), v_ins.x()), 2.0 * M_PI);
+  if (!filter_.correctHeadingFromCourse(z_rad, cross_track_sigma_mps / speed_mps, course_rad,
+                                        speed_mps))
+    return;
+  course_check_armed_ = false;
+  ++counters_.course_heading_checks;
+  // The gyro biases learned at rest under the heading error also took the Earth rate's
+  // second-order term Omega cos(lat) (1 - cos psi) on the north channel, which the first-order
+  // model does not have: their variance grows by its square (on every body axis).
+  const double second_order_radps = earth::kRotationRate_radps *
+                                    std::cos(filter_.state().position.latitude_rad) *
+                                    (1.0 - std::cos(z_rad));
+  for (int i = 0; i < 3; ++i)
+    filter_.addVariance(kGyroBias.index + i, second_order_radps * second_order_radps);
 }
 
 void NavigationEngine::applyStage(const StageDecision& d) {
@@ -300,6 +333,12 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
     return false;
   }
   if (!any) return false;
+  if (course_check_armed_ &&
+      filter_.state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
+    const PseudorangeFix pf =
+        pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_.state().position));
+    if (pf.valid) checkHeadingFromCourse(pf.fix.vel_ned_mps, pf.fix.vel_sigma_ned_mps.x());
+  }
   for (const auto& rep : filter_.update(used_)) {
     counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
   }
@@ -334,6 +373,8 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   } else if (config_.aiding != AidingMode::kLooselyCoupled) {
     return;
   }
+  if (course_check_armed_)
+    checkHeadingFromCourse(fix.vel_ned_mps, fix.vel_sigma_ned_mps.head<2>().maxCoeff());
   const auto p =
       filter_.update(positionMeasurement(filter_.state(), fix.position, fix.pos_sigma_ned_m),
                      AidingKind::kPosition);

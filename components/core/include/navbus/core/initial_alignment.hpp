@@ -46,7 +46,11 @@ struct InitialAlignmentConfig {
   double max_heading_sigma_rad{0.1745};  ///< gyrocompassing accepted below (10 deg)
   double course_min_speed_mps{5.0};      ///< GNSS course used above this horizontal speed
   double course_sigma_rad{0.0349};       ///< body x to velocity misalignment, 1 sigma (2 deg)
-  double imu_period_s{0.01};             ///< nominal increment interval (stationarity window)
+  /// After gyrocompassing with a heading sigma above this, the heading is measured once more
+  /// from the GNSS course when the vehicle first moves faster than course_min_speed_mps
+  /// (NavigationEngine; 0: never).
+  double course_check_heading_sigma_rad{0.05};
+  double imu_period_s{0.01};  ///< nominal increment interval (stationarity window)
 };
 
 /// The state a filter starts from, with the alignment's 1-sigma budget.
@@ -70,6 +74,19 @@ struct AlignedStart {
   /// the filter starts with these correlations. Zero for a star-tracker attitude.
   AlignmentSensitivity sensitivity;
 };
+
+/// One pseudorange epoch's least-squares position and velocity as a fix, with the receiver
+/// clock. Equal weights: each sigma is its DOP times the satellites' RMS sigma, each horizontal
+/// axis the whole HDOP (an upper bound). valid false: fewer than 4 usable satellites or no
+/// convergence.
+struct PseudorangeFix {
+  bool valid{false};
+  GnssFixMeasurement fix;
+  double clock_bias_m{0.0}, clock_drift_mps{0.0};
+  double clock_bias_sigma_m{0.0}, clock_drift_sigma_mps{0.0};
+};
+PseudorangeFix pseudorangeFix(std::int64_t time_ns, const std::vector<SatelliteObservation>& sats,
+                              const Eigen::Vector3d& guess_ecef_m);
 
 class InitialAligner {
  public:

@@ -82,6 +82,9 @@ struct EngineCounters {
   std::uint64_t zero_velocity_updates{0}, nonholonomic_updates{0};
   std::uint64_t rows_gated{0};  ///< measurement rows refused by the innovation gate
   std::uint64_t stage_switches{0};
+  /// Headings measured again from the GNSS course after gyrocompassing
+  /// (InitialAlignmentConfig::course_check_heading_sigma_rad).
+  std::uint64_t course_heading_checks{0};
 };
 
 class NavigationEngine {
@@ -154,6 +157,13 @@ class NavigationEngine {
              const StateMatrix& initial_covariance);
   void startFromAlignment();
   StateMatrix alignedCovariance(const AlignedStart& a) const;
+  /// Once after a gyrocompassing start whose heading sigma is above the configured limit, at
+  /// the first GNSS velocity faster than course_min_speed_mps: the GNSS course against the
+  /// INS course (IntegratedFilter::correctHeadingFromCourse), before the acceleration that
+  /// brought the vehicle there goes on through a heading error the first-order model cannot
+  /// carry. The INS velocity must have been gained from rest: the start was at rest.
+  void checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
+                              double cross_track_sigma_mps);
   bool aligning() const { return config_.start == StartSource::kAligned && !filter_.initialized(); }
 
   EngineConfig config_;
@@ -173,6 +183,7 @@ class NavigationEngine {
   std::int64_t next_output_ns_{0};
   std::int64_t last_fix_ns_{-1};
   std::int64_t next_constraint_ns_{0};
+  bool course_check_armed_{false};  ///< checkHeadingFromCourse still to come
 };
 
 }  // namespace navbus::core
