@@ -29,6 +29,18 @@ Eigen::Vector3d ecefOf(const SinCos& t, double height_m) {
           (n * (1.0 - kEccentricitySq) + height_m) * t.sl};
 }
 
+/// Earth rate in NED from the sine and cosine of the latitude.
+Eigen::Vector3d omegaIe(double sin_lat, double cos_lat) {
+  return {kRotationRate_radps * cos_lat, 0.0, -kRotationRate_radps * sin_lat};
+}
+
+/// Transport rate in NED from the velocity, the radii, the height and tan(latitude).
+Eigen::Vector3d omegaEn(const Eigen::Vector3d& v, const Radii& r, double height_m, double tan_lat) {
+  const double rn = r.prime_vertical_m + height_m;
+  const double rm = r.meridian_m + height_m;
+  return {v.y() / rn, -v.x() / rm, -v.y() * tan_lat / rn};
+}
+
 Eigen::Matrix3d nedToEcef(const SinCos& t) {
   Eigen::Matrix3d c;
   // Columns are the N, E, D unit vectors expressed in ECEF.
@@ -146,8 +158,7 @@ Eigen::Matrix3d C_n_e(double latitude_rad, double longitude_rad) {
 }
 
 Eigen::Vector3d omegaIeNed(double latitude_rad) {
-  return {kRotationRate_radps * std::cos(latitude_rad), 0.0,
-          -kRotationRate_radps * std::sin(latitude_rad)};
+  return omegaIe(std::sin(latitude_rad), std::cos(latitude_rad));
 }
 
 Eigen::Vector3d omegaEnNed(const Geodetic& p, const Eigen::Vector3d& v) {
@@ -155,9 +166,7 @@ Eigen::Vector3d omegaEnNed(const Geodetic& p, const Eigen::Vector3d& v) {
 }
 
 Eigen::Vector3d omegaEnNed(const Geodetic& p, const Eigen::Vector3d& v, const Radii& r) {
-  const double rn = r.prime_vertical_m + p.height_m;
-  const double rm = r.meridian_m + p.height_m;
-  return {v.y() / rn, -v.x() / rm, -v.y() * std::tan(p.latitude_rad) / rn};
+  return omegaEn(v, r, p.height_m, std::tan(p.latitude_rad));
 }
 
 LocalEarth localEarth(GravityModel model, const Geodetic& p, const Eigen::Vector3d& v) {
@@ -165,10 +174,8 @@ LocalEarth localEarth(GravityModel model, const Geodetic& p, const Eigen::Vector
   const SinCos t = sinCosOf(p.latitude_rad, p.longitude_rad);
   LocalEarth e;
   e.radii = radiiFromSinLatitude(t.sl);
-  e.w_ie_ned = {kRotationRate_radps * t.cl, 0.0, -kRotationRate_radps * t.sl};
-  const double rn = e.radii.prime_vertical_m + p.height_m;
-  const double rm = e.radii.meridian_m + p.height_m;
-  e.w_en_ned = {v.y() / rn, -v.x() / rm, -v.y() * (t.sl / t.cl) / rn};
+  e.w_ie_ned = omegaIe(t.sl, t.cl);
+  e.w_en_ned = omegaEn(v, e.radii, p.height_m, t.sl / t.cl);
   e.g_ned = gravityNed(model, t, p.height_m);
   return e;
 }

@@ -1,5 +1,5 @@
 // Products with a sparse square matrix, such as the error-state transition matrix
-// Phi = I + F dt + (F dt)^2 / 2 (about 110 of its 289 elements are nonzero): the covariance
+// Phi = I + F dt + (F dt)^2 / 2 (about 130 of its 400 elements are nonzero): the covariance
 // propagation Phi P Phi^T and the accumulated transition Phi Phi_acc cost a fraction of the
 // dense fixed-size products, whose general blocked kernel dominated the offline run.
 //
@@ -110,14 +110,8 @@ class SparseRows {
   /// A B = (B^T A^T)^T, through contiguous column sums.
   Square times(const Square& B) const { return timesTransposed(B.transpose()).transpose(); }
 
-  /// A B for a sparse B: only the products of nonzero elements.
-  Square times(const SparseRows& B) const {
-    Square out = Square::Zero();
-    addProductTo(B, 1.0, out);
-    return out;
-  }
-
-  /// out += scale A B for a sparse B, in place (no temporary to zero and add).
+  /// out += scale A B for a sparse B: only the products of nonzero elements, in place (no
+  /// temporary to zero and add).
   void addProductTo(const SparseRows& B, double scale, Square& out) const {
     for (int i = 0; i < N; ++i) {
       for (int n = 0; n < p_->count(i); ++n) {
