@@ -137,6 +137,30 @@ TEST(StaticAlignment, ErrorsDrawnFromTheBudgetAreConsistentWithItsSigmas) {
   EXPECT_LT(level_sq / kTrials, 1.21);
 }
 
+TEST(StaticAlignment, EarthRateMismatchRemainderIsTheExactRotationLessItsFirstOrder) {
+  // Given the Earth rate at 45 deg and heading errors from small to 0.5 rad,
+  const Eigen::Vector3d w_ie_ned = earth::omegaIeNed(kLatitude_rad);
+  for (const double psi : {-0.5, -0.27, 0.01, 0.1, 0.27, 0.5}) {
+    // the remainder (step 9) is exp(-[phi x]) w - w + phi x w, computed with Eigen's rotation,
+    const Eigen::Vector3d phi(0.0, 0.0, psi);
+    const Eigen::Vector3d exact = Eigen::AngleAxisd(-psi, Eigen::Vector3d::UnitZ()) * w_ie_ned -
+                                  w_ie_ned + phi.cross(w_ie_ned);
+    const core::EarthRateMismatch m = core::earthRateMismatchRemainder(psi, w_ie_ned);
+    EXPECT_LT((m.remainder_radps - exact).norm(), 1e-18) << "psi " << psi;
+    // and its derivative matches a central difference.
+    constexpr double kStep = 1e-6;
+    const Eigen::Vector3d numeric =
+        (core::earthRateMismatchRemainder(psi + kStep, w_ie_ned).remainder_radps -
+         core::earthRateMismatchRemainder(psi - kStep, w_ie_ned).remainder_radps) /
+        (2.0 * kStep);
+    EXPECT_LT((m.d_remainder_d_psi - numeric).norm(), 1e-14) << "psi " << psi;
+  }
+  // At seed 000's 3-sigma heading (0.27 rad, 36.5 deg) the north term is 0.44 deg/h.
+  const core::EarthRateMismatch seed000 =
+      core::earthRateMismatchRemainder(0.27, earth::omegaIeNed(36.5 * units::kDeg));
+  EXPECT_NEAR(seed000.remainder_radps.x() / units::kDegPerHour, -0.44, 0.01);
+}
+
 TEST(StaticAlignment, MemsGyrosCannotGyrocompassAndSaySo) {
   const double g = earth::normalGravity(kLatitude_rad, 0.0);
   core::AlignmentErrorBudget mems;

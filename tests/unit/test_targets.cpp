@@ -8,9 +8,11 @@
 
 #include "evaluation.hpp"
 #include "navbus/bus/config.hpp"
+#include "navbus/core/units.hpp"
 #include "offline_runner.hpp"
 
 namespace tool = navbus::tool;
+namespace units = navbus::units;
 
 namespace {
 
@@ -305,7 +307,7 @@ TEST(Alignment, Seed000GyrocompassesAtRestWithinItsOwnSigmas) {
 TEST(Alignment, Seed000MeasuresTheHeadingAgainFromTheCourseAtTakeoff) {
   // Given seed 000's seed 22, whose east gyro bias (3.3 sigma) gyrocompassing turns into a
   // heading error of 0.27 rad, and the takeoff at 501 s (20 m/s^2 for 10 s),
-  const AlignedRun run = alignedRun("seed000_aircraft.yaml", "filter_seed000_tc.yaml", 22, 520);
+  const AlignedRun run = alignedRun("seed000_aircraft.yaml", "filter_seed000_tc.yaml", 22, 1000);
   const tool::OfflineResult& r = run.result;
   ASSERT_TRUE(r.aligned) << r.summary;
   ASSERT_GT(std::abs(r.aligned_start_error.att_ned_rad.z()), 0.2);
@@ -316,8 +318,15 @@ TEST(Alignment, Seed000MeasuresTheHeadingAgainFromTheCourseAtTakeoff) {
       << r.summary;
   // and from there on the heading error is a few mrad and the tilt errors within 3 mrad
   // (without the check the first-order update turned the takeoff's (1 - cos psi) f into tilt:
-  // 6.9 mrad against a sigma of 0.33). Not yet within 3 of their sigmas (README,
-  // "Consistency").
+  // 6.9 mrad against a sigma of 0.33);
+  // the north gyro bias is freed of the Earth rate's second-order term it learned at rest
+  // (0.44 deg/h; with the linear correction alone it was -0.47 deg/h off after the check and
+  // -2.4 deg/h at 600 s),
+  // and the attitude stays within its own covariance through level flight (chi-square, 3
+  // degrees of freedom, 99.9 %; with the attitude rows of the covariance left unturned by the
+  // 0.28 rad correction the roll and the y accelerometer bias were learned as if separable in
+  // level flight: attitude NEES 3289 at 1000 s).
+  const double nees_att_bound = tool::chiSquareQuantile(0.999, 3.0);
   int checked = 0;
   for (const auto& e : r.errors) {
     const double t = 1e-9 * static_cast<double>(e.time_ns - kStart);
@@ -325,8 +334,11 @@ TEST(Alignment, Seed000MeasuresTheHeadingAgainFromTheCourseAtTakeoff) {
     ++checked;
     EXPECT_LT(std::abs(e.att_ned_rad.z()), 0.005) << "at " << t << " s";
     EXPECT_LT(e.att_ned_rad.head<2>().cwiseAbs().maxCoeff(), 0.003) << "at " << t << " s";
+    EXPECT_LT(std::abs(e.gyro_bias_err_b_radps.x()), 0.15 * units::kDegPerHour)
+        << "at " << t << " s";
+    EXPECT_LT(e.nees_blocks[2], nees_att_bound) << "at " << t << " s";
   }
-  EXPECT_GT(checked, 100);
+  EXPECT_GT(checked, 4000);
 }
 
 TEST(Alignment, Seed001TakesTheAttitudeFromTheFirstStarTrackerSampleAfterTheFirstFix) {

@@ -5,9 +5,11 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "navbus/core/earth.hpp"
 #include "navbus/core/information_fusion.hpp"
 #include "navbus/core/rotation.hpp"
 #include "navbus/core/sparse_rows.hpp"
+#include "navbus/core/static_alignment.hpp"
 
 namespace navbus::core {
 
@@ -298,6 +300,21 @@ bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, 
   const Eigen::Vector3d& v = ins_.state().vel_ned_mps;
   dx[kVel.index] = v.x() - (std::cos(a) * v.x() - std::sin(a) * v.y());
   dx[kVel.index + 1] = v.y() - (std::sin(a) * v.x() + std::cos(a) * v.y());
+  // The gyro biases learned under the heading error took the Earth rate's mismatch whole; the
+  // linear gain removed its first order only: add the rest (the sigma_psi term: its spread).
+  const Eigen::Matrix3d C_n_b = ins_.state().q_b_to_n.conjugate().toRotationMatrix();
+  const Eigen::Vector3d w_ie_n = earth::omegaIeNed(ins_.state().position.latitude_rad);
+  const EarthRateMismatch m = earthRateMismatchRemainder(a, w_ie_n);
+  dx.segment<3>(kGyroBias.index) += C_n_b * m.remainder_radps;
+  const Eigen::Vector3d spread_b = C_n_b * m.d_remainder_d_psi * std::sqrt(P(kHeading, kHeading));
+  P.block<3, 3>(kGyroBias.index, kGyroBias.index) += spread_b * spread_b.transpose();
+  // The linear model carried the attitude error in the frame the INS computed (the levelling
+  // correlated the tilts with the accelerometer biases there): corrected by psi, that frame
+  // turns by R_D(psi), and so do the attitude rows. (A normal update's turn is of second order.)
+  const Eigen::Matrix3d R_D =
+      Eigen::AngleAxisd(dx[kHeading], Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  P.middleRows<3>(kAtt.index) = (R_D * P.middleRows<3>(kAtt.index)).eval();
+  P.middleCols<3>(kAtt.index) = (P.middleCols<3>(kAtt.index) * R_D.transpose()).eval();
   feedback(dx);
   return true;
 }

@@ -220,14 +220,6 @@ void NavigationEngine::checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ne
     return;
   course_check_armed_ = false;
   ++counters_.course_heading_checks;
-  // The gyro biases learned at rest under the heading error also took the Earth rate's
-  // second-order term Omega cos(lat) (1 - cos psi) on the north channel, which the first-order
-  // model does not have: their variance grows by its square (on every body axis).
-  const double second_order_radps = earth::kRotationRate_radps *
-                                    std::cos(filter_.state().position.latitude_rad) *
-                                    (1.0 - std::cos(z_rad));
-  for (int i = 0; i < 3; ++i)
-    filter_.addVariance(kGyroBias.index + i, second_order_radps * second_order_radps);
 }
 
 void NavigationEngine::applyStage(const StageDecision& d) {

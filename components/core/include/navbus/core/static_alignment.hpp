@@ -95,4 +95,14 @@ struct AlignmentSensitivity {
 AlignmentSensitivity alignmentSensitivity(const Eigen::Matrix3d& C_b_n, double latitude_rad,
                                           double gravity_mps2, bool heading_from_gyros);
 
+/// Step 9: the part of the Earth-rate mismatch under a heading error psi (phi = (0, 0, psi),
+/// C_b_n computed = exp(-[phi x]) C_b_n true) that the first-order error model leaves out, in
+/// the computed NED frame, and its derivative with respect to psi. A filter at rest learns it
+/// as a gyro bias; once the heading is measured it is known and can be taken out.
+struct EarthRateMismatch {
+  Eigen::Vector3d remainder_radps{Eigen::Vector3d::Zero()};    ///< [rad/s] NED
+  Eigen::Vector3d d_remainder_d_psi{Eigen::Vector3d::Zero()};  ///< [rad/s / rad] NED
+};
+EarthRateMismatch earthRateMismatchRemainder(double psi_rad, const Eigen::Vector3d& w_ie_ned_radps);
+
 }  // namespace navbus::core
