@@ -319,3 +319,33 @@ TEST(NavigationEngine, RefusesIncrementsThatDoNotFollowTheStateTime) {
   EXPECT_EQ(e.state().time_ns, before.time_ns);
   EXPECT_EQ(e.state().vel_ned_mps, before.vel_ned_mps);
 }
+
+TEST(IntegratedFilter, EarthRateRemainderFloorsTheComputedNorthGyroBiasVariance) {
+  // Given a filter at rest with a gyrocompassing heading sigma of 83 mrad, heading 0.8 rad, and a
+  // gyro-bias covariance that claims the computed-north channel known to 0.001 deg/h,
+  const core::NavState truth = movingTruth({0.0, 0.0, 0.8}, Eigen::Vector3d::Zero());
+  core::FilterTuning t = tuning();
+  t.heading_sigma_rad = 0.083;
+  t.gyro_bias_sigma_radps = 0.001 * M_PI / 180 / 3600;
+  core::IntegratedFilter f;
+  f.initialize(truth, 0, 0, t, kFifteen);
+  const Eigen::Vector3d north_b = truth.q_b_to_n.conjugate() * Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d east_b = truth.q_b_to_n.conjugate() * Eigen::Vector3d::UnitY();
+  const auto variance = [&](const Eigen::Vector3d& u) {
+    return u.dot(f.covariance().block<3, 3>(layout::kGyroBias.index, layout::kGyroBias.index) * u);
+  };
+  const double east_before = variance(east_b);
+  // when the floor is applied,
+  f.floorEarthRateRemainderVariance();
+  // then that channel's variance is the remainder's, Var(W cos L cos psi) for psi ~ N(0, s^2)
+  // = (W cos L)^2 (1 - e^(-s^2))^2 / 2 (0.059 deg/h here), and the east channel is untouched;
+  const double w_h = earth::kRotationRate_radps * std::cos(truth.position.latitude_rad);
+  const double expected = 0.5 * std::pow(w_h * (1.0 - std::exp(-0.083 * 0.083)), 2);
+  EXPECT_NEAR(variance(north_b), expected, 1e-9 * expected);
+  EXPECT_NEAR(std::sqrt(expected) / (M_PI / 180 / 3600), 0.059, 0.001);
+  EXPECT_NEAR(variance(east_b), east_before, 1e-12 * expected);
+  // a covariance that already says more is left as it is.
+  const core::StateMatrix P = f.covariance();
+  f.floorEarthRateRemainderVariance();
+  EXPECT_EQ(f.covariance(), P);
+}

@@ -319,6 +319,20 @@ bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, 
   return true;
 }
 
+void IntegratedFilter::floorEarthRateRemainderVariance() {
+  StateMatrix& P = central_.P();
+  const double var_psi = P(kAtt.index + 2, kAtt.index + 2);
+  const double horizontal_rate =
+      earth::omegaIeNed(ins_.state().position.latitude_rad).head<2>().norm();
+  const double spread = horizontal_rate * (1.0 - std::exp(-var_psi));
+  const double required = 0.5 * spread * spread;  // Var(W cos L cos psi), psi ~ N(0, var_psi)
+  // The computed north axis in the body frame.
+  const Eigen::Vector3d u_b = ins_.state().q_b_to_n.conjugate() * Eigen::Vector3d::UnitX();
+  const double now = u_b.dot(P.block<3, 3>(kGyroBias.index, kGyroBias.index) * u_b);
+  if (now >= required) return;
+  P.block<3, 3>(kGyroBias.index, kGyroBias.index) += (required - now) * u_b * u_b.transpose();
+}
+
 void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
   for (int i = block.index; i < block.end(); ++i) {
     const double v = central_.P()(i, i);

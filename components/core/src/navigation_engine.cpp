@@ -325,6 +325,7 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
     return false;
   }
   if (!any) return false;
+  if (course_check_armed_) filter_.floorEarthRateRemainderVariance();
   if (course_check_armed_ &&
       filter_.state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
     const PseudorangeFix pf =

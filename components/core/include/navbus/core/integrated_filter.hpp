@@ -137,6 +137,12 @@ class IntegratedFilter {
   /// the linear one. Centralized and adaptive structures only (false: federated).
   bool correctHeadingFromCourse(double z_rad, double sigma_rad, double course_rad,
                                 double speed_mps);
+  /// While the heading sigma is large (before the course check): a filter at rest measures the
+  /// computed-north gyro bias together with the Earth rate's second-order remainder
+  /// W cos L (cos psi - 1) (static_alignment.cpp step 9), unknown while psi is. Keeps the
+  /// variance of that gyro-bias direction at least the remainder's, W^2 cos^2 L (1 -
+  /// e^(-sigma_psi^2))^2 / 2 for a Gaussian psi, so the filter does not claim it knows more.
+  void floorEarthRateRemainderVariance();
   /// Marks an IMU axis failed (or trusted again): while failed, its bias state is a random
   /// walk of the tuning's failed_* density, so the aiding carries that axis.
   void setAxisFailed(bool accelerometer, int axis, bool failed);
