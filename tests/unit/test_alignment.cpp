@@ -161,6 +161,31 @@ TEST(StaticAlignment, EarthRateMismatchRemainderIsTheExactRotationLessItsFirstOr
   EXPECT_NEAR(seed000.remainder_radps.x() / units::kDegPerHour, -0.44, 0.01);
 }
 
+TEST(StaticAlignment, EarthRateRemainderVarianceMatchesAQuadratureOverTheHeadingError) {
+  // Given the Earth rate at 45 deg and Gaussian heading errors of several sigmas,
+  const Eigen::Vector3d w_ie_ned = earth::omegaIeNed(kLatitude_rad);
+  for (const double sigma : {0.01, 0.083, 0.3}) {
+    // the variance of step 9's north term, integrated over psi ~ N(0, sigma^2) (trapezoids over
+    // +-8 sigma), equals step 10.
+    constexpr int kSteps = 20000;
+    const double h = 16.0 * sigma / kSteps;
+    double mean = 0.0, second = 0.0;
+    for (int i = 0; i <= kSteps; ++i) {
+      const double psi = -8.0 * sigma + i * h;
+      const double weight = (i == 0 || i == kSteps ? 0.5 : 1.0) * h *
+                            std::exp(-0.5 * psi * psi / (sigma * sigma)) /
+                            (sigma * std::sqrt(2.0 * M_PI));
+      const double north = core::earthRateMismatchRemainder(psi, w_ie_ned).remainder_radps.x();
+      mean += weight * north;
+      second += weight * north * north;
+    }
+    const double variance = second - mean * mean;
+    EXPECT_NEAR(core::earthRateRemainderNorthVariance(sigma * sigma, w_ie_ned), variance,
+                1e-6 * variance)
+        << "sigma " << sigma;
+  }
+}
+
 TEST(StaticAlignment, MemsGyrosCannotGyrocompassAndSaySo) {
   const double g = earth::normalGravity(kLatitude_rad, 0.0);
   core::AlignmentErrorBudget mems;

@@ -320,12 +320,11 @@ bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, 
 }
 
 void IntegratedFilter::floorEarthRateRemainderVariance() {
+  // The federated master is rebuilt from its locals at every update (and takes no course check).
+  if (structure_ == FusionStructure::kFederated) return;
   StateMatrix& P = central_.P();
-  const double var_psi = P(kAtt.index + 2, kAtt.index + 2);
-  const double horizontal_rate =
-      earth::omegaIeNed(ins_.state().position.latitude_rad).head<2>().norm();
-  const double spread = horizontal_rate * (1.0 - std::exp(-var_psi));
-  const double required = 0.5 * spread * spread;  // Var(W cos L cos psi), psi ~ N(0, var_psi)
+  const double required = earthRateRemainderNorthVariance(
+      P(kAtt.index + 2, kAtt.index + 2), earth::omegaIeNed(ins_.state().position.latitude_rad));
   // The computed north axis in the body frame.
   const Eigen::Vector3d u_b = ins_.state().q_b_to_n.conjugate() * Eigen::Vector3d::UnitX();
   const double now = u_b.dot(P.block<3, 3>(kGyroBias.index, kGyroBias.index) * u_b);

@@ -366,8 +366,10 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   } else if (config_.aiding != AidingMode::kLooselyCoupled) {
     return;
   }
-  if (course_check_armed_)
+  if (course_check_armed_) {
+    filter_.floorEarthRateRemainderVariance();
     checkHeadingFromCourse(fix.vel_ned_mps, fix.vel_sigma_ned_mps.head<2>().maxCoeff());
+  }
   const auto p =
       filter_.update(positionMeasurement(filter_.state(), fix.position, fix.pos_sigma_ned_m),
                      AidingKind::kPosition);

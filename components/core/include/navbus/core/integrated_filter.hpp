@@ -140,8 +140,8 @@ class IntegratedFilter {
   /// While the heading sigma is large (before the course check): a filter at rest measures the
   /// computed-north gyro bias together with the Earth rate's second-order remainder
   /// W cos L (cos psi - 1) (static_alignment.cpp step 9), unknown while psi is. Keeps the
-  /// variance of that gyro-bias direction at least the remainder's, W^2 cos^2 L (1 -
-  /// e^(-sigma_psi^2))^2 / 2 for a Gaussian psi, so the filter does not claim it knows more.
+  /// variance of that gyro-bias direction at least the remainder's (step 10), so the filter
+  /// does not claim it knows more. Centralized and adaptive structures (as the course check).
   void floorEarthRateRemainderVariance();
   /// Marks an IMU axis failed (or trusted again): while failed, its bias state is a random
   /// walk of the tuning's failed_* density, so the aiding carries that axis.

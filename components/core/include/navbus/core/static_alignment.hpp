@@ -104,5 +104,8 @@ struct EarthRateMismatch {
   Eigen::Vector3d d_remainder_d_psi{Eigen::Vector3d::Zero()};  ///< [rad/s / rad] NED
 };
 EarthRateMismatch earthRateMismatchRemainder(double psi_rad, const Eigen::Vector3d& w_ie_ned_radps);
+/// Step 10: the variance of step 9's north term while psi is unknown, psi ~ N(0, var_psi_rad2)
+/// [(rad/s)^2]: what a filter at rest cannot tell from its computed-north gyro bias.
+double earthRateRemainderNorthVariance(double var_psi_rad2, const Eigen::Vector3d& w_ie_ned_radps);
 
 }  // namespace navbus::core
