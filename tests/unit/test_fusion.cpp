@@ -11,6 +11,7 @@
 #include "navbus/core/multi_dimensional.hpp"
 #include "navbus/core/navigation_engine.hpp"
 #include "navbus/core/rotation.hpp"
+#include "navbus/core/static_alignment.hpp"
 
 namespace core = navbus::core;
 namespace earth = navbus::core::earth;
@@ -348,4 +349,47 @@ TEST(IntegratedFilter, EarthRateRemainderFloorsTheComputedNorthGyroBiasVariance)
   const core::StateMatrix P = f.covariance();
   f.floorEarthRateRemainderVariance();
   EXPECT_EQ(f.covariance(), P);
+}
+
+TEST(IntegratedFilter, AHeadingCorrectionTurnsTheLevelledTiltsWithTheComputedFrame) {
+  // Given a filter levelled at rest, heading 0.8 rad: its tilts are the horizontal accelerometer
+  // biases over g through the computed frame (static_alignment.cpp step 8), a combination the
+  // covariance holds to 1 urad while each part is 1 mrad,
+  const core::NavState truth = movingTruth({0.0, 0.0, 0.8}, Eigen::Vector3d::Zero());
+  const core::FilterTuning t = tuning();
+  const double g = 9.8;
+  const auto levelled = [&](const Eigen::Quaterniond& q) -> Eigen::Matrix<double, 2, 3> {
+    return core::alignmentSensitivity(q.toRotationMatrix(), truth.position.latitude_rad, g, false)
+        .d_att_d_accel_bias_b.topRows<2>();
+  };
+  const Eigen::Matrix<double, 2, 3> S = levelled(truth.q_b_to_n);
+  const double var_a = t.accel_bias_sigma_mps2 * t.accel_bias_sigma_mps2;
+  core::StateVector sigma = core::IntegratedFilter::initialSigma(t);
+  core::StateMatrix P0 = sigma.array().square().matrix().asDiagonal();
+  P0.block<2, 2>(layout::kAtt.index, layout::kAtt.index) =
+      var_a * S * S.transpose() + 1e-12 * Eigen::Matrix2d::Identity();
+  P0.block<2, 3>(layout::kAtt.index, layout::kAccelBias.index) = -var_a * S;
+  P0.block<3, 2>(layout::kAccelBias.index, layout::kAtt.index) = -var_a * S.transpose();
+  core::IntegratedFilter f;
+  f.initialize(truth, 0, 0, t, kFifteen, core::FusionStructure::kCentralized, P0);
+  // the tilts and the bias errors e = -b: phi_h + S e, in the frame the filter computes
+  const auto combinationVariance = [&]() {
+    Eigen::Matrix<double, 2, layout::kSize> u = Eigen::Matrix<double, 2, layout::kSize>::Zero();
+    u.middleCols<2>(layout::kAtt.index).setIdentity();
+    u.middleCols<3>(layout::kAccelBias.index) = levelled(f.state().q_b_to_n);
+    return Eigen::Matrix2d(u * f.covariance() * u.transpose()).trace();
+  };
+  ASSERT_LT(combinationVariance(), 3e-12);
+  // when a measured heading corrects it by 50 mrad (a normal update, not the course check),
+  core::AidingMeasurement<1> m;
+  m.h.setZero();
+  m.h(0, layout::kAtt.index + 2) = 1.0;
+  m.z << 0.05;
+  m.r << 1e-8;
+  f.update(m, core::AidingKind::kAttitude);
+  const double yaw = core::eulerFromDcm(f.state().q_b_to_n.toRotationMatrix()).z();
+  ASSERT_NEAR(std::abs(yaw - 0.8), 0.05, 1e-3);
+  // then the combination in the new frame is still known to 1 urad: the tilts turned with the
+  // frame. Left unturned they would be off by 50 mrad of each tilt (50 urad).
+  EXPECT_LT(combinationVariance(), 3e-12);
 }

@@ -174,6 +174,9 @@ class IntegratedFilter {
   /// Applies the estimate after an update: centralized feedback, or master fusion + feedback.
   void closeUpdate();
   void feedback(const StateVector& dx);
+  /// P's attitude rows and columns through the reset of a heading correction (before
+  /// feedback): turned by R_D(dpsi) with the frame the INS computes.
+  void turnAttitudeCovariance(double dpsi_rad);
   InnovationWindow<3>* window(AidingKind kind);
 
   FilterTuning tuning_;
