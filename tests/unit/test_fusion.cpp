@@ -351,6 +351,35 @@ TEST(IntegratedFilter, EarthRateRemainderFloorsTheComputedNorthGyroBiasVariance)
   EXPECT_EQ(f.covariance(), P);
 }
 
+TEST(IntegratedFilter, GyrocompassHeadingFloorKeepsTheHeadingAndEastGyroBiasCombination) {
+  // Given a filter at rest, heading 0.8 rad, that claims its heading to 20 mrad, with the heading
+  // and the east gyro bias correlated as gyrocompassing makes them (phi_D = -e_g^n_E / W cos L),
+  const core::NavState truth = movingTruth({0.0, 0.0, 0.8}, Eigen::Vector3d::Zero());
+  core::FilterTuning t = tuning();
+  t.heading_sigma_rad = 0.020;
+  t.gyro_bias_sigma_radps = 1.0 * M_PI / 180 / 3600;
+  core::IntegratedFilter f;
+  f.initialize(truth, 0, 0, t, kFifteen);
+  const double w_h = earth::kRotationRate_radps * std::cos(truth.position.latitude_rad);
+  const Eigen::Vector3d east_b = truth.q_b_to_n.conjugate() * Eigen::Vector3d::UnitY();
+  const auto variance = [&](const core::StateVector& u) { return u.dot(f.covariance() * u); };
+  core::StateVector heading = core::StateVector::Zero();
+  heading[layout::kAtt.index + 2] = 1.0;
+  core::StateVector combination = heading * w_h;  // W cos L phi_D + e_g^n_E: what rest measures
+  combination.segment<3>(layout::kGyroBias.index) = east_b;
+  const double combination_before = variance(combination);
+  // when the floor of an 83 mrad gyrocompass is applied,
+  f.floorGyrocompassHeadingVariance(0.083);
+  // then the heading's variance is the gyrocompass's, and the combination rest measures is as
+  // well known as before (the variance went along the direction that keeps it);
+  EXPECT_NEAR(variance(heading), 0.083 * 0.083, 1e-12);
+  EXPECT_NEAR(variance(combination), combination_before, 1e-9 * combination_before);
+  // a covariance that already says less is left as it is.
+  const core::StateMatrix P = f.covariance();
+  f.floorGyrocompassHeadingVariance(0.05);
+  EXPECT_EQ(f.covariance(), P);
+}
+
 TEST(IntegratedFilter, AHeadingCorrectionTurnsTheLevelledTiltsWithTheComputedFrame) {
   // Given a filter levelled at rest, heading 0.8 rad: its tilts are the horizontal accelerometer
   // biases over g through the computed frame (static_alignment.cpp step 8), a combination the

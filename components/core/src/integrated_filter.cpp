@@ -348,6 +348,25 @@ void IntegratedFilter::floorEarthRateRemainderVariance() {
   P.block<3, 3>(kGyroBias.index, kGyroBias.index) += (required - now) * u_b * u_b.transpose();
 }
 
+void IntegratedFilter::floorGyrocompassHeadingVariance(double heading_sigma_rad) {
+  if (structure_ == FusionStructure::kFederated) return;
+  // At rest the heading and the east gyro bias are one observable (static_alignment.cpp step
+  // 8: phi_D = -e_g^n_E / (W cos L) with the bias error e = -b), which gyrocompassing has read.
+  // Along the direction that moves both and keeps that combination, d = (phi_D 1, e_g^n_E
+  // -W cos L), the data hold nothing more; the filter's first-order model learns there from the
+  // second-order terms of a heading error this large (the heading sigma fell from 83 to 58 mrad
+  // in 440 s at rest, the error did not). Its variance stays the gyrocompass's.
+  StateMatrix& P = central_.P();
+  const int heading = kAtt.index + 2;
+  if (P(heading, heading) >= heading_sigma_rad * heading_sigma_rad) return;
+  const double w_h = earth::omegaIeNed(ins_.state().position.latitude_rad).x();
+  StateVector d = StateVector::Zero();
+  d[heading] = 1.0;
+  d.segment<3>(kGyroBias.index) =
+      ins_.state().q_b_to_n.conjugate() * Eigen::Vector3d(0.0, -w_h, 0.0);
+  P += (heading_sigma_rad * heading_sigma_rad - P(heading, heading)) * d * d.transpose();
+}
+
 void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
   for (int i = block.index; i < block.end(); ++i) {
     const double v = central_.P()(i, i);

@@ -199,6 +199,14 @@ void NavigationEngine::startFromAlignment() {
   const double limit = config_.alignment.course_check_heading_sigma_rad;
   course_check_armed_ = a.attitude_source == AttitudeSource::kGyrocompass && limit > 0.0 &&
                         a.att_sigma_ned_rad.z() > limit;
+  gyrocompass_heading_sigma_rad_ = a.att_sigma_ned_rad.z();
+}
+
+void NavigationEngine::floorBeforeCourseCheck() {
+  filter_.floorEarthRateRemainderVariance();
+  // At rest: once moving, accelerations make the heading observable by itself.
+  if (filter_.state().vel_ned_mps.head<2>().norm() < config_.alignment.rest.speed_mps)
+    filter_.floorGyrocompassHeadingVariance(gyrocompass_heading_sigma_rad_);
 }
 
 void NavigationEngine::checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
@@ -325,7 +333,7 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
     return false;
   }
   if (!any) return false;
-  if (course_check_armed_) filter_.floorEarthRateRemainderVariance();
+  if (course_check_armed_) floorBeforeCourseCheck();
   if (course_check_armed_ &&
       filter_.state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
     const PseudorangeFix pf =
@@ -367,7 +375,7 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
     return;
   }
   if (course_check_armed_) {
-    filter_.floorEarthRateRemainderVariance();
+    floorBeforeCourseCheck();
     checkHeadingFromCourse(fix.vel_ned_mps, fix.vel_sigma_ned_mps.head<2>().maxCoeff());
   }
   const auto p =

@@ -143,6 +143,10 @@ class IntegratedFilter {
   /// variance of that gyro-bias direction at least the remainder's (step 10), so the filter
   /// does not claim it knows more. Centralized and adaptive structures (as the course check).
   void floorEarthRateRemainderVariance();
+  /// At rest before the course check: keeps the heading variance at least the gyrocompass's
+  /// along the direction that changes the heading and the east gyro bias together (one
+  /// observable at rest). Centralized and adaptive structures.
+  void floorGyrocompassHeadingVariance(double heading_sigma_rad);
   /// Marks an IMU axis failed (or trusted again): while failed, its bias state is a random
   /// walk of the tuning's failed_* density, so the aiding carries that axis.
   void setAxisFailed(bool accelerometer, int axis, bool failed);

@@ -162,6 +162,9 @@ class NavigationEngine {
   /// INS course (IntegratedFilter::correctHeadingFromCourse), before the acceleration that
   /// brought the vehicle there goes on through a heading error the first-order model cannot
   /// carry. The INS velocity must have been gained from rest: the start was at rest.
+  /// While the course check is armed: the Earth-rate remainder's floor, and at rest the
+  /// gyrocompass heading's (IntegratedFilter).
+  void floorBeforeCourseCheck();
   void checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
                               double cross_track_sigma_mps);
   bool aligning() const { return config_.start == StartSource::kAligned && !filter_.initialized(); }
@@ -183,7 +186,8 @@ class NavigationEngine {
   std::int64_t next_output_ns_{0};
   std::int64_t last_fix_ns_{-1};
   std::int64_t next_constraint_ns_{0};
-  bool course_check_armed_{false};  ///< checkHeadingFromCourse still to come
+  bool course_check_armed_{false};             ///< checkHeadingFromCourse still to come
+  double gyrocompass_heading_sigma_rad_{0.0};  ///< the aligned start's heading sigma
 };
 
 }  // namespace navbus::core
