@@ -321,15 +321,24 @@ TEST(NavigationEngine, RefusesIncrementsThatDoNotFollowTheStateTime) {
   EXPECT_EQ(e.state().vel_ned_mps, before.vel_ned_mps);
 }
 
+namespace {
+/// A filter at rest at `truth` with the given heading and gyro-bias sigmas.
+core::IntegratedFilter filterAtRest(const core::NavState& truth, double heading_sigma_rad,
+                                    double gyro_bias_sigma_deg_per_h) {
+  core::FilterTuning t = tuning();
+  t.heading_sigma_rad = heading_sigma_rad;
+  t.gyro_bias_sigma_radps = gyro_bias_sigma_deg_per_h * M_PI / 180 / 3600;
+  core::IntegratedFilter f;
+  f.initialize(truth, 0, 0, t, kFifteen);
+  return f;
+}
+}  // namespace
+
 TEST(IntegratedFilter, EarthRateRemainderFloorsTheComputedNorthGyroBiasVariance) {
   // Given a filter at rest with a gyrocompassing heading sigma of 83 mrad, heading 0.8 rad, and a
   // gyro-bias covariance that claims the computed-north channel known to 0.001 deg/h,
   const core::NavState truth = movingTruth({0.0, 0.0, 0.8}, Eigen::Vector3d::Zero());
-  core::FilterTuning t = tuning();
-  t.heading_sigma_rad = 0.083;
-  t.gyro_bias_sigma_radps = 0.001 * M_PI / 180 / 3600;
-  core::IntegratedFilter f;
-  f.initialize(truth, 0, 0, t, kFifteen);
+  core::IntegratedFilter f = filterAtRest(truth, 0.083, 0.001);
   const Eigen::Vector3d north_b = truth.q_b_to_n.conjugate() * Eigen::Vector3d::UnitX();
   const Eigen::Vector3d east_b = truth.q_b_to_n.conjugate() * Eigen::Vector3d::UnitY();
   const auto variance = [&](const Eigen::Vector3d& u) {
@@ -352,14 +361,10 @@ TEST(IntegratedFilter, EarthRateRemainderFloorsTheComputedNorthGyroBiasVariance)
 }
 
 TEST(IntegratedFilter, GyrocompassHeadingFloorKeepsTheHeadingAndEastGyroBiasCombination) {
-  // Given a filter at rest, heading 0.8 rad, that claims its heading to 20 mrad, with the heading
-  // and the east gyro bias correlated as gyrocompassing makes them (phi_D = -e_g^n_E / W cos L),
+  // Given a filter at rest, heading 0.8 rad, that claims its heading to 20 mrad (gyro biases
+  // 1 deg/h),
   const core::NavState truth = movingTruth({0.0, 0.0, 0.8}, Eigen::Vector3d::Zero());
-  core::FilterTuning t = tuning();
-  t.heading_sigma_rad = 0.020;
-  t.gyro_bias_sigma_radps = 1.0 * M_PI / 180 / 3600;
-  core::IntegratedFilter f;
-  f.initialize(truth, 0, 0, t, kFifteen);
+  core::IntegratedFilter f = filterAtRest(truth, 0.020, 1.0);
   const double w_h = earth::kRotationRate_radps * std::cos(truth.position.latitude_rad);
   const Eigen::Vector3d east_b = truth.q_b_to_n.conjugate() * Eigen::Vector3d::UnitY();
   const auto variance = [&](const core::StateVector& u) { return u.dot(f.covariance() * u); };
