@@ -157,14 +157,14 @@ class NavigationEngine {
              const StateMatrix& initial_covariance);
   void startFromAlignment();
   StateMatrix alignedCovariance(const AlignedStart& a) const;
+  /// While the course check is armed: the Earth-rate remainder's floor, and at rest the
+  /// gyrocompass heading's (IntegratedFilter).
+  void floorBeforeCourseCheck();
   /// Once after a gyrocompassing start whose heading sigma is above the configured limit, at
   /// the first GNSS velocity faster than course_min_speed_mps: the GNSS course against the
   /// INS course (IntegratedFilter::correctHeadingFromCourse), before the acceleration that
   /// brought the vehicle there goes on through a heading error the first-order model cannot
   /// carry. The INS velocity must have been gained from rest: the start was at rest.
-  /// While the course check is armed: the Earth-rate remainder's floor, and at rest the
-  /// gyrocompass heading's (IntegratedFilter).
-  void floorBeforeCourseCheck();
   void checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
                               double cross_track_sigma_mps);
   bool aligning() const { return config_.start == StartSource::kAligned && !filter_.initialized(); }
