@@ -391,7 +391,7 @@ TEST(IntegratedFilter, AHeadingCorrectionTurnsTheLevelledTiltsWithTheComputedFra
   // covariance holds to 1 urad while each part is 1 mrad,
   const core::NavState truth = movingTruth({0.0, 0.0, 0.8}, Eigen::Vector3d::Zero());
   const core::FilterTuning t = tuning();
-  const double g = 9.8;
+  const double g = earth::normalGravity(truth.position.latitude_rad, truth.position.height_m);
   const auto levelled = [&](const Eigen::Quaterniond& q) -> Eigen::Matrix<double, 2, 3> {
     return core::alignmentSensitivity(q.toRotationMatrix(), truth.position.latitude_rad, g, false)
         .d_att_d_accel_bias_b.topRows<2>();
