@@ -3,7 +3,7 @@
 #include <string>
 
 #include "navbus/bus/config.hpp"
-#include "navbus/core/units.hpp"
+#include "navbus/core/math/units.hpp"
 
 namespace navbus::fault_manager {
 

@@ -15,9 +15,9 @@
 
 #include <Eigen/Core>
 
-#include "navbus/core/gnss_atmosphere.hpp"
-#include "navbus/core/gps_broadcast_ephemeris.hpp"
-#include "navbus/core/single_point_positioning.hpp"
+#include "navbus/core/gnss/gnss_atmosphere.hpp"
+#include "navbus/core/gnss/gps_broadcast_ephemeris.hpp"
+#include "navbus/core/gnss/single_point_positioning.hpp"
 
 namespace navbus::gnss_data {
 

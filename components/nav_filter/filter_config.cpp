@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "navbus/bus/config.hpp"
-#include "navbus/core/rotation.hpp"
-#include "navbus/core/units.hpp"
+#include "navbus/core/math/rotation.hpp"
+#include "navbus/core/math/units.hpp"
 
 namespace navbus::nav_filter {
 

@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "navbus/core/earth.hpp"
-#include "navbus/core/rotation.hpp"
+#include "navbus/core/math/earth.hpp"
+#include "navbus/core/math/rotation.hpp"
 
 namespace navbus::sensor_sim {
 

@@ -7,7 +7,7 @@
 
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
-#include "navbus/core/earth.hpp"
+#include "navbus/core/math/earth.hpp"
 
 namespace navbus::sensor_sim {
 

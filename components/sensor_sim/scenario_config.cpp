@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "navbus/bus/config.hpp"
-#include "navbus/core/units.hpp"
+#include "navbus/core/math/units.hpp"
 
 namespace navbus::sensor_sim {
 

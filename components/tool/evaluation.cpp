@@ -19,7 +19,7 @@
 #include "integrity_evaluation.hpp"
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
-#include "navbus/core/rotation.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "offline_runner.hpp"
 

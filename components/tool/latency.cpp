@@ -13,7 +13,7 @@
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
-#include "navbus/core/earth.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "spin.hpp"
 
 namespace navbus::tool {

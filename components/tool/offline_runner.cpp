@@ -11,7 +11,7 @@
 #include "frame_publisher.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
-#include "navbus/core/rotation.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/sim/scenario_source.hpp"

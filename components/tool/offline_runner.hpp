@@ -13,8 +13,8 @@
 #include <navbus_idl/Navigation.h>
 #include <Eigen/Core>
 
-#include "navbus/core/initial_alignment.hpp"
-#include "navbus/core/strapdown.hpp"
+#include "navbus/core/engine/initial_alignment.hpp"
+#include "navbus/core/ins/strapdown.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/fault_manager/glr_detector.hpp"
 #include "navbus/nav_filter/filter_config.hpp"

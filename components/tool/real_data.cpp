@@ -14,7 +14,7 @@
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
-#include "navbus/core/earth.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
 
 namespace navbus::tool {

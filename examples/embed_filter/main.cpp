@@ -28,7 +28,7 @@
 #include <navbus_idl/NavigationPubSubTypes.h>
 #include <navbus/bus/config.hpp>
 #include <navbus/bus/health.hpp>
-#include <navbus/core/earth.hpp>
+#include <navbus/core/math/earth.hpp>
 #include <navbus/nav_filter/filter_config.hpp>
 #include <navbus/nav_filter/filter_pipeline.hpp>
 

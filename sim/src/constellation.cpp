@@ -6,7 +6,7 @@
 
 #include <Eigen/Geometry>
 
-#include "navbus/core/earth.hpp"
+#include "navbus/core/math/earth.hpp"
 
 namespace navbus::sim {
 

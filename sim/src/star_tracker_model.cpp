@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "navbus/core/rotation.hpp"
+#include "navbus/core/math/rotation.hpp"
 
 namespace navbus::sim {
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "navbus/core/rotation.hpp"
+#include "navbus/core/math/rotation.hpp"
 
 namespace navbus::sim {
 

@@ -24,7 +24,7 @@
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/guarded_type.hpp"
 #include "navbus/bus/validation.hpp"
-#include "navbus/core/glr.hpp"
+#include "navbus/core/integrity/glr.hpp"
 
 namespace {
 

@@ -17,7 +17,7 @@ prefix=$work/moved
   fail "no navbusConfig.cmake / navbusConfigVersion.cmake installed"
 for f in share/navbus/qos/navbus_qos.xml share/navbus/config/filter.yaml \
   share/navbus/scenarios/seed000_aircraft.yaml share/doc/navbus/LICENSE \
-  include/navbus/core/strapdown.hpp include/navbus/nav_filter/filter_pipeline.hpp \
+  include/navbus/core/ins/strapdown.hpp include/navbus/nav_filter/filter_pipeline.hpp \
   include/navbus_idl/ImuPubSubTypes.h; do
   [[ -f $prefix/$f ]] || fail "$f not installed"
 done

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "navbus/bus/config.hpp"
-#include "navbus/core/earth.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "real_data.hpp"
 #include "rinex2.hpp"

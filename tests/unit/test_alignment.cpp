@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include "navbus/core/earth.hpp"
-#include "navbus/core/initial_alignment.hpp"
-#include "navbus/core/rotation.hpp"
-#include "navbus/core/static_alignment.hpp"
-#include "navbus/core/units.hpp"
+#include "navbus/core/math/earth.hpp"
+#include "navbus/core/engine/initial_alignment.hpp"
+#include "navbus/core/math/rotation.hpp"
+#include "navbus/core/ins/static_alignment.hpp"
+#include "navbus/core/math/units.hpp"
 
 namespace core = navbus::core;
 namespace earth = navbus::core::earth;

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "navbus/core/spectrum.hpp"
+#include "navbus/core/math/spectrum.hpp"
 #include "navbus/sim/dither.hpp"
 
 namespace {

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "navbus/core/dither_monitor.hpp"
+#include "navbus/core/integrity/dither_monitor.hpp"
 #include "navbus/sim/dither.hpp"
 
 namespace {

@@ -7,11 +7,11 @@
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
-#include "navbus/core/error_state.hpp"
-#include "navbus/core/gnss_measurement.hpp"
-#include "navbus/core/kalman_update.hpp"
-#include "navbus/core/rotation.hpp"
-#include "navbus/core/sparse_rows.hpp"
+#include "navbus/core/filter/error_state.hpp"
+#include "navbus/core/gnss/gnss_measurement.hpp"
+#include "navbus/core/math/kalman_update.hpp"
+#include "navbus/core/math/rotation.hpp"
+#include "navbus/core/math/sparse_rows.hpp"
 #include "navbus/sim/constellation.hpp"
 
 namespace earth = navbus::core::earth;
@@ -167,8 +167,8 @@ TEST(JosephUpdate, StaysSymmetricPositiveDefiniteAndGatesOutliers) {
   EXPECT_EQ(P, P0);
 }
 
-#include "navbus/core/ins_error_model.hpp"
-#include "navbus/core/rotation.hpp"
+#include "navbus/core/ins/ins_error_model.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "navbus/sim/trajectory.hpp"
 
 namespace {

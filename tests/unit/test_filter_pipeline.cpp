@@ -8,7 +8,7 @@
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/topics.hpp"
-#include "navbus/core/state_layout.hpp"
+#include "navbus/core/ins/state_layout.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/nav_filter/monitor_liveness.hpp"

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "navbus/core/allan.hpp"
+#include "navbus/core/math/allan.hpp"
 #include "navbus/sim/imu_model.hpp"
 
 using navbus::core::allanDeviation;

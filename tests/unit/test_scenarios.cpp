@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "navbus/bus/config.hpp"
-#include "navbus/core/spectrum.hpp"
+#include "navbus/core/math/spectrum.hpp"
 #include "scenario_config.hpp"
 
 namespace fs = std::filesystem;

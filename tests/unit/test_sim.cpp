@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "navbus/core/earth.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
 namespace earth = navbus::core::earth;

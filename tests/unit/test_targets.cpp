@@ -8,7 +8,7 @@
 
 #include "evaluation.hpp"
 #include "navbus/bus/config.hpp"
-#include "navbus/core/units.hpp"
+#include "navbus/core/math/units.hpp"
 #include "offline_runner.hpp"
 
 namespace tool = navbus::tool;

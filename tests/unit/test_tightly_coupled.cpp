@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "navbus/bus/config.hpp"
-#include "navbus/core/integrated_filter.hpp"
-#include "navbus/core/rotation.hpp"
+#include "navbus/core/filter/integrated_filter.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "scenario_config.hpp"
 
 namespace earth = navbus::core::earth;
@@ -120,7 +120,7 @@ TEST(IntegratedFilter, Seed000ClosedLoopTracksTheTruthConsistently) {
   }
 }
 
-#include "navbus/core/aiding_measurements.hpp"
+#include "navbus/core/filter/aiding_measurements.hpp"
 
 TEST(AidingMeasurements, InnovationsEqualHTimesTheConstructedError) {
   navbus::core::NavState truth;

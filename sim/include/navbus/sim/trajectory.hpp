@@ -8,8 +8,8 @@
 
 #include <Eigen/Core>
 
-#include "navbus/core/earth.hpp"
-#include "navbus/core/strapdown.hpp"
+#include "navbus/core/math/earth.hpp"
+#include "navbus/core/ins/strapdown.hpp"
 
 namespace navbus::sim {
 

@@ -11,7 +11,7 @@
 #include <navbus_idl/Imu.h>
 
 #include "navbus/bus/validation.hpp"
-#include "navbus/core/dither_monitor.hpp"
+#include "navbus/core/integrity/dither_monitor.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/fault_manager/fault_output.hpp"
 

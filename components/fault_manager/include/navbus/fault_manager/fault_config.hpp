@@ -6,8 +6,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "navbus/core/dither_monitor.hpp"
-#include "navbus/core/glr.hpp"
+#include "navbus/core/integrity/dither_monitor.hpp"
+#include "navbus/core/integrity/glr.hpp"
 
 namespace navbus::fault_manager {
 

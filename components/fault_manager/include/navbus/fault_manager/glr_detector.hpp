@@ -13,7 +13,7 @@
 #include <navbus_idl/Fault.h>
 #include <navbus_idl/Navigation.h>
 
-#include "navbus/core/glr.hpp"
+#include "navbus/core/integrity/glr.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/fault_manager/fault_output.hpp"
 

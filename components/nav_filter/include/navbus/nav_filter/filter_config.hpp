@@ -11,7 +11,7 @@
 
 #include "navbus/bus/topics.hpp"
 #include "navbus/bus/validation.hpp"
-#include "navbus/core/navigation_engine.hpp"
+#include "navbus/core/engine/navigation_engine.hpp"
 
 namespace navbus::nav_filter {
 

@@ -21,8 +21,8 @@
 
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/validation.hpp"
-#include "navbus/core/navigation_engine.hpp"
-#include "navbus/core/output_predictor.hpp"
+#include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/ins/output_predictor.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/input_history.hpp"
 #include "navbus/nav_filter/input_sequencer.hpp"

@@ -14,8 +14,8 @@
 
 #include <navbus_idl/Fault.h>
 
-#include "navbus/core/navigation_engine.hpp"
-#include "navbus/core/ring_buffer.hpp"
+#include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/math/ring_buffer.hpp"
 
 namespace navbus::nav_filter {
 

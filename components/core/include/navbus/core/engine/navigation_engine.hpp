@@ -1,0 +1,193 @@
+// The navigation engine: the filter policy between inputs in processing order and the
+// estimate (KF-GINS style: addImu, addGnss..., state). It decides when the filter starts,
+// restarts over inertial gaps, which measurements each aiding mode uses, runs the
+// multi-dimensional stage logic, and marks solution epochs. navbus-filter and the offline
+// runner call the same engine with the same inputs, which is what makes them bit-identical.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "navbus/core/filter/aiding_inputs.hpp"
+#include "navbus/core/integrity/glr_protection_level.hpp"
+#include "navbus/core/engine/initial_alignment.hpp"
+#include "navbus/core/filter/integrated_filter.hpp"
+#include "navbus/core/filter/multi_dimensional.hpp"
+
+namespace navbus::core {
+
+enum class AidingMode {
+  kInertialOnly,     ///< mechanization and covariance propagation, no updates
+  kTightlyCoupled,   ///< pseudoranges and rates (seed 000)
+  kLooselyCoupled,   ///< GNSS position/velocity fixes (+ star tracker when enabled; seed 001)
+  kMultiDimensional  ///< land vehicle: fixes, ZUPT, NHC with the stage logic (seed 004)
+};
+
+enum class EngineMode {
+  kInitializing,
+  kInertialOnly,
+  kInertialLost,
+  kTightlyCoupled,
+  kLooselyCoupled,
+  kMdfF1,
+  kMdfF2,
+  kMdfF3,
+  kMdfF4,
+  kAidedAxisFailed,  ///< tightly or loosely coupled with a failed IMU axis
+  kAligning          ///< aligning from the inputs (InitialAligner): no solution yet
+};
+
+/// Where the filter's start comes from.
+enum class StartSource {
+  kConfigured,  ///< EngineConfig::initial_state with the tuning's initial sigmas
+  kAligned      ///< InitialAligner from the inputs, with the alignment's own sigmas
+};
+
+/// Engine status bits (the participant maps them to the solution's fault flags).
+enum EngineStatus : std::uint32_t {
+  kStatusImuGap = 1u << 0,
+  kStatusSatelliteExcluded = 1u << 1,
+  kStatusBiasCompensated = 1u << 2,
+  kStatusAxisFailed = 1u << 3,
+};
+
+/// Which measurements of a satellite an exclusion concerns (bit mask).
+enum class SatelliteScope : std::uint8_t { kRange = 1, kRate = 2, kAll = 3 };
+
+struct EngineConfig {
+  AidingMode aiding{AidingMode::kInertialOnly};
+  FusionStructure fusion{FusionStructure::kCentralized};
+  FilterTuning tuning;
+  bool use_star_tracker{false};  ///< loosely coupled: star-tracker attitude updates
+  MdfConfig mdf;                 ///< multi-dimensional mode only
+  double imu_period_s{0.01};     ///< nominal increment interval (stationarity window)
+  StartSource start{StartSource::kConfigured};
+  NavState initial_state;            ///< kConfigured; time is taken from the first increment
+  InitialAlignmentConfig alignment;  ///< kAligned (budget, rest detection, course)
+  double initial_clock_bias_m{0.0};
+  double initial_clock_drift_mps{0.0};
+  std::int64_t solution_period_ns{100'000'000};
+  /// Protection levels from the GLR's statistics (tightly coupled mode only).
+  IntegrityConfig integrity;
+};
+
+struct EngineCounters {
+  std::uint64_t imu_used{0}, imu_gaps{0};
+  std::uint64_t imu_aligning{0};  ///< increments the alignment took before the filter started
+  /// Increments refused: interval not positive and finite, or not after the state time (an
+  /// embedding application may call the engine without the bus validation).
+  std::uint64_t imu_refused{0};
+  std::uint64_t gnss_epochs_fused{0}, fixes_fused{0}, star_fused{0};
+  std::uint64_t zero_velocity_updates{0}, nonholonomic_updates{0};
+  std::uint64_t rows_gated{0};  ///< measurement rows refused by the innovation gate
+  std::uint64_t stage_switches{0};
+  /// Headings measured again from the GNSS course after gyrocompassing
+  /// (InitialAlignmentConfig::course_check_heading_sigma_rad).
+  std::uint64_t course_heading_checks{0};
+};
+
+class NavigationEngine {
+ public:
+  explicit NavigationEngine(const EngineConfig& config);
+
+  /// Integrates one increment; true when the state time reached a solution epoch. An increment
+  /// with a bad interval or one that does not follow the state time is refused and counted.
+  bool addImu(const ImuIncrement& inc);
+  /// Fuses a pseudorange epoch of time `time_ns` (tightly coupled mode); true when fused
+  /// (diagnostics ready). While aligning, the epoch goes to the aligner.
+  bool addGnssEpoch(std::int64_t time_ns, const std::vector<SatelliteObservation>& satellites);
+  void addGnssFix(const GnssFixMeasurement& fix);
+  void addStarAttitude(const StarAttitudeMeasurement& st);
+
+  // Commands.
+  /// Stops fusing the scope's measurements of sv_id (they stay in the diagnostics, monitored).
+  void excludeSatellite(int sv_id, SatelliteScope scope = SatelliteScope::kAll);
+  void readmitSatellite(int sv_id, SatelliteScope scope = SatelliteScope::kAll);
+  /// Adds a bias (accelerometer [m/s^2] or gyro [rad/s], body axis 0..2) to the compensation.
+  /// `bias_sigma` [same unit] is the compensation's own uncertainty: added to the bias
+  /// variance, so that the filter can still estimate what the compensation missed.
+  void compensateBias(bool accelerometer, int axis, double bias, double bias_sigma = 0.0);
+  /// A bias step of unknown size: its variance grows by sigma^2 and the filter re-estimates it.
+  void relearnBias(bool accelerometer, int axis, double sigma) {
+    compensateBias(accelerometer, axis, 0.0, sigma);
+  }
+  /// An IMU axis has failed: its error becomes a random-walk bias (IntegratedFilter::
+  /// setAxisFailed) and an aided solution reports kAidedAxisFailed. Free inertial navigation
+  /// keeps its mode and shows the failure in the status (its sigmas grow with the bias walk).
+  void failSensorAxis(bool accelerometer, int axis);
+  void restoreSensorAxis(bool accelerometer, int axis);
+  bool anyAxisFailed() const { return failed_axes_ != 0; }
+  /// False when the structure does not apply to the aiding mode (see the .cpp).
+  bool selectFusion(FusionStructure s);
+  void markInertialLost();
+  void reset();
+
+  bool initialized() const { return filter_.initialized(); }
+  const NavState& state() const { return filter_.state(); }
+  const StateMatrix& covariance() const { return filter_.covariance(); }
+  Eigen::Vector3d accelBias() const { return filter_.accelBias() + accel_compensation_; }
+  Eigen::Vector3d gyroBias() const { return filter_.gyroBias() + gyro_compensation_; }
+  double clockBias() const { return filter_.clockBias(); }
+  double clockDrift() const { return filter_.clockDrift(); }
+  EngineMode mode() const { return mode_; }
+  FusionStructure fusion() const { return filter_.structure(); }
+  const EngineConfig& config() const { return config_; }
+  std::uint32_t status() const { return status_; }
+  const EngineCounters& counters() const { return counters_; }
+  const EpochDiagnostics& lastEpoch() const { return filter_.lastEpoch(); }
+  const IntegratedFilter& filter() const { return filter_; }
+  /// StartSource::kAligned: where the alignment stands, and once aligned what it started from
+  /// (attitude and position sources, its sigmas, the gyrocompassing limit).
+  const InitialAligner& aligner() const { return aligner_; }
+  /// Horizontal and vertical protection levels of the current state (kNotMonitored unless
+  /// integrity is enabled in tightly coupled mode and the filter runs).
+  ProtectionLevels protectionLevels() const;
+  const GlrProtectionLevel& integrity() const { return integrity_; }
+
+ private:
+  StateMask baseMask() const;
+  /// The white part of a star-tracker sample's sigma, per body axis [rad].
+  Eigen::Vector3d starTrackerWhiteSigma(const Eigen::Vector3d& sigma_b_rad) const;
+  EngineMode aidedMode() const;
+  void applyStage(const StageDecision& d);
+  void constraintUpdate();
+  void countGated(const ScalarUpdateResult* results, int n);
+  void start(const NavState& state, double clock_bias_m, double clock_drift_mps,
+             const StateMatrix& initial_covariance);
+  void startFromAlignment();
+  StateMatrix alignedCovariance(const AlignedStart& a) const;
+  /// While the course check is armed: the Earth-rate remainder's floor, and at rest the
+  /// gyrocompass heading's (IntegratedFilter).
+  void floorBeforeCourseCheck();
+  /// Once after a gyrocompassing start whose heading sigma is above the configured limit, at
+  /// the first GNSS velocity faster than course_min_speed_mps: the GNSS course against the
+  /// INS course (IntegratedFilter::correctHeadingFromCourse), before the acceleration that
+  /// brought the vehicle there goes on through a heading error the first-order model cannot
+  /// carry. The INS velocity must have been gained from rest: the start was at rest.
+  void checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
+                              double cross_track_sigma_mps);
+  bool aligning() const { return config_.start == StartSource::kAligned && !filter_.initialized(); }
+
+  EngineConfig config_;
+  IntegratedFilter filter_;
+  InitialAligner aligner_;
+  GlrProtectionLevel integrity_;
+  StationarityDetector stationarity_;
+  StageSelector stages_;
+  EngineMode mode_{EngineMode::kInitializing};
+  std::uint32_t status_{0};
+  EngineCounters counters_;
+  std::map<int, std::uint8_t> excluded_;    ///< sv -> SatelliteScope bits excluded
+  std::vector<SatelliteObservation> used_;  ///< reused buffer of the satellites fused
+  Eigen::Vector3d accel_compensation_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d gyro_compensation_{Eigen::Vector3d::Zero()};
+  std::uint8_t failed_axes_{0};  ///< bit i: accelerometer i (0-2), gyro i - 3 (3-5)
+  std::int64_t next_output_ns_{0};
+  std::int64_t last_fix_ns_{-1};
+  std::int64_t next_constraint_ns_{0};
+  bool course_check_armed_{false};             ///< checkHeadingFromCourse still to come
+  double gyrocompass_heading_sigma_rad_{0.0};  ///< the aligned start's heading sigma
+};
+
+}  // namespace navbus::core

@@ -1,0 +1,53 @@
+// Loosely coupled aiding measurements over the state layout: GNSS position and velocity
+// (seed 004 eq. 5, seed 001) and star-tracker attitude (seed 001 eq. 17). Each returns the
+// innovation z = predicted - measured in error-state form (z = H dx + v), H and R.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "navbus/core/ins/state_layout.hpp"
+#include "navbus/core/ins/strapdown.hpp"
+
+namespace navbus::core {
+
+/// An M-row aiding measurement in error-state form.
+template <int M>
+struct AidingMeasurement {
+  static constexpr int kRows = M;
+  Eigen::Matrix<double, M, 1> z;              ///< innovation, predicted minus measured
+  Eigen::Matrix<double, M, layout::kSize> h;  ///< d z / d dx
+  Eigen::Matrix<double, M, M> r;              ///< measurement noise covariance
+};
+using VectorMeasurement = AidingMeasurement<3>;
+
+/// GNSS position fix: z = (INS position - fix position) in NED metres (lever arm zero).
+VectorMeasurement positionMeasurement(const NavState& ins, const earth::Geodetic& fix,
+                                      const Eigen::Vector3d& sigma_ned_m);
+
+/// GNSS velocity: z = INS velocity - fix velocity [m/s, NED].
+VectorMeasurement velocityMeasurement(const NavState& ins, const Eigen::Vector3d& fix_vel_ned_mps,
+                                      const Eigen::Vector3d& sigma_ned_mps);
+
+/// Star tracker: the measured body-to-ECI attitude brought into NED at the INS position and
+/// time; z = phi_INS - phi_ST (seed 001 eq. 17) as the small rotation between the INS attitude
+/// and the measured one. Body-axis sigmas are rotated into NED. The tracker's bias b (a small
+/// rotation about its axes, which are the body axes: C_meas = C_true exp([b + v] x)) appears
+/// in NED as C_b_n b: with the estimate b^ subtracted, z = phi - C_b_n (b^ - b) + C_b_n v, so
+/// H selects phi and gives -C_b_n on the bias error states.
+VectorMeasurement attitudeMeasurement(const NavState& ins,
+                                      const Eigen::Quaterniond& q_b_to_i_measured,
+                                      const Eigen::Vector3d& sigma_b_rad,
+                                      const Eigen::Vector3d& bias_estimate_b_rad);
+
+/// Zero-velocity update while the vehicle stands still (seed 004 eq. 4): z = V_INS - 0 [m/s,
+/// NED], H selects the velocity error.
+VectorMeasurement zeroVelocityMeasurement(const NavState& ins, double sigma_mps);
+
+/// Non-holonomic constraint of a land vehicle (seed 004 eq. 6): the lateral and vertical body
+/// velocities are zero, z = (C_n_b V_INS)_{y,z} [m/s, body]. With C_b_n,est = (I - [phi x])
+/// C_b_n, the body velocity error is C_n_b dV - C_n_b [V x] phi, which gives the velocity and
+/// attitude columns of H.
+AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps);
+
+}  // namespace navbus::core

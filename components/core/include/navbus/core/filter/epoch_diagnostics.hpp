@@ -1,0 +1,41 @@
+// What a GNSS measurement epoch of a filter over the state layout publishes for an
+// independent fault monitor (the GLR of seed 000 eqs. 6-16): innovations, their covariance
+// from the prior, H, the gain actually applied and the transition since the previous epoch.
+// Shared by the tightly coupled filter and the static receiver filter.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "navbus/core/ins/ins_error_model.hpp"
+
+namespace navbus::core {
+
+/// Batch form of one epoch from the prior covariance; rows in the filter's order.
+struct EpochDiagnostics {
+  std::vector<int> sv_ids;         ///< per row
+  std::vector<bool> is_rate;       ///< per row
+  std::vector<bool> used;          ///< per row: fused (false: gated, or monitored only)
+  Eigen::VectorXd innovation;      ///< predicted minus measured, m rows
+  Eigen::MatrixXd innovation_cov;  ///< V = H P- H^T + R, m x m
+  Eigen::MatrixXd h;               ///< m x n (n = layout::kSize)
+  Eigen::MatrixXd k;  ///< n x m: the gain applied, P- H_u^T V_uu^-1 on the used rows, 0 elsewhere
+  StateMatrix phi{StateMatrix::Identity()};  ///< transition accumulated since the previous epoch
+  std::vector<double> test_ratio;            ///< per row, from the sequential gated update
+};
+
+/// Sets d.k to the gain a sequence of scalar updates applied in total: for the accepted rows a
+/// (diagonal R) the batch gain K_a = P- H_a^T V_aa^-1, 0 for the others. Decoupling the other
+/// rows in V (identity block) gives it in one solve. Keeps its storage between epochs.
+class AppliedGain {
+ public:
+  void compute(EpochDiagnostics& d, const StateMatrix& prior_P);
+
+ private:
+  Eigen::MatrixXd cov_;
+  Eigen::LLT<Eigen::MatrixXd> llt_;
+};
+
+}  // namespace navbus::core

@@ -1,0 +1,91 @@
+// An error-state Kalman filter over the state layout (state_layout.hpp): the error estimate x, its
+// covariance P and the set of active states. It knows nothing of the navigation state it corrects;
+// the integrated filter (integrated_filter.hpp) owns the mechanization and applies the feedback.
+#pragma once
+
+#include <array>
+#include <bitset>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "navbus/core/filter/aiding_measurements.hpp"
+#include "navbus/core/ins/ins_error_model.hpp"
+#include "navbus/core/math/kalman_update.hpp"
+
+namespace navbus::core {
+
+using StateVector = Eigen::Matrix<double, layout::kSize, 1>;
+using StateMask = std::bitset<layout::kSize>;
+
+/// The mask with the given blocks active.
+StateMask maskOf(std::initializer_list<StateBlock> blocks);
+
+class ErrorState {
+ public:
+  void initialize(const StateMatrix& P0, const StateMask& active);
+
+  /// x = Phi x, P = Phi P Phi^T + Q, Q = diag(q_diagonal) (the process noises of every
+  /// configuration are uncorrelated), on the active states only: an inactive state keeps its
+  /// variance, is not driven by the active ones and does not drive them (seed 004 fig. 9: each
+  /// reduced filter uses its region of the 15-state system matrix). Phi's nonzero elements
+  /// must lie within transitionPattern() (ins_error_model.hpp), as every transitionMatrix()
+  /// does (asserted in builds without NDEBUG); that pattern is block upper triangular at
+  /// layout::kCoupledSize, which the product exploits (sparse_rows.hpp).
+  void predict(const StateMatrix& Phi, const StateVector& q_diagonal);
+
+  /// Sequential Joseph-form update, rows decorrelated by the Cholesky factor of R, inactive
+  /// columns of H ignored. gate_sigma <= 0 disables gating. Returns one result per row.
+  template <int M>
+  std::array<ScalarUpdateResult, M> update(const AidingMeasurement<M>& m, double gate_sigma);
+
+  /// Covariance reset rules of seed 004 (eq. 12): zero every off-diagonal element, then
+  /// re-initialize the listed variances.
+  void zeroOffDiagonal();
+  void setVariances(const StateBlock& block, double sigma);
+
+  /// Changes the active set (inactive states keep their variance, cross terms removed).
+  void setActive(const StateMask& active);
+  /// Which active states updates correct; the other active ones are consider states
+  /// (kalman_update.hpp): propagated and correlated, never corrected. Default: all.
+  void setEstimated(const StateMask& estimated) { estimated_ = estimated; }
+
+  /// The navigation state was corrected by dx: the error estimate becomes x - dx.
+  void shift(const StateVector& dx) { x_ -= dx; }
+
+  StateVector& x() { return x_; }
+  const StateVector& x() const { return x_; }
+  StateMatrix& P() { return P_; }
+  const StateMatrix& P() const { return P_; }
+  const StateMask& active() const { return active_; }
+
+ private:
+  void removeInactiveCoupling();
+
+  StateVector x_{StateVector::Zero()};
+  StateMatrix P_{StateMatrix::Zero()};
+  StateMask active_;
+  /// transitionPattern() without the inactive states' coupling.
+  SparsityPattern<layout::kSize> pattern_{transitionPattern()};
+  StateMask estimated_{StateMask().set()};
+};
+
+template <int M>
+std::array<ScalarUpdateResult, M> ErrorState::update(const AidingMeasurement<M>& m,
+                                                     double gate_sigma) {
+  using RowMatrix = Eigen::Matrix<double, M, layout::kSize>;
+  const Eigen::Matrix<double, M, M> L = m.r.llt().matrixL();
+  const Eigen::Matrix<double, M, 1> z = L.template triangularView<Eigen::Lower>().solve(m.z);
+  RowMatrix H = L.template triangularView<Eigen::Lower>().solve(m.h);
+  for (int j = 0; j < layout::kSize; ++j) {
+    if (!active_[static_cast<std::size_t>(j)]) H.col(j).setZero();
+  }
+  std::array<ScalarUpdateResult, M> out;
+  for (int i = 0; i < M; ++i) {
+    out[static_cast<std::size_t>(i)] =
+        scalarUpdate<layout::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma, &estimated_);
+  }
+  return out;
+}
+
+}  // namespace navbus::core

@@ -1,0 +1,226 @@
+// The integrated navigation filter: strapdown mechanization with error-state feedback and the
+// fusion structures of seed 001 over the state layout of state_layout.hpp.
+//  - centralized: one error-state EKF takes every measurement (seed 001 eqs. 22-23 in
+//    sequential Joseph form);
+//  - federated, no-reset mode: a GNSS/INS and a star-tracker/INS local filter, each with its own
+//    covariance, fused by the master (eqs. 28-29) after every local update; the master estimate
+//    is fed back into the shared mechanization and subtracted from both local estimates, whose
+//    covariances are never reset;
+//  - adaptive: the centralized filter with R of the aiding measurements re-estimated from a
+//    window of innovations (eqs. 30-34).
+// Attitude errors are phi angles in NED (computed C_b_n = (I - [phi x]) C_b_n,true), see
+// state_layout.hpp; all errors are estimate minus truth.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "navbus/core/filter/aiding_measurements.hpp"
+#include "navbus/core/filter/epoch_diagnostics.hpp"
+#include "navbus/core/filter/error_state.hpp"
+#include "navbus/core/gnss/gnss_measurement.hpp"
+#include "navbus/core/filter/innovation_window.hpp"
+#include "navbus/core/ins/ins_error_model.hpp"
+#include "navbus/core/math/kalman_update.hpp"
+
+namespace navbus::core {
+
+enum class FusionStructure { kCentralized, kFederated, kAdaptive };
+
+/// What an aiding measurement is: selects the local filter (federated) and the innovation
+/// window (adaptive).
+enum class AidingKind { kPosition, kVelocity, kAttitude, kZeroVelocity, kNonHolonomic };
+
+struct FilterTuning {
+  earth::GravityModel gravity{earth::GravityModel::kWgs84Normal};
+  // Process noise densities.
+  double accel_noise_mps2_per_sqrthz{1e-4};
+  double gyro_noise_radps_per_sqrthz{1e-6};
+  double clock_bias_noise_m_per_sqrts{0.1};
+  double clock_drift_noise_mps_per_sqrts{0.01};
+  // Initial 1-sigma (also the values the covariance reset rules re-initialize to).
+  double pos_sigma_m{40.0};
+  double vel_sigma_mps{1.0};
+  double level_sigma_rad{1e-3};
+  double heading_sigma_rad{5e-3};
+  double accel_bias_sigma_mps2{1e-2};
+  double gyro_bias_sigma_radps{5e-6};
+  double clock_bias_sigma_m{3000.0};
+  double clock_drift_sigma_mps{1.0};
+  double gate_sigma{5.0};  ///< innovation gate in standard deviations; <= 0: no gate
+  // Star-tracker bias (seed 001): a first-order Gauss-Markov rotation about each star-tracker
+  // axis, modelled as the layout's kStarTrackerBias states when its sigma is positive (0: not
+  // modelled, the states stay inactive).
+  double star_tracker_bias_sigma_rad{0.0};             ///< stationary 1 sigma per axis [rad]
+  double star_tracker_bias_correlation_time_s{300.0};  ///< [s]
+  // Adaptive structure (seed 001 eqs. 30-34).
+  int adaptive_window{50};                ///< innovations per estimate [epochs]
+  double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]
+  double adaptive_floor_velocity_mps{0.01};
+  double adaptive_floor_attitude_rad{1e-6};
+  bool adaptive_floor_at_reported{true};  ///< R never below the measurement's own R
+  // A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its output error (a stuck value minus the true
+  // specific force or rate) is modelled as a bias with this random walk, and its variance grows
+  // by the sigma at the failure. The walk must cover the vehicle's manoeuvres on that axis.
+  double failed_accel_bias_sigma_mps2{1.0};
+  double failed_accel_bias_rw_mps2_per_sqrts{1.0};
+  double failed_gyro_bias_sigma_radps{0.02};
+  double failed_gyro_bias_rw_radps_per_sqrts{0.005};
+  // Federated structure: each local filter starts from, and is driven by, share times the
+  // covariance and process noise (information sharing 1/share, Carlson's no-reset mode).
+  double federated_share{2.0};
+};
+
+struct MeasurementReport {
+  int sv_id;
+  bool rate;   ///< false: pseudorange row, true: pseudorange-rate row
+  bool fused;  ///< offered to the update (false: excluded, monitored only)
+  ScalarUpdateResult result;
+};
+
+class IntegratedFilter {
+ public:
+  /// Number of leading states the federated master fuses: all but the receiver clock, which
+  /// only the GNSS local filter observes.
+  static constexpr int kFusedStates = layout::kClockBias.index;
+  static_assert(layout::kClockDrift.end() == layout::kSize, "the clock must trail the layout");
+
+  /// Starts from `state` with the tuning's initial sigmas (initialSigma).
+  void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
+                  const FilterTuning& tuning, const StateMask& active,
+                  FusionStructure structure = FusionStructure::kCentralized);
+  /// Starts from `state` with an explicit initial covariance (an alignment's own budget, with
+  /// its attitude-bias correlations), in the units of the state layout.
+  void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
+                  const FilterTuning& tuning, const StateMask& active, FusionStructure structure,
+                  const StateMatrix& initial_covariance);
+  /// The tuning's initial 1-sigma of every state (the configured start).
+  static StateVector initialSigma(const FilterTuning& tuning);
+  /// Mechanizes one increment (bias-corrected) and propagates the clock and, unless
+  /// `suspend_filter` (the filter is not run: seed 004's case I during an outage), the
+  /// covariance(s).
+  void propagate(const ImuIncrement& raw, bool suspend_filter = false);
+  /// Processes one epoch of pseudoranges and rates; returns one report per row (a buffer
+  /// reused from epoch to epoch, valid until the next call). Rows a satellite's use_range /
+  /// use_rate exclude are monitored only: their innovations are in the diagnostics (for the
+  /// fault monitor's readmission test) but they do not update the filter.
+  const std::vector<MeasurementReport>& update(const std::vector<SatelliteObservation>& sats);
+  /// Processes an aiding measurement, one decorrelated row at a time.
+  template <int M>
+  std::array<ScalarUpdateResult, M> update(const AidingMeasurement<M>& m, AidingKind kind);
+
+  /// Switches the fusion structure at run time (the estimate carries over; see .cpp).
+  void setStructure(FusionStructure s);
+  FusionStructure structure() const { return structure_; }
+
+  /// Covariance management for the multi-dimensional filter (seed 004).
+  void setActive(const StateMask& active);
+  /// Which states the updates correct; the others are consider states (error_state.hpp).
+  void setEstimated(const StateMask& estimated);
+  void zeroOffDiagonal();
+  void resetVariances(const StateBlock& block, double sigma);
+  /// Raises each variance of the block to at least sigma^2, correlations kept (adding a
+  /// nonnegative diagonal keeps P positive definite).
+  void inflateVariances(const StateBlock& block, double sigma);
+  /// Adds `variance` to one state's variance (a correction of uncertain size was applied).
+  void addVariance(int state, double variance);
+  /// The GNSS course against the INS course (NavigationEngine::checkHeadingFromCourse):
+  ///   z = course_gnss - course_ins = -u_c . e_v / speed + noise,
+  /// u_c the unit vector across the track: the cross-track velocity error, which the velocity
+  /// gained from rest through a heading error phi_D makes -phi_D speed (the covariance carries
+  /// that correlation). The covariance takes the linear update; the heading and the horizontal
+  /// velocity take theirs as an exact rotation about the vertical (the INS velocity gained
+  /// through the heading error is the true one rotated by it: the first-order correction would
+  /// leave (1 - cos phi_D) of the speed along the track, 3.6 % at 0.27 rad), the other states
+  /// the linear one. Centralized and adaptive structures only (false: federated).
+  bool correctHeadingFromCourse(double z_rad, double sigma_rad, double course_rad,
+                                double speed_mps);
+  /// While the heading sigma is large (before the course check): a filter at rest measures the
+  /// computed-north gyro bias together with the Earth rate's second-order remainder
+  /// W cos L (cos psi - 1) (static_alignment.cpp step 9), unknown while psi is. Keeps the
+  /// variance of that gyro-bias direction at least the remainder's (step 10), so the filter
+  /// does not claim it knows more. Centralized and adaptive structures (as the course check).
+  void floorEarthRateRemainderVariance();
+  /// At rest before the course check: keeps the heading variance at least the gyrocompass's
+  /// along the direction that changes the heading and the east gyro bias together (one
+  /// observable at rest). Centralized and adaptive structures.
+  void floorGyrocompassHeadingVariance(double heading_sigma_rad);
+  /// Marks an IMU axis failed (or trusted again): while failed, its bias state is a random
+  /// walk of the tuning's failed_* density, so the aiding carries that axis.
+  void setAxisFailed(bool accelerometer, int axis, bool failed);
+  const StateMask& active() const { return central_.active(); }
+
+  const NavState& state() const { return ins_.state(); }
+  /// The covariance of the estimate: the centralized one, or the master's (federated).
+  const StateMatrix& covariance() const { return central_.P(); }
+  const ErrorState& local(int i) const { return local_[static_cast<std::size_t>(i)]; }
+  const Eigen::Vector3d& accelBias() const { return accel_bias_; }
+  const Eigen::Vector3d& gyroBias() const { return gyro_bias_; }
+  /// The star tracker's estimated bias [rad, star-tracker axes], subtracted from its
+  /// measurements (attitudeMeasurement()); 0 while the bias is not modelled.
+  const Eigen::Vector3d& starTrackerBias() const { return star_tracker_bias_; }
+  double clockBias() const { return clock_bias_m_; }
+  double clockDrift() const { return clock_drift_mps_; }
+  /// Whether the transition since the last update is kept for the pseudorange epochs'
+  /// diagnostics (the GLR's Phi): on for tightly coupled aiding, off otherwise (it costs a third
+  /// of the covariance propagation).
+  void keepTransitionSinceUpdate(bool on) { keep_transition_ = on; }
+  const EpochDiagnostics& lastEpoch() const { return last_epoch_; }
+  void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
+  bool initialized() const { return ins_.initialized(); }
+  const FilterTuning& tuning() const { return tuning_; }
+
+ private:
+  /// The error state a measurement goes to.
+  ErrorState& target(AidingKind kind);
+  /// Applies the estimate after an update: centralized feedback, or master fusion + feedback.
+  void closeUpdate();
+  void feedback(const StateVector& dx);
+  /// P's attitude rows and columns through the reset of a heading correction (before
+  /// feedback): turned by R_D(dpsi) with the frame the INS computes.
+  void turnAttitudeCovariance(double dpsi_rad);
+  InnovationWindow<3>* window(AidingKind kind);
+
+  FilterTuning tuning_;
+  std::array<bool, 6> axis_failed_{};  ///< accelerometers x y z, gyros x y z
+  FusionStructure structure_{FusionStructure::kCentralized};
+  StrapdownNed ins_;
+  ErrorState central_;               ///< centralized/adaptive filter; master result (federated)
+  std::array<ErrorState, 2> local_;  ///< federated: [0] GNSS/INS, [1] star tracker/INS
+  std::array<InnovationWindow<3>, 3> windows_;  ///< adaptive: position, velocity, attitude
+  StateMatrix phi_since_update_{StateMatrix::Identity()};
+  bool keep_transition_{true};
+  EpochDiagnostics last_epoch_;
+  StateMatrix prior_P_{StateMatrix::Zero()};  ///< P- of the latest GNSS epoch
+  AppliedGain applied_gain_;                  ///< the diagnostics' K from the sequential updates
+  std::vector<MeasurementReport> reports_;
+  Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d star_tracker_bias_{Eigen::Vector3d::Zero()};
+  double clock_bias_m_{0.0};
+  double clock_drift_mps_{0.0};
+};
+
+template <int M>
+std::array<ScalarUpdateResult, M> IntegratedFilter::update(const AidingMeasurement<M>& m,
+                                                           AidingKind kind) {
+  AidingMeasurement<M> used = m;
+  ErrorState& es = target(kind);
+  if constexpr (M == 3) {
+    if (InnovationWindow<3>* w = window(kind)) {
+      // Eq. 30: dz = z - H x-; eqs. 31-34 with this epoch's H P- H^T.
+      const Eigen::Vector3d dz = m.z - m.h * es.x();
+      const Eigen::Matrix3d hpht = m.h * es.P() * m.h.transpose();
+      w->push(dz);
+      if (w->full())
+        used.r = w->adaptedR(hpht, tuning_.adaptive_floor_at_reported ? &m.r : nullptr);
+    }
+  }
+  const std::array<ScalarUpdateResult, M> out = es.update(used, tuning_.gate_sigma);
+  closeUpdate();
+  return out;
+}
+
+}  // namespace navbus::core

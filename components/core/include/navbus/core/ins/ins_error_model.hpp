@@ -1,0 +1,41 @@
+// Continuous-time error dynamics of the strapdown INS and the receiver clock over the state
+// layout of state_layout.hpp (phi-angle attitude error, NED position error in metres of the
+// curvilinear position), and the transition matrix of one propagation step. The model is the
+// full local-level one (Titterton & Weston, Strapdown Inertial Navigation Technology, ch. 12;
+// Shin, EKF-based adaptive INS/GNSS, 2005, ch. 2): the Earth and transport rates' dependence on
+// the position and velocity errors is kept, which matters in orbit (seed 001, 7.6 km/s).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "navbus/core/math/sparse_rows.hpp"
+#include "navbus/core/ins/state_layout.hpp"
+#include "navbus/core/ins/strapdown.hpp"
+
+namespace navbus::core {
+
+using StateMatrix = Eigen::Matrix<double, layout::kSize, layout::kSize>;
+
+/// F of dx/dt = F dx at `state`, with the specific force in the body frame `f_b`:
+///   d(dr)/dt  = -[w_en x] dr + dv
+///   d(dv)/dt  = [f_n x] phi - (2 w_ie + w_en) x dv - C_b_n dba + (2 g / R) dr_D e_D
+///   d(phi)/dt = -w_in x phi + d(w_en)/d(dv) dv + C_b_n dbg
+///   d(cb)/dt  = cd,  d(cd)/dt = 0           (seed 000 eq. 3)
+/// Errors are estimate minus truth; biases are random constants (seed 000 eq. 1). The small
+/// couplings of position error into the Earth and transport rates are neglected.
+StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
+                          earth::GravityModel gravity);
+/// The same with the Earth at the state already computed (earth::localEarth).
+StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
+                          const earth::LocalEarth& at_state);
+
+/// Transition matrix over dt: I + F dt + (F dt)^2 / 2.
+StateMatrix transitionMatrix(const StateMatrix& F, double dt);
+
+/// The elements errorDynamics() can fill (read once from a state where all of them are
+/// nonzero), and those of a transitionMatrix() built from such an F (I + F + F^2). Every
+/// transition matrix of the filters lies within the latter (tested at random states).
+const SparsityPattern<layout::kSize>& errorDynamicsPattern();
+const SparsityPattern<layout::kSize>& transitionPattern();
+
+}  // namespace navbus::core

@@ -1,0 +1,492 @@
+#include "navbus/core/engine/navigation_engine.hpp"
+
+#include <cmath>
+
+namespace navbus::core {
+
+using namespace layout;
+
+namespace {
+EngineMode stageMode(MdfStage s) {
+  switch (s) {
+    case MdfStage::kF1ZeroVelocity:
+      return EngineMode::kMdfF1;
+    case MdfStage::kF2Gnss:
+      return EngineMode::kMdfF2;
+    case MdfStage::kF3Recovery:
+      return EngineMode::kMdfF3;
+    case MdfStage::kF4Constraint:
+      return EngineMode::kMdfF4;
+  }
+  return EngineMode::kMdfF2;
+}
+}  // namespace
+
+NavigationEngine::NavigationEngine(const EngineConfig& config)
+    : config_(config), aligner_(config.alignment) {
+  integrity_.configure(config.integrity);
+  used_.reserve(32);
+  reset();
+}
+
+void NavigationEngine::reset() {
+  filter_ = IntegratedFilter();
+  aligner_ = InitialAligner(config_.alignment);
+  integrity_.reset();
+  mode_ = EngineMode::kInitializing;
+  status_ = 0;
+  failed_axes_ = 0;
+  excluded_.clear();
+  accel_compensation_.setZero();
+  gyro_compensation_.setZero();
+  last_fix_ns_ = -1;
+  course_check_armed_ = false;
+  stationarity_.configure(config_.mdf.stationarity, config_.imu_period_s);
+  stages_.configure(config_.mdf);
+  stages_.restart();
+}
+
+StateMask NavigationEngine::baseMask() const {
+  // The receiver clock is a state only when pseudoranges are used.
+  if (config_.aiding == AidingMode::kTightlyCoupled || config_.aiding == AidingMode::kInertialOnly)
+    return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift});
+  // The star tracker's bias where it is modelled and the tracker used.
+  if (config_.use_star_tracker && config_.tuning.star_tracker_bias_sigma_rad > 0.0)
+    return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kStarTrackerBias});
+  return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias});
+}
+
+bool NavigationEngine::addImu(const ImuIncrement& raw) {
+  ImuIncrement inc = raw;
+  inc.delta_vel_b_mps -= accel_compensation_ * inc.interval_s;
+  inc.delta_angle_b_rad -= gyro_compensation_ * inc.interval_s;
+  if (!(inc.interval_s > 0.0 && inc.interval_s < 1.0) || !inc.delta_vel_b_mps.allFinite() ||
+      !inc.delta_angle_b_rad.allFinite()) {
+    ++counters_.imu_refused;
+    return false;
+  }
+  if (aligning()) {
+    aligner_.addImu(inc);
+    ++counters_.imu_aligning;
+    mode_ = EngineMode::kAligning;
+    if (aligner_.aligned()) startFromAlignment();  // at the end of this increment
+    // Every input is taken by the aligner until it has aligned; the filter starts at the time
+    // of the latest increment it took, so the next one continues without a gap.
+    return false;
+  }
+  const auto interval_ns = static_cast<std::int64_t>(std::llround(inc.interval_s * 1e9));
+  const std::int64_t start_ns = inc.time_ns - interval_ns;
+  const std::int64_t period = config_.solution_period_ns;
+  if (filter_.initialized() && start_ns < filter_.state().time_ns - interval_ns / 2) {
+    ++counters_.imu_refused;  // overlaps or precedes what is already integrated
+    return false;
+  }
+  if (!filter_.initialized()) {
+    NavState s = config_.initial_state;
+    s.time_ns = start_ns;
+    const StateVector sigma = IntegratedFilter::initialSigma(config_.tuning);
+    start(s, config_.initial_clock_bias_m, config_.initial_clock_drift_mps,
+          sigma.array().square().matrix().asDiagonal());
+  } else if (start_ns - filter_.state().time_ns > interval_ns / 2) {
+    // Inertial data is missing between the state time and this interval: nothing can be
+    // propagated across the gap, so restart the integration and flag the solution.
+    filter_.restartAt(start_ns);
+    status_ |= kStatusImuGap;
+    ++counters_.imu_gaps;
+    next_output_ns_ = (start_ns / period + 1) * period;
+    next_constraint_ns_ = start_ns;
+  }
+  // Seed 004's comparison cases stop the filter during an outage (the mechanization runs on);
+  // it resumes with the covariance it had (case I) or a re-initialized one (case II).
+  const bool suspended = config_.aiding == AidingMode::kMultiDimensional &&
+                         config_.mdf.policy != MdfPolicy::kMultiDimensional &&
+                         stages_.stage() == MdfStage::kF4Constraint;
+  filter_.propagate(inc, suspended);
+  ++counters_.imu_used;
+  if (mode_ == EngineMode::kInitializing || mode_ == EngineMode::kInertialLost) {
+    // Back to inertial navigation; aided modes resume with the next measurement.
+    mode_ = EngineMode::kInertialOnly;
+  }
+  if (config_.aiding == AidingMode::kMultiDimensional) {
+    const double speed = filter_.state().vel_ned_mps.head<2>().norm();
+    stationarity_.update(inc, speed);
+    if (stationarity_.ready()) {
+      const bool gnss =
+          last_fix_ns_ >= 0 &&
+          1e-9 * static_cast<double>(inc.time_ns - last_fix_ns_) <= config_.mdf.gnss_timeout_s;
+      applyStage(stages_.update(stationarity_.stationary(), gnss, inc.time_ns));
+      constraintUpdate();
+    }
+  }
+  if (filter_.state().time_ns >= next_output_ns_) {
+    next_output_ns_ = (filter_.state().time_ns / period + 1) * period;
+    return true;
+  }
+  return false;
+}
+
+void NavigationEngine::start(const NavState& state, double clock_bias_m, double clock_drift_mps,
+                             const StateMatrix& initial_covariance) {
+  filter_.initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
+                     config_.fusion, initial_covariance);
+  filter_.keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled);
+  integrity_.reset();  // the hypotheses describe the previous run of the filter
+  for (int i = 0; i < 6; ++i) {
+    if (failed_axes_ & (1u << i)) filter_.setAxisFailed(i < 3, i % 3, true);
+  }
+  const std::int64_t period = config_.solution_period_ns;
+  next_output_ns_ = (state.time_ns / period + 1) * period;
+  next_constraint_ns_ = state.time_ns;
+}
+
+StateMatrix NavigationEngine::alignedCovariance(const AlignedStart& a) const {
+  // Position, velocity and clock with the alignment's sigmas; the sensor biases keep the
+  // tuning's. The alignment read those biases as tilt and heading (static_alignment.cpp step
+  // 8), so the attitude errors are correlated with them: with phi = S_a b_a + S_g b_g + n and
+  // the bias error states e = estimate - truth = -b (the estimates start at 0),
+  //   P_phi,phi = S_a Sa S_a^T + S_g Sg S_g^T + N,  P_phi,e_a = -S_a Sa,  P_phi,e_g = -S_g Sg,
+  // with Sa, Sg the tuning's bias variances and N the rest of the alignment's own budget
+  // (noise; at least 0 per axis).
+  StateVector sigma = IntegratedFilter::initialSigma(config_.tuning);
+  sigma.segment<3>(kPos.index) = a.pos_sigma_ned_m;
+  sigma.segment<3>(kVel.index) = a.vel_sigma_ned_mps;
+  if (a.has_clock) {
+    sigma[kClockBias.index] = a.clock_bias_sigma_m;
+    sigma[kClockDrift.index] = a.clock_drift_sigma_mps;
+  }
+  StateMatrix P = sigma.array().square().matrix().asDiagonal();
+  const Eigen::Matrix3d& S_a = a.sensitivity.d_att_d_accel_bias_b;
+  const Eigen::Matrix3d& S_g = a.sensitivity.d_att_d_gyro_bias_b;
+  const double var_a = config_.tuning.accel_bias_sigma_mps2 * config_.tuning.accel_bias_sigma_mps2;
+  const double var_g = config_.tuning.gyro_bias_sigma_radps * config_.tuning.gyro_bias_sigma_radps;
+  const Eigen::Matrix3d from_biases = var_a * S_a * S_a.transpose() + var_g * S_g * S_g.transpose();
+  const Eigen::Vector3d rest =
+      (a.att_sigma_ned_rad.cwiseAbs2() - from_biases.diagonal()).cwiseMax(0.0);
+  P.block<3, 3>(kAtt.index, kAtt.index) = from_biases + Eigen::Matrix3d(rest.asDiagonal());
+  P.block<3, 3>(kAtt.index, kAccelBias.index) = -var_a * S_a;
+  P.block<3, 3>(kAtt.index, kGyroBias.index) = -var_g * S_g;
+  P.block<3, 3>(kAccelBias.index, kAtt.index) = -var_a * S_a.transpose();
+  P.block<3, 3>(kGyroBias.index, kAtt.index) = -var_g * S_g.transpose();
+  if (a.attitude_source == AttitudeSource::kStarTracker &&
+      baseMask()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
+    // The start took the tracker's attitude with its bias b: phi = -C_b_n (b + v), and the
+    // bias error state starts at -b. The tracker's sigma (the alignment's) holds both, so
+    // P_phi,phi = Sb I (C Sb C^T, isotropic) + the rest of the alignment's budget, and
+    // P_phi,e_st = C_b_n Sb.
+    const double var_st =
+        config_.tuning.star_tracker_bias_sigma_rad * config_.tuning.star_tracker_bias_sigma_rad;
+    const Eigen::Matrix3d C_b_n = a.state.q_b_to_n.toRotationMatrix();
+    const Eigen::Vector3d noise = (a.att_sigma_ned_rad.cwiseAbs2().array() - var_st).max(0.0);
+    P.block<3, 3>(kAtt.index, kAtt.index) =
+        var_st * Eigen::Matrix3d::Identity() + Eigen::Matrix3d(noise.asDiagonal());
+    P.block<3, 3>(kAtt.index, kStarTrackerBias.index) = var_st * C_b_n;
+    P.block<3, 3>(kStarTrackerBias.index, kAtt.index) = var_st * C_b_n.transpose();
+  }
+  return P;
+}
+
+void NavigationEngine::startFromAlignment() {
+  // The clock from the pseudorange solution when there was one.
+  const AlignedStart& a = aligner_.start();
+  double clock_bias_m = config_.initial_clock_bias_m;
+  double clock_drift_mps = config_.initial_clock_drift_mps;
+  if (a.has_clock) {
+    clock_bias_m = a.clock_bias_m;
+    clock_drift_mps = a.clock_drift_mps;
+  }
+  start(a.state, clock_bias_m, clock_drift_mps, alignedCovariance(a));
+  mode_ = EngineMode::kInertialOnly;  // aided modes with the next measurement
+  const double limit = config_.alignment.course_check_heading_sigma_rad;
+  course_check_armed_ = a.attitude_source == AttitudeSource::kGyrocompass && limit > 0.0 &&
+                        a.att_sigma_ned_rad.z() > limit;
+  gyrocompass_heading_sigma_rad_ = a.att_sigma_ned_rad.z();
+}
+
+void NavigationEngine::floorBeforeCourseCheck() {
+  filter_.floorEarthRateRemainderVariance();
+  // At rest: once moving, accelerations make the heading observable by itself.
+  if (filter_.state().vel_ned_mps.head<2>().norm() < config_.alignment.rest.speed_mps)
+    filter_.floorGyrocompassHeadingVariance(gyrocompass_heading_sigma_rad_);
+}
+
+void NavigationEngine::checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
+                                              double cross_track_sigma_mps) {
+  const StateMatrix& P = filter_.covariance();
+  if (std::sqrt(P(kAtt.index + 2, kAtt.index + 2)) <=
+      config_.alignment.course_check_heading_sigma_rad) {
+    course_check_armed_ = false;  // the filter has found the heading by itself
+    return;
+  }
+  const double min_speed = config_.alignment.course_min_speed_mps;
+  const Eigen::Vector3d& v_ins = filter_.state().vel_ned_mps;
+  const double speed_mps = gnss_vel_ned_mps.head<2>().norm();
+  if (speed_mps < min_speed || v_ins.head<2>().norm() < min_speed) return;
+  const double course_rad = std::atan2(gnss_vel_ned_mps.y(), gnss_vel_ned_mps.x());
+  const double z_rad = std::remainder(course_rad - std::atan2(v_ins.y(), v_ins.x()), 2.0 * M_PI);
+  if (!filter_.correctHeadingFromCourse(z_rad, cross_track_sigma_mps / speed_mps, course_rad,
+                                        speed_mps))
+    return;
+  course_check_armed_ = false;
+  ++counters_.course_heading_checks;
+}
+
+void NavigationEngine::applyStage(const StageDecision& d) {
+  mode_ = stageMode(d.stage);
+  if (!d.changed) return;
+  ++counters_.stage_switches;
+  const FilterTuning& t = config_.tuning;
+  if (config_.mdf.policy == MdfPolicy::kMultiDimensional) {
+    if (config_.mdf.unestimated == ReducedStates::kConsidered)
+      filter_.setEstimated(stageMask(d.stage));
+    else
+      filter_.setActive(stageMask(d.stage));
+  }
+  const StateBlock horizontal_att{kAtt.index, 2};
+  const StateBlock heading{kAtt.index + 2, 1};
+  // Cases I and II are the paper's comparison: always its resets.
+  const bool paper = config_.mdf.reset_form == ResetForm::kPaper ||
+                     config_.mdf.policy != MdfPolicy::kMultiDimensional;
+  const auto reset = [&](const StateBlock& b, double sigma) {
+    if (paper)
+      filter_.resetVariances(b, sigma);
+    else
+      filter_.inflateVariances(b, sigma);
+  };
+  if (paper && d.reset != CovarianceReset::kNone) filter_.zeroOffDiagonal();  // FS
+  switch (d.reset) {
+    case CovarianceReset::kNone:
+    case CovarianceReset::kFs:
+      break;
+    case CovarianceReset::kFsA:
+      reset(horizontal_att, t.level_sigma_rad);
+      reset(kVel, t.vel_sigma_mps);
+      break;
+    case CovarianceReset::kAll:
+      reset(kAccelBias, t.accel_bias_sigma_mps2);
+      reset(kGyroBias, t.gyro_bias_sigma_radps);
+      [[fallthrough]];
+    case CovarianceReset::kFsI:
+      reset(kPos, t.pos_sigma_m);
+      reset(kVel, t.vel_sigma_mps);
+      reset(horizontal_att, t.level_sigma_rad);
+      reset(heading, t.heading_sigma_rad);
+      break;
+  }
+}
+
+void NavigationEngine::constraintUpdate() {
+  const std::int64_t t = filter_.state().time_ns;
+  if (t < next_constraint_ns_) return;
+  next_constraint_ns_ =
+      t + static_cast<std::int64_t>(std::llround(config_.mdf.constraint_period_s * 1e9));
+  const MdfStage stage = stages_.stage();
+  if (stage == MdfStage::kF1ZeroVelocity) {
+    const auto r =
+        filter_.update(zeroVelocityMeasurement(filter_.state(), config_.mdf.zupt_sigma_mps),
+                       AidingKind::kZeroVelocity);
+    countGated(r.data(), 3);
+    ++counters_.zero_velocity_updates;
+  } else if (stage == MdfStage::kF4Constraint &&
+             config_.mdf.policy == MdfPolicy::kMultiDimensional) {
+    const auto r =
+        filter_.update(nonHolonomicMeasurement(filter_.state(), config_.mdf.nhc_sigma_mps),
+                       AidingKind::kNonHolonomic);
+    countGated(r.data(), 2);
+    ++counters_.nonholonomic_updates;
+  }
+}
+
+void NavigationEngine::countGated(const ScalarUpdateResult* results, int n) {
+  for (int i = 0; i < n; ++i) counters_.rows_gated += results[i].accepted ? 0 : 1;
+}
+
+EngineMode NavigationEngine::aidedMode() const {
+  if (failed_axes_ != 0) return EngineMode::kAidedAxisFailed;
+  return config_.aiding == AidingMode::kTightlyCoupled ? EngineMode::kTightlyCoupled
+                                                       : EngineMode::kLooselyCoupled;
+}
+
+bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
+                                    const std::vector<SatelliteObservation>& satellites) {
+  // While aligning, any mode's pseudoranges serve the alignment's position.
+  if (mode_ == EngineMode::kInertialLost ||
+      (!aligning() && (config_.aiding != AidingMode::kTightlyCoupled || !filter_.initialized()))) {
+    return false;
+  }
+  // Excluded measurements stay in the epoch, monitored only (their innovations go to the
+  // diagnostics for the readmission test); the diagnostics carry at most 24 satellites.
+  used_.clear();
+  bool any = false;
+  for (const auto& s : satellites) {
+    if (used_.size() >= static_cast<std::size_t>(kMaxEpochSatellites)) break;
+    SatelliteObservation o = s;
+    const auto it = excluded_.find(s.sv_id);
+    const std::uint8_t mask = it == excluded_.end() ? 0 : it->second;
+    o.use_range = (mask & static_cast<std::uint8_t>(SatelliteScope::kRange)) == 0;
+    o.use_rate = (mask & static_cast<std::uint8_t>(SatelliteScope::kRate)) == 0;
+    any = any || o.use_range || o.use_rate;
+    used_.push_back(o);
+  }
+  if (aligning()) {
+    aligner_.addPseudoranges(time_ns, used_);  // excluded satellites are not used there either
+    if (aligner_.aligned()) startFromAlignment();
+    return false;
+  }
+  if (!any) return false;
+  if (course_check_armed_) floorBeforeCourseCheck();
+  if (course_check_armed_ &&
+      filter_.state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
+    const PseudorangeFix pf =
+        pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_.state().position));
+    if (pf.valid) checkHeadingFromCourse(pf.fix.vel_ned_mps, pf.fix.vel_sigma_ned_mps.x());
+  }
+  for (const auto& rep : filter_.update(used_)) {
+    counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
+  }
+  ++counters_.gnss_epochs_fused;
+  mode_ = aidedMode();
+  if (config_.integrity.enabled) integrity_.onEpoch(time_ns, filter_.lastEpoch());
+  return true;
+}
+
+ProtectionLevels NavigationEngine::protectionLevels() const {
+  if (!config_.integrity.enabled || config_.aiding != AidingMode::kTightlyCoupled ||
+      !filter_.initialized())
+    return {};
+  return integrity_.levels(filter_.covariance().block<3, 3>(kPos.index, kPos.index));
+}
+
+void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
+  if (aligning()) {
+    aligner_.addGnssFix(fix);
+    if (aligner_.aligned()) startFromAlignment();  // the course: from the next increment on
+    return;
+  }
+  if (!filter_.initialized() || mode_ == EngineMode::kInertialLost) return;
+  if (config_.aiding == AidingMode::kMultiDimensional) {
+    last_fix_ns_ = fix.time_ns;
+    if (!stationarity_.ready()) return;
+    // GNSS availability changes the stage at once, so that the first fix after an outage
+    // is used by F3 with the FS/I reset already applied.
+    applyStage(stages_.update(stationarity_.stationary(), true, fix.time_ns));
+    const MdfStage s = stages_.stage();
+    if (s != MdfStage::kF2Gnss && s != MdfStage::kF3Recovery) return;  // stationary: ZUPT only
+  } else if (config_.aiding != AidingMode::kLooselyCoupled) {
+    return;
+  }
+  if (course_check_armed_) {
+    floorBeforeCourseCheck();
+    checkHeadingFromCourse(fix.vel_ned_mps, fix.vel_sigma_ned_mps.head<2>().maxCoeff());
+  }
+  const auto p =
+      filter_.update(positionMeasurement(filter_.state(), fix.position, fix.pos_sigma_ned_m),
+                     AidingKind::kPosition);
+  countGated(p.data(), 3);
+  const auto v =
+      filter_.update(velocityMeasurement(filter_.state(), fix.vel_ned_mps, fix.vel_sigma_ned_mps),
+                     AidingKind::kVelocity);
+  countGated(v.data(), 3);
+  ++counters_.fixes_fused;
+  if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();
+}
+
+void NavigationEngine::addStarAttitude(const StarAttitudeMeasurement& st) {
+  if (aligning()) {
+    aligner_.addStarAttitude(st);
+    if (aligner_.aligned()) startFromAlignment();
+    return;
+  }
+  if (!config_.use_star_tracker || !filter_.initialized() || mode_ == EngineMode::kInertialLost ||
+      config_.aiding == AidingMode::kInertialOnly ||
+      config_.aiding == AidingMode::kMultiDimensional)
+    return;
+  const auto a = filter_.update(
+      attitudeMeasurement(filter_.state(), st.q_b_to_i, starTrackerWhiteSigma(st.sigma_b_rad),
+                          filter_.starTrackerBias()),
+      AidingKind::kAttitude);
+  countGated(a.data(), 3);
+  ++counters_.star_fused;
+  mode_ = aidedMode();
+}
+
+Eigen::Vector3d NavigationEngine::starTrackerWhiteSigma(const Eigen::Vector3d& sigma_b_rad) const {
+  // The message's sigma is the tracker's whole error per sample (bias and noise). Where the
+  // bias is a state, R keeps the rest: sigma^2 - sigma_bias^2, at least 1 % of sigma^2 (a
+  // tracker reporting less than the configured bias is taken as mostly bias).
+  if (!filter_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) return sigma_b_rad;
+  const double var_bias =
+      config_.tuning.star_tracker_bias_sigma_rad * config_.tuning.star_tracker_bias_sigma_rad;
+  const Eigen::Vector3d var = sigma_b_rad.cwiseAbs2();
+  return (var.array() - var_bias).max(0.01 * var.array()).sqrt().matrix();
+}
+
+void NavigationEngine::excludeSatellite(int sv_id, SatelliteScope scope) {
+  excluded_[sv_id] |= static_cast<std::uint8_t>(scope);
+  status_ |= kStatusSatelliteExcluded;
+}
+
+void NavigationEngine::readmitSatellite(int sv_id, SatelliteScope scope) {
+  auto it = excluded_.find(sv_id);
+  if (it != excluded_.end()) {
+    it->second &= static_cast<std::uint8_t>(~static_cast<std::uint8_t>(scope));
+    if (it->second == 0) excluded_.erase(it);
+  }
+  if (excluded_.empty()) status_ &= ~static_cast<std::uint32_t>(kStatusSatelliteExcluded);
+}
+
+void NavigationEngine::compensateBias(bool accelerometer, int axis, double bias,
+                                      double bias_sigma) {
+  (accelerometer ? accel_compensation_ : gyro_compensation_)[axis] += bias;
+  if (filter_.initialized() && bias_sigma > 0.0) {
+    const int state = (accelerometer ? kAccelBias.index : kGyroBias.index) + axis;
+    filter_.addVariance(state, bias_sigma * bias_sigma);
+  }
+  status_ |= kStatusBiasCompensated;
+}
+
+void NavigationEngine::failSensorAxis(bool accelerometer, int axis) {
+  failed_axes_ |= static_cast<std::uint8_t>(1u << ((accelerometer ? 0 : 3) + axis));
+  if (filter_.initialized()) filter_.setAxisFailed(accelerometer, axis, true);
+  status_ |= kStatusAxisFailed;
+  if (mode_ == EngineMode::kTightlyCoupled || mode_ == EngineMode::kLooselyCoupled)
+    mode_ = aidedMode();
+}
+
+void NavigationEngine::restoreSensorAxis(bool accelerometer, int axis) {
+  failed_axes_ &= static_cast<std::uint8_t>(~(1u << ((accelerometer ? 0 : 3) + axis)));
+  if (filter_.initialized()) filter_.setAxisFailed(accelerometer, axis, false);
+  if (failed_axes_ == 0) {
+    status_ &= ~static_cast<std::uint32_t>(kStatusAxisFailed);
+    if (mode_ == EngineMode::kAidedAxisFailed) mode_ = aidedMode();
+  }
+}
+
+bool NavigationEngine::selectFusion(FusionStructure s) {
+  // Federated needs two local filters (GNSS/INS and star tracker/INS); the adaptive R is
+  // estimated for the loosely coupled position, velocity and attitude measurements; the
+  // multi-dimensional filter switches the dimension of one centralized filter.
+  bool ok = false;
+  switch (s) {
+    case FusionStructure::kCentralized:
+      ok = config_.aiding != AidingMode::kInertialOnly;
+      break;
+    case FusionStructure::kFederated:
+      ok = (config_.aiding == AidingMode::kLooselyCoupled ||
+            config_.aiding == AidingMode::kTightlyCoupled) &&
+           config_.use_star_tracker;
+      break;
+    case FusionStructure::kAdaptive:
+      ok = config_.aiding == AidingMode::kLooselyCoupled;
+      break;
+  }
+  if (!ok) return false;
+  config_.fusion = s;
+  if (filter_.initialized()) filter_.setStructure(s);
+  return true;
+}
+
+void NavigationEngine::markInertialLost() {
+  if (filter_.initialized()) mode_ = EngineMode::kInertialLost;
+}
+
+}  // namespace navbus::core

@@ -1,0 +1,71 @@
+#include "navbus/core/filter/error_state.hpp"
+
+#include <cassert>
+
+#include "navbus/core/math/sparse_rows.hpp"
+
+namespace navbus::core {
+
+StateMask maskOf(std::initializer_list<StateBlock> blocks) {
+  StateMask m;
+  for (const StateBlock& b : blocks) {
+    for (int i = b.index; i < b.end(); ++i) m.set(static_cast<std::size_t>(i));
+  }
+  return m;
+}
+
+void ErrorState::initialize(const StateMatrix& P0, const StateMask& active) {
+  x_.setZero();
+  P_ = P0;
+  active_ = active;
+  estimated_.set();
+  removeInactiveCoupling();
+}
+
+void ErrorState::predict(const StateMatrix& Phi, const StateVector& q_diagonal) {
+  // Phi is sparse, within the error model's transition pattern (sparse_rows.hpp,
+  // ins_error_model.hpp), and block upper triangular: no navigation error drives the biases or
+  // the clock. The pattern used here leaves the inactive states out of the coupling, so
+  // whatever Phi holds for them, they neither drive the active states nor are driven.
+  assert(transitionPattern().covers(Phi));
+  const SparseRows<layout::kSize> phi(Phi, pattern_);
+  const StateVector variance_before = P_.diagonal();
+  x_ = phi.times(x_);
+  P_ = phi.sandwichBlockTriangular<layout::kCoupledSize>(P_);
+  for (int i = 0; i < layout::kSize; ++i) {
+    if (active_[static_cast<std::size_t>(i)]) {
+      P_(i, i) += q_diagonal[i];
+    } else {
+      P_(i, i) = variance_before[i];  // kept as it was, whatever Phi(i, i) is
+      x_[i] = 0.0;
+    }
+  }
+}
+
+void ErrorState::zeroOffDiagonal() {
+  P_ = StateMatrix(P_.diagonal().asDiagonal());
+}
+
+void ErrorState::setVariances(const StateBlock& block, double sigma) {
+  for (int i = block.index; i < block.end(); ++i) P_(i, i) = sigma * sigma;
+}
+
+void ErrorState::setActive(const StateMask& active) {
+  active_ = active;
+  removeInactiveCoupling();
+}
+
+void ErrorState::removeInactiveCoupling() {
+  pattern_ = transitionPattern();
+  for (int i = 0; i < layout::kSize; ++i) {
+    if (active_[static_cast<std::size_t>(i)]) continue;
+    const double v = P_(i, i);
+    P_.row(i).setZero();
+    P_.col(i).setZero();
+    P_(i, i) = v;
+    x_[i] = 0.0;
+    pattern_.decouple(i);
+  }
+}
+
+}  // namespace navbus::core

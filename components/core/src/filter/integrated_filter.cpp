@@ -1,0 +1,382 @@
+#include "navbus/core/filter/integrated_filter.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "navbus/core/math/earth.hpp"
+#include "navbus/core/filter/information_fusion.hpp"
+#include "navbus/core/math/rotation.hpp"
+#include "navbus/core/math/sparse_rows.hpp"
+#include "navbus/core/ins/static_alignment.hpp"
+
+namespace navbus::core {
+
+using namespace layout;
+
+namespace {
+constexpr std::size_t kGnssLocal = 0;
+constexpr std::size_t kStarLocal = 1;
+}  // namespace
+
+StateVector IntegratedFilter::initialSigma(const FilterTuning& tuning) {
+  StateVector sigma;
+  sigma.segment<3>(kPos.index).setConstant(tuning.pos_sigma_m);
+  sigma.segment<3>(kVel.index).setConstant(tuning.vel_sigma_mps);
+  sigma.segment<3>(kAtt.index) << tuning.level_sigma_rad, tuning.level_sigma_rad,
+      tuning.heading_sigma_rad;
+  sigma.segment<3>(kAccelBias.index).setConstant(tuning.accel_bias_sigma_mps2);
+  sigma.segment<3>(kGyroBias.index).setConstant(tuning.gyro_bias_sigma_radps);
+  // Not modelled: inactive states, whose variance only has to keep P invertible.
+  sigma.segment<3>(kStarTrackerBias.index)
+      .setConstant(tuning.star_tracker_bias_sigma_rad > 0.0 ? tuning.star_tracker_bias_sigma_rad
+                                                            : 1.0);
+  sigma[kClockBias.index] = tuning.clock_bias_sigma_m;
+  sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
+  return sigma;
+}
+
+void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
+                                  double clock_drift_mps, const FilterTuning& tuning,
+                                  const StateMask& active, FusionStructure structure) {
+  const StateVector sigma = initialSigma(tuning);
+  initialize(state, clock_bias_m, clock_drift_mps, tuning, active, structure,
+             sigma.array().square().matrix().asDiagonal());
+}
+
+void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
+                                  double clock_drift_mps, const FilterTuning& tuning,
+                                  const StateMask& active, FusionStructure structure,
+                                  const StateMatrix& initial_covariance) {
+  tuning_ = tuning;
+  ins_ = StrapdownNed(tuning.gravity);
+  ins_.initialize(state);
+  clock_bias_m_ = clock_bias_m;
+  clock_drift_mps_ = clock_drift_mps;
+  accel_bias_.setZero();
+  gyro_bias_.setZero();
+  star_tracker_bias_.setZero();
+  central_.initialize(initial_covariance, active);
+  const Eigen::Vector3d floor_pos = Eigen::Vector3d::Constant(tuning.adaptive_floor_position_m);
+  windows_[0].configure(tuning.adaptive_window, floor_pos);
+  windows_[1].configure(tuning.adaptive_window,
+                        Eigen::Vector3d::Constant(tuning.adaptive_floor_velocity_mps));
+  windows_[2].configure(tuning.adaptive_window,
+                        Eigen::Vector3d::Constant(tuning.adaptive_floor_attitude_rad));
+  phi_since_update_.setIdentity();
+  structure_ = FusionStructure::kCentralized;
+  setStructure(structure);
+}
+
+void IntegratedFilter::setStructure(FusionStructure s) {
+  if (s == FusionStructure::kFederated && structure_ != FusionStructure::kFederated) {
+    // The locals start from the current estimate with 1/share of its information each; their
+    // fusion gives back the current covariance.
+    for (ErrorState& l : local_) {
+      l.initialize(central_.P() * tuning_.federated_share, central_.active());
+    }
+  }
+  if (s == FusionStructure::kAdaptive && structure_ != FusionStructure::kAdaptive) {
+    for (auto& w : windows_) w.clear();  // statistics of a new run of innovations
+  }
+  // Federated -> centralized/adaptive: central_ already holds the master covariance.
+  structure_ = s;
+}
+
+void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
+  ImuIncrement inc = raw;
+  inc.delta_vel_b_mps -= accel_bias_ * inc.interval_s;
+  inc.delta_angle_b_rad -= gyro_bias_ * inc.interval_s;
+  const double dt = inc.interval_s;
+  // F at the state at the start of the interval (first-order hold of the error dynamics).
+  const earth::LocalEarth at_state = ins_.earthAtState();
+  StateMatrix Phi =
+      transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, at_state), dt);
+  ins_.propagate(inc, at_state);
+  clock_bias_m_ += clock_drift_mps_ * dt;
+  if (suspend_filter) return;
+  // Discrete process noise: white specific force / rate noise into velocity / attitude
+  // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3).
+  StateVector q = StateVector::Zero();
+  q.segment<3>(kVel.index).setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt);
+  q.segment<3>(kAtt.index).setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt);
+  q[kClockBias.index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
+  q[kClockDrift.index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
+  if (central_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
+    // First-order Gauss-Markov: decay exp(-dt / tau), driving noise that keeps the variance
+    // at sigma^2 (exact discretization). The estimate is the process's expected value and
+    // decays with it; held constant, its error would gain the unmodelled (1 - decay) b_est.
+    const double decay = std::exp(-dt / tuning_.star_tracker_bias_correlation_time_s);
+    const double sigma = tuning_.star_tracker_bias_sigma_rad;
+    star_tracker_bias_ *= decay;
+    for (int i = kStarTrackerBias.index; i < kStarTrackerBias.end(); ++i) {
+      Phi(i, i) = decay;
+      q[i] = sigma * sigma * (1.0 - decay * decay);
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (axis_failed_[static_cast<std::size_t>(a)])
+      q[kAccelBias.index + a] = std::pow(tuning_.failed_accel_bias_rw_mps2_per_sqrts, 2) * dt;
+    if (axis_failed_[static_cast<std::size_t>(3 + a)])
+      q[kGyroBias.index + a] = std::pow(tuning_.failed_gyro_bias_rw_radps_per_sqrts, 2) * dt;
+  }
+  if (structure_ == FusionStructure::kFederated) {
+    for (ErrorState& l : local_) l.predict(Phi, q * tuning_.federated_share);
+  }
+  // The master (federated) covariance is propagated too, so that it is valid between updates.
+  central_.predict(Phi, q);
+  if (keep_transition_)
+    phi_since_update_ =
+        SparseRows<layout::kSize>(Phi, transitionPattern()).times(phi_since_update_);
+}
+
+ErrorState& IntegratedFilter::target(AidingKind kind) {
+  if (structure_ != FusionStructure::kFederated) return central_;
+  return kind == AidingKind::kAttitude ? local_[kStarLocal] : local_[kGnssLocal];
+}
+
+InnovationWindow<3>* IntegratedFilter::window(AidingKind kind) {
+  if (structure_ != FusionStructure::kAdaptive) return nullptr;
+  switch (kind) {
+    case AidingKind::kPosition:
+      return &windows_[0];
+    case AidingKind::kVelocity:
+      return &windows_[1];
+    case AidingKind::kAttitude:
+      return &windows_[2];
+    default:
+      return nullptr;
+  }
+}
+
+const std::vector<MeasurementReport>& IntegratedFilter::update(
+    const std::vector<SatelliteObservation>& sats) {
+  ErrorState& es = structure_ == FusionStructure::kFederated ? local_[kGnssLocal] : central_;
+  const auto m = static_cast<Eigen::Index>(2 * sats.size());
+  EpochDiagnostics& d = last_epoch_;
+  d.sv_ids.clear();
+  d.is_rate.clear();
+  d.used.clear();
+  d.test_ratio.clear();
+  d.innovation.resize(m);
+  d.h.resize(m, kSize);
+  Eigen::VectorXd r(m);
+  for (std::size_t i = 0; i < sats.size(); ++i) {
+    const auto& sat = sats[i];
+    const RangePrediction p = predictRange(ins_.state(), clock_bias_m_, clock_drift_mps_, sat);
+    const auto row = static_cast<Eigen::Index>(2 * i);
+    // Innovations in the error-state form z = H dx + v: predicted minus measured (seed 000 eq. 5).
+    d.innovation[row] = p.pseudorange_m - sat.pseudorange_m;
+    d.innovation[row + 1] = p.pseudorange_rate_mps - sat.pseudorange_rate_mps;
+    d.h.row(row) = p.h_range;
+    d.h.row(row + 1) = p.h_rate;
+    r[row] = sat.pseudorange_sigma_m * sat.pseudorange_sigma_m;
+    r[row + 1] = sat.pseudorange_rate_sigma_mps * sat.pseudorange_rate_sigma_mps;
+    d.sv_ids.insert(d.sv_ids.end(), {sat.sv_id, sat.sv_id});
+    d.is_rate.insert(d.is_rate.end(), {false, true});
+  }
+  // Batch view from the prior covariance, published for the GLR; the update itself is
+  // sequential (exact for the diagonal R) so that each row can be gated on its own.
+  d.innovation_cov = d.h * es.P() * d.h.transpose();
+  d.innovation_cov.diagonal() += r;
+  d.phi = phi_since_update_;
+  prior_P_ = es.P();
+  std::vector<MeasurementReport>& reports = reports_;
+  reports.clear();
+  for (Eigen::Index row = 0; row < m; ++row) {
+    ScalarUpdateResult res;
+    const SatelliteObservation& sat = sats[static_cast<std::size_t>(row / 2)];
+    const bool fuse = row % 2 == 0 ? sat.use_range : sat.use_rate;
+    if (fuse) {
+      AidingMeasurement<1> one;
+      one.z[0] = d.innovation[row];
+      one.h = d.h.row(row);
+      one.r(0, 0) = r[row];
+      res = es.update(one, tuning_.gate_sigma)[0];
+    } else {
+      // Monitored only: the innovation test of the row, no update.
+      res.innovation = d.innovation[row];
+      res.innovation_var = d.innovation_cov(row, row);
+      const double gate = tuning_.gate_sigma > 0.0 ? tuning_.gate_sigma : 1.0;
+      res.test_ratio = res.innovation * res.innovation / (gate * gate * res.innovation_var);
+    }
+    d.test_ratio.push_back(res.test_ratio);
+    d.used.push_back(res.accepted);
+    reports.push_back({d.sv_ids[static_cast<std::size_t>(row)],
+                       d.is_rate[static_cast<std::size_t>(row)], fuse, res});
+  }
+  applied_gain_.compute(last_epoch_, prior_P_);
+  closeUpdate();
+  return reports_;
+}
+
+void IntegratedFilter::closeUpdate() {
+  if (structure_ == FusionStructure::kFederated) {
+    // Master fusion (eqs. 28-29) of the shared states; the clock comes from the GNSS local.
+    const FusedEstimate<kFusedStates> f =
+        fuseInformation<kFusedStates>(local_[kGnssLocal], local_[kStarLocal]);
+    StateVector dx = StateVector::Zero();
+    dx.head<kFusedStates>() = f.x;
+    dx.tail<kSize - kFusedStates>() = local_[kGnssLocal].x().tail<kSize - kFusedStates>();
+    StateMatrix P = StateMatrix::Zero();
+    P.topLeftCorner<kFusedStates, kFusedStates>() = f.P;
+    P.bottomRightCorner<kSize - kFusedStates, kSize - kFusedStates>() =
+        local_[kGnssLocal].P().bottomRightCorner<kSize - kFusedStates, kSize - kFusedStates>();
+    central_.initialize(P, central_.active());
+    // No-reset mode: the locals keep their covariances; their estimates are now relative to
+    // the corrected mechanization.
+    for (ErrorState& l : local_) l.shift(dx);
+    feedback(dx);
+  } else {
+    turnAttitudeCovariance(central_.x()[kAtt.index + 2]);
+    feedback(central_.x());
+    central_.x().setZero();
+  }
+  phi_since_update_.setIdentity();
+}
+
+void IntegratedFilter::turnAttitudeCovariance(double dpsi_rad) {
+  // The reset of the tilt errors under a heading correction. The levelling left the computed
+  // horizontal specific force at 0, -(phi x f^n)_h = (C_est e_a)_h with f^n = (0, 0, -g): the
+  // tilts and the horizontal accelerometer-bias errors are correlated through the frame the INS
+  // computed. The feedback turns that frame about the vertical, C_new = R_D(dpsi) C_est, and the
+  // computed specific force with it, which keeps it vertical: the relation holds with C_new,
+  // so the true tilts after the correction are R_D(dpsi) times those before. The linear update
+  // keeps them as they were, wrong by [dpsi x] phi: a second order, but P holds the levelled
+  // combination far more tightly than its parts, and a 28 mrad correction (3 sigma of a
+  // 0.1 deg/h gyrocompass, taken while the vehicle accelerates) turns 2.8 % of each tilt into
+  // the other. So the attitude rows and columns of P turn by R_D(dpsi), the Jacobian of this
+  // reset. A tilt correction keeps the computed force vertical only to first order, with no
+  // heading term: nothing to turn (turning by it too mixes the heading's variance, up to a
+  // gyrocompass's 83 mrad, into the levelled tilts; measured: seed 000 NEES 10 -> 32).
+  const Eigen::Matrix3d R_D =
+      Eigen::AngleAxisd(dpsi_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  StateMatrix& P = central_.P();
+  P.middleRows<3>(kAtt.index) = (R_D * P.middleRows<3>(kAtt.index)).eval();
+  P.middleCols<3>(kAtt.index) = (P.middleCols<3>(kAtt.index) * R_D.transpose()).eval();
+}
+
+void IntegratedFilter::feedback(const StateVector& dx) {
+  // Errors are estimate minus truth: subtract them from the estimate, then the error state is 0.
+  NavState s = ins_.state();
+  s.position = earth::offsetNed(s.position, -dx.segment<3>(kPos.index));
+  s.vel_ned_mps -= dx.segment<3>(kVel.index);
+  // C_est = (I - [phi x]) C_true  =>  C_true = (I + [phi x]) C_est.
+  s.q_b_to_n = (quaternionFromRotationVector(dx.segment<3>(kAtt.index)) * s.q_b_to_n).normalized();
+  ins_.correct(s);
+  accel_bias_ -= dx.segment<3>(kAccelBias.index);
+  gyro_bias_ -= dx.segment<3>(kGyroBias.index);
+  star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);
+  clock_bias_m_ -= dx[kClockBias.index];
+  clock_drift_mps_ -= dx[kClockDrift.index];
+}
+
+void IntegratedFilter::setActive(const StateMask& active) {
+  central_.setActive(active);
+  for (ErrorState& l : local_) l.setActive(active);
+}
+
+void IntegratedFilter::setEstimated(const StateMask& estimated) {
+  central_.setEstimated(estimated);
+  for (ErrorState& l : local_) l.setEstimated(estimated);
+}
+
+void IntegratedFilter::zeroOffDiagonal() {
+  central_.zeroOffDiagonal();
+  for (ErrorState& l : local_) l.zeroOffDiagonal();
+}
+
+void IntegratedFilter::setAxisFailed(bool accelerometer, int axis, bool failed) {
+  bool& flag = axis_failed_[static_cast<std::size_t>((accelerometer ? 0 : 3) + axis)];
+  if (failed && !flag) {
+    const double sigma =
+        accelerometer ? tuning_.failed_accel_bias_sigma_mps2 : tuning_.failed_gyro_bias_sigma_radps;
+    addVariance((accelerometer ? kAccelBias.index : kGyroBias.index) + axis, sigma * sigma);
+  }
+  flag = failed;
+}
+
+void IntegratedFilter::addVariance(int state, double variance) {
+  central_.P()(state, state) += variance;
+  for (ErrorState& l : local_) l.P()(state, state) += variance * tuning_.federated_share;
+}
+
+bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, double course_rad,
+                                                double speed_mps) {
+  if (structure_ == FusionStructure::kFederated || speed_mps <= 0.0) return false;
+  constexpr int kHeading = kAtt.index + 2;
+  // z observes the cross-track velocity error; the heading follows through its correlation
+  // with it (the velocity gained through the heading error).
+  StateVector h = StateVector::Zero();
+  h[kVel.index] = std::sin(course_rad) / speed_mps;  // -u_c / speed, u_c = (-sin c, cos c, 0)
+  h[kVel.index + 1] = -std::cos(course_rad) / speed_mps;
+  StateMatrix& P = central_.P();
+  const StateVector Ph = P * h;
+  const StateVector k = Ph / (h.dot(Ph) + sigma_rad * sigma_rad);
+  P -= k * Ph.transpose();
+  P = (0.5 * (P + P.transpose())).eval();
+  StateVector dx = k * z_rad;
+  // The horizontal velocity turns with the heading: v - dx_v = R_D(dx_psi) v.
+  const double a = dx[kHeading];
+  const Eigen::Vector3d& v = ins_.state().vel_ned_mps;
+  dx[kVel.index] = v.x() - (std::cos(a) * v.x() - std::sin(a) * v.y());
+  dx[kVel.index + 1] = v.y() - (std::sin(a) * v.x() + std::cos(a) * v.y());
+  // The gyro biases learned under the heading error took the Earth rate's mismatch whole; the
+  // linear gain removed its first order only: add the rest (the sigma_psi term: its spread).
+  const Eigen::Matrix3d C_n_b = ins_.state().q_b_to_n.conjugate().toRotationMatrix();
+  const Eigen::Vector3d w_ie_n = earth::omegaIeNed(ins_.state().position.latitude_rad);
+  const EarthRateMismatch m = earthRateMismatchRemainder(a, w_ie_n);
+  dx.segment<3>(kGyroBias.index) += C_n_b * m.remainder_radps;
+  const Eigen::Vector3d spread_b = C_n_b * m.d_remainder_d_psi * std::sqrt(P(kHeading, kHeading));
+  P.block<3, 3>(kGyroBias.index, kGyroBias.index) += spread_b * spread_b.transpose();
+  turnAttitudeCovariance(dx[kHeading]);
+  feedback(dx);
+  return true;
+}
+
+void IntegratedFilter::floorEarthRateRemainderVariance() {
+  // The federated master is rebuilt from its locals at every update (and takes no course check).
+  if (structure_ == FusionStructure::kFederated) return;
+  StateMatrix& P = central_.P();
+  const double required = earthRateRemainderNorthVariance(
+      P(kAtt.index + 2, kAtt.index + 2), earth::omegaIeNed(ins_.state().position.latitude_rad));
+  // The computed north axis in the body frame.
+  const Eigen::Vector3d u_b = ins_.state().q_b_to_n.conjugate() * Eigen::Vector3d::UnitX();
+  const double now = u_b.dot(P.block<3, 3>(kGyroBias.index, kGyroBias.index) * u_b);
+  if (now >= required) return;
+  P.block<3, 3>(kGyroBias.index, kGyroBias.index) += (required - now) * u_b * u_b.transpose();
+}
+
+void IntegratedFilter::floorGyrocompassHeadingVariance(double heading_sigma_rad) {
+  if (structure_ == FusionStructure::kFederated) return;
+  // At rest the heading and the east gyro bias are one observable (static_alignment.cpp step
+  // 8: phi_D = -e_g^n_E / (W cos L) with the bias error e = -b), which gyrocompassing has read.
+  // Along the direction that moves both and keeps that combination, d = (phi_D 1, e_g^n_E
+  // -W cos L), the data hold nothing more; the filter's first-order model learns there from the
+  // second-order terms of a heading error this large (the heading sigma fell from 83 to 58 mrad
+  // in 440 s at rest, the error did not). Its variance stays the gyrocompass's.
+  StateMatrix& P = central_.P();
+  const int heading = kAtt.index + 2;
+  if (P(heading, heading) >= heading_sigma_rad * heading_sigma_rad) return;
+  const double w_h = earth::omegaIeNed(ins_.state().position.latitude_rad).x();
+  StateVector d = StateVector::Zero();
+  d[heading] = 1.0;
+  d.segment<3>(kGyroBias.index) =
+      ins_.state().q_b_to_n.conjugate() * Eigen::Vector3d(0.0, -w_h, 0.0);
+  P += (heading_sigma_rad * heading_sigma_rad - P(heading, heading)) * d * d.transpose();
+}
+
+void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
+  for (int i = block.index; i < block.end(); ++i) {
+    const double v = central_.P()(i, i);
+    if (v < sigma * sigma) addVariance(i, sigma * sigma - v);
+  }
+}
+
+void IntegratedFilter::resetVariances(const StateBlock& block, double sigma) {
+  central_.setVariances(block, sigma);
+  for (ErrorState& l : local_) l.setVariances(block, sigma * std::sqrt(tuning_.federated_share));
+}
+
+}  // namespace navbus::core

@@ -1,0 +1,118 @@
+#include "navbus/core/ins/ins_error_model.hpp"
+
+#include <cmath>
+
+#include "navbus/core/math/rotation.hpp"
+#include "navbus/core/math/sparse_rows.hpp"
+
+namespace navbus::core {
+
+StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
+                          earth::GravityModel gravity) {
+  return errorDynamics(s, f_b, earth::localEarth(gravity, s.position, s.vel_ned_mps));
+}
+
+StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
+                          const earth::LocalEarth& at_state) {
+  using namespace layout;
+  const Eigen::Matrix3d C_b_n = s.q_b_to_n.toRotationMatrix();
+  const Eigen::Vector3d f_n = C_b_n * f_b;
+  const Eigen::Vector3d& w_ie = at_state.w_ie_ned;
+  const earth::Radii& r = at_state.radii;
+  const Eigen::Vector3d& w_en = at_state.w_en_ned;
+  const double rn = r.prime_vertical_m + s.position.height_m;
+  const double rm = r.meridian_m + s.position.height_m;
+  const double g = at_state.g_ned.z();
+  const double radius = std::sqrt(rm * rn);
+
+  const Eigen::Vector3d& v = s.vel_ned_mps;
+  const double w_ie_n = w_ie.x();  // Omega cos(lat)
+  const double w_ie_d = w_ie.z();  // -Omega sin(lat)
+  const double tan_lat = -w_ie_d / w_ie_n;
+  const double sec2_lat = 1.0 + tan_lat * tan_lat;
+  // The position error is in NED metres of the curvilinear position: dN = (R_M + h) dlat,
+  // dE = (R_N + h) cos(lat) dlon, dD = -dh. The Earth and transport rates depend on the
+  // position through lat and h:
+  //   w_ie = Omega [cos lat, 0, -sin lat],  w_en = [vE / rn, -vN / rm, -vE tan(lat) / rn],
+  // so d(w)/d(dN) = d(w)/d(lat) / rm and d(w)/d(dD) = -d(w)/d(h) (radii's latitude terms, of
+  // the order of the flattening, left out).
+  Eigen::Matrix3d dwie_dr = Eigen::Matrix3d::Zero();
+  dwie_dr(0, 0) = w_ie_d / rm;
+  dwie_dr(2, 0) = -w_ie_n / rm;
+  Eigen::Matrix3d dwen_dr = Eigen::Matrix3d::Zero();
+  dwen_dr(2, 0) = -v.y() * sec2_lat / (rn * rm);
+  dwen_dr(0, 2) = v.y() / (rn * rn);
+  dwen_dr(1, 2) = -v.x() / (rm * rm);
+  dwen_dr(2, 2) = -v.y() * tan_lat / (rn * rn);
+  // ... and w_en on the velocity.
+  Eigen::Matrix3d dwen_dv = Eigen::Matrix3d::Zero();
+  dwen_dv(0, 1) = 1.0 / rn;
+  dwen_dv(1, 0) = -1.0 / rm;
+  dwen_dv(2, 1) = -tan_lat / rn;
+
+  StateMatrix F = StateMatrix::Zero();
+  // Position (the curvilinear rates lat' = vN / rm, lon' = vE / (rn cos lat), h' = -vD, in the
+  // metres above): dN' = dvN + (vN dD - vD dN) / rm,
+  // dE' = dvE + vE tan(lat) dN / rm - (vD + vN tan(lat)) dE / rn + vE dD / rn, dD' = dvD.
+  F(kPos.index, kPos.index) = -v.z() / rm;
+  F(kPos.index, kPos.index + 2) = v.x() / rm;
+  F(kPos.index + 1, kPos.index) = v.y() * tan_lat / rm;
+  F(kPos.index + 1, kPos.index + 1) = -(v.z() + v.x() * tan_lat) / rn;
+  F(kPos.index + 1, kPos.index + 2) = v.y() / rn;
+  F.block<3, 3>(kPos.index, kVel.index) = Eigen::Matrix3d::Identity();
+  // Velocity, v' = C f - (2 w_ie + w_en) x v + g: the perturbation of the Coriolis and transport
+  // term is -(2 w_ie + w_en) x dv + v x (2 dw_ie + dw_en).
+  F.block<3, 3>(kVel.index, kPos.index) = skew(v) * (2.0 * dwie_dr + dwen_dr);
+  F(kVel.index + 2, kPos.index + 2) += 2.0 * g / radius;  // gravity grows downwards
+  F.block<3, 3>(kVel.index, kVel.index) = -skew(2.0 * w_ie + w_en) + skew(v) * dwen_dv;
+  F.block<3, 3>(kVel.index, kAtt.index) = skew(f_n);
+  F.block<3, 3>(kVel.index, kAccelBias.index) = -C_b_n;
+  // Attitude, phi' = -w_in x phi + dw_in + C_b_n e_g.
+  F.block<3, 3>(kAtt.index, kPos.index) = dwie_dr + dwen_dr;
+  F.block<3, 3>(kAtt.index, kVel.index) = dwen_dv;
+  F.block<3, 3>(kAtt.index, kAtt.index) = -skew(w_ie + w_en);
+  F.block<3, 3>(kAtt.index, kGyroBias.index) = C_b_n;
+  F(kClockBias.index, kClockDrift.index) = 1.0;
+  return F;
+}
+
+StateMatrix transitionMatrix(const StateMatrix& F, double dt) {
+  // I + F dt + (F dt)^2 / 2 = I + dt (F + (dt / 2) F F): the sparse product accumulates into
+  // a copy of F, and the identity is added on the diagonal (Eigen's StateMatrix::Identity()
+  // expression tests i == j for each of the 400 elements, which cost as much as the product).
+  const SparseRows<layout::kSize> sparse(F, errorDynamicsPattern());
+  StateMatrix Phi = F;
+  sparse.addProductTo(sparse, 0.5 * dt, Phi);
+  Phi *= dt;
+  Phi.diagonal().array() += 1.0;
+  return Phi;
+}
+
+namespace {
+/// F at a state where every term of errorDynamics() is nonzero: off the equator and the
+/// meridians, moving in all three axes, rotated about a skew axis, a specific force with
+/// three components.
+StateMatrix genericErrorDynamics() {
+  NavState s;
+  s.position = {0.6, 2.2, 1000.0};
+  s.vel_ned_mps = Eigen::Vector3d(120.0, -80.0, 15.0);
+  s.q_b_to_n = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  return errorDynamics(s, Eigen::Vector3d(0.3, -0.2, -9.7), earth::GravityModel::kWgs84Normal);
+}
+}  // namespace
+
+const SparsityPattern<layout::kSize>& errorDynamicsPattern() {
+  static const auto pattern = SparsityPattern<layout::kSize>::of(genericErrorDynamics());
+  return pattern;
+}
+
+const SparsityPattern<layout::kSize>& transitionPattern() {
+  // Magnitudes, so that no sum cancels to an accidental zero.
+  static const auto pattern = [] {
+    const StateMatrix A = genericErrorDynamics().cwiseAbs();
+    return SparsityPattern<layout::kSize>::of(StateMatrix::Identity() + A + A * A);
+  }();
+  return pattern;
+}
+
+}  // namespace navbus::core
