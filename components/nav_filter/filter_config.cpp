@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/core/filter/innovation_window.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
 

@@ -345,7 +345,7 @@ void FilterPipeline::publishSolution() {
   sol.fusion(toIdl(engine_.fusion(), config_.engine.aiding));
   sol.active_fault_flags(stream_flags_ | monitor_flags_ | faultFlags(engine_.status()));
   sol.imu_samples_used(engine_.counters().imu_used);
-  sol.start_source(toIdl(config_.engine.start, engine_.aligner().start().attitude_source));
+  sol.start_source(toIdl(config_.engine.start, engine_.alignedStart().attitude_source));
   // The levels assume the fault manager's GLR is watching: without it nothing bounds a fault.
   if (monitor_flags_ == 0) {
     const core::ProtectionLevels pl = engine_.protectionLevels();
@@ -660,19 +660,19 @@ std::string FilterPipeline::alignmentSummary() const {
                                        "levelled, waiting for the GNSS course", "aligned"};
   static const char* const attitude[] = {"none", "star tracker", "gyrocompassing", "GNSS course"};
   static const char* const position[] = {"none", "GNSS fix", "pseudoranges"};
-  const core::InitialAligner& a = engine_.aligner();
   std::ostringstream out;
-  out << "alignment: " << phases[static_cast<int>(a.phase())] << " after "
+  out << "alignment: " << phases[static_cast<int>(engine_.alignmentPhase())] << " after "
       << engine_.counters().imu_aligning << " increments";
-  if (a.aligned()) {
-    const core::AlignedStart& s = a.start();
+  if (engine_.alignmentPhase() == core::AlignmentPhase::kAligned) {
+    const core::AlignedStart& s = engine_.alignedStart();
     out << " (attitude from " << attitude[static_cast<int>(s.attitude_source)] << ", position from "
         << position[static_cast<int>(s.position_source)] << "; 1-sigma tilt "
         << s.att_sigma_ned_rad.x() * 1e3 << " mrad, heading " << s.att_sigma_ned_rad.z() * 1e3
         << " mrad; gyrocompassing would reach " << s.gyrocompass_heading_sigma_rad * 1e3
         << " mrad)";
   }
-  if (a.failedSolutions() > 0) out << ", pseudorange solutions failed " << a.failedSolutions();
+  if (engine_.alignmentFailedSolutions() > 0)
+    out << ", pseudorange solutions failed " << engine_.alignmentFailedSolutions();
   if (engine_.counters().course_heading_checks > 0)
     out << ", heading measured again from the GNSS course "
         << engine_.counters().course_heading_checks << " time(s)";
@@ -701,8 +701,8 @@ std::string FilterPipeline::summary() const {
   }
   if (config_.engine.start == core::StartSource::kAligned) out << ", " << alignmentSummary();
   if (config_.engine.integrity.enabled) {
-    out << ", protection-level epochs " << engine_.integrity().epochs() << " refused "
-        << engine_.integrity().refused();
+    out << ", protection-level epochs " << engine_.protectionLevelEpochs() << " refused "
+        << engine_.protectionLevelEpochsRefused();
   }
   if (config_.low_latency_output) {
     const core::OutputPredictorCounters& l = predictor_.counters();

@@ -68,8 +68,8 @@ double blockNees(const core::StateMatrix& P, const core::StateMask& active,
 /// Once, when the engine has just aligned: its start against the truth at the start's time.
 void recordAlignedStart(const core::NavigationEngine& engine, const std::deque<Truth>& truths,
                         OfflineResult& result) {
-  if (result.aligned || !engine.aligner().aligned()) return;
-  const core::AlignedStart& a = engine.aligner().start();
+  if (result.aligned || engine.alignmentPhase() != core::AlignmentPhase::kAligned) return;
+  const core::AlignedStart& a = engine.alignedStart();
   for (const Truth& truth : truths) {
     const core::NavState& t = truth.state;
     if (t.time_ns != a.state.time_ns) continue;
@@ -115,11 +115,10 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     d << err.pos_ned_m, err.vel_ned_mps, err.att_ned_rad;
     const Eigen::Matrix<double, 9, 9> P9 = P.topLeftCorner<9, 9>();
     err.nees9 = d.dot(P9.ldlt().solve(d));
-    const core::StateMask& active = engine.filter().active();
+    const core::StateMask& active = engine.activeStates();
     err.accel_bias_err_b_mps2 = engine.accelBias() - truth.accel_bias_b_mps2;
     err.gyro_bias_err_b_radps = engine.gyroBias() - truth.gyro_bias_b_radps;
-    err.star_tracker_bias_err_b_rad =
-        engine.filter().starTrackerBias() - truth.star_tracker_bias_b_rad;
+    err.star_tracker_bias_err_b_rad = engine.starTrackerBias() - truth.star_tracker_bias_b_rad;
     err.nees_blocks << blockNees(P, active, kPos, err.pos_ned_m),
         blockNees(P, active, kVel, err.vel_ned_mps), blockNees(P, active, kAtt, err.att_ned_rad),
         blockNees(P, active, kAccelBias, err.accel_bias_err_b_mps2),

@@ -2,6 +2,11 @@
 
 #include <cmath>
 
+#include "navbus/core/engine/initial_alignment.hpp"
+#include "navbus/core/filter/integrated_filter.hpp"
+#include "navbus/core/filter/multi_dimensional.hpp"
+#include "navbus/core/integrity/glr_protection_level.hpp"
+
 namespace navbus::core {
 
 using namespace layout;
@@ -23,16 +28,79 @@ EngineMode stageMode(MdfStage s) {
 }  // namespace
 
 NavigationEngine::NavigationEngine(const EngineConfig& config)
-    : config_(config), aligner_(config.alignment) {
-  integrity_.configure(config.integrity);
+    : config_(config),
+      filter_(std::in_place),
+      aligner_(std::in_place, config.alignment),
+      integrity_(std::in_place),
+      stationarity_(std::in_place),
+      stages_(std::in_place) {
+  integrity_->configure(config.integrity);
   used_.reserve(32);
   reset();
 }
 
+NavigationEngine::NavigationEngine(const NavigationEngine& other) = default;
+NavigationEngine::NavigationEngine(NavigationEngine&& other) noexcept = default;
+NavigationEngine& NavigationEngine::operator=(const NavigationEngine& other) = default;
+NavigationEngine& NavigationEngine::operator=(NavigationEngine&& other) noexcept = default;
+NavigationEngine::~NavigationEngine() = default;
+
+bool NavigationEngine::initialized() const {
+  return filter_->initialized();
+}
+const NavState& NavigationEngine::state() const {
+  return filter_->state();
+}
+const StateMatrix& NavigationEngine::covariance() const {
+  return filter_->covariance();
+}
+const StateMask& NavigationEngine::activeStates() const {
+  return filter_->active();
+}
+Eigen::Vector3d NavigationEngine::accelBias() const {
+  return filter_->accelBias() + accel_compensation_;
+}
+Eigen::Vector3d NavigationEngine::gyroBias() const {
+  return filter_->gyroBias() + gyro_compensation_;
+}
+Eigen::Vector3d NavigationEngine::starTrackerBias() const {
+  return filter_->starTrackerBias();
+}
+double NavigationEngine::clockBias() const {
+  return filter_->clockBias();
+}
+double NavigationEngine::clockDrift() const {
+  return filter_->clockDrift();
+}
+FusionStructure NavigationEngine::fusion() const {
+  return filter_->structure();
+}
+const EpochDiagnostics& NavigationEngine::lastEpoch() const {
+  return filter_->lastEpoch();
+}
+AlignmentPhase NavigationEngine::alignmentPhase() const {
+  return aligner_->phase();
+}
+const AlignedStart& NavigationEngine::alignedStart() const {
+  return aligner_->start();
+}
+std::uint64_t NavigationEngine::alignmentFailedSolutions() const {
+  return aligner_->failedSolutions();
+}
+std::uint64_t NavigationEngine::protectionLevelEpochs() const {
+  return integrity_->epochs();
+}
+std::uint64_t NavigationEngine::protectionLevelEpochsRefused() const {
+  return integrity_->refused();
+}
+bool NavigationEngine::aligning() const {
+  return config_.start == StartSource::kAligned && !filter_->initialized();
+}
+
 void NavigationEngine::reset() {
-  filter_ = IntegratedFilter();
-  aligner_ = InitialAligner(config_.alignment);
-  integrity_.reset();
+  *filter_ = IntegratedFilter();
+  *aligner_ = InitialAligner(config_.alignment);
+  integrity_->reset();
   mode_ = EngineMode::kInitializing;
   status_ = 0;
   failed_axes_ = 0;
@@ -41,9 +109,9 @@ void NavigationEngine::reset() {
   gyro_compensation_.setZero();
   last_fix_ns_ = -1;
   course_check_armed_ = false;
-  stationarity_.configure(config_.mdf.stationarity, config_.imu_period_s);
-  stages_.configure(config_.mdf);
-  stages_.restart();
+  stationarity_->configure(config_.mdf.stationarity, config_.imu_period_s);
+  stages_->configure(config_.mdf);
+  stages_->restart();
 }
 
 StateMask NavigationEngine::baseMask() const {
@@ -66,10 +134,10 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
     return false;
   }
   if (aligning()) {
-    aligner_.addImu(inc);
+    aligner_->addImu(inc);
     ++counters_.imu_aligning;
     mode_ = EngineMode::kAligning;
-    if (aligner_.aligned()) startFromAlignment();  // at the end of this increment
+    if (aligner_->aligned()) startFromAlignment();  // at the end of this increment
     // Every input is taken by the aligner until it has aligned; the filter starts at the time
     // of the latest increment it took, so the next one continues without a gap.
     return false;
@@ -77,20 +145,20 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
   const auto interval_ns = static_cast<std::int64_t>(std::llround(inc.interval_s * 1e9));
   const std::int64_t start_ns = inc.time_ns - interval_ns;
   const std::int64_t period = config_.solution_period_ns;
-  if (filter_.initialized() && start_ns < filter_.state().time_ns - interval_ns / 2) {
+  if (filter_->initialized() && start_ns < filter_->state().time_ns - interval_ns / 2) {
     ++counters_.imu_refused;  // overlaps or precedes what is already integrated
     return false;
   }
-  if (!filter_.initialized()) {
+  if (!filter_->initialized()) {
     NavState s = config_.initial_state;
     s.time_ns = start_ns;
     const StateVector sigma = IntegratedFilter::initialSigma(config_.tuning);
     start(s, config_.initial_clock_bias_m, config_.initial_clock_drift_mps,
           sigma.array().square().matrix().asDiagonal());
-  } else if (start_ns - filter_.state().time_ns > interval_ns / 2) {
+  } else if (start_ns - filter_->state().time_ns > interval_ns / 2) {
     // Inertial data is missing between the state time and this interval: nothing can be
     // propagated across the gap, so restart the integration and flag the solution.
-    filter_.restartAt(start_ns);
+    filter_->restartAt(start_ns);
     status_ |= kStatusImuGap;
     ++counters_.imu_gaps;
     next_output_ns_ = (start_ns / period + 1) * period;
@@ -100,26 +168,26 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
   // it resumes with the covariance it had (case I) or a re-initialized one (case II).
   const bool suspended = config_.aiding == AidingMode::kMultiDimensional &&
                          config_.mdf.policy != MdfPolicy::kMultiDimensional &&
-                         stages_.stage() == MdfStage::kF4Constraint;
-  filter_.propagate(inc, suspended);
+                         stages_->stage() == MdfStage::kF4Constraint;
+  filter_->propagate(inc, suspended);
   ++counters_.imu_used;
   if (mode_ == EngineMode::kInitializing || mode_ == EngineMode::kInertialLost) {
     // Back to inertial navigation; aided modes resume with the next measurement.
     mode_ = EngineMode::kInertialOnly;
   }
   if (config_.aiding == AidingMode::kMultiDimensional) {
-    const double speed = filter_.state().vel_ned_mps.head<2>().norm();
-    stationarity_.update(inc, speed);
-    if (stationarity_.ready()) {
+    const double speed = filter_->state().vel_ned_mps.head<2>().norm();
+    stationarity_->update(inc, speed);
+    if (stationarity_->ready()) {
       const bool gnss =
           last_fix_ns_ >= 0 &&
           1e-9 * static_cast<double>(inc.time_ns - last_fix_ns_) <= config_.mdf.gnss_timeout_s;
-      applyStage(stages_.update(stationarity_.stationary(), gnss, inc.time_ns));
+      applyStage(stages_->update(stationarity_->stationary(), gnss, inc.time_ns));
       constraintUpdate();
     }
   }
-  if (filter_.state().time_ns >= next_output_ns_) {
-    next_output_ns_ = (filter_.state().time_ns / period + 1) * period;
+  if (filter_->state().time_ns >= next_output_ns_) {
+    next_output_ns_ = (filter_->state().time_ns / period + 1) * period;
     return true;
   }
   return false;
@@ -127,12 +195,12 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
 
 void NavigationEngine::start(const NavState& state, double clock_bias_m, double clock_drift_mps,
                              const StateMatrix& initial_covariance) {
-  filter_.initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
-                     config_.fusion, initial_covariance);
-  filter_.keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled);
-  integrity_.reset();  // the hypotheses describe the previous run of the filter
+  filter_->initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
+                      config_.fusion, initial_covariance);
+  filter_->keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled);
+  integrity_->reset();  // the hypotheses describe the previous run of the filter
   for (int i = 0; i < 6; ++i) {
-    if (failed_axes_ & (1u << i)) filter_.setAxisFailed(i < 3, i % 3, true);
+    if (failed_axes_ & (1u << i)) filter_->setAxisFailed(i < 3, i % 3, true);
   }
   const std::int64_t period = config_.solution_period_ns;
   next_output_ns_ = (state.time_ns / period + 1) * period;
@@ -187,7 +255,7 @@ StateMatrix NavigationEngine::alignedCovariance(const AlignedStart& a) const {
 
 void NavigationEngine::startFromAlignment() {
   // The clock from the pseudorange solution when there was one.
-  const AlignedStart& a = aligner_.start();
+  const AlignedStart& a = aligner_->start();
   double clock_bias_m = config_.initial_clock_bias_m;
   double clock_drift_mps = config_.initial_clock_drift_mps;
   if (a.has_clock) {
@@ -203,28 +271,28 @@ void NavigationEngine::startFromAlignment() {
 }
 
 void NavigationEngine::floorBeforeCourseCheck() {
-  filter_.floorEarthRateRemainderVariance();
+  filter_->floorEarthRateRemainderVariance();
   // At rest: once moving, accelerations make the heading observable by itself.
-  if (filter_.state().vel_ned_mps.head<2>().norm() < config_.alignment.rest.speed_mps)
-    filter_.floorGyrocompassHeadingVariance(gyrocompass_heading_sigma_rad_);
+  if (filter_->state().vel_ned_mps.head<2>().norm() < config_.alignment.rest.speed_mps)
+    filter_->floorGyrocompassHeadingVariance(gyrocompass_heading_sigma_rad_);
 }
 
 void NavigationEngine::checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
                                               double cross_track_sigma_mps) {
-  const StateMatrix& P = filter_.covariance();
+  const StateMatrix& P = filter_->covariance();
   if (std::sqrt(P(kAtt.index + 2, kAtt.index + 2)) <=
       config_.alignment.course_check_heading_sigma_rad) {
     course_check_armed_ = false;  // the filter has found the heading by itself
     return;
   }
   const double min_speed = config_.alignment.course_min_speed_mps;
-  const Eigen::Vector3d& v_ins = filter_.state().vel_ned_mps;
+  const Eigen::Vector3d& v_ins = filter_->state().vel_ned_mps;
   const double speed_mps = gnss_vel_ned_mps.head<2>().norm();
   if (speed_mps < min_speed || v_ins.head<2>().norm() < min_speed) return;
   const double course_rad = std::atan2(gnss_vel_ned_mps.y(), gnss_vel_ned_mps.x());
   const double z_rad = std::remainder(course_rad - std::atan2(v_ins.y(), v_ins.x()), 2.0 * M_PI);
-  if (!filter_.correctHeadingFromCourse(z_rad, cross_track_sigma_mps / speed_mps, course_rad,
-                                        speed_mps))
+  if (!filter_->correctHeadingFromCourse(z_rad, cross_track_sigma_mps / speed_mps, course_rad,
+                                         speed_mps))
     return;
   course_check_armed_ = false;
   ++counters_.course_heading_checks;
@@ -237,9 +305,9 @@ void NavigationEngine::applyStage(const StageDecision& d) {
   const FilterTuning& t = config_.tuning;
   if (config_.mdf.policy == MdfPolicy::kMultiDimensional) {
     if (config_.mdf.unestimated == ReducedStates::kConsidered)
-      filter_.setEstimated(stageMask(d.stage));
+      filter_->setEstimated(stageMask(d.stage));
     else
-      filter_.setActive(stageMask(d.stage));
+      filter_->setActive(stageMask(d.stage));
   }
   const StateBlock horizontal_att{kAtt.index, 2};
   const StateBlock heading{kAtt.index + 2, 1};
@@ -248,11 +316,11 @@ void NavigationEngine::applyStage(const StageDecision& d) {
                      config_.mdf.policy != MdfPolicy::kMultiDimensional;
   const auto reset = [&](const StateBlock& b, double sigma) {
     if (paper)
-      filter_.resetVariances(b, sigma);
+      filter_->resetVariances(b, sigma);
     else
-      filter_.inflateVariances(b, sigma);
+      filter_->inflateVariances(b, sigma);
   };
-  if (paper && d.reset != CovarianceReset::kNone) filter_.zeroOffDiagonal();  // FS
+  if (paper && d.reset != CovarianceReset::kNone) filter_->zeroOffDiagonal();  // FS
   switch (d.reset) {
     case CovarianceReset::kNone:
     case CovarianceReset::kFs:
@@ -275,22 +343,22 @@ void NavigationEngine::applyStage(const StageDecision& d) {
 }
 
 void NavigationEngine::constraintUpdate() {
-  const std::int64_t t = filter_.state().time_ns;
+  const std::int64_t t = filter_->state().time_ns;
   if (t < next_constraint_ns_) return;
   next_constraint_ns_ =
       t + static_cast<std::int64_t>(std::llround(config_.mdf.constraint_period_s * 1e9));
-  const MdfStage stage = stages_.stage();
+  const MdfStage stage = stages_->stage();
   if (stage == MdfStage::kF1ZeroVelocity) {
     const auto r =
-        filter_.update(zeroVelocityMeasurement(filter_.state(), config_.mdf.zupt_sigma_mps),
-                       AidingKind::kZeroVelocity);
+        filter_->update(zeroVelocityMeasurement(filter_->state(), config_.mdf.zupt_sigma_mps),
+                        AidingKind::kZeroVelocity);
     countGated(r.data(), 3);
     ++counters_.zero_velocity_updates;
   } else if (stage == MdfStage::kF4Constraint &&
              config_.mdf.policy == MdfPolicy::kMultiDimensional) {
     const auto r =
-        filter_.update(nonHolonomicMeasurement(filter_.state(), config_.mdf.nhc_sigma_mps),
-                       AidingKind::kNonHolonomic);
+        filter_->update(nonHolonomicMeasurement(filter_->state(), config_.mdf.nhc_sigma_mps),
+                        AidingKind::kNonHolonomic);
     countGated(r.data(), 2);
     ++counters_.nonholonomic_updates;
   }
@@ -310,7 +378,7 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
                                     const std::vector<SatelliteObservation>& satellites) {
   // While aligning, any mode's pseudoranges serve the alignment's position.
   if (mode_ == EngineMode::kInertialLost ||
-      (!aligning() && (config_.aiding != AidingMode::kTightlyCoupled || !filter_.initialized()))) {
+      (!aligning() && (config_.aiding != AidingMode::kTightlyCoupled || !filter_->initialized()))) {
     return false;
   }
   // Excluded measurements stay in the epoch, monitored only (their innovations go to the
@@ -328,48 +396,48 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
     used_.push_back(o);
   }
   if (aligning()) {
-    aligner_.addPseudoranges(time_ns, used_);  // excluded satellites are not used there either
-    if (aligner_.aligned()) startFromAlignment();
+    aligner_->addPseudoranges(time_ns, used_);  // excluded satellites are not used there either
+    if (aligner_->aligned()) startFromAlignment();
     return false;
   }
   if (!any) return false;
   if (course_check_armed_) floorBeforeCourseCheck();
   if (course_check_armed_ &&
-      filter_.state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
+      filter_->state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
     const PseudorangeFix pf =
-        pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_.state().position));
+        pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_->state().position));
     if (pf.valid) checkHeadingFromCourse(pf.fix.vel_ned_mps, pf.fix.vel_sigma_ned_mps.x());
   }
-  for (const auto& rep : filter_.update(used_)) {
+  for (const auto& rep : filter_->update(used_)) {
     counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
   }
   ++counters_.gnss_epochs_fused;
   mode_ = aidedMode();
-  if (config_.integrity.enabled) integrity_.onEpoch(time_ns, filter_.lastEpoch());
+  if (config_.integrity.enabled) integrity_->onEpoch(time_ns, filter_->lastEpoch());
   return true;
 }
 
 ProtectionLevels NavigationEngine::protectionLevels() const {
   if (!config_.integrity.enabled || config_.aiding != AidingMode::kTightlyCoupled ||
-      !filter_.initialized())
+      !filter_->initialized())
     return {};
-  return integrity_.levels(filter_.covariance().block<3, 3>(kPos.index, kPos.index));
+  return integrity_->levels(filter_->covariance().block<3, 3>(kPos.index, kPos.index));
 }
 
 void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   if (aligning()) {
-    aligner_.addGnssFix(fix);
-    if (aligner_.aligned()) startFromAlignment();  // the course: from the next increment on
+    aligner_->addGnssFix(fix);
+    if (aligner_->aligned()) startFromAlignment();  // the course: from the next increment on
     return;
   }
-  if (!filter_.initialized() || mode_ == EngineMode::kInertialLost) return;
+  if (!filter_->initialized() || mode_ == EngineMode::kInertialLost) return;
   if (config_.aiding == AidingMode::kMultiDimensional) {
     last_fix_ns_ = fix.time_ns;
-    if (!stationarity_.ready()) return;
+    if (!stationarity_->ready()) return;
     // GNSS availability changes the stage at once, so that the first fix after an outage
     // is used by F3 with the FS/I reset already applied.
-    applyStage(stages_.update(stationarity_.stationary(), true, fix.time_ns));
-    const MdfStage s = stages_.stage();
+    applyStage(stages_->update(stationarity_->stationary(), true, fix.time_ns));
+    const MdfStage s = stages_->stage();
     if (s != MdfStage::kF2Gnss && s != MdfStage::kF3Recovery) return;  // stationary: ZUPT only
   } else if (config_.aiding != AidingMode::kLooselyCoupled) {
     return;
@@ -379,12 +447,12 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
     checkHeadingFromCourse(fix.vel_ned_mps, fix.vel_sigma_ned_mps.head<2>().maxCoeff());
   }
   const auto p =
-      filter_.update(positionMeasurement(filter_.state(), fix.position, fix.pos_sigma_ned_m),
-                     AidingKind::kPosition);
+      filter_->update(positionMeasurement(filter_->state(), fix.position, fix.pos_sigma_ned_m),
+                      AidingKind::kPosition);
   countGated(p.data(), 3);
   const auto v =
-      filter_.update(velocityMeasurement(filter_.state(), fix.vel_ned_mps, fix.vel_sigma_ned_mps),
-                     AidingKind::kVelocity);
+      filter_->update(velocityMeasurement(filter_->state(), fix.vel_ned_mps, fix.vel_sigma_ned_mps),
+                      AidingKind::kVelocity);
   countGated(v.data(), 3);
   ++counters_.fixes_fused;
   if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();
@@ -392,17 +460,17 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
 
 void NavigationEngine::addStarAttitude(const StarAttitudeMeasurement& st) {
   if (aligning()) {
-    aligner_.addStarAttitude(st);
-    if (aligner_.aligned()) startFromAlignment();
+    aligner_->addStarAttitude(st);
+    if (aligner_->aligned()) startFromAlignment();
     return;
   }
-  if (!config_.use_star_tracker || !filter_.initialized() || mode_ == EngineMode::kInertialLost ||
+  if (!config_.use_star_tracker || !filter_->initialized() || mode_ == EngineMode::kInertialLost ||
       config_.aiding == AidingMode::kInertialOnly ||
       config_.aiding == AidingMode::kMultiDimensional)
     return;
-  const auto a = filter_.update(
-      attitudeMeasurement(filter_.state(), st.q_b_to_i, starTrackerWhiteSigma(st.sigma_b_rad),
-                          filter_.starTrackerBias()),
+  const auto a = filter_->update(
+      attitudeMeasurement(filter_->state(), st.q_b_to_i, starTrackerWhiteSigma(st.sigma_b_rad),
+                          filter_->starTrackerBias()),
       AidingKind::kAttitude);
   countGated(a.data(), 3);
   ++counters_.star_fused;
@@ -413,7 +481,7 @@ Eigen::Vector3d NavigationEngine::starTrackerWhiteSigma(const Eigen::Vector3d& s
   // The message's sigma is the tracker's whole error per sample (bias and noise). Where the
   // bias is a state, R keeps the rest: sigma^2 - sigma_bias^2, at least 1 % of sigma^2 (a
   // tracker reporting less than the configured bias is taken as mostly bias).
-  if (!filter_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) return sigma_b_rad;
+  if (!filter_->active()[static_cast<std::size_t>(kStarTrackerBias.index)]) return sigma_b_rad;
   const double var_bias =
       config_.tuning.star_tracker_bias_sigma_rad * config_.tuning.star_tracker_bias_sigma_rad;
   const Eigen::Vector3d var = sigma_b_rad.cwiseAbs2();
@@ -437,16 +505,16 @@ void NavigationEngine::readmitSatellite(int sv_id, SatelliteScope scope) {
 void NavigationEngine::compensateBias(bool accelerometer, int axis, double bias,
                                       double bias_sigma) {
   (accelerometer ? accel_compensation_ : gyro_compensation_)[axis] += bias;
-  if (filter_.initialized() && bias_sigma > 0.0) {
+  if (filter_->initialized() && bias_sigma > 0.0) {
     const int state = (accelerometer ? kAccelBias.index : kGyroBias.index) + axis;
-    filter_.addVariance(state, bias_sigma * bias_sigma);
+    filter_->addVariance(state, bias_sigma * bias_sigma);
   }
   status_ |= kStatusBiasCompensated;
 }
 
 void NavigationEngine::failSensorAxis(bool accelerometer, int axis) {
   failed_axes_ |= static_cast<std::uint8_t>(1u << ((accelerometer ? 0 : 3) + axis));
-  if (filter_.initialized()) filter_.setAxisFailed(accelerometer, axis, true);
+  if (filter_->initialized()) filter_->setAxisFailed(accelerometer, axis, true);
   status_ |= kStatusAxisFailed;
   if (mode_ == EngineMode::kTightlyCoupled || mode_ == EngineMode::kLooselyCoupled)
     mode_ = aidedMode();
@@ -454,7 +522,7 @@ void NavigationEngine::failSensorAxis(bool accelerometer, int axis) {
 
 void NavigationEngine::restoreSensorAxis(bool accelerometer, int axis) {
   failed_axes_ &= static_cast<std::uint8_t>(~(1u << ((accelerometer ? 0 : 3) + axis)));
-  if (filter_.initialized()) filter_.setAxisFailed(accelerometer, axis, false);
+  if (filter_->initialized()) filter_->setAxisFailed(accelerometer, axis, false);
   if (failed_axes_ == 0) {
     status_ &= ~static_cast<std::uint32_t>(kStatusAxisFailed);
     if (mode_ == EngineMode::kAidedAxisFailed) mode_ = aidedMode();
@@ -481,12 +549,12 @@ bool NavigationEngine::selectFusion(FusionStructure s) {
   }
   if (!ok) return false;
   config_.fusion = s;
-  if (filter_.initialized()) filter_.setStructure(s);
+  if (filter_->initialized()) filter_->setStructure(s);
   return true;
 }
 
 void NavigationEngine::markInertialLost() {
-  if (filter_.initialized()) mode_ = EngineMode::kInertialLost;
+  if (filter_->initialized()) mode_ = EngineMode::kInertialLost;
 }
 
 }  // namespace navbus::core

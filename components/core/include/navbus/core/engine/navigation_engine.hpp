@@ -9,13 +9,29 @@
 #include <map>
 #include <vector>
 
+#include <Eigen/Core>
+
+#include "navbus/core/engine/alignment_config.hpp"
 #include "navbus/core/filter/aiding_inputs.hpp"
-#include "navbus/core/integrity/glr_protection_level.hpp"
-#include "navbus/core/engine/initial_alignment.hpp"
-#include "navbus/core/filter/integrated_filter.hpp"
-#include "navbus/core/filter/multi_dimensional.hpp"
+#include "navbus/core/filter/epoch_diagnostics.hpp"
+#include "navbus/core/filter/filter_tuning.hpp"
+#include "navbus/core/filter/mdf_config.hpp"
+#include "navbus/core/gnss/gnss_measurement.hpp"
+#include "navbus/core/ins/ins_error_model.hpp"
+#include "navbus/core/ins/strapdown.hpp"
+#include "navbus/core/integrity/protection_level_config.hpp"
+#include "navbus/core/math/indirect.hpp"
 
 namespace navbus::core {
+
+// The engine's parts: their headers are not part of its interface.
+class IntegratedFilter;
+class InitialAligner;
+class GlrProtectionLevel;
+class StationarityDetector;
+class StageSelector;
+struct StageDecision;
+struct ScalarUpdateResult;
 
 enum class AidingMode {
   kInertialOnly,     ///< mechanization and covariance propagation, no updates
@@ -90,6 +106,13 @@ struct EngineCounters {
 class NavigationEngine {
  public:
   explicit NavigationEngine(const EngineConfig& config);
+  NavigationEngine(const NavigationEngine& other);
+  NavigationEngine(NavigationEngine&& other) noexcept;
+  /// Copies into this engine's storage (the rollback history's snapshots allocate nothing once
+  /// they hold an engine).
+  NavigationEngine& operator=(const NavigationEngine& other);
+  NavigationEngine& operator=(NavigationEngine&& other) noexcept;
+  ~NavigationEngine();
 
   /// Integrates one increment; true when the state time reached a solution epoch. An increment
   /// with a bad interval or one that does not follow the state time is refused and counted.
@@ -123,27 +146,38 @@ class NavigationEngine {
   void markInertialLost();
   void reset();
 
-  bool initialized() const { return filter_.initialized(); }
-  const NavState& state() const { return filter_.state(); }
-  const StateMatrix& covariance() const { return filter_.covariance(); }
-  Eigen::Vector3d accelBias() const { return filter_.accelBias() + accel_compensation_; }
-  Eigen::Vector3d gyroBias() const { return filter_.gyroBias() + gyro_compensation_; }
-  double clockBias() const { return filter_.clockBias(); }
-  double clockDrift() const { return filter_.clockDrift(); }
+  bool initialized() const;
+  const NavState& state() const;
+  const StateMatrix& covariance() const;
+  /// The states the filter estimates now (the others keep their variance, uncorrected).
+  const StateMask& activeStates() const;
+  /// Estimated sensor biases, the compensation commanded so far included: accelerometer
+  /// [m/s^2, body], gyro [rad/s, body].
+  Eigen::Vector3d accelBias() const;
+  Eigen::Vector3d gyroBias() const;
+  /// Estimated star-tracker bias [rad, star-tracker body axes] (zero when not modelled).
+  Eigen::Vector3d starTrackerBias() const;
+  double clockBias() const;   ///< receiver clock bias c*b [m]
+  double clockDrift() const;  ///< receiver clock drift c*f [m/s]
   EngineMode mode() const { return mode_; }
-  FusionStructure fusion() const { return filter_.structure(); }
+  FusionStructure fusion() const;
   const EngineConfig& config() const { return config_; }
   std::uint32_t status() const { return status_; }
   const EngineCounters& counters() const { return counters_; }
-  const EpochDiagnostics& lastEpoch() const { return filter_.lastEpoch(); }
-  const IntegratedFilter& filter() const { return filter_; }
+  /// The latest fused pseudorange epoch's diagnostics (innovations, S, H, K, Phi).
+  const EpochDiagnostics& lastEpoch() const;
   /// StartSource::kAligned: where the alignment stands, and once aligned what it started from
-  /// (attitude and position sources, its sigmas, the gyrocompassing limit).
-  const InitialAligner& aligner() const { return aligner_; }
+  /// (attitude and position sources, its sigmas, the gyrocompassing limit; valid once the
+  /// phase is kAligned), and the pseudorange epochs whose least-squares solution failed.
+  AlignmentPhase alignmentPhase() const;
+  const AlignedStart& alignedStart() const;
+  std::uint64_t alignmentFailedSolutions() const;
   /// Horizontal and vertical protection levels of the current state (kNotMonitored unless
   /// integrity is enabled in tightly coupled mode and the filter runs).
   ProtectionLevels protectionLevels() const;
-  const GlrProtectionLevel& integrity() const { return integrity_; }
+  /// Pseudorange epochs the protection levels took, and refused (not finite).
+  std::uint64_t protectionLevelEpochs() const;
+  std::uint64_t protectionLevelEpochsRefused() const;
 
  private:
   StateMask baseMask() const;
@@ -167,14 +201,14 @@ class NavigationEngine {
   /// carry. The INS velocity must have been gained from rest: the start was at rest.
   void checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
                               double cross_track_sigma_mps);
-  bool aligning() const { return config_.start == StartSource::kAligned && !filter_.initialized(); }
+  bool aligning() const;
 
   EngineConfig config_;
-  IntegratedFilter filter_;
-  InitialAligner aligner_;
-  GlrProtectionLevel integrity_;
-  StationarityDetector stationarity_;
-  StageSelector stages_;
+  Indirect<IntegratedFilter> filter_;
+  Indirect<InitialAligner> aligner_;
+  Indirect<GlrProtectionLevel> integrity_;
+  Indirect<StationarityDetector> stationarity_;
+  Indirect<StageSelector> stages_;
   EngineMode mode_{EngineMode::kInitializing};
   std::uint32_t status_{0};
   EngineCounters counters_;

@@ -16,7 +16,6 @@
 namespace navbus::core {
 
 using StateVector = Eigen::Matrix<double, layout::kSize, 1>;
-using StateMask = std::bitset<layout::kSize>;
 
 /// The mask with the given blocks active.
 StateMask maskOf(std::initializer_list<StateBlock> blocks);

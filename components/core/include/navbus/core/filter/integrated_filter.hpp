@@ -20,58 +20,17 @@
 #include "navbus/core/filter/aiding_measurements.hpp"
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 #include "navbus/core/filter/error_state.hpp"
-#include "navbus/core/gnss/gnss_measurement.hpp"
+#include "navbus/core/filter/filter_tuning.hpp"
 #include "navbus/core/filter/innovation_window.hpp"
+#include "navbus/core/gnss/gnss_measurement.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/math/kalman_update.hpp"
 
 namespace navbus::core {
 
-enum class FusionStructure { kCentralized, kFederated, kAdaptive };
-
 /// What an aiding measurement is: selects the local filter (federated) and the innovation
 /// window (adaptive).
 enum class AidingKind { kPosition, kVelocity, kAttitude, kZeroVelocity, kNonHolonomic };
-
-struct FilterTuning {
-  earth::GravityModel gravity{earth::GravityModel::kWgs84Normal};
-  // Process noise densities.
-  double accel_noise_mps2_per_sqrthz{1e-4};
-  double gyro_noise_radps_per_sqrthz{1e-6};
-  double clock_bias_noise_m_per_sqrts{0.1};
-  double clock_drift_noise_mps_per_sqrts{0.01};
-  // Initial 1-sigma (also the values the covariance reset rules re-initialize to).
-  double pos_sigma_m{40.0};
-  double vel_sigma_mps{1.0};
-  double level_sigma_rad{1e-3};
-  double heading_sigma_rad{5e-3};
-  double accel_bias_sigma_mps2{1e-2};
-  double gyro_bias_sigma_radps{5e-6};
-  double clock_bias_sigma_m{3000.0};
-  double clock_drift_sigma_mps{1.0};
-  double gate_sigma{5.0};  ///< innovation gate in standard deviations; <= 0: no gate
-  // Star-tracker bias (seed 001): a first-order Gauss-Markov rotation about each star-tracker
-  // axis, modelled as the layout's kStarTrackerBias states when its sigma is positive (0: not
-  // modelled, the states stay inactive).
-  double star_tracker_bias_sigma_rad{0.0};             ///< stationary 1 sigma per axis [rad]
-  double star_tracker_bias_correlation_time_s{300.0};  ///< [s]
-  // Adaptive structure (seed 001 eqs. 30-34).
-  int adaptive_window{50};                ///< innovations per estimate [epochs]
-  double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]
-  double adaptive_floor_velocity_mps{0.01};
-  double adaptive_floor_attitude_rad{1e-6};
-  bool adaptive_floor_at_reported{true};  ///< R never below the measurement's own R
-  // A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its output error (a stuck value minus the true
-  // specific force or rate) is modelled as a bias with this random walk, and its variance grows
-  // by the sigma at the failure. The walk must cover the vehicle's manoeuvres on that axis.
-  double failed_accel_bias_sigma_mps2{1.0};
-  double failed_accel_bias_rw_mps2_per_sqrts{1.0};
-  double failed_gyro_bias_sigma_radps{0.02};
-  double failed_gyro_bias_rw_radps_per_sqrts{0.005};
-  // Federated structure: each local filter starts from, and is driven by, share times the
-  // covariance and process noise (information sharing 1/share, Carlson's no-reset mode).
-  double federated_share{2.0};
-};
 
 struct MeasurementReport {
   int sv_id;

@@ -2,6 +2,8 @@
 // (`P.block<3, 3>(kVel.index, kVel.index)`, never `P(4, 4)`).
 #pragma once
 
+#include <bitset>
+
 namespace navbus::core {
 
 struct StateBlock {
@@ -40,5 +42,8 @@ static_assert(kPos.end() == kVel.index && kVel.end() == kAtt.index &&
                   kClockBias.end() == kClockDrift.index && kClockDrift.end() == kSize,
               "the layout's blocks must tile the state vector");
 }  // namespace layout
+
+/// Which states of the layout a filter estimates (the others are inactive, error_state.hpp).
+using StateMask = std::bitset<layout::kSize>;
 
 }  // namespace navbus::core
