@@ -15,8 +15,8 @@
 #include <navbus_idl/Fault.h>
 #include <Eigen/Core>
 
-#include "navbus/core/gnss/single_point_positioning.hpp"
 #include "navbus/core/filter/static_receiver_filter.hpp"
+#include "navbus/core/gnss/single_point_positioning.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/fault_manager/glr_detector.hpp"
 #include "rinex2.hpp"

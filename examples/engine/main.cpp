@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include <navbus/core/math/earth.hpp>
 #include <navbus/core/ins/strapdown.hpp>
+#include <navbus/core/math/earth.hpp>
 
 namespace earth = navbus::core::earth;
 

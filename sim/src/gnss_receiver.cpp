@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "navbus/core/math/earth.hpp"
 #include "navbus/core/gnss/gnss_fix.hpp"
+#include "navbus/core/math/earth.hpp"
 
 namespace navbus::sim {
 

@@ -11,8 +11,8 @@
 
 #include "allocation_counter.hpp"
 #include "navbus/bus/config.hpp"
-#include "navbus/core/integrity/dither_monitor.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/integrity/dither_monitor.hpp"
 #include "navbus/sim/scenario_source.hpp"
 #include "scenario_config.hpp"
 

@@ -14,8 +14,8 @@
 
 #include "allocation_counter.hpp"
 #include "navbus/bus/config.hpp"
-#include "navbus/core/integrity/glr.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/integrity/glr.hpp"
 #include "navbus/sim/scenario_source.hpp"
 #include "scenario_config.hpp"
 

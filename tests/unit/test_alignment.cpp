@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "navbus/core/math/earth.hpp"
 #include "navbus/core/engine/initial_alignment.hpp"
-#include "navbus/core/math/rotation.hpp"
 #include "navbus/core/ins/static_alignment.hpp"
+#include "navbus/core/math/earth.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
 
 namespace core = navbus::core;

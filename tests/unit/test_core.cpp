@@ -3,9 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/rotation.hpp"
-#include "navbus/core/ins/strapdown.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
 namespace earth = navbus::core::earth;

@@ -6,12 +6,12 @@
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
+#include "navbus/core/engine/navigation_engine.hpp"
 #include "navbus/core/filter/information_fusion.hpp"
 #include "navbus/core/filter/integrated_filter.hpp"
 #include "navbus/core/filter/multi_dimensional.hpp"
-#include "navbus/core/engine/navigation_engine.hpp"
-#include "navbus/core/math/rotation.hpp"
 #include "navbus/core/ins/static_alignment.hpp"
+#include "navbus/core/math/rotation.hpp"
 
 namespace core = navbus::core;
 namespace earth = navbus::core::earth;

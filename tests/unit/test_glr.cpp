@@ -12,9 +12,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
-#include "navbus/core/math/chi_square.hpp"
 #include "navbus/core/integrity/glr.hpp"
 #include "navbus/core/integrity/glr_protection_level.hpp"
+#include "navbus/core/math/chi_square.hpp"
 
 namespace nc = navbus::core;
 using nc::GlrFault;

@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "navbus/core/math/earth.hpp"
 #include "navbus/core/gnss/gnss_fix.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "navbus/sim/gnss_receiver.hpp"
 
 namespace earth = navbus::core::earth;

@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "navbus/bus/config.hpp"
-#include "navbus/core/math/rotation.hpp"
 #include "navbus/core/ins/strapdown.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "navbus/sim/trajectory.hpp"
 #include "scenario_config.hpp"
 

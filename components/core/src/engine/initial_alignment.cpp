@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "navbus/core/math/earth.hpp"
 #include "navbus/core/gnss/gnss_fix.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/rotation.hpp"
 
 namespace navbus::core {

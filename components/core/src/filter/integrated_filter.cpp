@@ -5,11 +5,11 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
-#include "navbus/core/math/earth.hpp"
 #include "navbus/core/filter/information_fusion.hpp"
+#include "navbus/core/ins/static_alignment.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/sparse_rows.hpp"
-#include "navbus/core/ins/static_alignment.hpp"
 
 namespace navbus::core {
 

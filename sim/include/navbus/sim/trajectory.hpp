@@ -8,8 +8,8 @@
 
 #include <Eigen/Core>
 
-#include "navbus/core/math/earth.hpp"
 #include "navbus/core/ins/strapdown.hpp"
+#include "navbus/core/math/earth.hpp"
 
 namespace navbus::sim {
 

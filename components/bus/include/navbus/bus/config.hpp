@@ -8,8 +8,8 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Core>
 
-#include "navbus/core/math/earth.hpp"
 #include "navbus/core/integrity/glr.hpp"
+#include "navbus/core/math/earth.hpp"
 
 namespace navbus::bus {
 

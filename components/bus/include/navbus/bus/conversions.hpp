@@ -11,11 +11,11 @@
 #include <navbus_idl/StarTracker.h>
 
 #include "navbus/bus/validation.hpp"
-#include "navbus/core/filter/epoch_diagnostics.hpp"
-#include "navbus/core/integrity/glr.hpp"
-#include "navbus/core/gnss/gnss_measurement.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/filter/epoch_diagnostics.hpp"
+#include "navbus/core/gnss/gnss_measurement.hpp"
 #include "navbus/core/ins/strapdown.hpp"
+#include "navbus/core/integrity/glr.hpp"
 
 namespace navbus::bus {
 

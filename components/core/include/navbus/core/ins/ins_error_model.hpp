@@ -8,9 +8,9 @@
 
 #include <Eigen/Core>
 
-#include "navbus/core/math/sparse_rows.hpp"
 #include "navbus/core/ins/state_layout.hpp"
 #include "navbus/core/ins/strapdown.hpp"
+#include "navbus/core/math/sparse_rows.hpp"
 
 namespace navbus::core {
 

@@ -18,8 +18,8 @@
 
 #include <Eigen/Core>
 
-#include "navbus/core/math/ring_buffer.hpp"
 #include "navbus/core/ins/strapdown.hpp"
+#include "navbus/core/math/ring_buffer.hpp"
 
 namespace navbus::core {
 
