@@ -12,8 +12,8 @@
 #include "allocation_counter.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/scenario_source.hpp"
-#include "scenario_config.hpp"
 
 namespace {
 

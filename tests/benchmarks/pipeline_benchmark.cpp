@@ -13,13 +13,13 @@
 #include <vector>
 
 #include "allocation_counter.hpp"
-#include "frame_publisher.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/sensor_sim/frame_publisher.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/scenario_source.hpp"
-#include "scenario_config.hpp"
 
 namespace {
 

@@ -18,10 +18,10 @@
 #include <navbus_idl/HealthPubSubTypes.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
-#include "frame_publisher.hpp"
 #include "harness.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
+#include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
 using namespace navbus;

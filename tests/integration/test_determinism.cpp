@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
-#include "formatters.hpp"
-#include "frame_publisher.hpp"
 #include "harness.hpp"
 #include "navbus/bus/conversions.hpp"
+#include "navbus/records/formatters.hpp"
+#include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
 using namespace navbus;
@@ -58,14 +58,14 @@ Run runFilter(int domain, Delivery delivery, const std::vector<sim::SensorFrame>
   me.subscribe<NavigationSolutionPubSubType>(
       bus::topic::kNavSolution, bus::profile::kSolutionReader,
       [&](const NavigationSolution& s, const auto&) {
-        solutions.push_back(tool::csvRows(s).at(0));
+        solutions.push_back(records::csvRows(s).at(0));
         run.tightly_coupled_reached =
             run.tightly_coupled_reached || s.mode() == MODE_TIGHTLY_COUPLED;
       });
   me.subscribe<FilterDiagnosticsPubSubType>(bus::topic::kFilterDiagnostics,
                                             bus::profile::kDiagnosticsReader,
                                             [&](const FilterDiagnostics& d, const auto&) {
-                                              run.diagnostics.push_back(tool::csvRows(d).at(0));
+                                              run.diagnostics.push_back(records::csvRows(d).at(0));
                                             });
   test::SensorInputWriters w(me);
   EXPECT_TRUE(test::spinUntil(me, 20s, [&] { return w.matched(); }));

@@ -12,8 +12,8 @@
 #include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
-#include "formatters.hpp"
 #include "harness.hpp"
+#include "navbus/records/formatters.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -73,7 +73,7 @@ void runCase(const Case& c) {
                                              bus::profile::kSolutionReader,
                                              [&](const NavigationSolution& s, const auto&) {
                                                if (s.mode() != MODE_INERTIAL_LOST)
-                                                 rows.push_back(tool::csvRows(s).at(0));
+                                                 rows.push_back(records::csvRows(s).at(0));
                                              });
   test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
   test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
@@ -220,7 +220,7 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
                                              bus::profile::kSolutionReader,
                                              [&](const NavigationSolution& s, const auto&) {
                                                if (s.mode() == MODE_INERTIAL_LOST) return;
-                                               rows.push_back(tool::csvRows(s).at(0));
+                                               rows.push_back(records::csvRows(s).at(0));
                                                solutions.push_back(s);
                                              });
   me.subscribe<FaultDecisionPubSubType>(

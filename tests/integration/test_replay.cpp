@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
-#include "formatters.hpp"
 #include "harness.hpp"
+#include "navbus/records/formatters.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -79,7 +79,7 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
                                              bus::profile::kSolutionReader,
                                              [&](const NavigationSolution& s, const auto&) {
                                                if (s.mode() != MODE_INERTIAL_LOST)
-                                                 rows.push_back(tool::csvRows(s).at(0));
+                                                 rows.push_back(records::csvRows(s).at(0));
                                              });
   test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
   test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());

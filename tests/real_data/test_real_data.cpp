@@ -10,9 +10,9 @@
 
 #include "navbus/bus/config.hpp"
 #include "navbus/core/math/earth.hpp"
+#include "navbus/evaluation/real_data.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
-#include "real_data.hpp"
-#include "rinex2.hpp"
+#include "navbus/gnss_data/rinex2.hpp"
 
 namespace nb = navbus;
 using nb::gnss_data::readNavigationFile;
@@ -24,8 +24,8 @@ const std::string kObs = std::string(NAVBUS_RINEX_DIR) + "/07590920.05o";
 const std::string kNav = std::string(NAVBUS_RINEX_DIR) + "/07590920.05n";
 const Eigen::Vector3d kReference(-3976219.5082, 3382372.5671, 3652512.9849);
 
-nb::tool::RealDataSetup loadSetup(bool with_fault_manager) {
-  nb::tool::RealDataSetup s;
+nb::evaluation::RealDataSetup loadSetup(bool with_fault_manager) {
+  nb::evaluation::RealDataSetup s;
   std::ifstream o(kObs), n(kNav);
   s.obs = readObservationFile(o, kObs);
   s.nav = readNavigationFile(n, kNav);
@@ -85,7 +85,7 @@ TEST(GpsTime, CalendarToGpsSeconds) {
 }
 
 TEST(Rinex, ReadsTheStationHour) {
-  const nb::tool::RealDataSetup s = loadSetup(false);
+  const nb::evaluation::RealDataSetup s = loadSetup(false);
   EXPECT_EQ(s.obs.marker, "0759");
   ASSERT_EQ(s.obs.types, (std::vector<std::string>{"L1", "C1", "L2", "P2"}));
   EXPECT_EQ(s.obs.epochs.size(), 120u);
@@ -132,7 +132,7 @@ TEST(Rinex, MalformedFieldsNameLineAndField) {
 TEST(SinglePoint, MatchesRtklibEpochByEpoch) {
   const std::vector<RtklibFix> rtk = runRtklib();
   ASSERT_EQ(rtk.size(), 120u);
-  const nb::tool::RealDataResult r = nb::tool::runRealData(loadSetup(false));
+  const nb::evaluation::RealDataResult r = nb::evaluation::runRealData(loadSetup(false));
   ASSERT_EQ(r.epochs.size(), 120u);
   EXPECT_EQ(r.fixes, 120u);
   double max_diff = 0.0, sum_sq = 0.0;
@@ -153,8 +153,8 @@ TEST(SinglePoint, MatchesRtklibEpochByEpoch) {
 }
 
 TEST(RealData, CleanHourHasNoFalseAlarm) {
-  const nb::tool::RealDataSetup s = loadSetup(true);
-  const nb::tool::RealDataResult r = nb::tool::runRealData(s);
+  const nb::evaluation::RealDataSetup s = loadSetup(true);
+  const nb::evaluation::RealDataResult r = nb::evaluation::runRealData(s);
   std::printf("clean hour: largest GLR statistic %.2f (h %.3f), final filter error %.2f m\n",
               r.max_glr_statistic, s.fault_manager->glr.glr.threshold,
               r.epochs.back().filter_error_ned_m.norm());
@@ -170,9 +170,9 @@ TEST(RealData, CleanHourHasNoFalseAlarm) {
 // from the onset without it and back near the reference.
 TEST(RealData, InjectedRampIsDetectedAndTheSatelliteIsolated) {
   for (int sv : {7, 11, 19, 20, 24, 28}) {
-    nb::tool::RealDataSetup s = loadSetup(true);
-    s.ramp = nb::tool::RampInjection{sv, 10.0, 1800.0};
-    const nb::tool::RealDataResult r = nb::tool::runRealData(s);
+    nb::evaluation::RealDataSetup s = loadSetup(true);
+    s.ramp = nb::evaluation::RampInjection{sv, 10.0, 1800.0};
+    const nb::evaluation::RealDataResult r = nb::evaluation::runRealData(s);
     ASSERT_EQ(r.decisions.size(), 1u) << "sv " << sv;
     const nb::FaultDecision& d = r.decisions.front();
     const double start = s.obs.epochs.front().time_s;
@@ -192,9 +192,9 @@ TEST(RealData, InjectedRampIsDetectedAndTheSatelliteIsolated) {
 // The detector's sensitivity on real data: a slow 0.1 m/s ramp (3 m per epoch) is found too,
 // later.
 TEST(RealData, SlowRampIsDetectedLater) {
-  nb::tool::RealDataSetup s = loadSetup(true);
-  s.ramp = nb::tool::RampInjection{28, 0.1, 1800.0};
-  const nb::tool::RealDataResult r = nb::tool::runRealData(s);
+  nb::evaluation::RealDataSetup s = loadSetup(true);
+  s.ramp = nb::evaluation::RampInjection{28, 0.1, 1800.0};
+  const nb::evaluation::RealDataResult r = nb::evaluation::runRealData(s);
   ASSERT_EQ(r.decisions.size(), 1u);
   EXPECT_EQ(r.decisions.front().sv_id(), 28);
   const double delay = static_cast<double>(r.decisions.front().time_gps_ns()) * 1e-9 -

@@ -10,7 +10,7 @@
 #include "navbus/bus/config.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
-#include "scenario_config.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
 
 namespace fs = std::filesystem;
 using navbus::bus::ConfigError;

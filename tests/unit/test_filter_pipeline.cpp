@@ -3,7 +3,6 @@
 // about this run's data acts.
 #include <gtest/gtest.h>
 
-#include "frame_publisher.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
@@ -12,8 +11,9 @@
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/nav_filter/monitor_liveness.hpp"
+#include "navbus/sensor_sim/frame_publisher.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/scenario_source.hpp"
-#include "scenario_config.hpp"
 
 #include <map>
 

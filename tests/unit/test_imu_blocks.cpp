@@ -6,16 +6,16 @@
 #include <cstring>
 #include <vector>
 
-#include "frame_publisher.hpp"
-#include "imu_block_batcher.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/sensor_sim/frame_publisher.hpp"
+#include "navbus/sensor_sim/imu_block_batcher.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/scenario_source.hpp"
-#include "scenario_config.hpp"
 
 using namespace navbus;
 

@@ -2,9 +2,9 @@
 // tool's formatters.
 #include <gtest/gtest.h>
 
-#include "formatters.hpp"
 #include "navbus/fault_manager/stream_watchdog.hpp"
 #include "navbus/nav_filter/input_sequencer.hpp"
+#include "navbus/records/formatters.hpp"
 
 using navbus::nav_filter::InputSequencer;
 using navbus::nav_filter::StreamId;
@@ -160,25 +160,25 @@ TEST(Formatters, CsvHasOneRowPerSatelliteAndRoundTripsDoubles) {
     m.pseudorange_m(20000000.125);
     e.satellites().push_back(m);
   }
-  const std::string header = navbus::tool::csvHeader<navbus::GnssObservationEpoch>();
+  const std::string header = navbus::records::csvHeader<navbus::GnssObservationEpoch>();
   EXPECT_EQ(
       header.rfind("receiver_id,seq,time_gps_ns,satellites.sv_id,satellites.pseudorange_m", 0), 0u);
-  const auto rows = navbus::tool::csvRows(e);
+  const auto rows = navbus::records::csvRows(e);
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1].rfind("3,0,42,9,20000000.125", 0), 0u);
   navbus::Health h;
   h.participant("navbus-filter");
   h.state(navbus::STATE_DEGRADED);
-  const auto hr = navbus::tool::csvRows(h);
+  const auto hr = navbus::records::csvRows(h);
   ASSERT_EQ(hr.size(), 1u);  // no inputs: one row with empty input cells
   EXPECT_EQ(hr[0].rfind("navbus-filter,0,0,DEGRADED,0", 0), 0u);
   // Shortest text that reads back to the same bits.
   for (const double v :
        {0.1 + 0.2, 0.00980665, 9.80665 / 1000.0, 1e-300, -3000.0, 6378137.0, 1.1309733552923256}) {
-    const std::string text = navbus::tool::formatNumber(v);
+    const std::string text = navbus::records::formatNumber(v);
     EXPECT_EQ(std::stod(text), v) << text;
   }
-  EXPECT_EQ(navbus::tool::formatNumber(0.00980665), "0.00980665");
-  EXPECT_EQ(navbus::tool::formatNumber(0.1 + 0.2), "0.30000000000000004");
-  EXPECT_EQ(navbus::tool::formatNumber(3000.0), "3000");
+  EXPECT_EQ(navbus::records::formatNumber(0.00980665), "0.00980665");
+  EXPECT_EQ(navbus::records::formatNumber(0.1 + 0.2), "0.30000000000000004");
+  EXPECT_EQ(navbus::records::formatNumber(3000.0), "3000");
 }

@@ -8,7 +8,7 @@
 
 #include "navbus/bus/config.hpp"
 #include "navbus/core/math/spectrum.hpp"
-#include "scenario_config.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
 
 namespace fs = std::filesystem;
 using navbus::sim::ScenarioConfig;

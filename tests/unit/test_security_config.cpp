@@ -7,13 +7,13 @@
 #include <gtest/gtest.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 
-#include "latency.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/dds_context.hpp"
 #include "navbus/bus/peer_identities.hpp"
 #include "navbus/bus/qos_files.hpp"
 #include "navbus/bus/security.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
+#include "navbus/tool/latency.hpp"
 
 namespace fs = std::filesystem;
 namespace fdds = eprosima::fastdds::dds;

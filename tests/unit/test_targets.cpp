@@ -6,12 +6,12 @@
 
 #include <gtest/gtest.h>
 
-#include "evaluation.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/math/units.hpp"
-#include "offline_runner.hpp"
+#include "navbus/evaluation/evaluation.hpp"
+#include "navbus/evaluation/offline_runner.hpp"
 
-namespace tool = navbus::tool;
+namespace evaluation = navbus::evaluation;
 namespace units = navbus::units;
 
 namespace {
@@ -28,24 +28,25 @@ constexpr std::int64_t kStart = 1'400'000'000'000'000'000;  // the scenarios' st
 
 /// Runs one scenario through the offline runner with a filter configuration (both optionally
 /// edited), starting at the truth or at a draw from the filter's initial sigmas.
-tool::OfflineResult runResult(const std::string& scenario, const std::string& filter,
-                              std::uint64_t seed, double duration_s, bool perturb,
-                              const std::function<void(YAML::Node&)>& edit_filter = {},
-                              const std::function<void(YAML::Node&)>& edit_scenario = {}) {
+evaluation::OfflineResult runResult(const std::string& scenario, const std::string& filter,
+                                    std::uint64_t seed, double duration_s, bool perturb,
+                                    const std::function<void(YAML::Node&)>& edit_filter = {},
+                                    const std::function<void(YAML::Node&)>& edit_scenario = {}) {
   YAML::Node sy = YAML::Clone(navbus::bus::loadYamlFile(kScenarios + "/" + scenario));
   if (edit_scenario) edit_scenario(sy);
   YAML::Node fy = YAML::Clone(navbus::bus::loadYamlFile(kConfig + "/" + filter));
   if (edit_filter) edit_filter(fy);
-  tool::OfflineSetup s;
+  evaluation::OfflineSetup s;
   s.sim = navbus::sensor_sim::parseSimConfig(sy);
   s.sim.scenario.seed = seed;
   s.filter = navbus::nav_filter::parseFilterConfig(fy);
   s.duration_s = duration_s;
-  const auto truth0 = tool::initialTruth(s.sim.scenario);
+  const auto truth0 = evaluation::initialTruth(s.sim.scenario);
   s.filter.engine.initial_state =
-      perturb ? tool::perturbedInitialState(truth0, s.filter.engine.tuning, seed * 7 + 1) : truth0;
+      perturb ? evaluation::perturbedInitialState(truth0, s.filter.engine.tuning, seed * 7 + 1)
+              : truth0;
   EXPECT_EQ(s.sim.scenario.start_time_ns, kStart);
-  return tool::runOffline(s);
+  return evaluation::runOffline(s);
 }
 
 /// Error statistics of one run from `from_s` to `to_s` (relative to the start).
@@ -53,7 +54,7 @@ Errors run(const std::string& scenario, const std::string& filter, std::uint64_t
            double duration_s, double from_s, double to_s, bool perturb,
            const std::function<void(YAML::Node&)>& edit_filter = {},
            const std::function<void(YAML::Node&)>& edit_scenario = {}) {
-  const tool::OfflineResult r =
+  const evaluation::OfflineResult r =
       runResult(scenario, filter, seed, duration_s, perturb, edit_filter, edit_scenario);
   const std::int64_t t0 = kStart;
   Errors e;
@@ -134,8 +135,8 @@ TEST(Targets, Seed000TightlyCoupledIsConsistent) {
                 .nees;
   }
   nees /= runs;
-  const double lo = tool::chiSquareQuantile(0.025, 9.0 * runs) / runs;
-  const double hi = tool::chiSquareQuantile(0.975, 9.0 * runs) / runs;
+  const double lo = evaluation::chiSquareQuantile(0.025, 9.0 * runs) / runs;
+  const double hi = evaluation::chiSquareQuantile(0.975, 9.0 * runs) / runs;
   std::printf("seed000 tightly coupled, %d runs: average NEES(9) %.2f, 95%% band [%.2f, %.2f]\n",
               runs, nees, lo, hi);
   // then the average NEES lies in the 95 % chi-square band.
@@ -153,11 +154,11 @@ TEST(Targets, Seed004MultiDimensionalFilterConvergesFasterThanTheInterruptedFilt
   std::map<std::string, std::vector<double>> recovery;
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     for (const char* p : {"mdf", "continue", "reset_all"}) {
-      const tool::OfflineResult r = runResult(
+      const evaluation::OfflineResult r = runResult(
           "seed004_land_vehicle.yaml", "filter_seed004_mdf.yaml", seed, 160, false, policy(p));
       for (double t : {80.0, 130.0}) {
-        const double s =
-            tool::convergenceTime(r.errors, kStart + static_cast<std::int64_t>(t * 1e9), 1.5, 10.0);
+        const double s = evaluation::convergenceTime(
+            r.errors, kStart + static_cast<std::int64_t>(t * 1e9), 1.5, 10.0);
         recovery[p].push_back(std::isnan(s) ? 1e9 : s);  // never converged: slowest
       }
     }
@@ -186,7 +187,7 @@ TEST(Targets, Seed004ReducedFiltersAreConsistentWithConsiderStates) {
     double sum = 0.0;
     int n = 0;
     for (std::uint64_t seed = 1; seed <= 10; ++seed) {
-      const tool::OfflineResult r =
+      const evaluation::OfflineResult r =
           runResult("seed004_land_vehicle.yaml", "filter_seed004_mdf.yaml", seed, 160, false,
                     [unestimated, resets](YAML::Node& y) {
                       y["multi_dimensional"]["unestimated_states"] = unestimated;
@@ -231,9 +232,9 @@ TEST(Targets, Seed004ReducedFiltersAreConsistentWithConsiderStates) {
 }
 
 TEST(ChiSquare, QuantilesMatchTables) {
-  EXPECT_NEAR(tool::chiSquareQuantile(0.975, 9), 19.023, 0.03);
-  EXPECT_NEAR(tool::chiSquareQuantile(0.025, 9), 2.700, 0.03);
-  EXPECT_NEAR(tool::chiSquareQuantile(0.975, 360), 414.0, 0.5);
+  EXPECT_NEAR(evaluation::chiSquareQuantile(0.975, 9), 19.023, 0.03);
+  EXPECT_NEAR(evaluation::chiSquareQuantile(0.025, 9), 2.700, 0.03);
+  EXPECT_NEAR(evaluation::chiSquareQuantile(0.975, 360), 414.0, 0.5);
 }
 
 namespace {
@@ -241,7 +242,7 @@ namespace {
 /// One run with the filter aligning from its inputs (the configuration's initial_state
 /// removed): the alignment's start against the truth, and the first solution.
 struct AlignedRun {
-  tool::OfflineResult result;
+  evaluation::OfflineResult result;
   navbus::StartSource first_source{navbus::START_CONFIGURED};
   double first_solution_s{-1};
 };
@@ -250,15 +251,15 @@ AlignedRun alignedRun(const std::string& scenario, const std::string& filter, st
                       double duration_s) {
   YAML::Node fy = YAML::Clone(navbus::bus::loadYamlFile(kConfig + "/" + filter));
   fy.remove("initial_state");
-  tool::OfflineSetup s;
+  evaluation::OfflineSetup s;
   s.sim =
       navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(kScenarios + "/" + scenario));
   s.sim.scenario.seed = seed;
   s.filter = navbus::nav_filter::parseFilterConfig(fy);
   s.duration_s = duration_s;
   AlignedRun run;
-  run.result =
-      tool::runOffline(s, [&](const navbus::NavigationSolution& sol, const auto&, const auto&) {
+  run.result = evaluation::runOffline(
+      s, [&](const navbus::NavigationSolution& sol, const auto&, const auto&) {
         if (run.first_solution_s >= 0) return;
         run.first_solution_s = 1e-9 * static_cast<double>(sol.time_gps_ns() - kStart);
         run.first_source = sol.start_source();
@@ -266,7 +267,7 @@ AlignedRun alignedRun(const std::string& scenario, const std::string& filter, st
   return run;
 }
 
-double alignedAt(const tool::OfflineResult& r) {
+double alignedAt(const evaluation::OfflineResult& r) {
   return 1e-9 * static_cast<double>(r.aligned_start.state.time_ns - kStart);
 }
 
@@ -280,7 +281,7 @@ TEST(Alignment, Seed000GyrocompassesAtRestWithinItsOwnSigmas) {
   for (int seed = 1; seed <= runs; ++seed) {
     const AlignedRun run = alignedRun("seed000_aircraft.yaml", "filter_seed000_tc.yaml",
                                       static_cast<unsigned>(seed), 80);
-    const tool::OfflineResult& r = run.result;
+    const evaluation::OfflineResult& r = run.result;
     // when the filter aligns itself,
     ASSERT_TRUE(r.aligned) << "seed " << seed << ": " << r.summary;
     // then it levels and gyrocompasses over the 60 s window at rest (the attitude source is in
@@ -301,14 +302,14 @@ TEST(Alignment, Seed000GyrocompassesAtRestWithinItsOwnSigmas) {
   }
   // and the attitude errors of the starts are consistent with those sigmas (chi-square with
   // 3 x runs degrees of freedom, 99.9 % bound).
-  EXPECT_LT(normalized, tool::chiSquareQuantile(0.999, 3.0 * runs));
+  EXPECT_LT(normalized, evaluation::chiSquareQuantile(0.999, 3.0 * runs));
 }
 
 TEST(Alignment, Seed000MeasuresTheHeadingAgainFromTheCourseAtTakeoff) {
   // Given seed 000's seed 22, whose east gyro bias (3.3 sigma) gyrocompassing turns into a
   // heading error of 0.27 rad, and the takeoff at 501 s (20 m/s^2 for 10 s),
   const AlignedRun run = alignedRun("seed000_aircraft.yaml", "filter_seed000_tc.yaml", 22, 1000);
-  const tool::OfflineResult& r = run.result;
+  const evaluation::OfflineResult& r = run.result;
   ASSERT_TRUE(r.aligned) << r.summary;
   ASSERT_GT(std::abs(r.aligned_start_error.att_ned_rad.z()), 0.2);
   // when the filter starts from that alignment, it measures the heading again from the GNSS
@@ -326,7 +327,7 @@ TEST(Alignment, Seed000MeasuresTheHeadingAgainFromTheCourseAtTakeoff) {
   // degrees of freedom, 99.9 %; with the attitude rows of the covariance left unturned by the
   // 0.28 rad correction the roll and the y accelerometer bias were learned as if separable in
   // level flight: attitude NEES 3289 at 1000 s).
-  const double nees_att_bound = tool::chiSquareQuantile(0.999, 3.0);
+  const double nees_att_bound = evaluation::chiSquareQuantile(0.999, 3.0);
   int checked = 0;
   for (const auto& e : r.errors) {
     const double t = 1e-9 * static_cast<double>(e.time_ns - kStart);
@@ -344,7 +345,7 @@ TEST(Alignment, Seed000MeasuresTheHeadingAgainFromTheCourseAtTakeoff) {
 TEST(Alignment, Seed001TakesTheAttitudeFromTheFirstStarTrackerSampleAfterTheFirstFix) {
   // Given the LEO orbit, GNSS fixes at 10 Hz and a 5 Hz star tracker, no configured state,
   const AlignedRun run = alignedRun("seed001_leo.yaml", "filter_seed001_lc.yaml", 1, 5);
-  const tool::OfflineResult& r = run.result;
+  const evaluation::OfflineResult& r = run.result;
   ASSERT_TRUE(r.aligned) << r.summary;
   // then the attitude comes from the star tracker and the position from the first fix, at
   // once (the first star-tracker sample at 0.2 s),
@@ -363,7 +364,7 @@ TEST(Alignment, Seed004MemsLevelsAtRestAndTakesTheHeadingFromTheGnssCourse) {
   // Given the land vehicle with MEMS gyros (0.1 deg/s: no gyrocompassing), at rest for 10 s and
   // then accelerating, no configured state,
   const AlignedRun run = alignedRun("seed004_land_vehicle.yaml", "filter_seed004_mdf.yaml", 1, 30);
-  const tool::OfflineResult& r = run.result;
+  const evaluation::OfflineResult& r = run.result;
   ASSERT_TRUE(r.aligned) << r.summary;
   // then the heading comes from the GNSS course once the vehicle is faster than 5 m/s, and the
   // alignment says gyrocompassing could not reach 10 deg here,

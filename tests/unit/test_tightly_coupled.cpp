@@ -7,7 +7,7 @@
 #include "navbus/bus/config.hpp"
 #include "navbus/core/filter/integrated_filter.hpp"
 #include "navbus/core/math/rotation.hpp"
-#include "scenario_config.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
 
 namespace earth = navbus::core::earth;
 namespace layout = navbus::core::layout;

@@ -7,8 +7,8 @@
 #include "navbus/bus/config.hpp"
 #include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/math/rotation.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/trajectory.hpp"
-#include "scenario_config.hpp"
 
 namespace earth = navbus::core::earth;
 using navbus::sim::Segment;

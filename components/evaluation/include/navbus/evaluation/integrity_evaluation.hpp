@@ -1,0 +1,37 @@
+// Evaluation of the protection levels in Monte Carlo runs (`navbus montecarlo`, filters with an
+// `integrity` block): at every solution with levels, the true horizontal and vertical position
+// errors against the levels. An alarm stands from a fault decision until the fault manager's
+// next command (its answer; the end of the run if none comes): an error beyond its level
+// while no alarm stands is misleading information, also after an answered alarm (the solution
+// claims its levels again). Availability: the share of those solutions whose levels are both
+// within the alert limits (INTEGRITY_AVAILABLE).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "navbus/evaluation/offline_runner.hpp"
+
+namespace navbus::evaluation {
+
+struct IntegrityTally {
+  std::uint64_t epochs{0};                   ///< solutions with protection levels
+  std::uint64_t available{0};                ///< ... both within the alert limits
+  std::uint64_t misleading{0};               ///< error beyond a level while no alarm stands
+  std::uint64_t misleading_after_answer{0};  ///< of `misleading`: after an answered alarm
+  std::uint64_t beyond_during_alarm{0};      ///< error beyond a level while an alarm stands
+  std::uint64_t misleading_unavailable{0};   ///< of `misleading`: while unavailable
+  int runs{0}, runs_with_misleading{0};
+  std::vector<std::uint64_t> misleading_seeds;  ///< the runs with misleading information
+  double max_ratio_h{0.0}, max_ratio_v{0.0};    ///< largest error / level
+  std::vector<double> hpl_m, vpl_m;             ///< every level, for the quantiles
+
+  /// Adds one run's solutions (OfflineResult::errors and the decisions' order).
+  void add(const OfflineResult& r, std::uint64_t seed);
+};
+
+/// One table row per configuration (skips configurations without levels).
+void printIntegrityTable(const std::vector<std::pair<std::string, IntegrityTally>>& rows);
+
+}  // namespace navbus::evaluation

@@ -1,0 +1,228 @@
+#include "navbus/evaluation/fault_evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "navbus/records/formatters.hpp"
+
+namespace navbus::evaluation {
+
+namespace {
+
+bool matches(const sim::Fault& f, navbus::FaultSource source, int sv_id, int axis) {
+  if (f.kind == sim::FaultKind::kPseudorangeRamp) {
+    return source == navbus::SOURCE_SATELLITE && sv_id == f.sv_id;
+  }
+  const navbus::FaultSource want = f.sensor == sim::SensorKind::kAccelerometer
+                                       ? navbus::SOURCE_ACCELEROMETER
+                                       : navbus::SOURCE_GYRO;
+  return source == want && axis == f.axis;
+}
+
+double trueMagnitude(const sim::Fault& f) {
+  return f.kind == sim::FaultKind::kPseudorangeRamp ? f.slope : f.magnitude;
+}
+
+std::string describe(const navbus::FaultDecision& d) {
+  std::ostringstream s;
+  switch (d.source()) {
+    case navbus::SOURCE_ACCELEROMETER:
+      s << "accel "
+        << "xyz"[d.axis() % 3];
+      break;
+    case navbus::SOURCE_GYRO:
+      s << "gyro "
+        << "xyz"[d.axis() % 3];
+      break;
+    case navbus::SOURCE_SATELLITE:
+      s << "sv " << d.sv_id() << (d.shape() == navbus::SHAPE_RAMP ? " ramp" : " step");
+      break;
+    default:
+      s << "source " << static_cast<int>(d.source());
+  }
+  s << " " << d.magnitude();
+  if (d.ambiguous() && d.candidates().size() > 1) {
+    const auto& c = d.candidates()[1];
+    s << " | "
+      << (c.source() == navbus::SOURCE_SATELLITE ? "sv "
+          : c.source() == navbus::SOURCE_GYRO    ? "gyro "
+                                                 : "accel ")
+      << (c.source() == navbus::SOURCE_SATELLITE ? std::to_string(c.sv_id())
+                                                 : std::string(1, "xyz"[c.axis() % 3]));
+  }
+  return s.str();
+}
+
+bool insideEnvelope(const EpochError& e) {
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(e.pos_ned_m[i]) > 3.0 * e.pos_sigma_ned_m[i]) return false;
+  }
+  return true;
+}
+
+double recoveryTime(const std::vector<EpochError>& errors, std::int64_t decision_ns) {
+  constexpr std::int64_t kStay = 30'000'000'000;
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    if (errors[i].time_ns < decision_ns) continue;
+    bool stays = true;
+    std::size_t j = i;
+    for (; j < errors.size() && errors[j].time_ns <= errors[i].time_ns + kStay; ++j) {
+      if (!insideEnvelope(errors[j])) {
+        stays = false;
+        break;
+      }
+    }
+    if (stays) return 1e-9 * static_cast<double>(errors[i].time_ns - decision_ns);
+    i = j;  // the next candidate starts after the epoch that left the envelope
+  }
+  return std::nan("");
+}
+
+}  // namespace
+
+bool writeGlrCsv(const std::string& path,
+                 const std::vector<fault_manager::GlrEpochStatistic>& trace) {
+  std::ofstream f(path);
+  f << "time_gps_ns,statistic,threshold,onset_epochs_ago,detected\n";
+  for (const fault_manager::GlrEpochStatistic& e : trace) {
+    f << e.time_ns << "," << records::formatNumber(e.statistic) << ","
+      << records::formatNumber(e.threshold) << "," << e.onset_epochs_ago << ","
+      << (e.detected ? 1 : 0) << "\n";
+  }
+  return static_cast<bool>(f);
+}
+
+std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule) {
+  for (const sim::Fault& f : schedule.faults()) {
+    if (f.kind == sim::FaultKind::kImuBiasStep || f.kind == sim::FaultKind::kPseudorangeRamp)
+      return f;
+  }
+  return std::nullopt;
+}
+
+FaultRunOutcome evaluateRun(const OfflineResult& r, const std::optional<sim::Fault>& fault,
+                            std::int64_t start_ns, std::uint64_t seed) {
+  FaultRunOutcome out;
+  out.seed = seed;
+  const double fault_s = fault ? fault->start_s : 1e300;
+  for (const navbus::FaultDecision& d : r.decisions) {
+    if (d.event() != navbus::EVENT_FAULT_DETECTED) continue;
+    const double t =
+        1e-9 * static_cast<double>(static_cast<std::int64_t>(d.time_gps_ns()) - start_ns);
+    if (t < fault_s) {
+      ++out.false_alarms;
+      continue;
+    }
+    if (out.detected) continue;
+    out.detected = true;
+    out.detection_s = t;
+    out.onset_s =
+        1e-9 * static_cast<double>(static_cast<std::int64_t>(d.onset_time_gps_ns()) - start_ns);
+    out.decided = describe(d);
+    out.ambiguous = d.ambiguous();
+    const bool imu_truth = fault->kind == sim::FaultKind::kImuBiasStep;
+    const bool imu_decided =
+        d.source() == navbus::SOURCE_ACCELEROMETER || d.source() == navbus::SOURCE_GYRO;
+    out.class_correct = imu_truth == imu_decided;
+    out.source_correct = matches(*fault, d.source(), d.sv_id(), d.axis());
+    double magnitude = out.source_correct ? d.magnitude() : std::nan("");
+    for (const auto& c : d.candidates()) {
+      if (matches(*fault, c.source(), c.sv_id(), c.axis())) {
+        out.truth_among_candidates = true;
+        if (std::isnan(magnitude)) magnitude = c.magnitude();
+      }
+    }
+    out.magnitude_error = (magnitude - trueMagnitude(*fault)) / trueMagnitude(*fault);
+    // A ramp named as a step (or the reverse) has a magnitude in another unit.
+    const bool ramp = fault->kind == sim::FaultKind::kPseudorangeRamp;
+    out.shape_correct = !ramp || d.shape() == navbus::SHAPE_RAMP;
+    if (!out.shape_correct) out.magnitude_error = std::nan("");
+    for (const navbus::FilterCommand& c : r.commands) {
+      if (c.decision_id() == d.decision_id() && c.kind() == navbus::CMD_COMPENSATE_BIAS &&
+          matches(*fault, c.sensor(), 0, c.axis()))
+        out.commanded_error = (c.bias() - trueMagnitude(*fault)) / trueMagnitude(*fault);
+    }
+    out.recovery_s = recoveryTime(r.errors, static_cast<std::int64_t>(d.time_gps_ns()));
+  }
+  return out;
+}
+
+void printFaultTable(const std::string& label, const std::optional<sim::Fault>& fault,
+                     const std::vector<FaultRunOutcome>& runs, double hours_per_run) {
+  int detected = 0, class_ok = 0, source_ok = 0, honest = 0, false_alarms = 0, shape_ok = 0;
+  double sum_t = 0, min_t = 1e300, max_t = -1e300, sum_mag = 0;
+  int mag_n = 0, cmd_n = 0, recovered_10s = 0, recovered = 0;
+  double sum_cmd = 0;
+  std::vector<double> recovery;
+  for (const FaultRunOutcome& o : runs) {
+    false_alarms += o.false_alarms;
+    if (!o.detected) continue;
+    ++detected;
+    sum_t += o.detection_s;
+    min_t = std::min(min_t, o.detection_s);
+    max_t = std::max(max_t, o.detection_s);
+    class_ok += o.class_correct ? 1 : 0;
+    shape_ok += o.shape_correct ? 1 : 0;
+    source_ok += o.source_correct ? 1 : 0;
+    honest += (o.source_correct || (o.ambiguous && o.truth_among_candidates)) ? 1 : 0;
+    if (std::isfinite(o.commanded_error)) {
+      sum_cmd += std::abs(o.commanded_error);
+      ++cmd_n;
+    }
+    if (std::isfinite(o.recovery_s)) {
+      ++recovered;
+      recovered_10s += o.recovery_s <= 10.0 ? 1 : 0;
+      recovery.push_back(o.recovery_s);
+    }
+    if (std::isfinite(o.magnitude_error)) {
+      sum_mag += std::abs(o.magnitude_error);
+      ++mag_n;
+    }
+  }
+  const double n = static_cast<double>(runs.size());
+  std::printf("\n%s: %zu runs\n", label.c_str(), runs.size());
+  if (fault) {
+    std::printf(
+        "  fault %s at %.1f s: detected %d/%zu; detection time mean %.1f s, min %.1f, max %.1f "
+        "(%.1f s after onset on average)\n",
+        sim::faultKindName(fault->kind), fault->start_s, detected, runs.size(),
+        detected ? sum_t / detected : std::nan(""), detected ? min_t : std::nan(""),
+        detected ? max_t : std::nan(""),
+        detected ? sum_t / detected - fault->start_s : std::nan(""));
+    std::printf(
+        "  isolation: INS vs GNSS correct %.1f %%; source named first %.1f %%; source named or "
+        "honestly ambiguous %.1f %% (of detected runs); shape (step/ramp) right %.1f %%; mean "
+        "|magnitude error| %.1f %% (where the shape is right)\n",
+        detected ? 100.0 * class_ok / detected : 0.0, detected ? 100.0 * source_ok / detected : 0.0,
+        detected ? 100.0 * honest / detected : 0.0, detected ? 100.0 * shape_ok / detected : 0.0,
+        mag_n ? 100.0 * sum_mag / mag_n : std::nan(""));
+  }
+  if (fault && detected) {
+    std::sort(recovery.begin(), recovery.end());
+    std::printf(
+        "  compensation commanded in %d runs, mean |magnitude error| %.1f %%; position error back "
+        "in the 3-sigma envelope (and staying 30 s) after the decision: median %.1f s, within "
+        "10 s in %d/%d runs, never in %d\n",
+        cmd_n, cmd_n ? 100.0 * sum_cmd / cmd_n : std::nan(""),
+        recovery.empty() ? std::nan("") : recovery[recovery.size() / 2], recovered_10s, detected,
+        detected - recovered);
+  }
+  std::printf("  false alarms: %d in %.2f h of data (%.3f per hour)%s\n", false_alarms,
+              n * hours_per_run, false_alarms / std::max(n * hours_per_run, 1e-9),
+              fault ? " (before the fault)" : "");
+  std::printf("  per run (seed: detection s, onset s, decision):");
+  for (const FaultRunOutcome& o : runs) {
+    if (o.detected) {
+      std::printf(" [%llu: %.0f, %.0f, %s]", static_cast<unsigned long long>(o.seed), o.detection_s,
+                  o.onset_s, o.decided.c_str());
+    } else {
+      std::printf(" [%llu: -]", static_cast<unsigned long long>(o.seed));
+    }
+  }
+  std::printf("\n");
+}
+
+}  // namespace navbus::evaluation

@@ -1,0 +1,200 @@
+#include "navbus/evaluation/offline_runner.hpp"
+
+#include <cmath>
+#include <deque>
+#include <random>
+#include <type_traits>
+
+#include <navbus_idl/Fault.h>
+
+#include "navbus/bus/conversions.hpp"
+#include "navbus/bus/health.hpp"
+#include "navbus/core/math/rotation.hpp"
+#include "navbus/evaluation/frame_prefetcher.hpp"
+#include "navbus/fault_manager/fault_pipeline.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/sensor_sim/frame_publisher.hpp"
+#include "navbus/sim/scenario_source.hpp"
+
+namespace navbus::evaluation {
+
+core::NavState initialTruth(const sim::ScenarioConfig& scenario) {
+  return sim::ScenarioSource(scenario).truth();
+}
+
+core::NavState perturbedInitialState(const core::NavState& truth, const core::FilterTuning& t,
+                                     std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  core::NavState s = truth;
+  const Eigen::Vector3d dp(t.pos_sigma_m * n(rng), t.pos_sigma_m * n(rng), t.pos_sigma_m * n(rng));
+  s.position = core::earth::offsetNed(s.position, dp);
+  s.vel_ned_mps += Eigen::Vector3d(n(rng), n(rng), n(rng)) * t.vel_sigma_mps;
+  const Eigen::Vector3d phi(t.level_sigma_rad * n(rng), t.level_sigma_rad * n(rng),
+                            t.heading_sigma_rad * n(rng));
+  // C_est = (I - [phi x]) C_true.
+  s.q_b_to_n = (core::quaternionFromRotationVector(-phi) * s.q_b_to_n).normalized();
+  return s;
+}
+
+EpochError epochError(const core::NavState& e, const core::NavState& t) {
+  EpochError out;
+  out.time_ns = e.time_ns;
+  out.pos_ned_m = core::earth::differenceNed(e.position, t.position);
+  out.vel_ned_mps = e.vel_ned_mps - t.vel_ned_mps;
+  const Eigen::Matrix3d M =
+      e.q_b_to_n.toRotationMatrix() * t.q_b_to_n.toRotationMatrix().transpose();
+  out.att_ned_rad = Eigen::Vector3d(M(1, 2) - M(2, 1), M(2, 0) - M(0, 2), M(0, 1) - M(1, 0)) / 2.0;
+  return out;
+}
+
+namespace {
+/// The truth of one frame: navigation state and sensor biases.
+struct Truth {
+  core::NavState state;
+  Eigen::Vector3d accel_bias_b_mps2;
+  Eigen::Vector3d gyro_bias_b_radps;
+  Eigen::Vector3d star_tracker_bias_b_rad;
+};
+
+/// NEES of one 3-state block of the error (estimate minus truth) against its covariance
+/// block; NaN when the filter does not estimate the block.
+double blockNees(const core::StateMatrix& P, const core::StateMask& active,
+                 const core::StateBlock& b, const Eigen::Vector3d& error) {
+  if (!active[static_cast<std::size_t>(b.index)]) return std::nan("");
+  return error.dot(P.block<3, 3>(b.index, b.index).ldlt().solve(error));
+}
+
+/// Once, when the engine has just aligned: its start against the truth at the start's time.
+void recordAlignedStart(const core::NavigationEngine& engine, const std::deque<Truth>& truths,
+                        OfflineResult& result) {
+  if (result.aligned || engine.alignmentPhase() != core::AlignmentPhase::kAligned) return;
+  const core::AlignedStart& a = engine.alignedStart();
+  for (const Truth& truth : truths) {
+    const core::NavState& t = truth.state;
+    if (t.time_ns != a.state.time_ns) continue;
+    result.aligned = true;
+    result.aligned_start = a;
+    EpochError& e = result.aligned_start_error;
+    e = epochError(a.state, t);
+    e.pos_sigma_ned_m = a.pos_sigma_ned_m;
+    e.vel_sigma_ned_mps = a.vel_sigma_ned_mps;
+    e.att_sigma_ned_rad = a.att_sigma_ned_rad;
+    return;
+  }
+}
+}  // namespace
+
+OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
+  OfflineResult result;
+  const sensor_sim::SimConfig& sim = setup.sim;
+  // One error per solution: reserved, so that the vector does not double past what it needs.
+  result.errors.reserve(static_cast<std::size_t>(
+      setup.duration_s * 1e9 / static_cast<double>(setup.filter.engine.solution_period_ns) + 2));
+  sim::ScenarioSource source(sim.scenario);
+  bus::HealthCounters health("navbus-offline");
+  std::deque<Truth> truths;
+  const nav_filter::FilterPipeline* pipeline_ptr = nullptr;
+  auto on_solution = [&](const navbus::NavigationSolution& sol) {
+    ++result.solutions;
+    const auto t = static_cast<std::int64_t>(sol.time_gps_ns());
+    while (!truths.empty() && truths.front().state.time_ns < t) truths.pop_front();
+    if (truths.empty() || truths.front().state.time_ns != t) {
+      ++result.solutions_without_truth;
+      return;
+    }
+    const core::NavigationEngine& engine = pipeline_ptr->engine();
+    const Truth& truth = truths.front();
+    EpochError err = epochError(engine.state(), truth.state);
+    const core::StateMatrix& P = engine.covariance();
+    using namespace core::layout;
+    err.pos_sigma_ned_m = P.block<3, 3>(kPos.index, kPos.index).diagonal().cwiseSqrt();
+    err.vel_sigma_ned_mps = P.block<3, 3>(kVel.index, kVel.index).diagonal().cwiseSqrt();
+    err.att_sigma_ned_rad = P.block<3, 3>(kAtt.index, kAtt.index).diagonal().cwiseSqrt();
+    Eigen::Matrix<double, 9, 1> d;
+    d << err.pos_ned_m, err.vel_ned_mps, err.att_ned_rad;
+    const Eigen::Matrix<double, 9, 9> P9 = P.topLeftCorner<9, 9>();
+    err.nees9 = d.dot(P9.ldlt().solve(d));
+    const core::StateMask& active = engine.activeStates();
+    err.accel_bias_err_b_mps2 = engine.accelBias() - truth.accel_bias_b_mps2;
+    err.gyro_bias_err_b_radps = engine.gyroBias() - truth.gyro_bias_b_radps;
+    err.star_tracker_bias_err_b_rad = engine.starTrackerBias() - truth.star_tracker_bias_b_rad;
+    err.nees_blocks << blockNees(P, active, kPos, err.pos_ned_m),
+        blockNees(P, active, kVel, err.vel_ned_mps), blockNees(P, active, kAtt, err.att_ned_rad),
+        blockNees(P, active, kAccelBias, err.accel_bias_err_b_mps2),
+        blockNees(P, active, kGyroBias, err.gyro_bias_err_b_radps),
+        blockNees(P, active, kStarTrackerBias, err.star_tracker_bias_err_b_rad);
+    err.mode = static_cast<int>(sol.mode());
+    err.integrity = static_cast<int>(sol.integrity());
+    err.hpl_m = sol.horizontal_protection_level_m();
+    err.vpl_m = sol.vertical_protection_level_m();
+    result.errors.push_back(err);
+    if (hook) hook(sol, truth.state, err);
+  };
+  // The fault manager's pipeline, when configured, sees every diagnostics sample as the
+  // filter emits it and its commands go back to the filter at once.
+  std::optional<fault_manager::FaultPipeline> faults;
+  nav_filter::FilterPipeline* filter_ptr = nullptr;
+  if (setup.fault_manager) {
+    faults.emplace(*setup.fault_manager, health,
+                   fault_manager::FaultPipeline::Sinks{
+                       [&](const navbus::FaultDecision& d) {
+                         result.decisions.push_back(d);
+                         result.decision_after_solutions.push_back(result.errors.size());
+                       },
+                       [&](const navbus::FilterCommand& c) {
+                         result.commands.push_back(c);
+                         result.command_after_solutions.push_back(result.errors.size());
+                         filter_ptr->onCommand(c);
+                       }});
+  }
+  std::function<void(const navbus::FilterDiagnostics&)> on_diagnostics;
+  if (faults) {
+    on_diagnostics = [&](const navbus::FilterDiagnostics& d) {
+      if (faults->onDiagnostics(d)) result.glr_trace.push_back(faults->glr().latest());
+    };
+  }
+  nav_filter::FilterPipeline pipeline(setup.filter, health, {on_solution, on_diagnostics});
+  pipeline_ptr = &pipeline;
+  filter_ptr = &pipeline;
+
+  const auto period_ns = sim.scenario.imu_period_ns;
+  const auto total = static_cast<std::int64_t>(
+      std::llround(setup.duration_s * 1e9 / static_cast<double>(period_ns)));
+  sensor_sim::FrameSequence seq;
+  auto feed = [&pipeline, &faults](const auto& sample) {
+    using T = std::decay_t<decltype(sample)>;
+    if constexpr (std::is_same_v<T, navbus::ImuIncrement>) pipeline.onImu(sample);
+    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
+      pipeline.onGnssObservations(sample);
+    if constexpr (std::is_same_v<T, navbus::GnssFix>) pipeline.onGnssFix(sample);
+    if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) pipeline.onStarTracker(sample);
+    if constexpr (std::is_same_v<T, navbus::ImuRawBlock>) faults->onRawBlock(sample);
+    return true;
+  };
+  sensor_sim::SimConfig emitted = sim;
+  // Raw blocks only feed the fault manager's dither monitor.
+  emitted.publish_raw = sim.publish_raw && faults && faults->dither().has_value();
+  FramePrefetcher frames(source, total);
+  while (const sim::SensorFrame* next = frames.next()) {
+    const sim::SensorFrame& f = *next;
+    truths.push_back({f.truth, f.truth_accel_bias_b_mps2, f.truth_gyro_bias_b_radps,
+                      f.truth_star_tracker_bias_b_rad});
+    // The same samples, in the same order and with the same sequence numbers as the
+    // simulator participant publishes them.
+    sensor_sim::emitFrame(f, emitted, seq, feed);
+    // Data time bounds the wait for a silent stream (the bus uses steady time).
+    pipeline.pump(f.increment.time_ns);
+    recordAlignedStart(pipeline.engine(), truths, result);
+  }
+  // End of data: whatever waits for a stream that will not speak again is released.
+  pipeline.flush(sim.scenario.start_time_ns + total * period_ns);
+  result.summary = pipeline.summary();
+  if (faults) {
+    result.fault_summary = faults->summary();
+    result.max_glr_statistic = faults->glr().counters().max_statistic;
+  }
+  return result;
+}
+
+}  // namespace navbus::evaluation

@@ -1,0 +1,126 @@
+// Converts simulated sensor frames to IDL samples and writes them, never dropping one:
+// a write that times out (a reliable reader is behind) is retried until it succeeds or the
+// run is stopped.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+
+#include <navbus_idl/GnssPubSubTypes.h>
+#include <navbus_idl/ImuPubSubTypes.h>
+#include <navbus_idl/StarTrackerPubSubTypes.h>
+
+#include "navbus/bus/conversions.hpp"
+#include "navbus/bus/participant.hpp"
+#include "navbus/sensor_sim/imu_block_batcher.hpp"
+#include "navbus/sensor_sim/scenario_config.hpp"
+#include "navbus/sim/samples.hpp"
+
+namespace navbus::sensor_sim {
+
+navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id,
+                          std::uint64_t seq);
+navbus::GnssObservationEpoch toIdl(const sim::GnssEpoch& epoch, std::uint32_t receiver_id,
+                                   std::uint64_t seq);
+navbus::GnssFix toIdl(const sim::GnssFixSample& fix, std::uint32_t receiver_id, std::uint64_t seq);
+navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_t tracker_id,
+                                  std::uint64_t seq);
+
+/// Sequence numbers of the last samples emitted per stream.
+struct FrameSequence {
+  std::uint64_t imu{0}, raw{0}, gnss_epochs{0}, gnss_fixes{0}, star_tracker{0};
+};
+
+/// What a FramePublisher wrote to the bus: measurements per stream and the DDS samples that
+/// carried them (fewer than the measurements where increments and raw samples go in blocks).
+struct WrittenCounts {
+  std::uint64_t increments{0}, increment_samples{0};  ///< increments; samples carrying them
+  std::uint64_t raw_samples{0}, raw_blocks{0};
+  std::uint64_t gnss_epochs{0}, gnss_fixes{0}, star_tracker{0};
+
+  /// DDS samples written, all streams.
+  std::uint64_t samples() const {
+    return increment_samples + raw_blocks + gnss_epochs + gnss_fixes + star_tracker;
+  }
+  /// Measurements carried: each increment, raw sample, GNSS epoch and fix, attitude.
+  std::uint64_t measurements() const {
+    return increments + raw_samples + gnss_epochs + gnss_fixes + star_tracker;
+  }
+};
+
+/// The bus samples of one simulator frame, in emit order (the increment first, then the raw
+/// block, then the measurements valid at its end time), with their sequence numbers: the one
+/// definition of what the simulator participant publishes, shared by FramePublisher and
+/// `navbus offline`. `emit(sample)` returns false to stop; the sequence advances per sample
+/// emitted. Returns false if stopped.
+template <class Emit>
+bool emitFrame(const sim::SensorFrame& f, const SimConfig& c, FrameSequence& seq, Emit&& emit) {
+  if (!emit(bus::toIdl(f.increment, c.imu_sensor_id, seq.imu + 1))) return false;
+  ++seq.imu;
+  if (c.publish_raw) {
+    if (!emit(toIdl(f.raw, c.imu_sensor_id, seq.raw + 1))) return false;
+    ++seq.raw;
+  }
+  if (c.publish_gnss && f.has_gnss) {
+    if (!emit(toIdl(f.gnss, c.gnss_receiver_id, seq.gnss_epochs + 1))) return false;
+    ++seq.gnss_epochs;
+    if (!emit(toIdl(f.fix, c.gnss_receiver_id, seq.gnss_fixes + 1))) return false;
+    ++seq.gnss_fixes;
+  }
+  if (c.publish_star_tracker && f.has_star_tracker) {
+    if (!emit(toIdl(f.star_tracker, c.star_tracker_id, seq.star_tracker + 1))) return false;
+    ++seq.star_tracker;
+  }
+  return true;
+}
+
+class FramePublisher {
+ public:
+  FramePublisher(bus::Participant& participant, const SimConfig& config);
+
+  /// Writes every sample of the frame (in fast pacing with blocks, increments and raw samples
+  /// once a block is full); returns false if the run was stopped meanwhile.
+  bool publish(const sim::SensorFrame& frame);
+  /// Readers matched on the topic that carries the increments.
+  std::size_t imuReaders() const;
+  /// True when every enabled topic has at least its configured number of matched readers.
+  bool readersMatched() const;
+  /// Waits (bounded) until every written sample is acknowledged by the reliable readers.
+  void flush();
+  /// Writes the blocks still pending, then disposes every stream instance written: readers
+  /// see the streams end as announced (the fault manager's watchdog reports no loss). A
+  /// crashed simulator cannot do this: its streams are lost.
+  void endStreams();
+
+  /// What was written, and writes retried because a reliable reader was behind.
+  const WrittenCounts& counts() const { return written_; }
+  std::uint64_t writeRetries() const { return write_retries_; }
+  /// Increments per ImuIncrementBlock, 0 when each goes out alone.
+  std::size_t incrementsPerBlock() const { return increments_per_block_; }
+
+ private:
+  template <class Sample>
+  bool writeReliably(bus::Writer<Sample>& writer, const Sample& sample);
+  bool writeIncrement(const navbus::ImuIncrement& increment);
+  bool writeRaw(const navbus::ImuRawBlock& raw);
+  bool batchRaw(const navbus::ImuRawBlock& raw);
+  /// Writes the pending blocks (fast pacing with blocks).
+  bool writeBlocks();
+
+  bus::Participant& participant_;
+  SimConfig config_;
+  std::size_t increments_per_block_;
+  bus::Writer<navbus::ImuIncrement> imu_;              ///< one increment per sample
+  bus::Writer<navbus::ImuIncrementBlock> imu_blocks_;  ///< or blocks of them
+  bus::Writer<navbus::ImuRawBlock> raw_;
+  bus::Writer<navbus::GnssObservationEpoch> gnss_;
+  bus::Writer<navbus::GnssFix> fix_;
+  bus::Writer<navbus::StarTrackerAttitude> star_;
+  std::optional<ImuBlockBatcher> batcher_;  ///< with blocks
+  FrameSequence sequence_;                  ///< the frames' sequence numbers (emitFrame)
+  WrittenCounts written_;
+  std::uint64_t write_retries_{0};
+};
+
+}  // namespace navbus::sensor_sim

@@ -1,0 +1,48 @@
+// navbus-sensor-sim scenario files: YAML in the units of the papers' tables (written in the key
+// names and comments), converted to SI here, once. See scenarios/*.yaml and the README.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include <yaml-cpp/yaml.h>
+
+#include "navbus/sensor_sim/imu_block_batcher.hpp"
+#include "navbus/sim/scenario_source.hpp"
+
+namespace navbus::sensor_sim {
+
+enum class Pacing { kRealTime, kFast };
+
+struct SimConfig {
+  sim::ScenarioConfig scenario;
+  bool start_now{true};    ///< start at the current GPS time (real time), else the configured time
+  double duration_s{0.0};  ///< 0: until stopped (bus) or the end of the segments (files)
+  Pacing pacing{Pacing::kRealTime};
+  /// [s] of IMU data per DDS sample in fast pacing: increments go out as ImuIncrementBlocks and
+  /// raw samples in blocks as long (bus throughput); 0: one ImuIncrement per sample, as in
+  /// real time, which always publishes each increment as it is due.
+  double fast_pacing_block_s{0.1};
+  double wait_for_readers_s{10.0};  ///< wait this long for readers before publishing
+  /// Readers to wait for before publishing, per topic.
+  struct MinReaders {
+    int imu{1}, raw_imu{0}, gnss{1}, star_tracker{1};
+  } min_readers;
+  std::uint32_t imu_sensor_id{1};
+  std::uint32_t gnss_receiver_id{1};
+  std::uint32_t star_tracker_id{1};
+  bool publish_raw{true};
+  bool publish_gnss{true};
+  bool publish_star_tracker{true};
+};
+
+/// Throws bus::ConfigError naming the key and value on any invalid entry.
+SimConfig parseSimConfig(const YAML::Node& root);
+
+/// Increments per ImuIncrementBlock (fast_pacing_block_s at the IMU rate), 0 when increments
+/// go out one per sample (real time, or a block of 0 s). Throws bus::ConfigError naming
+/// timing.fast_pacing_block_s when it is not 1..ImuBlockBatcher::kMaxIncrements increments.
+std::size_t incrementsPerBlock(const SimConfig& config);
+
+}  // namespace navbus::sensor_sim

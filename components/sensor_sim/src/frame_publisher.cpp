@@ -1,0 +1,251 @@
+#include "navbus/sensor_sim/frame_publisher.hpp"
+
+#include <cmath>
+#include <type_traits>
+
+#include <spdlog/spdlog.h>
+
+#include "navbus/bus/conversions.hpp"
+#include "navbus/bus/topics.hpp"
+#include "navbus/core/math/earth.hpp"
+
+namespace navbus::sensor_sim {
+
+using bus::toArray;
+
+navbus::ImuRawBlock toIdl(const sim::RawImuBlock& block, std::uint32_t sensor_id,
+                          std::uint64_t seq) {
+  navbus::ImuRawBlock msg;
+  msg.sensor_id(sensor_id);
+  msg.seq(seq);
+  msg.first_sample_time_gps_ns(static_cast<std::uint64_t>(block.first_time_ns));
+  msg.sample_period_ns(static_cast<std::uint32_t>(std::llround(block.sample_period_s * 1e9)));
+  msg.samples().reserve(block.samples.size());
+  for (const auto& s : block.samples) {
+    navbus::ImuRawSample r;
+    r.angular_rate_b_radps(toArray(s.angular_rate_b_radps));
+    r.specific_force_b_mps2(toArray(s.specific_force_b_mps2));
+    msg.samples().push_back(r);
+  }
+  return msg;
+}
+
+navbus::GnssObservationEpoch toIdl(const sim::GnssEpoch& epoch, std::uint32_t receiver_id,
+                                   std::uint64_t seq) {
+  navbus::GnssObservationEpoch msg;
+  msg.receiver_id(receiver_id);
+  msg.seq(seq);
+  msg.time_gps_ns(static_cast<std::uint64_t>(epoch.time_ns));
+  for (const auto& s : epoch.satellites) {
+    navbus::GnssSatelliteMeasurement m;
+    m.sv_id(static_cast<std::uint16_t>(s.sv_id));
+    m.pseudorange_m(s.pseudorange_m);
+    m.pseudorange_rate_mps(s.pseudorange_rate_mps);
+    m.sat_pos_ecef_m(toArray(s.sat_pos_ecef_m));
+    m.sat_vel_ecef_mps(toArray(s.sat_vel_ecef_mps));
+    m.sat_clock_correction_m(s.sat_clock_correction_m);
+    m.sat_clock_drift_mps(s.sat_clock_drift_mps);
+    m.cn0_dbhz(s.cn0_dbhz);
+    m.pseudorange_sigma_m(s.pseudorange_sigma_m);
+    m.pseudorange_rate_sigma_mps(s.pseudorange_rate_sigma_mps);
+    m.valid(true);
+    msg.satellites().push_back(m);
+  }
+  return msg;
+}
+
+navbus::GnssFix toIdl(const sim::GnssFixSample& fix, std::uint32_t receiver_id, std::uint64_t seq) {
+  navbus::GnssFix msg;
+  msg.receiver_id(receiver_id);
+  msg.seq(seq);
+  msg.time_gps_ns(static_cast<std::uint64_t>(fix.time_ns));
+  msg.latitude_rad(fix.position.latitude_rad);
+  msg.longitude_rad(fix.position.longitude_rad);
+  msg.height_m(fix.position.height_m);
+  msg.pos_ecef_m(toArray(core::earth::geodeticToEcef(fix.position)));
+  msg.vel_ned_mps(toArray(fix.vel_ned_mps));
+  msg.pos_sigma_ned_m(toArray(fix.pos_sigma_ned_m));
+  msg.vel_sigma_ned_mps(toArray(fix.vel_sigma_ned_mps));
+  msg.num_satellites_used(static_cast<std::uint16_t>(fix.num_satellites));
+  msg.valid(fix.valid);
+  return msg;
+}
+
+navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_t tracker_id,
+                                  std::uint64_t seq) {
+  navbus::StarTrackerAttitude msg;
+  msg.tracker_id(tracker_id);
+  msg.seq(seq);
+  msg.time_gps_ns(static_cast<std::uint64_t>(st.time_ns));
+  msg.q_b_to_i() = {st.q_b_to_i.w(), st.q_b_to_i.x(), st.q_b_to_i.y(), st.q_b_to_i.z()};
+  msg.sigma_b_rad(toArray(st.sigma_b_rad));
+  msg.valid(true);
+  return msg;
+}
+
+FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& config)
+    : participant_(participant),
+      config_(config),
+      increments_per_block_(sensor_sim::incrementsPerBlock(config)) {
+  using namespace bus;
+  // Fast pacing writes asynchronously (several samples per datagram); real time synchronously
+  // (no thread hop in the latency). qos/navbus_qos.xml says what each measured.
+  const bool fast = config.pacing == Pacing::kFast;
+  const char* sensor_profile = fast ? profile::kSensorWriterFastPacing : profile::kSensorWriter;
+  const char* measurement_profile =
+      fast ? profile::kMeasurementWriterFastPacing : profile::kMeasurementWriter;
+  if (increments_per_block_ > 0) {
+    batcher_.emplace(increments_per_block_);
+    imu_blocks_ = participant.createWriter<navbus::ImuIncrementBlockPubSubType>(
+        topic::kImuIncrementBlock, sensor_profile);
+  } else {
+    imu_ = participant.createWriter<navbus::ImuIncrementPubSubType>(topic::kImuIncrement,
+                                                                    sensor_profile);
+  }
+  if (config.publish_raw) {
+    raw_ = participant.createWriter<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, sensor_profile);
+  }
+  if (config.publish_gnss) {
+    gnss_ = participant.createWriter<navbus::GnssObservationEpochPubSubType>(
+        topic::kGnssObservations, measurement_profile);
+    fix_ =
+        participant.createWriter<navbus::GnssFixPubSubType>(topic::kGnssFix, measurement_profile);
+  }
+  if (config.publish_star_tracker) {
+    star_ = participant.createWriter<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker,
+                                                                            measurement_profile);
+  }
+}
+
+template <class Sample>
+bool FramePublisher::writeReliably(bus::Writer<Sample>& writer, const Sample& sample) {
+  while (!writer.write(sample)) {
+    // max_blocking_time elapsed with the history full: a reliable reader is behind.
+    ++write_retries_;
+    if (participant_.stopping()) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool FramePublisher::writeIncrement(const navbus::ImuIncrement& increment) {
+  if (batcher_) {
+    batcher_->addIncrement(increment);  // written by writeBlocks when full
+    return true;
+  }
+  if (!writeReliably(imu_, increment)) return false;
+  ++written_.increments;
+  ++written_.increment_samples;
+  return true;
+}
+
+bool FramePublisher::writeRaw(const navbus::ImuRawBlock& raw) {
+  if (!writeReliably(raw_, raw)) return false;
+  written_.raw_samples += raw.samples().size();
+  ++written_.raw_blocks;
+  return true;
+}
+
+bool FramePublisher::batchRaw(const navbus::ImuRawBlock& raw) {
+  if (batcher_->addRaw(raw)) return true;
+  // Not a continuation of the pending block (or no room): that one goes first.
+  if (batcher_->hasRaw() && !writeRaw(batcher_->takeRaw())) return false;
+  if (batcher_->addRaw(raw)) return true;
+  return writeRaw(raw);  // longer than any block: as it is
+}
+
+bool FramePublisher::writeBlocks() {
+  if (batcher_->hasIncrements()) {
+    const navbus::ImuIncrementBlock block = batcher_->takeIncrements();
+    if (!writeReliably(imu_blocks_, block)) return false;
+    written_.increments += block.increments().size();
+    ++written_.increment_samples;
+  }
+  return !batcher_->hasRaw() || writeRaw(batcher_->takeRaw());
+}
+
+bool FramePublisher::publish(const sim::SensorFrame& f) {
+  const bool written = emitFrame(f, config_, sequence_, [this](const auto& sample) {
+    using T = std::decay_t<decltype(sample)>;
+    if constexpr (std::is_same_v<T, navbus::ImuIncrement>) return writeIncrement(sample);
+    if constexpr (std::is_same_v<T, navbus::ImuRawBlock>)
+      return batcher_ ? batchRaw(sample) : writeRaw(sample);
+    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>) {
+      if (!writeReliably(gnss_, sample)) return false;
+      ++written_.gnss_epochs;
+      return true;
+    }
+    if constexpr (std::is_same_v<T, navbus::GnssFix>) {
+      if (!writeReliably(fix_, sample)) return false;
+      ++written_.gnss_fixes;
+      return true;
+    }
+    if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) {
+      if (!writeReliably(star_, sample)) return false;
+      ++written_.star_tracker;
+      return true;
+    }
+  });
+  if (!written) return false;
+  // A full block of increments goes out with the raw samples of the same frames.
+  return !(batcher_ && batcher_->full()) || writeBlocks();
+}
+
+std::size_t FramePublisher::imuReaders() const {
+  return batcher_ ? imu_blocks_.matchedReaders() : imu_.matchedReaders();
+}
+
+bool FramePublisher::readersMatched() const {
+  const auto& m = config_.min_readers;
+  auto enough = [](const auto& writer, int wanted) {
+    return writer.matchedReaders() >= static_cast<std::size_t>(wanted);
+  };
+  return imuReaders() >= static_cast<std::size_t>(m.imu) &&
+         (!config_.publish_raw || enough(raw_, m.raw_imu)) &&
+         (!config_.publish_gnss || (enough(gnss_, m.gnss) && enough(fix_, m.gnss))) &&
+         (!config_.publish_star_tracker || enough(star_, m.star_tracker));
+}
+
+void FramePublisher::flush() {
+  const eprosima::fastrtps::Duration_t timeout(5, 0);
+  for (auto* w :
+       {imu_.raw(), imu_blocks_.raw(), raw_.raw(), gnss_.raw(), fix_.raw(), star_.raw()}) {
+    if (w != nullptr && w->wait_for_acknowledgments(timeout) != ReturnCode_t::RETCODE_OK) {
+      spdlog::warn("{}: not every reliable reader acknowledged the data within {} s",
+                   w->get_topic()->get_name(), timeout.seconds);
+    }
+  }
+}
+
+namespace {
+/// Disposes the instance `key` names, if the stream published anything.
+template <class Sample>
+void disposeIfPublished(bus::Writer<Sample>& writer, std::uint64_t published, const Sample& key) {
+  if (published > 0) writer.dispose(key);
+}
+}  // namespace
+
+void FramePublisher::endStreams() {
+  if (batcher_ && !writeBlocks()) return;  // stopped meanwhile
+  navbus::ImuIncrement imu;
+  imu.sensor_id(config_.imu_sensor_id);
+  disposeIfPublished(imu_, batcher_ ? 0 : written_.increment_samples, imu);
+  navbus::ImuIncrementBlock imu_block;
+  imu_block.sensor_id(config_.imu_sensor_id);
+  disposeIfPublished(imu_blocks_, batcher_ ? written_.increment_samples : 0, imu_block);
+  navbus::ImuRawBlock raw;
+  raw.sensor_id(config_.imu_sensor_id);
+  disposeIfPublished(raw_, written_.raw_blocks, raw);
+  navbus::GnssObservationEpoch gnss;
+  gnss.receiver_id(config_.gnss_receiver_id);
+  disposeIfPublished(gnss_, written_.gnss_epochs, gnss);
+  navbus::GnssFix fix;
+  fix.receiver_id(config_.gnss_receiver_id);
+  disposeIfPublished(fix_, written_.gnss_fixes, fix);
+  navbus::StarTrackerAttitude star;
+  star.tracker_id(config_.star_tracker_id);
+  disposeIfPublished(star_, written_.star_tracker, star);
+}
+
+}  // namespace navbus::sensor_sim

@@ -1,0 +1,278 @@
+#include "navbus/tool/replay.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include <navbus_idl/GnssPubSubTypes.h>
+#include <navbus_idl/ImuPubSubTypes.h>
+#include <navbus_idl/StarTrackerPubSubTypes.h>
+#include <spdlog/spdlog.h>
+
+#include "navbus/bus/app.hpp"
+#include "navbus/bus/topics.hpp"
+#include "navbus/records/csv_messages.hpp"
+#include "navbus/tool/spin.hpp"
+#include "navbus/tool/topic_registry.hpp"
+
+namespace navbus::tool {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr const char* kSourceTimeColumn = "source_timestamp_ns";
+
+// The data time of a sample: when its (last) measurement is valid [ns, GPS time].
+std::int64_t dataTimeNs(const ImuIncrement& m) {
+  return static_cast<std::int64_t>(m.time_gps_ns());
+}
+std::int64_t dataTimeNs(const ImuIncrementBlock& m) {
+  return m.increments().empty() ? 0 : dataTimeNs(m.increments().back());
+}
+std::int64_t dataTimeNs(const ImuRawBlock& m) {
+  const auto n = static_cast<std::int64_t>(m.samples().size());
+  return static_cast<std::int64_t>(m.first_sample_time_gps_ns()) +
+         std::max<std::int64_t>(n - 1, 0) * static_cast<std::int64_t>(m.sample_period_ns());
+}
+template <class T>
+std::int64_t dataTimeNs(const T& m) {
+  return static_cast<std::int64_t>(m.time_gps_ns());
+}
+
+/// One recorded topic: its messages, their pacing times, and its writer.
+class Stream {
+ public:
+  virtual ~Stream() = default;
+  virtual const std::string& topic() const = 0;
+  virtual std::size_t size() const = 0;
+  /// Pacing time of message i [ns]: its source time stamp, or its data time.
+  virtual std::int64_t paceNs(std::size_t i, bool source_times) const = 0;
+  virtual bool hasSourceTimes() const = 0;
+  virtual void open(bus::Participant& p) = 0;
+  virtual std::size_t matchedReaders() const = 0;
+  virtual bool publish(std::size_t i) = 0;
+  /// Disposes the instance (end of stream) and waits for the readers' acknowledgments.
+  virtual void end() = 0;
+};
+
+template <class PubSubType>
+class TypedStream : public Stream {
+ public:
+  using T = typename PubSubType::type;
+  TypedStream(std::string topic, std::string profile, const records::CsvTable& table)
+      : topic_(std::move(topic)), profile_(std::move(profile)) {
+    const auto ranges = records::messageRowRanges(table);
+    messages_ = records::parseMessages<T>(table, ranges);
+    if (table.has(kSourceTimeColumn)) {
+      const std::size_t column = table.column(kSourceTimeColumn);
+      for (const auto& [first, count] : ranges) {
+        const std::string& cell = table.rows[first][column];
+        std::int64_t ns = 0;
+        const auto [ptr, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), ns);
+        if (ec != std::errc() || ptr != cell.data() + cell.size()) {
+          throw bus::ConfigError(table.file + " line " + std::to_string(first + 2) + " column '" +
+                                 kSourceTimeColumn + "': '" + cell + "' is not a valid number");
+        }
+        source_ns_.push_back(ns);
+      }
+    }
+  }
+  const std::string& topic() const override { return topic_; }
+  std::size_t size() const override { return messages_.size(); }
+  std::int64_t paceNs(std::size_t i, bool source_times) const override {
+    return source_times ? source_ns_[i] : dataTimeNs(messages_[i]);
+  }
+  bool hasSourceTimes() const override { return !source_ns_.empty() || messages_.empty(); }
+  void open(bus::Participant& p) override {
+    writer_ = p.createWriter<PubSubType>(topic_, profile_);
+  }
+  std::size_t matchedReaders() const override { return writer_.matchedReaders(); }
+  bool publish(std::size_t i) override { return writer_.write(messages_[i]); }
+  void end() override {
+    if (messages_.empty()) return;
+    writer_.dispose(messages_.back());
+    writer_.raw()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0));
+  }
+
+ private:
+  std::string topic_, profile_;
+  std::vector<T> messages_;
+  std::vector<std::int64_t> source_ns_;
+  bus::Writer<T> writer_;
+};
+
+std::unique_ptr<Stream> loadStream(const std::string& topic, const std::filesystem::path& file) {
+  using namespace bus;
+  const records::CsvTable table = records::readCsv(file);
+  if (topic == topic::kImuIncrement) {
+    return std::make_unique<TypedStream<ImuIncrementPubSubType>>(topic, profile::kSensorWriter,
+                                                                 table);
+  }
+  if (topic == topic::kImuIncrementBlock) {
+    return std::make_unique<TypedStream<ImuIncrementBlockPubSubType>>(topic, profile::kSensorWriter,
+                                                                      table);
+  }
+  if (topic == topic::kImuRaw) {
+    return std::make_unique<TypedStream<ImuRawBlockPubSubType>>(topic, profile::kSensorWriter,
+                                                                table);
+  }
+  if (topic == topic::kGnssObservations) {
+    return std::make_unique<TypedStream<GnssObservationEpochPubSubType>>(
+        topic, profile::kMeasurementWriter, table);
+  }
+  if (topic == topic::kGnssFix) {
+    return std::make_unique<TypedStream<GnssFixPubSubType>>(topic, profile::kMeasurementWriter,
+                                                            table);
+  }
+  return std::make_unique<TypedStream<StarTrackerAttitudePubSubType>>(
+      topic, profile::kMeasurementWriter, table);
+}
+
+std::vector<std::unique_ptr<Stream>> loadStreams(const ReplayOptions& o) {
+  const auto& replayable = replayableTopics();
+  for (const auto& t : o.topics) {
+    if (std::find(replayable.begin(), replayable.end(), t) == replayable.end()) {
+      std::string known;
+      for (const auto& r : replayable) known += " " + r;
+      throw bus::ConfigError("topic '" + t + "' cannot be replayed; replayable topics:" + known);
+    }
+  }
+  std::vector<std::unique_ptr<Stream>> streams;
+  for (const auto& topic : o.topics.empty() ? replayable : o.topics) {
+    const std::filesystem::path file = std::filesystem::path(o.dir) / recordFileName(topic);
+    if (!std::filesystem::exists(file)) {
+      if (!o.topics.empty()) throw bus::ConfigError(file.string() + ": no such file");
+      continue;
+    }
+    auto stream = loadStream(topic, file);
+    spdlog::info("{}: {} samples of {}", file.string(), stream->size(), topic);
+    if (stream->size() > 0) streams.push_back(std::move(stream));  // nothing to wait a reader for
+  }
+  if (streams.empty()) {
+    throw bus::ConfigError("no recording of a sensor topic in '" + o.dir +
+                           "' (navbus record writes navbus_imu_increment.csv, ...)");
+  }
+  return streams;
+}
+
+/// Readers to wait for per topic: 1, or what --min-readers TOPIC=N says.
+std::map<std::string, std::size_t> minReaders(const ReplayOptions& o) {
+  std::map<std::string, std::size_t> wanted;
+  for (const auto& t : replayableTopics()) wanted[t] = 1;
+  for (const std::string& entry : o.min_readers) {
+    const std::size_t eq = entry.find('=');
+    std::size_t n = 0;
+    const char* end = entry.data() + entry.size();
+    const auto parsed = eq == std::string::npos
+                            ? std::from_chars_result{end, std::errc::invalid_argument}
+                            : std::from_chars(entry.data() + eq + 1, end, n);
+    if (parsed.ec != std::errc() || parsed.ptr != end || n > 64 ||
+        wanted.count(entry.substr(0, eq)) == 0) {
+      throw bus::ConfigError("--min-readers '" + entry +
+                             "': expected TOPIC=N with a replayable topic and N in 0..64");
+    }
+    wanted[entry.substr(0, eq)] = n;
+  }
+  return wanted;
+}
+
+struct Event {
+  std::int64_t pace_ns;
+  std::size_t stream, index;
+};
+
+/// Every sample of every stream in pacing order (a stable sort keeps each file's order).
+std::vector<Event> schedule(const std::vector<std::unique_ptr<Stream>>& streams,
+                            bool source_times) {
+  std::vector<Event> events;
+  for (std::size_t s = 0; s < streams.size(); ++s) {
+    for (std::size_t i = 0; i < streams[s]->size(); ++i) {
+      events.push_back({streams[s]->paceNs(i, source_times), s, i});
+    }
+  }
+  std::stable_sort(events.begin(), events.end(),
+                   [](const Event& a, const Event& b) { return a.pace_ns < b.pace_ns; });
+  return events;
+}
+
+}  // namespace
+
+const std::vector<std::string>& replayableTopics() {
+  using namespace bus::topic;
+  static const std::vector<std::string> topics{kImuIncrement,     kImuIncrementBlock, kImuRaw,
+                                               kGnssObservations, kGnssFix,           kStarTracker};
+  return topics;
+}
+
+int runReplayCommand(const bus::Participant::Options& participant, const ReplayOptions& o,
+                     bus::ShutdownSignal& shutdown) {
+  if (!(o.speed >= 0.0)) {
+    throw bus::ConfigError("--speed " + std::to_string(o.speed) + " must be >= 0");
+  }
+  const std::map<std::string, std::size_t> min_readers = minReaders(o);
+  auto streams = loadStreams(o);
+  if (o.pace != "data" && o.pace != "source") {
+    throw bus::ConfigError("--pace '" + o.pace + "' must be data or source");
+  }
+  const bool source_times = o.pace == "source";
+  for (const auto& s : streams) {
+    if (source_times && !s->hasSourceTimes()) {
+      throw bus::ConfigError("--pace source: the recording of " + s->topic() + " has no " +
+                             kSourceTimeColumn + " column");
+    }
+  }
+  spdlog::info("pacing by {} at speed {}",
+               source_times ? "the recorded source time stamps" : "the samples' data times",
+               o.speed);
+  const std::vector<Event> events = schedule(streams, source_times);
+
+  bus::Participant p(participant, shutdown);
+  for (auto& s : streams) s->open(p);
+  const auto matched = [&](const Stream& s) {
+    return s.matchedReaders() >= min_readers.at(s.topic());
+  };
+  const auto all_matched = [&] {
+    return std::all_of(streams.begin(), streams.end(), [&](const auto& s) { return matched(*s); });
+  };
+  if (!spinUntil(p, o.match_timeout_s, all_matched)) {
+    for (const auto& s : streams) {
+      if (!matched(*s)) {
+        spdlog::error("{} of {} readers of {} within {} s", s->matchedReaders(),
+                      min_readers.at(s->topic()), s->topic(), o.match_timeout_s);
+      }
+    }
+    p.finish();
+    return bus::kExitRuntimeError;
+  }
+
+  std::vector<std::uint64_t> published(streams.size(), 0);
+  const auto start = Clock::now();
+  for (const Event& e : events) {
+    if (p.stopping()) break;
+    if (o.speed > 0.0) {
+      const auto due =
+          start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                      1e-9 * static_cast<double>(e.pace_ns - events.front().pace_ns) / o.speed));
+      while (Clock::now() < due && !p.stopping()) p.spinOnce(due - Clock::now());
+    }
+    if (streams[e.stream]->publish(e.index)) ++published[e.stream];
+  }
+  for (auto& s : streams) s->end();
+  const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+  bool complete = true;
+  for (std::size_t s = 0; s < streams.size(); ++s) {
+    spdlog::info("replayed {} of {} samples of {}", published[s], streams[s]->size(),
+                 streams[s]->topic());
+    complete = complete && published[s] == streams[s]->size();
+  }
+  const double span_s =
+      events.empty() ? 0.0
+                     : 1e-9 * static_cast<double>(events.back().pace_ns - events.front().pace_ns);
+  spdlog::info("{:.3f} s of recording in {:.3f} s", span_s, elapsed_s);
+  p.finish();
+  return complete ? bus::kExitOk : bus::kExitRuntimeError;
+}
+
+}  // namespace navbus::tool

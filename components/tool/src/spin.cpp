@@ -1,0 +1,14 @@
+#include "navbus/tool/spin.hpp"
+
+#include <chrono>
+
+namespace navbus::tool {
+
+bool spinUntil(bus::Participant& p, double timeout_s, const std::function<bool()>& done) {
+  using Clock = std::chrono::steady_clock;
+  const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!done() && !p.stopping() && Clock::now() < end) p.spinOnce(std::chrono::milliseconds(5));
+  return done();
+}
+
+}  // namespace navbus::tool
