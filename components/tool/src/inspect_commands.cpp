@@ -1,0 +1,277 @@
+// `navbus topics`, `echo` and `record`: what is on the bus, one topic's samples, every
+// chosen topic into CSV files.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+
+#include "navbus/bus/app.hpp"
+#include "navbus/bus/config.hpp"
+#include "navbus/tool/topic_registry.hpp"
+#include "subcommand.hpp"
+
+namespace nb = navbus;
+namespace fdds = eprosima::fastdds::dds;
+
+namespace navbus::tool::cli {
+namespace {
+
+/// Collects discovered writers and readers by GUID.
+class DiscoveryListener : public fdds::DomainParticipantListener {
+ public:
+  struct Endpoints {
+    std::string type;
+    std::set<std::string> writers, readers;
+  };
+  void on_publisher_discovery(fdds::DomainParticipant*,
+                              eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    update(info.info.topicName().to_string(), info.info.typeName().to_string(),
+           guid(info.info.guid()), true,
+           info.status == eprosima::fastrtps::rtps::WriterDiscoveryInfo::REMOVED_WRITER);
+  }
+  void on_subscriber_discovery(fdds::DomainParticipant*,
+                               eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+    update(info.info.topicName().to_string(), info.info.typeName().to_string(),
+           guid(info.info.guid()), false,
+           info.status == eprosima::fastrtps::rtps::ReaderDiscoveryInfo::REMOVED_READER);
+  }
+  std::map<std::string, Endpoints> snapshot() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return topics_;
+  }
+
+ private:
+  static std::string guid(const eprosima::fastrtps::rtps::GUID_t& g) {
+    std::ostringstream out;
+    out << g;
+    return out.str();
+  }
+  void update(const std::string& topic, const std::string& type, const std::string& id, bool writer,
+              bool removed) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto& e = topics_[topic];
+    e.type = type;
+    auto& set = writer ? e.writers : e.readers;
+    if (removed)
+      set.erase(id);
+    else
+      set.insert(id);
+  }
+  std::mutex mutex_;
+  std::map<std::string, Endpoints> topics_;
+};
+
+/// Prints samples as text blocks or CSV lines.
+class EchoSink : public SampleSink {
+ public:
+  EchoSink(bool csv, const std::string& header, std::uint64_t limit) : csv_(csv), limit_(limit) {
+    if (csv_) std::cout << header << "\n";
+  }
+  void onSample(const std::string& topic, const SampleTimes&,
+                const std::function<std::string()>& text,
+                const std::function<std::vector<std::string>()>& rows) override {
+    if (limit_ > 0 && count_ >= limit_) return;  // one dispatch round may hold more samples
+    ++count_;
+    if (csv_) {
+      for (const auto& r : rows()) std::cout << r << "\n";
+    } else {
+      std::cout << "--- " << topic << " #" << count_ << "\n" << text();
+    }
+    std::cout.flush();
+  }
+  std::uint64_t count() const { return count_; }
+
+ private:
+  bool csv_;
+  std::uint64_t limit_;
+  std::uint64_t count_{0};
+};
+
+/// Writes one CSV file per topic: the message's columns, then when it was written (DDS source
+/// time stamp) and received [ns, system clocks], so that `navbus replay` can pace it.
+class RecordSink : public SampleSink {
+ public:
+  void open(const TopicEntry& e, const std::filesystem::path& dir) {
+    const std::filesystem::path path = dir / recordFileName(e.name);
+    auto& f = files_[e.name];
+    f.stream = std::make_unique<std::ofstream>(path);
+    if (!*f.stream) throw std::runtime_error("cannot write " + path.string());
+    *f.stream << e.csv_header << ",source_timestamp_ns,reception_timestamp_ns\n";
+  }
+  void onSample(const std::string& topic, const SampleTimes& times,
+                const std::function<std::string()>&,
+                const std::function<std::vector<std::string>()>& rows) override {
+    auto& f = files_.at(topic);
+    ++f.samples;
+    last_sample_ = std::chrono::steady_clock::now();
+    for (const auto& r : rows()) {
+      *f.stream << r << ',' << times.source_ns << ',' << times.reception_ns << '\n';
+    }
+  }
+  void flush() {
+    for (auto& [name, f] : files_) f.stream->flush();
+  }
+  std::uint64_t samples(const std::string& topic) const { return files_.at(topic).samples; }
+  /// Seconds since the last sample of any topic; negative before the first.
+  double idleSeconds() const {
+    if (!last_sample_) return -1.0;
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - *last_sample_).count();
+  }
+
+ private:
+  struct File {
+    std::unique_ptr<std::ofstream> stream;
+    std::uint64_t samples{0};
+  };
+  std::map<std::string, File> files_;
+  std::optional<std::chrono::steady_clock::time_point> last_sample_;
+};
+
+const TopicEntry& requireTopic(const std::string& name) {
+  const auto* e = findTopic(name);
+  if (e == nullptr) {
+    std::string known;
+    for (const auto& t : topicRegistry()) known += " " + t.name;
+    throw nb::bus::ConfigError("unknown topic '" + name + "'; navbus topics are:" + known);
+  }
+  return *e;
+}
+
+/// Runs the participant until `done()` or `duration_s` (0: until SIGINT/SIGTERM).
+void runFor(nb::bus::Participant& p, double duration_s, const std::function<bool()>& done) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
+  while (!p.stopping() && !done() &&
+         (duration_s <= 0.0 || std::chrono::steady_clock::now() < end)) {
+    p.spinOnce(std::chrono::milliseconds(50));
+  }
+  p.finish();
+}
+
+class TopicsCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = app.add_subcommand("topics",
+                              "list the topics seen on the bus with their writers and readers");
+    cli_->add_option("--wait", wait_s, "seconds of discovery before printing")
+        ->check(CLI::Range(0.1, 600.0));
+  }
+  bool inspectsBus() const override { return true; }
+  int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
+    DiscoveryListener listener;
+    options.dds.listener = &listener;
+    nb::bus::Participant p(options, shutdown);
+    runFor(p, wait_s, [] { return false; });
+    std::printf("%-30s %-36s %8s %8s\n", "TOPIC", "TYPE", "WRITERS", "READERS");
+    for (const auto& [topic, e] : listener.snapshot()) {
+      std::printf("%-30s %-36s %8zu %8zu\n", topic.c_str(), e.type.c_str(), e.writers.size(),
+                  e.readers.size());
+    }
+    return nb::bus::kExitOk;
+  }
+
+ private:
+  double wait_s{2.0};
+};
+
+class EchoCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = app.add_subcommand("echo", "print the samples of one topic");
+    cli_->add_option("topic", echo_topic, "topic name, e.g. navbus/nav/solution")->required();
+    cli_->add_flag("--csv", echo_csv, "CSV instead of text");
+    cli_->add_option("-n,--count", count, "stop after this many samples (exit 1 if not reached)");
+    cli_->add_option("--duration", duration_s, "stop after this many seconds (0: until SIGINT)");
+  }
+  bool inspectsBus() const override { return true; }
+  int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
+    const auto& entry = requireTopic(echo_topic);
+    nb::bus::Participant p(options, shutdown);
+    EchoSink sink(echo_csv, entry.csv_header, count);
+    entry.subscribe(p, sink);
+    runFor(p, duration_s, [&] { return count > 0 && sink.count() >= count; });
+    return (count > 0 && sink.count() < count) ? nb::bus::kExitRuntimeError : nb::bus::kExitOk;
+  }
+
+ private:
+  std::string echo_topic;
+  bool echo_csv{false};
+  std::uint64_t count{0};
+  double duration_s{0.0};
+};
+
+class RecordCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = app.add_subcommand("record", "record topics into CSV files, one per topic");
+    cli_->add_option("topics", record_topics, "topic names");
+    cli_->add_flag("--all", record_all, "every navbus topic");
+    cli_->add_option("-o,--out", out_dir, "output directory (created)")->required();
+    cli_->add_option("-n,--count", count,
+                     "stop when every topic has this many samples (exit 1 if not reached)");
+    cli_->add_option("--idle", idle_s,
+                     "stop once no sample of any topic came for this many seconds after the "
+                     "first (0: never)")
+        ->check(CLI::Range(0.0, 3600.0));
+    cli_->add_option("--duration", duration_s, "stop after this many seconds (0: until SIGINT)");
+  }
+  bool inspectsBus() const override { return true; }
+  int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
+    std::filesystem::create_directories(out_dir);
+    nb::bus::Participant p(options, shutdown);
+    RecordSink sink;
+    std::vector<const TopicEntry*> entries;
+    if (record_all) {
+      for (const auto& t : topicRegistry()) record_topics.push_back(t.name);
+    }
+    if (record_topics.empty()) {
+      throw nb::bus::ConfigError("record: name the topics, or --all");
+    }
+    for (const auto& t : record_topics) {
+      entries.push_back(&requireTopic(t));
+      sink.open(*entries.back(), out_dir);
+      entries.back()->subscribe(p, sink);
+    }
+    auto all_counted = [&] {
+      if (idle_s > 0.0 && sink.idleSeconds() >= idle_s) return true;
+      if (count == 0) return false;
+      for (const auto* e : entries)
+        if (sink.samples(e->name) < count) return false;
+      return true;
+    };
+    runFor(p, duration_s, all_counted);
+    sink.flush();
+    bool reached = true;
+    for (const auto* e : entries) {
+      spdlog::info("recorded {} samples of {}", sink.samples(e->name), e->name);
+      reached = reached && sink.samples(e->name) >= count;
+    }
+    return reached ? nb::bus::kExitOk : nb::bus::kExitRuntimeError;
+  }
+
+ private:
+  std::vector<std::string> record_topics;
+  std::string out_dir;
+  bool record_all{false};
+  double idle_s{0.0};
+  std::uint64_t count{0};
+  double duration_s{0.0};
+};
+
+}  // namespace
+
+void addInspectionSubcommands(Subcommands& out) {
+  out.push_back(std::make_unique<TopicsCommand>());
+  out.push_back(std::make_unique<EchoCommand>());
+  out.push_back(std::make_unique<RecordCommand>());
+}
+
+}  // namespace navbus::tool::cli
