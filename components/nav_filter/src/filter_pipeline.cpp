@@ -11,6 +11,8 @@
 
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
+#include "navbus/nav_filter/engine_commands.hpp"
+#include "navbus/nav_filter/solution_messages.hpp"
 
 namespace navbus::nav_filter {
 
@@ -28,90 +30,7 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   return s;
 }
 
-constexpr std::uint32_t kStreamLostFlags =
-    navbus::FAULT_IMU_STREAM_LOST | navbus::FAULT_GNSS_STREAM_LOST | navbus::FAULT_ST_STREAM_LOST |
-    navbus::FAULT_RAW_IMU_LOST;
-
-std::uint32_t faultFlags(std::uint32_t engine_status) {
-  std::uint32_t f = 0;
-  if (engine_status & core::kStatusImuGap) f |= navbus::FAULT_IMU_GAP;
-  if (engine_status & core::kStatusSatelliteExcluded) f |= navbus::FAULT_SATELLITE_EXCLUDED;
-  if (engine_status & core::kStatusBiasCompensated) f |= navbus::FAULT_SENSOR_AXIS;
-  if (engine_status & core::kStatusAxisFailed) f |= navbus::FAULT_IMU_AXIS_FAILED;
-  return f;
-}
-
 }  // namespace
-
-navbus::IntegrityState toIdl(core::IntegrityState s) {
-  switch (s) {
-    case core::IntegrityState::kNotMonitored:
-      return navbus::INTEGRITY_NOT_MONITORED;
-    case core::IntegrityState::kInitializing:
-      return navbus::INTEGRITY_INITIALIZING;
-    case core::IntegrityState::kAvailable:
-      return navbus::INTEGRITY_AVAILABLE;
-    case core::IntegrityState::kUnavailable:
-      return navbus::INTEGRITY_UNAVAILABLE;
-  }
-  return navbus::INTEGRITY_NOT_MONITORED;
-}
-
-navbus::FilterMode toIdl(core::EngineMode mode) {
-  switch (mode) {
-    case core::EngineMode::kInitializing:
-      return navbus::MODE_INITIALIZING;
-    case core::EngineMode::kInertialOnly:
-      return navbus::MODE_INERTIAL_ONLY;
-    case core::EngineMode::kInertialLost:
-      return navbus::MODE_INERTIAL_LOST;
-    case core::EngineMode::kTightlyCoupled:
-      return navbus::MODE_TIGHTLY_COUPLED;
-    case core::EngineMode::kLooselyCoupled:
-      return navbus::MODE_LOOSELY_COUPLED;
-    case core::EngineMode::kMdfF1:
-      return navbus::MODE_MDF_F1_ZUPT;
-    case core::EngineMode::kMdfF2:
-      return navbus::MODE_MDF_F2_GNSS;
-    case core::EngineMode::kMdfF3:
-      return navbus::MODE_MDF_F3_RECOVERY;
-    case core::EngineMode::kMdfF4:
-      return navbus::MODE_MDF_F4_CIF;
-    case core::EngineMode::kAidedAxisFailed:
-      return navbus::MODE_AIDED_AXIS_FAILED;
-    case core::EngineMode::kAligning:
-      return navbus::MODE_ALIGNING;
-  }
-  return navbus::MODE_INITIALIZING;
-}
-
-navbus::StartSource toIdl(core::StartSource start, core::AttitudeSource attitude) {
-  if (start == core::StartSource::kConfigured) return navbus::START_CONFIGURED;
-  switch (attitude) {
-    case core::AttitudeSource::kStarTracker:
-      return navbus::START_STAR_TRACKER;
-    case core::AttitudeSource::kGyrocompass:
-      return navbus::START_GYROCOMPASS;
-    case core::AttitudeSource::kGnssCourse:
-      return navbus::START_GNSS_COURSE;
-    case core::AttitudeSource::kNone:
-      break;  // not aligned yet: no solution is published
-  }
-  return navbus::START_CONFIGURED;
-}
-
-navbus::FusionStructure toIdl(core::FusionStructure s, core::AidingMode aiding) {
-  if (aiding == core::AidingMode::kInertialOnly) return navbus::FUSION_NONE;
-  switch (s) {
-    case core::FusionStructure::kCentralized:
-      return navbus::FUSION_CENTRALIZED;
-    case core::FusionStructure::kFederated:
-      return navbus::FUSION_FEDERATED;
-    case core::FusionStructure::kAdaptive:
-      return navbus::FUSION_ADAPTIVE;
-  }
-  return navbus::FUSION_NONE;
-}
 
 FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks)
     : config_(config),
@@ -131,17 +50,7 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
                      &time_reference_),
       star_gate_(bus::topic::kStarTracker, health.stream(bus::topic::kStarTracker),
                  config.time_jump, &time_reference_),
-      command_counters_(health.stream(bus::topic::kFilterCommand)) {}
-
-void FilterPipeline::countCommand(bool applied, navbus::RejectReason reason) {
-  if (applied) {
-    ++commands_applied_;
-    ++command_counters_.accepted;
-  } else {
-    ++commands_refused_;
-    ++command_counters_.rejected[reason];
-  }
-}
+      commands_(config, health.stream(bus::topic::kFilterCommand)) {}
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
                            FilterInput input) {
@@ -203,12 +112,7 @@ void FilterPipeline::onImuBlock(const navbus::ImuIncrementBlock& msg) {
 void FilterPipeline::publishLowLatency(const core::ImuIncrement& inc) {
   const std::optional<core::NavState> s = predictor_.addIncrement(inc);
   if (!s) return;
-  navbus::NavigationSolution out = anchor_solution_;
-  out.seq(++low_latency_seq_);
-  bus::fillSolution(*s, out);
-  out.output(navbus::OUTPUT_LOW_LATENCY);
-  out.propagated_from_gps_ns(anchor_solution_.time_gps_ns());
-  sinks_.low_latency(out);
+  sinks_.low_latency(lowLatencySolution(anchor_solution_, *s, ++low_latency_seq_));
 }
 
 void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
@@ -317,42 +221,8 @@ void FilterPipeline::publishDiagnostics() {
 
 void FilterPipeline::publishSolution() {
   if (!engine_.initialized()) return;
-  navbus::NavigationSolution sol;
-  sol.vehicle_id(config_.vehicle_id);
-  sol.seq(++solution_seq_);
-  bus::fillSolution(engine_.state(), sol);
-  // Sigmas from the filter covariance: propagated only (inertial-only mode) or updated.
-  const core::StateMatrix& P = engine_.covariance();
-  auto sigma3 = [&P](const core::StateBlock& b) {
-    return bus::toArray(P.block<3, 3>(b.index, b.index).diagonal().cwiseSqrt());
-  };
-  sol.pos_sigma_ned_m(sigma3(core::layout::kPos));
-  sol.vel_sigma_ned_mps(sigma3(core::layout::kVel));
-  sol.att_sigma_ned_rad(sigma3(core::layout::kAtt));
-  sol.accel_bias_sigma_b_mps2(sigma3(core::layout::kAccelBias));
-  sol.gyro_bias_sigma_b_radps(sigma3(core::layout::kGyroBias));
-  sol.clock_bias_m(engine_.clockBias());
-  sol.clock_drift_mps(engine_.clockDrift());
-  sol.clock_bias_sigma_m(
-      std::sqrt(P(core::layout::kClockBias.index, core::layout::kClockBias.index)));
-  sol.clock_drift_sigma_mps(
-      std::sqrt(P(core::layout::kClockDrift.index, core::layout::kClockDrift.index)));
-  sol.covariance_valid(true);
-  // Biases: estimated plus those compensated by command.
-  sol.accel_bias_b_mps2(bus::toArray(engine_.accelBias()));
-  sol.gyro_bias_b_radps(bus::toArray(engine_.gyroBias()));
-  sol.mode(toIdl(engine_.mode()));
-  sol.fusion(toIdl(engine_.fusion(), config_.engine.aiding));
-  sol.active_fault_flags(stream_flags_ | monitor_flags_ | faultFlags(engine_.status()));
-  sol.imu_samples_used(engine_.counters().imu_used);
-  sol.start_source(toIdl(config_.engine.start, engine_.alignedStart().attitude_source));
-  // The levels assume the fault manager's GLR is watching: without it nothing bounds a fault.
-  if (monitor_flags_ == 0) {
-    const core::ProtectionLevels pl = engine_.protectionLevels();
-    sol.integrity(toIdl(pl.state));
-    sol.horizontal_protection_level_m(pl.horizontal_m);
-    sol.vertical_protection_level_m(pl.vertical_m);
-  }
+  const navbus::NavigationSolution sol = buildSolution(engine_, config_.vehicle_id, ++solution_seq_,
+                                                       flags_.flags(), flags_.faultMonitorAlive());
   sinks_.solution(sol);
   if (config_.low_latency_output && sinks_.low_latency) {
     predictor_.setAnchor({engine_.state(), engine_.accelBias(), engine_.gyroBias()});
@@ -362,22 +232,6 @@ void FilterPipeline::publishSolution() {
 
 void FilterPipeline::publishHeldSolution() {
   if (engine_.mode() == core::EngineMode::kInertialLost) publishSolution();
-}
-
-bool FilterPipeline::degraded() const {
-  return (stream_flags_ & kStreamLostFlags) != 0 || monitor_flags_ != 0;
-}
-
-void FilterPipeline::setFaultMonitorAlive(bool alive) {
-  const std::uint32_t flags = alive ? 0 : navbus::FAULT_NO_FAULT_MONITOR;
-  if (flags == monitor_flags_) return;
-  monitor_flags_ = flags;
-  if (alive) {
-    spdlog::info("a fault monitor is alive again: faults are monitored");
-  } else {
-    ++monitor_losses_;
-    spdlog::warn("no fault monitor is alive: solutions flagged FAULT_NO_FAULT_MONITOR");
-  }
 }
 
 void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
@@ -391,79 +245,26 @@ void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
 }
 
 bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
-  std::uint32_t flag = 0;
-  bool is_imu = false;
-  switch (c.sensor()) {
-    case navbus::SOURCE_IMU_STREAM:
-      if (c.sensor_id() != config_.imu.id) return false;
-      flag = navbus::FAULT_IMU_STREAM_LOST;
-      is_imu = true;
-      break;
-    case navbus::SOURCE_IMU_RAW_STREAM:
-      flag = navbus::FAULT_RAW_IMU_LOST;
-      break;
-    case navbus::SOURCE_GNSS_OBS_STREAM:
-    case navbus::SOURCE_GNSS_FIX_STREAM:
-      flag = navbus::FAULT_GNSS_STREAM_LOST;
-      break;
-    case navbus::SOURCE_ST_STREAM:
-      flag = navbus::FAULT_ST_STREAM_LOST;
-      break;
-    default:
-      return false;
+  const std::optional<std::uint32_t> flag = SolutionFlags::streamFlag(c, config_.imu.id);
+  if (!flag) return false;
+  flags_.applyStreamCommand(c, *flag);
+  if (c.kind() == navbus::CMD_EXCLUDE_STREAM && *flag == navbus::FAULT_IMU_STREAM_LOST) {
+    sequencer_.setActive({kRankImu, config_.imu.id}, false);
+    engine_.markInertialLost();
   }
-  if (c.kind() == navbus::CMD_EXCLUDE_STREAM) {
-    stream_flags_ |= flag;
-    if (is_imu) {
-      sequencer_.setActive({kRankImu, config_.imu.id}, false);
-      engine_.markInertialLost();
-    }
-  } else {
-    stream_flags_ &= ~flag;
-  }
-  spdlog::log(c.kind() == navbus::CMD_EXCLUDE_STREAM ? spdlog::level::warn : spdlog::level::info,
-              "stream source {} id {} {}; flags 0x{:x}", static_cast<int>(c.sensor()),
-              c.sensor_id(), c.kind() == navbus::CMD_EXCLUDE_STREAM ? "lost" : "restored",
-              stream_flags_);
   publishHeldSolution();
-  return true;
-}
-
-bool FilterPipeline::issuerAuthorized(const navbus::FilterCommand& c,
-                                      const std::optional<std::string>& writer_identity) {
-  const std::string issuer = c.issuer().to_string();
-  if (std::find(config_.command_issuers.begin(), config_.command_issuers.end(), issuer) ==
-      config_.command_issuers.end()) {
-    countCommand(false, navbus::REJECT_UNAUTHORIZED);
-    ++commands_unauthorized_;
-    spdlog::warn(
-        "command {} (kind {}) from '{}' refused: not a configured issuer "
-        "(command_issuers); {} refused so far",
-        c.command_id(), static_cast<int>(c.kind()), issuer, commands_unauthorized_);
-    return false;
-  }
-  if (writer_identity && *writer_identity != config_.issuer_identities.at(issuer)) {
-    countCommand(false, navbus::REJECT_UNAUTHORIZED);
-    ++commands_impersonated_;
-    spdlog::warn(
-        "command {} (kind {}) claims issuer '{}' but was written by identity '{}' (expected "
-        "'{}', issuer_identities): refused; {} refused so far",
-        c.command_id(), static_cast<int>(c.kind()), issuer, *writer_identity,
-        config_.issuer_identities.at(issuer), commands_impersonated_);
-    return false;
-  }
   return true;
 }
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c,
                                const std::optional<std::string>& writer_identity) {
-  if (c.vehicle_id() != config_.vehicle_id) return;  // for another vehicle: not ours
-  if (!issuerAuthorized(c, writer_identity)) return;
+  if (!commands_.addressedToThisVehicle(c)) return;  // for another vehicle: not ours
+  if (!commands_.authorized(c, writer_identity)) return;
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM || c.kind() == navbus::CMD_READMIT_STREAM) {
     // About the merge itself (a lost stream must stop holding it): at once.
-    if (refuseIfStale(c)) return;
+    if (commands_.refuseIfStale(c, first_input_ns_)) return;
     const bool applied = applyStreamCommand(c);
-    countCommand(applied, navbus::REJECT_UNEXPECTED_SOURCE);
+    commands_.count(applied, navbus::REJECT_UNEXPECTED_SOURCE);
     if (!applied)
       spdlog::warn(
           "command {} from '{}' refused: stream source {} id {} is not a stream of this "
@@ -476,36 +277,21 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c,
                          InputSequencer<FilterInput>::PushResult::kQueued) {
     return;  // takes effect in order, at its data time
   }
-  if (time_ns > 0) ++commands_late_;
+  if (time_ns > 0) commands_.countLate();
   executeCommand(c);
 }
 
-bool FilterPipeline::refuseIfStale(const navbus::FilterCommand& c) {
-  const auto time_ns = static_cast<std::int64_t>(c.time_gps_ns());
-  if (time_ns == 0 || (first_input_ns_ >= 0 && time_ns >= first_input_ns_)) return false;
-  countCommand(false, navbus::REJECT_STALE);
-  ++commands_stale_;
-  spdlog::warn(
-      "command {} (kind {}, decision {}) from '{}' refused: stale, about data at {:.3f} s, "
-      "before this run's first input{}; {} stale so far",
-      c.command_id(), static_cast<int>(c.kind()), c.decision_id(), c.issuer(),
-      1e-9 * static_cast<double>(time_ns),
-      first_input_ns_ < 0
-          ? " (none yet)"
-          : fmt::format(" at {:.3f} s", 1e-9 * static_cast<double>(first_input_ns_)),
-      commands_stale_);
-  return true;
-}
-
 void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
-  if (refuseIfStale(c)) return;
+  if (commands_.refuseIfStale(c, first_input_ns_)) return;
   std::string why;
   bool applied = false;
   navbus::RejectReason reason = navbus::REJECT_NOT_APPLICABLE;
-  if (auto refusal = checkCommand(c)) {
+  if (auto refusal = commands_.check(c)) {
     why = *refusal;
     reason = navbus::REJECT_OUT_OF_RANGE;
-  } else if (recoversFromOnset(c) && history_.rollback(restorePoint(c), engine_, replay_)) {
+  } else if (history_.enabled() && answersFaultWithOnset(c) &&
+             history_.rollback(restorePoint(c, config_.recovery_onset_margin_ns), engine_,
+                               replay_)) {
     // Restored to before the onset: the command applies there, and what followed is
     // re-processed without the fault (nothing is published meanwhile: those solutions went out).
     const std::int64_t restored_ns = engine_.state().time_ns;
@@ -522,7 +308,7 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
     applied = applyToEngine(c);
     why = "not available in the configured mode";
   }
-  countCommand(applied, reason);
+  commands_.count(applied, reason);
   if (applied) {
     spdlog::info("command {} from '{}' applied (kind {})", c.command_id(), c.issuer(),
                  static_cast<int>(c.kind()));
@@ -532,155 +318,15 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
   }
 }
 
-core::SatelliteScope toCore(navbus::SatelliteScope s) {
-  switch (s) {
-    case navbus::SCOPE_PSEUDORANGE:
-      return core::SatelliteScope::kRange;
-    case navbus::SCOPE_PSEUDORANGE_RATE:
-      return core::SatelliteScope::kRate;
-    default:
-      return core::SatelliteScope::kAll;
-  }
-}
-
-std::int64_t FilterPipeline::restorePoint(const navbus::FilterCommand& c) const {
-  // The onset is an estimate: a satellite is excluded from a margin before it (using one
-  // satellite fewer for a few seconds costs little); a bias is compensated from the onset
-  // itself (earlier would add the bias where there was none).
-  const auto onset = static_cast<std::int64_t>(c.onset_time_gps_ns());
-  return c.kind() == navbus::CMD_EXCLUDE_SATELLITE ? onset - config_.recovery_onset_margin_ns
-                                                   : onset;
-}
-
-bool FilterPipeline::recoversFromOnset(const navbus::FilterCommand& c) const {
-  return history_.enabled() && c.onset_time_gps_ns() > 0 &&
-         (c.kind() == navbus::CMD_EXCLUDE_SATELLITE || c.kind() == navbus::CMD_COMPENSATE_BIAS ||
-          c.kind() == navbus::CMD_RELEARN_BIAS || c.kind() == navbus::CMD_FAIL_SENSOR_AXIS);
-}
-
-std::optional<std::string> FilterPipeline::checkCommand(const navbus::FilterCommand& c) const {
-  switch (c.kind()) {
-    case navbus::CMD_EXCLUDE_SATELLITE:
-    case navbus::CMD_READMIT_SATELLITE:
-      if (c.sv_id() < 1 || c.sv_id() > 32) return fmt::format("sv_id {} outside 1..32", c.sv_id());
-      return std::nullopt;
-    case navbus::CMD_FAIL_SENSOR_AXIS:
-    case navbus::CMD_RESTORE_SENSOR_AXIS:
-      if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
-        return fmt::format("sensor {} is not an accelerometer or gyro",
-                           static_cast<int>(c.sensor()));
-      if (c.axis() > 2) return fmt::format("axis {} outside 0..2", c.axis());
-      return std::nullopt;
-    case navbus::CMD_COMPENSATE_BIAS:
-    case navbus::CMD_RELEARN_BIAS: {
-      if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
-        return fmt::format("sensor {} is not an accelerometer or gyro",
-                           static_cast<int>(c.sensor()));
-      if (c.axis() > 2) return fmt::format("axis {} outside 0..2", c.axis());
-      const bool accel = c.sensor() == navbus::SOURCE_ACCELEROMETER;
-      const double limit = compensationLimit(accel);
-      // A re-learned bias is unknown up to bias_sigma; one beyond the limit is re-learned up to
-      // the limit (relearnSigma), the largest bias the filter is configured to take.
-      const bool relearn = c.kind() == navbus::CMD_RELEARN_BIAS;
-      if (!std::isfinite(c.bias_sigma()) || c.bias_sigma() < 0.0 ||
-          (c.bias_sigma() > limit && !relearn))
-        return fmt::format("bias_sigma {} outside 0..{}", c.bias_sigma(), limit);
-      if (!std::isfinite(c.bias()) || std::abs(c.bias()) > limit)
-        return fmt::format(
-            "bias {} outside +-{} ({})", c.bias(), limit,
-            accel ? "m/s^2, max_accel_compensation_mg" : "rad/s, max_gyro_compensation_deg_per_h");
-      return std::nullopt;
-    }
-    default:
-      return std::nullopt;
-  }
-}
-
-double FilterPipeline::compensationLimit(bool accel) const {
-  return accel ? config_.max_accel_compensation_mps2 : config_.max_gyro_compensation_radps;
-}
-
-double FilterPipeline::relearnSigma(const navbus::FilterCommand& c) {
-  const double limit = compensationLimit(c.sensor() == navbus::SOURCE_ACCELEROMETER);
-  if (c.bias_sigma() <= limit) return c.bias_sigma();
-  ++relearn_sigmas_clamped_;
-  spdlog::warn(
-      "command {} from '{}': re-learn bias_sigma {} beyond the compensation limit {} (recovery."
-      "max_{}_compensation): re-learned up to the limit; {} clamped so far",
-      c.command_id(), c.issuer(), c.bias_sigma(), limit,
-      c.sensor() == navbus::SOURCE_ACCELEROMETER ? "accel" : "gyro", relearn_sigmas_clamped_);
-  return limit;
-}
-
 bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
-  switch (c.kind()) {
-    case navbus::CMD_EXCLUDE_SATELLITE:
-      engine_.excludeSatellite(c.sv_id(), toCore(c.scope()));
-      return true;
-    case navbus::CMD_READMIT_SATELLITE:
-      engine_.readmitSatellite(c.sv_id(), toCore(c.scope()));
-      return true;
-    case navbus::CMD_RELEARN_BIAS:
-      engine_.relearnBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), relearnSigma(c));
-      return true;
-    case navbus::CMD_COMPENSATE_BIAS:
-      engine_.compensateBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias(),
-                             c.bias_sigma());
-      return true;
-    case navbus::CMD_FAIL_SENSOR_AXIS:
-      engine_.failSensorAxis(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis());
-      return true;
-    case navbus::CMD_RESTORE_SENSOR_AXIS:
-      engine_.restoreSensorAxis(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis());
-      return true;
-    case navbus::CMD_SELECT_FUSION:
-      switch (c.fusion()) {
-        case navbus::FUSION_CENTRALIZED:
-          return engine_.selectFusion(core::FusionStructure::kCentralized);
-        case navbus::FUSION_FEDERATED:
-          return engine_.selectFusion(core::FusionStructure::kFederated);
-        case navbus::FUSION_ADAPTIVE:
-          return engine_.selectFusion(core::FusionStructure::kAdaptive);
-        default:
-          return config_.engine.aiding == core::AidingMode::kInertialOnly;
-      }
-    case navbus::CMD_SELECT_MODE:
-      // The aiding mode follows the configured inputs; only the current one is accepted.
-      return c.mode() == toIdl(engine_.mode());
-    case navbus::CMD_RESET:
-      engine_.reset();
-      return true;
-    default:
-      return false;
-  }
-}
-
-std::string FilterPipeline::alignmentSummary() const {
-  static const char* const phases[] = {"waiting for a GNSS position", "waiting for rest",
-                                       "levelled, waiting for the GNSS course", "aligned"};
-  static const char* const attitude[] = {"none", "star tracker", "gyrocompassing", "GNSS course"};
-  static const char* const position[] = {"none", "GNSS fix", "pseudoranges"};
-  std::ostringstream out;
-  out << "alignment: " << phases[static_cast<int>(engine_.alignmentPhase())] << " after "
-      << engine_.counters().imu_aligning << " increments";
-  if (engine_.alignmentPhase() == core::AlignmentPhase::kAligned) {
-    const core::AlignedStart& s = engine_.alignedStart();
-    out << " (attitude from " << attitude[static_cast<int>(s.attitude_source)] << ", position from "
-        << position[static_cast<int>(s.position_source)] << "; 1-sigma tilt "
-        << s.att_sigma_ned_rad.x() * 1e3 << " mrad, heading " << s.att_sigma_ned_rad.z() * 1e3
-        << " mrad; gyrocompassing would reach " << s.gyrocompass_heading_sigma_rad * 1e3
-        << " mrad)";
-  }
-  if (engine_.alignmentFailedSolutions() > 0)
-    out << ", pseudorange solutions failed " << engine_.alignmentFailedSolutions();
-  if (engine_.counters().course_heading_checks > 0)
-    out << ", heading measured again from the GNSS course "
-        << engine_.counters().course_heading_checks << " time(s)";
-  return out.str();
+  const double relearn_sigma =
+      c.kind() == navbus::CMD_RELEARN_BIAS ? commands_.relearnSigma(c) : 0.0;
+  return applyEngineCommand(engine_, c, relearn_sigma);
 }
 
 std::string FilterPipeline::summary() const {
   const core::EngineCounters& n = engine_.counters();
+  const CommandCounters& k = commands_.counters();
   std::ostringstream out;
   out << "increments integrated " << n.imu_used << " refused by the engine " << n.imu_refused
       << ", solutions published " << solution_seq_ << ", inertial gaps " << n.imu_gaps
@@ -688,18 +334,18 @@ std::string FilterPipeline::summary() const {
       << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
       << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
       << ", stage switches " << n.stage_switches << ", decisions seen " << decisions_seen_
-      << ", commands applied " << commands_applied_ << " refused " << commands_refused_
-      << " (unauthorized issuer " << commands_unauthorized_ << ", issuer not the writer's identity "
-      << commands_impersonated_ << ", stale " << commands_stale_ << ") late " << commands_late_
-      << ", re-learn sigmas clamped to the compensation limit " << relearn_sigmas_clamped_
-      << ", sequencer timeouts " << sequencer_.timeouts() << ", pending " << sequencer_.pending()
-      << ", recoveries from onset " << history_.rollbacks() << " (onset beyond history "
-      << history_.outOfReach() << ")";
-  if (monitor_losses_ > 0) {
-    out << ", fault monitor found not alive " << monitor_losses_ << " time(s)"
-        << (monitor_flags_ != 0 ? " (still not)" : "");
+      << ", commands applied " << k.applied << " refused " << k.refused << " (unauthorized issuer "
+      << k.unauthorized << ", issuer not the writer's identity " << k.impersonated << ", stale "
+      << k.stale << ") late " << k.late << ", re-learn sigmas clamped to the compensation limit "
+      << k.relearn_clamped << ", sequencer timeouts " << sequencer_.timeouts() << ", pending "
+      << sequencer_.pending() << ", recoveries from onset " << history_.rollbacks()
+      << " (onset beyond history " << history_.outOfReach() << ")";
+  if (flags_.monitorLosses() > 0) {
+    out << ", fault monitor found not alive " << flags_.monitorLosses() << " time(s)"
+        << (flags_.faultMonitorAlive() ? "" : " (still not)");
   }
-  if (config_.engine.start == core::StartSource::kAligned) out << ", " << alignmentSummary();
+  if (config_.engine.start == core::StartSource::kAligned)
+    out << ", " << describeAlignment(engine_);
   if (config_.engine.integrity.enabled) {
     out << ", protection-level epochs " << engine_.protectionLevelEpochs() << " refused "
         << engine_.protectionLevelEpochsRefused();

@@ -23,9 +23,11 @@
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
 #include "navbus/core/ins/output_predictor.hpp"
+#include "navbus/nav_filter/command_gate.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/input_history.hpp"
 #include "navbus/nav_filter/input_sequencer.hpp"
+#include "navbus/nav_filter/solution_flags.hpp"
 
 namespace navbus::nav_filter {
 
@@ -105,17 +107,14 @@ class FilterPipeline {
 
   /// Whether a fault monitor is alive (the participant watches its reports): while not,
   /// solutions carry FAULT_NO_FAULT_MONITOR. Changes are logged and counted.
-  void setFaultMonitorAlive(bool alive);
+  void setFaultMonitorAlive(bool alive) { flags_.setFaultMonitorAlive(alive); }
   /// Some stream is currently lost, or no fault monitor is alive (the participant reports
   /// DEGRADED).
-  bool degraded() const;
+  bool degraded() const { return flags_.degraded(); }
   /// New runs started because the IMU source restarted at an earlier time.
   std::uint64_t newRuns() const { return new_runs_; }
   const core::NavigationEngine& engine() const { return engine_; }
   std::string summary() const;
-  /// Where the alignment stands, and what it started from (configurations without an
-  /// initial_state).
-  std::string alignmentSummary() const;
 
  private:
   template <class Sample>
@@ -124,24 +123,8 @@ class FilterPipeline {
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
   void process(std::int64_t time_ns, const FilterInput& input);
   static std::int64_t timeOf(const FilterInput& input);
-  /// The issuer is configured and, under DDS Security, is the identity that wrote the command;
-  /// otherwise the command is refused, logged and counted.
-  bool issuerAuthorized(const navbus::FilterCommand& c,
-                        const std::optional<std::string>& writer_identity);
-  /// Counts a command in the health of the command topic: accepted, or rejected for `reason`.
-  void countCommand(bool applied, navbus::RejectReason reason = navbus::REJECT_NOT_APPLICABLE);
-  /// Refuses and counts a stale command (see onCommand); true if it was.
-  bool refuseIfStale(const navbus::FilterCommand& c);
-  /// Why a command cannot be applied (field and value), or nothing.
-  std::optional<std::string> checkCommand(const navbus::FilterCommand& c) const;
   bool applyToEngine(const navbus::FilterCommand& c);
-  /// recovery.max_*_compensation of the accelerometers or the gyros [m/s^2, rad/s].
-  double compensationLimit(bool accel) const;
-  /// A re-learn's bias_sigma, at most the compensation limit (counted and logged when clamped).
-  double relearnSigma(const navbus::FilterCommand& c);
   void executeCommand(const navbus::FilterCommand& c);
-  bool recoversFromOnset(const navbus::FilterCommand& c) const;
-  std::int64_t restorePoint(const navbus::FilterCommand& c) const;
   /// The IMU source restarted at an earlier time (a restarted simulator replaying its
   /// scenario): what is held of the old run is processed, then the filter starts over as at
   /// construction (engine, order, history, the other streams' time checks), so that the new
@@ -172,34 +155,17 @@ class FilterPipeline {
   bus::StreamGate gnss_obs_gate_;
   bus::StreamGate gnss_fix_gate_;
   bus::StreamGate star_gate_;
-  std::uint32_t stream_flags_{0};  ///< FAULT_*_STREAM_LOST bits, set by stream commands
+  SolutionFlags flags_;  ///< stream-lost and fault-monitor flags of the solutions
   std::uint64_t solution_seq_{0};
   std::uint64_t diagnostics_seq_{0};
   std::uint64_t decisions_seen_{0};
-  std::uint64_t commands_applied_{0};
-  std::uint64_t commands_refused_{0};
-  std::uint64_t relearn_sigmas_clamped_{0};  ///< CMD_RELEARN_BIAS applied at the limit
-  std::uint64_t commands_unauthorized_{0};   ///< of those refused: not from a configured issuer
-  std::uint64_t commands_impersonated_{0};   ///< of those refused: issuer not the writer's identity
-  std::uint64_t commands_stale_{0};  ///< of those refused: about data before this run's first input
   std::int64_t first_input_ns_{-1};  ///< data time of the first input processed (-1: none yet)
-  bus::StreamCounters& command_counters_;  ///< health of the command topic
-  std::uint64_t commands_late_{0};
+  CommandGate commands_;             ///< who may command what; the command counters
   std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
-  std::uint32_t monitor_flags_{0};   ///< FAULT_NO_FAULT_MONITOR while no fault monitor is alive
-  std::uint64_t monitor_losses_{0};  ///< times the fault monitor was found not alive
   std::uint64_t new_runs_{0};
   std::uint64_t solutions_earlier_runs_{0};   ///< published before the latest new run
   std::uint64_t increments_earlier_runs_{0};  ///< integrated before the latest new run
   std::int64_t last_pump_ns_{0};              ///< the clock of the latest pump
 };
-
-core::SatelliteScope toCore(navbus::SatelliteScope s);
-
-/// IDL names of the engine's modes and structures.
-navbus::FilterMode toIdl(core::EngineMode mode);
-navbus::IntegrityState toIdl(core::IntegrityState s);
-navbus::FusionStructure toIdl(core::FusionStructure s, core::AidingMode aiding);
-navbus::StartSource toIdl(core::StartSource start, core::AttitudeSource attitude);
 
 }  // namespace navbus::nav_filter

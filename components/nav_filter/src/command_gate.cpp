@@ -1,0 +1,119 @@
+#include "navbus/nav_filter/command_gate.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <spdlog/spdlog.h>
+
+namespace navbus::nav_filter {
+
+CommandGate::CommandGate(const FilterConfig& config, bus::StreamCounters& topic_counters)
+    : vehicle_id_(config.vehicle_id),
+      issuers_(config.command_issuers),
+      issuer_identities_(config.issuer_identities),
+      max_accel_compensation_mps2_(config.max_accel_compensation_mps2),
+      max_gyro_compensation_radps_(config.max_gyro_compensation_radps),
+      topic_counters_(topic_counters) {}
+
+void CommandGate::count(bool applied, navbus::RejectReason reason) {
+  if (applied) {
+    ++counters_.applied;
+    ++topic_counters_.accepted;
+  } else {
+    ++counters_.refused;
+    ++topic_counters_.rejected[reason];
+  }
+}
+
+bool CommandGate::authorized(const navbus::FilterCommand& c,
+                             const std::optional<std::string>& writer_identity) {
+  const std::string issuer = c.issuer().to_string();
+  if (std::find(issuers_.begin(), issuers_.end(), issuer) == issuers_.end()) {
+    count(false, navbus::REJECT_UNAUTHORIZED);
+    ++counters_.unauthorized;
+    spdlog::warn(
+        "command {} (kind {}) from '{}' refused: not a configured issuer "
+        "(command_issuers); {} refused so far",
+        c.command_id(), static_cast<int>(c.kind()), issuer, counters_.unauthorized);
+    return false;
+  }
+  if (writer_identity && *writer_identity != issuer_identities_.at(issuer)) {
+    count(false, navbus::REJECT_UNAUTHORIZED);
+    ++counters_.impersonated;
+    spdlog::warn(
+        "command {} (kind {}) claims issuer '{}' but was written by identity '{}' (expected "
+        "'{}', issuer_identities): refused; {} refused so far",
+        c.command_id(), static_cast<int>(c.kind()), issuer, *writer_identity,
+        issuer_identities_.at(issuer), counters_.impersonated);
+    return false;
+  }
+  return true;
+}
+
+bool CommandGate::refuseIfStale(const navbus::FilterCommand& c, std::int64_t first_input_ns) {
+  const auto time_ns = static_cast<std::int64_t>(c.time_gps_ns());
+  if (time_ns == 0 || (first_input_ns >= 0 && time_ns >= first_input_ns)) return false;
+  count(false, navbus::REJECT_STALE);
+  ++counters_.stale;
+  spdlog::warn(
+      "command {} (kind {}, decision {}) from '{}' refused: stale, about data at {:.3f} s, "
+      "before this run's first input{}; {} stale so far",
+      c.command_id(), static_cast<int>(c.kind()), c.decision_id(), c.issuer(),
+      1e-9 * static_cast<double>(time_ns),
+      first_input_ns < 0 ? " (none yet)"
+                         : fmt::format(" at {:.3f} s", 1e-9 * static_cast<double>(first_input_ns)),
+      counters_.stale);
+  return true;
+}
+
+std::optional<std::string> CommandGate::check(const navbus::FilterCommand& c) const {
+  switch (c.kind()) {
+    case navbus::CMD_EXCLUDE_SATELLITE:
+    case navbus::CMD_READMIT_SATELLITE:
+      if (c.sv_id() < 1 || c.sv_id() > 32) return fmt::format("sv_id {} outside 1..32", c.sv_id());
+      return std::nullopt;
+    case navbus::CMD_FAIL_SENSOR_AXIS:
+    case navbus::CMD_RESTORE_SENSOR_AXIS:
+      if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
+        return fmt::format("sensor {} is not an accelerometer or gyro",
+                           static_cast<int>(c.sensor()));
+      if (c.axis() > 2) return fmt::format("axis {} outside 0..2", c.axis());
+      return std::nullopt;
+    case navbus::CMD_COMPENSATE_BIAS:
+    case navbus::CMD_RELEARN_BIAS: {
+      if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
+        return fmt::format("sensor {} is not an accelerometer or gyro",
+                           static_cast<int>(c.sensor()));
+      if (c.axis() > 2) return fmt::format("axis {} outside 0..2", c.axis());
+      const bool accel = c.sensor() == navbus::SOURCE_ACCELEROMETER;
+      const double limit = compensationLimit(accel);
+      // A re-learned bias is unknown up to bias_sigma; one beyond the limit is re-learned up to
+      // the limit (relearnSigma), the largest bias the filter is configured to take.
+      const bool relearn = c.kind() == navbus::CMD_RELEARN_BIAS;
+      if (!std::isfinite(c.bias_sigma()) || c.bias_sigma() < 0.0 ||
+          (c.bias_sigma() > limit && !relearn))
+        return fmt::format("bias_sigma {} outside 0..{}", c.bias_sigma(), limit);
+      if (!std::isfinite(c.bias()) || std::abs(c.bias()) > limit)
+        return fmt::format(
+            "bias {} outside +-{} ({})", c.bias(), limit,
+            accel ? "m/s^2, max_accel_compensation_mg" : "rad/s, max_gyro_compensation_deg_per_h");
+      return std::nullopt;
+    }
+    default:
+      return std::nullopt;
+  }
+}
+
+double CommandGate::relearnSigma(const navbus::FilterCommand& c) {
+  const double limit = compensationLimit(c.sensor() == navbus::SOURCE_ACCELEROMETER);
+  if (c.bias_sigma() <= limit) return c.bias_sigma();
+  ++counters_.relearn_clamped;
+  spdlog::warn(
+      "command {} from '{}': re-learn bias_sigma {} beyond the compensation limit {} (recovery."
+      "max_{}_compensation): re-learned up to the limit; {} clamped so far",
+      c.command_id(), c.issuer(), c.bias_sigma(), limit,
+      c.sensor() == navbus::SOURCE_ACCELEROMETER ? "accel" : "gyro", counters_.relearn_clamped);
+  return limit;
+}
+
+}  // namespace navbus::nav_filter

@@ -1,0 +1,59 @@
+#include "navbus/nav_filter/solution_flags.hpp"
+
+#include <spdlog/spdlog.h>
+
+namespace navbus::nav_filter {
+
+namespace {
+constexpr std::uint32_t kStreamLostFlags =
+    navbus::FAULT_IMU_STREAM_LOST | navbus::FAULT_GNSS_STREAM_LOST | navbus::FAULT_ST_STREAM_LOST |
+    navbus::FAULT_RAW_IMU_LOST;
+}  // namespace
+
+std::optional<std::uint32_t> SolutionFlags::streamFlag(const navbus::FilterCommand& c,
+                                                       std::uint32_t imu_id) {
+  switch (c.sensor()) {
+    case navbus::SOURCE_IMU_STREAM:
+      if (c.sensor_id() != imu_id) return std::nullopt;
+      return navbus::FAULT_IMU_STREAM_LOST;
+    case navbus::SOURCE_IMU_RAW_STREAM:
+      return navbus::FAULT_RAW_IMU_LOST;
+    case navbus::SOURCE_GNSS_OBS_STREAM:
+    case navbus::SOURCE_GNSS_FIX_STREAM:
+      return navbus::FAULT_GNSS_STREAM_LOST;
+    case navbus::SOURCE_ST_STREAM:
+      return navbus::FAULT_ST_STREAM_LOST;
+    default:
+      return std::nullopt;
+  }
+}
+
+void SolutionFlags::applyStreamCommand(const navbus::FilterCommand& c, std::uint32_t flag) {
+  const bool lost = c.kind() == navbus::CMD_EXCLUDE_STREAM;
+  if (lost) {
+    stream_flags_ |= flag;
+  } else {
+    stream_flags_ &= ~flag;
+  }
+  spdlog::log(lost ? spdlog::level::warn : spdlog::level::info,
+              "stream source {} id {} {}; flags 0x{:x}", static_cast<int>(c.sensor()),
+              c.sensor_id(), lost ? "lost" : "restored", stream_flags_);
+}
+
+void SolutionFlags::setFaultMonitorAlive(bool alive) {
+  const std::uint32_t flags = alive ? 0 : navbus::FAULT_NO_FAULT_MONITOR;
+  if (flags == monitor_flags_) return;
+  monitor_flags_ = flags;
+  if (alive) {
+    spdlog::info("a fault monitor is alive again: faults are monitored");
+  } else {
+    ++monitor_losses_;
+    spdlog::warn("no fault monitor is alive: solutions flagged FAULT_NO_FAULT_MONITOR");
+  }
+}
+
+bool SolutionFlags::degraded() const {
+  return (stream_flags_ & kStreamLostFlags) != 0 || monitor_flags_ != 0;
+}
+
+}  // namespace navbus::nav_filter

@@ -1,0 +1,97 @@
+// CommandGate: who may command navbus-filter and what, and the counts it keeps.
+#include <gtest/gtest.h>
+
+#include "navbus/nav_filter/command_gate.hpp"
+
+namespace nb = navbus;
+using nb::nav_filter::CommandGate;
+
+namespace {
+
+nb::nav_filter::FilterConfig gateConfig() {
+  nb::nav_filter::FilterConfig c;
+  c.command_issuers = {"fault-manager", "operator"};
+  c.issuer_identities = {{"fault-manager", "navbus-fault-manager"}, {"operator", "navbus-operator"}};
+  c.max_accel_compensation_mps2 = 0.5;
+  c.max_gyro_compensation_radps = 1e-3;
+  return c;
+}
+
+nb::FilterCommand relearn(double sigma) {
+  nb::FilterCommand c;
+  c.vehicle_id(1);
+  c.issuer("fault-manager");
+  c.kind(nb::CMD_RELEARN_BIAS);
+  c.sensor(nb::SOURCE_GYRO);
+  c.axis(1);
+  c.bias_sigma(sigma);
+  return c;
+}
+
+}  // namespace
+
+TEST(CommandGate, RefusesIssuersNotConfiguredAndWritersNotTheirIdentity) {
+  nb::bus::StreamCounters topic;
+  CommandGate gate(gateConfig(), topic);
+  nb::FilterCommand c = relearn(1e-4);
+  EXPECT_TRUE(gate.authorized(c, std::nullopt));
+  EXPECT_TRUE(gate.authorized(c, std::string("navbus-fault-manager")));
+  EXPECT_FALSE(gate.authorized(c, std::string("navbus-operator")));  // impersonation
+  c.issuer("somebody");
+  EXPECT_FALSE(gate.authorized(c, std::nullopt));
+  EXPECT_EQ(gate.counters().unauthorized, 1u);
+  EXPECT_EQ(gate.counters().impersonated, 1u);
+  EXPECT_EQ(gate.counters().refused, 2u);
+  EXPECT_EQ(topic.rejected.at(nb::REJECT_UNAUTHORIZED), 2u);
+  EXPECT_EQ(topic.accepted, 0u);
+}
+
+TEST(CommandGate, RefusesCommandsAboutDataBeforeTheFirstInput) {
+  nb::bus::StreamCounters topic;
+  CommandGate gate(gateConfig(), topic);
+  nb::FilterCommand c = relearn(1e-4);
+  c.time_gps_ns(1'000);
+  EXPECT_TRUE(gate.refuseIfStale(c, -1));     // no input yet
+  EXPECT_TRUE(gate.refuseIfStale(c, 2'000));  // before the first input
+  EXPECT_FALSE(gate.refuseIfStale(c, 1'000));
+  c.time_gps_ns(0);  // at once: never stale
+  EXPECT_FALSE(gate.refuseIfStale(c, 2'000));
+  EXPECT_EQ(gate.counters().stale, 2u);
+  EXPECT_EQ(topic.rejected.at(nb::REJECT_STALE), 2u);
+}
+
+TEST(CommandGate, NamesTheFieldAndValueOutOfRange) {
+  nb::bus::StreamCounters topic;
+  CommandGate gate(gateConfig(), topic);
+  nb::FilterCommand c = relearn(1e-4);
+  c.axis(3);
+  EXPECT_EQ(gate.check(c).value_or(""), "axis 3 outside 0..2");
+  c = relearn(1e-4);
+  c.kind(nb::CMD_COMPENSATE_BIAS);
+  c.bias(2e-3);
+  EXPECT_EQ(gate.check(c).value_or(""),
+            "bias 0.002 outside +-0.001 (rad/s, max_gyro_compensation_deg_per_h)");
+  c.kind(nb::CMD_EXCLUDE_SATELLITE);
+  c.sv_id(33);
+  EXPECT_EQ(gate.check(c).value_or(""), "sv_id 33 outside 1..32");
+  c.sv_id(12);
+  EXPECT_FALSE(gate.check(c).has_value());
+}
+
+TEST(CommandGate, ClampsARelearnSigmaToTheCompensationLimitAndCountsIt) {
+  nb::bus::StreamCounters topic;
+  CommandGate gate(gateConfig(), topic);
+  EXPECT_FALSE(gate.check(relearn(5e-3)).has_value());  // a re-learn beyond the limit passes
+  EXPECT_DOUBLE_EQ(gate.relearnSigma(relearn(5e-3)), 1e-3);
+  EXPECT_DOUBLE_EQ(gate.relearnSigma(relearn(2e-4)), 2e-4);
+  EXPECT_EQ(gate.counters().relearn_clamped, 1u);
+  nb::FilterCommand compensate = relearn(5e-3);
+  compensate.kind(nb::CMD_COMPENSATE_BIAS);  // a compensation beyond the limit does not
+  EXPECT_EQ(gate.check(compensate).value_or(""), "bias_sigma 0.005 outside 0..0.001");
+  gate.count(true);
+  gate.count(false, nb::REJECT_OUT_OF_RANGE);
+  EXPECT_EQ(topic.accepted, 1u);
+  EXPECT_EQ(topic.rejected.at(nb::REJECT_OUT_OF_RANGE), 1u);
+  EXPECT_EQ(gate.counters().applied, 1u);
+  EXPECT_EQ(gate.counters().refused, 1u);
+}
