@@ -1,5 +1,5 @@
 // The same sensor input, delivered with two different interleavings and pacings, gives a
-// bit-identical solution stream (README, Architecture: Determinism).
+// bit-identical solution stream (docs/architecture.md, the ordered merge).
 #include <gtest/gtest.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 

@@ -1,5 +1,5 @@
 // Issue 4's targets with fixed seeds and small run counts (the full counts are the benchmark
-// commands in the README): scenarios through the offline runner, errors against the truth.
+// commands in docs/results.md): scenarios through the offline runner, errors against the truth.
 #include <algorithm>
 #include <cmath>
 #include <map>

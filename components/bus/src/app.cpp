@@ -28,7 +28,7 @@ void addCommonOptions(CLI::App& app, CommonOptions& o, bool config_required) {
                  "IP[:PORT] of the discovery server (server id 0, port 11811 by default) for a "
                  "discovery-client --profile");
   app.add_flag("--ros2", o.ros2_names,
-               "ROS 2 naming: topics rt/<name>, types navbus::msg::dds_::<Type>_ (README)");
+               "ROS 2 naming: topics rt/<name>, types navbus::msg::dds_::<Type>_ (docs/bus.md)");
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
 }

@@ -82,7 +82,7 @@ dds::Topic* DdsContext::topicForType(const std::string& name, dds::TypeSupport t
   if (participant_->find_type(type_name).empty()) {
     // The type object (NAVBUS_TYPE_OBJECTS) is announced for dynamic tools, the XTypes type
     // information is not: Fast DDS 2.9 compares it with a remote endpoint's own and refused
-    // Cyclone DDS 0.10's writers with it (interop_cyclone; README, Type information).
+    // Cyclone DDS 0.10's writers with it (interop_cyclone; docs/bus.md, type information).
     type->auto_fill_type_information(false);
     if (type.register_type(participant_, type_name) != ReturnCode_t::RETCODE_OK) {
       throw DdsError("cannot register type '" + type_name + "'");

@@ -108,8 +108,8 @@ void FaultPipeline::onWritersGone(StreamKind kind, std::int64_t wall_now_ns) {
 void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id,
                                   std::uint64_t end_time_gps_ns) {
   // An IMU's raw stream ends with its increment stream, at the same data time (the same
-  // sensor; the raw reader does not see the raw writer's dispose with Fast DDS 2.9, see the
-  // README). Raw blocks up to that time may still arrive after it: they are no new run.
+  // sensor; the raw reader does not see the raw writer's dispose with Fast DDS 2.9, see
+  // docs/results.md). Raw blocks up to that time may still arrive after it: they are no new run.
   if (kind == StreamKind::kImu)
     onStreamEnded(StreamKind::kImuRaw, sensor_id, watchdog_.lastTime({kind, sensor_id}));
   if (!watchdog_.onEnded({kind, sensor_id}, end_time_gps_ns)) return;

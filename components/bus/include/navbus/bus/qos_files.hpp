@@ -1,5 +1,5 @@
 // Which Fast DDS XML profile files a navbus process reads, in which order, and where navbus's
-// own file is. The rule (README, "QoS profiles"): Fast DDS keeps the first definition of a
+// own file is. The rule (docs/bus.md, "QoS profiles"): Fast DDS keeps the first definition of a
 // profile name it reads, so the files are read in the order of precedence:
 //   1. the user's file (--qos or the configuration's qos_file): adds profiles, and overrides
 //      navbus's profiles of the same name (navbus's definitions of those are left out);

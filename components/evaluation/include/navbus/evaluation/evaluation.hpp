@@ -20,7 +20,7 @@ struct OfflineOptions {
   bool align{true};  ///< align from the inputs even when the filter YAML has an initial_state
 };
 
-/// Writes solution.csv, truth.csv and error.csv (columns in the README); returns an exit code.
+/// Writes solution.csv, truth.csv and error.csv (columns in docs/tools.md); returns an exit code.
 int runOfflineCommand(const OfflineOptions& o);
 
 struct MonteCarloOptions {

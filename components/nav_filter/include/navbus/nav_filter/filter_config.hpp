@@ -52,7 +52,7 @@ struct FilterConfig {
   std::string solution_writer_profile{bus::profile::kSolutionWriter};
   /// Issuers whose commands the filter accepts (FilterCommand.issuer); others are refused and
   /// counted. Without DDS Security the issuer is what the sender claims: this stops a
-  /// misconfigured or stray tool, not an attacker (see the README).
+  /// misconfigured or stray tool, not an attacker (docs/security.md).
   std::vector<std::string> command_issuers{"fault-manager", "operator"};
   /// Under DDS Security: the certificate common name each issuer must be authenticated as
   /// (a command whose issuer is not the identity that wrote it is refused and counted). An

@@ -1,5 +1,5 @@
 // `navbus-sensor-sim --files DIR`: the scenario's streams as plain CSV files for offline work
-// (columns documented in the README): imu.csv, imu_raw.csv, gnss.csv, gnss_fix.csv,
+// (columns documented in docs/simulation.md): imu.csv, imu_raw.csv, gnss.csv, gnss_fix.csv,
 // star_tracker.csv, truth.csv, faults.csv.
 #pragma once
 

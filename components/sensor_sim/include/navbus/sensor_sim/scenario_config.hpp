@@ -1,5 +1,5 @@
 // navbus-sensor-sim scenario files: YAML in the units of the papers' tables (written in the key
-// names and comments), converted to SI here, once. See scenarios/*.yaml and the README.
+// names and comments), converted to SI here, once. See scenarios/*.yaml and docs/simulation.md.
 #pragma once
 
 #include <cstddef>

@@ -1,7 +1,7 @@
 // The low-latency output: the latest solution of the deterministic filter, propagated with
 // every inertial increment as it arrives (the output predictor of PX4's EKF2, which runs its
 // filter on a delayed time horizon and predicts forward at IMU rate; here the delay is what
-// the ordered merge waits for, see the README's latency section).
+// the ordered merge waits for, see docs/bus.md, the low-latency output).
 //
 // Definition, so that any output can be reproduced from the bus alone: an output at increment
 // time t_k is the anchor (the newest deterministic solution at time t_j <= t_k the predictor
