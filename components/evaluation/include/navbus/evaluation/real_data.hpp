@@ -1,7 +1,7 @@
 // `navbus rinex`: real GPS observations through navbus's GNSS path. RINEX 2 observation and
 // navigation files are read (gnss_data/rinex2.hpp), every epoch is solved by single point
-// positioning (core/single_point_positioning.hpp), and the corrected pseudoranges drive the
-// static receiver filter (core/static_receiver_filter.hpp) whose diagnostics go through the
+// positioning (core/gnss/single_point_positioning.hpp), and the corrected pseudoranges drive the
+// static receiver filter (core/filter/static_receiver_filter.hpp) whose diagnostics go through the
 // fault manager's pipeline: the same GLR detector, decisions and commands as on the bus, the
 // commands applied back to the filter (satellite exclusion, re-processing from the onset,
 // readmission). A ramp can be injected into one satellite's pseudoranges to test detection.

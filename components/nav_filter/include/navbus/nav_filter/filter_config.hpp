@@ -65,7 +65,7 @@ struct FilterConfig {
   /// FAULT_NO_FAULT_MONITOR (nobody is detecting faults). Absent: the filter runs without one
   /// and says nothing about it.
   std::optional<FaultMonitorWatch> fault_monitor;
-  /// The low-latency output (core/output_predictor.hpp): the latest solution propagated with
+  /// The low-latency output (core/ins/output_predictor.hpp): the latest solution propagated with
   /// every IMU increment as it arrives, on its own topic; off unless configured.
   bool low_latency_output{false};
   /// Increments kept while the filter lags behind the newest one (at 200 Hz, 2 s).
