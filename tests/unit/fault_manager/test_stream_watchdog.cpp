@@ -1,0 +1,77 @@
+// The fault manager's stream watchdog: one decision per transition, announced ends, deadline
+// events confirmed by the stream's own silence.
+#include <gtest/gtest.h>
+
+#include "navbus/fault_manager/stream_watchdog.hpp"
+
+using navbus::fault_manager::StreamKind;
+using navbus::fault_manager::StreamWatchdog;
+
+namespace {
+constexpr std::int64_t kMs = 1'000'000;
+}  // namespace
+
+TEST(StreamWatchdog, OneDecisionPerTransition) {
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1};
+  EXPECT_FALSE(w.onDeadlineMissed(imu, 0));  // never seen: nothing to lose
+  EXPECT_FALSE(w.onSample(imu, 100, 1 * kMs));
+  auto lost = w.onDeadlineMissed(imu, 251 * kMs);
+  ASSERT_TRUE(lost);
+  EXPECT_TRUE(lost->lost);
+  EXPECT_EQ(lost->last_time_gps_ns, 100u);
+  EXPECT_NEAR(lost->silence_s, 0.25, 1e-9);
+  EXPECT_FALSE(w.onDeadlineMissed(imu, 501 * kMs));  // repeated misses: no new decision
+  EXPECT_TRUE(w.onWritersGone(StreamKind::kImu, 600 * kMs).empty());
+  auto back = w.onSample(imu, 5000, 2000 * kMs);
+  ASSERT_TRUE(back);
+  EXPECT_FALSE(back->lost);
+  EXPECT_EQ(back->last_time_gps_ns, 5000u);
+  EXPECT_FALSE(w.isLost(imu));
+  // Writers gone: every alive stream of that kind is lost at once.
+  w.onSample({StreamKind::kImu, 2}, 1, 2000 * kMs);
+  EXPECT_EQ(w.onWritersGone(StreamKind::kImu, 2100 * kMs).size(), 2u);
+}
+
+TEST(StreamWatchdog, SamplesInFlightAfterAnAnnouncedEndAreNoNewRun) {
+  // The raw stream ends with the IMU's dispose at data time 1000; a reliable reader may still
+  // deliver raw blocks up to that time afterwards: they must not start a run that then
+  // "falls silent" (the demo's end-of-data false alarm).
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey raw{StreamKind::kImuRaw, 1};
+  EXPECT_FALSE(w.onSample(raw, 900, 1 * kMs));
+  EXPECT_TRUE(w.onEnded(raw, 1000));
+  EXPECT_FALSE(w.onSample(raw, 950, 2 * kMs));
+  EXPECT_FALSE(w.onSample(raw, 1000, 3 * kMs));
+  EXPECT_FALSE(w.onDeadlineMissed(raw, 300 * kMs));
+  EXPECT_FALSE(w.onEnded(raw));  // nothing running
+  // A later sample is a new run of the stream, watched again.
+  EXPECT_FALSE(w.onSample(raw, 5000, 400 * kMs));
+  EXPECT_EQ(w.lastTime(raw), 5000u);
+  EXPECT_TRUE(w.onDeadlineMissed(raw, 700 * kMs));
+}
+
+TEST(StreamWatchdog, DeadlineEventIsConfirmedByTheOwnSilence) {
+  // Under CPU load DDS's deadline timer (from reception) can fire before this participant has
+  // been silent for the deadline by its own clock (from the hand-over): the stream is only
+  // suspect then; the tick declares it once the own silence reaches the deadline, and a sample
+  // before that clears it.
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1};
+  const std::int64_t deadline = 250 * kMs;
+  EXPECT_FALSE(w.onSample(imu, 100, 1000 * kMs));
+  EXPECT_FALSE(w.onDeadlineMissed(imu, 1247 * kMs, deadline));  // silent 0.247 s < 0.25 s
+  EXPECT_EQ(w.unconfirmedDeadlines(), 1u);
+  EXPECT_TRUE(w.onTick(1249 * kMs).empty());
+  const auto lost = w.onTick(1250 * kMs);
+  ASSERT_EQ(lost.size(), 1u);
+  EXPECT_TRUE(lost[0].lost);
+  EXPECT_NEAR(lost[0].silence_s, 0.25, 1e-9);
+  EXPECT_TRUE(w.onTick(1300 * kMs).empty());  // once
+  // A sample clears a suspect stream: the delayed hand-over was no silence.
+  EXPECT_TRUE(w.onSample(imu, 200, 1400 * kMs));  // restored
+  EXPECT_FALSE(w.onDeadlineMissed(imu, 1640 * kMs, deadline));
+  EXPECT_FALSE(w.onSample(imu, 300, 1645 * kMs));
+  EXPECT_TRUE(w.onTick(1900 * kMs).empty());
+  EXPECT_FALSE(w.isLost(imu));
+}
