@@ -8,6 +8,7 @@
 // same whenever the command arrives. Pure logic, DDS-free.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <variant>
@@ -34,6 +35,11 @@ class InputHistory {
     if (!enabled()) return;
     if (snapshots_.empty() || time_ns - snapshots_.back().time_ns >= snapshot_period_ns_) {
       const std::size_t first_item = first_index_ + items_.size();
+      // The engine owns heap storage: every snapshot slot the span needs is made at the first
+      // snapshot, so that the history allocates nothing afterwards, not even while it fills.
+      if (snapshots_.empty() && snapshots_.capacity() < maxSnapshots()) {
+        snapshots_.prefill(maxSnapshots(), [&] { return Snapshot{time_ns, first_item, engine}; });
+      }
       snapshots_.push_back_reusing(
           [&] {
             return Snapshot{time_ns, first_item, engine};
@@ -77,6 +83,13 @@ class InputHistory {
   }
 
   std::uint64_t rollbacks() const { return rollbacks_; }
+  /// The most snapshots the span holds: one per period, the one kept beyond the span and the
+  /// one being taken (at most 4096).
+  std::size_t maxSnapshots() const {
+    if (snapshot_period_ns_ <= 0) return 1;
+    return static_cast<std::size_t>(
+        std::min<std::int64_t>(span_ns_ / snapshot_period_ns_ + 2, 4096));
+  }
   std::uint64_t outOfReach() const { return out_of_reach_; }
 
  private:

@@ -49,6 +49,16 @@ class RingBuffer {
     }
     ++size_;
   }
+  /// Makes the buffer hold at least `n` slots, each with an object made by `make()` where it has
+  /// none, so that the next pushes up to `n` only assign: objects that own memory allocate here,
+  /// once, rather than one by one as the buffer fills.
+  template <class Make>
+  void prefill(std::size_t n, Make&& make) {
+    while (slots_.size() < n) grow();
+    for (std::optional<T>& s : slots_) {
+      if (!s) s.emplace(make());
+    }
+  }
   void pop_front() {
     head_ = slot(1);
     --size_;
