@@ -1,8 +1,8 @@
 // The offline runner (`navbus offline`, no DDS) and the three participants over the bus give
-// bit-identical solutions for the same scenario, seed and filter configuration (docs/architecture.md,
-// the ordered merge). Two scenarios: the seed-004 land vehicle with the multi-dimensional
-// filter (ZUPT, NHC, stage switches, resets) and 40 s of the seed-001 LEO with GNSS fixes and the
-// star tracker in the federated structure.
+// bit-identical solutions for the same scenario, seed and filter configuration
+// (docs/architecture.md, the ordered merge). Two scenarios: the seed-004 land vehicle with the
+// multi-dimensional filter (ZUPT, NHC, stage switches, resets) and 40 s of the seed-001 LEO with
+// GNSS fixes and the star tracker in the federated structure.
 #include <algorithm>
 #include <cmath>
 #include <fstream>

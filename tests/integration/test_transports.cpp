@@ -1,8 +1,8 @@
 // As-fast-as-possible pacing is flow-controlled (reliable KEEP_ALL writers block instead of
 // dropping), so nothing is lost, over UDP loopback, shared memory and through a discovery
 // server. The shared-memory case was out of this suite after a reliable stream over SHM stalled
-// for ~24 s in 2 of about 8 full-suite runs (cause not found; see docs/testing.md). It did not recur
-// in 40 runs of this test after the profile's discovery moved to UDP (20 with increment
+// for ~24 s in 2 of about 8 full-suite runs (cause not found; see docs/testing.md). It did not
+// recur in 40 runs of this test after the profile's discovery moved to UDP (20 with increment
 // blocks; 20 with one increment per sample beside two busy loops), so it is back, and a run
 // slower than kStallS (normally 1.2 s, 4.5 s under the sanitizers) fails as a stall.
 #include <gtest/gtest.h>

@@ -11,7 +11,8 @@ namespace {
 nb::nav_filter::FilterConfig gateConfig() {
   nb::nav_filter::FilterConfig c;
   c.command_issuers = {"fault-manager", "operator"};
-  c.issuer_identities = {{"fault-manager", "navbus-fault-manager"}, {"operator", "navbus-operator"}};
+  c.issuer_identities = {{"fault-manager", "navbus-fault-manager"},
+                         {"operator", "navbus-operator"}};
   c.max_accel_compensation_mps2 = 0.5;
   c.max_gyro_compensation_radps = 1e-3;
   return c;

@@ -20,7 +20,6 @@ std::vector<std::pair<std::int64_t, int>> drain(Seq& s, std::int64_t now) {
 }
 }  // namespace
 
-
 TEST(InputSequencer, OrdersByTimeThenRankWhateverTheArrivalOrder) {
   // Given a 100 Hz IMU and a 1 Hz receiver, delivered in two different interleavings,
   // when everything has arrived, then both release the same sequence.
@@ -80,4 +79,3 @@ TEST(InputSequencer, AStreamDeclaredLostDoesNotHoldOthers) {
   EXPECT_EQ(drain(s, 0).size(), 1u);
   EXPECT_EQ(s.timeouts(), 0u);
 }
-

@@ -1,4 +1,5 @@
-// Deterministic merge of several time-stamped input streams (docs/architecture.md, the ordered merge).
+// Deterministic merge of several time-stamped input streams (docs/architecture.md, the ordered
+// merge).
 //
 // Fast DDS 2.9 has no DESTINATION_ORDER BY_SOURCE_TIMESTAMP, and samples of different topics
 // arrive in any interleaving. The sequencer orders them by (time, stream rank, sensor id) and
