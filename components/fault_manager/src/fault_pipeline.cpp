@@ -4,59 +4,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include "navbus/bus/streams.hpp"
 #include "navbus/bus/topics.hpp"
 
 namespace navbus::fault_manager {
-
-navbus::FaultSource toSource(StreamKind k) {
-  switch (k) {
-    case StreamKind::kImu:
-      return navbus::SOURCE_IMU_STREAM;
-    case StreamKind::kImuRaw:
-      return navbus::SOURCE_IMU_RAW_STREAM;
-    case StreamKind::kGnssObservations:
-      return navbus::SOURCE_GNSS_OBS_STREAM;
-    case StreamKind::kGnssFix:
-      return navbus::SOURCE_GNSS_FIX_STREAM;
-    case StreamKind::kStarTracker:
-      return navbus::SOURCE_ST_STREAM;
-  }
-  return navbus::SOURCE_IMU_STREAM;
-}
-
-const char* kindName(StreamKind k) {
-  switch (k) {
-    case StreamKind::kImu:
-      return "imu";
-    case StreamKind::kImuRaw:
-      return "imu-raw";
-    case StreamKind::kGnssObservations:
-      return "gnss-observations";
-    case StreamKind::kGnssFix:
-      return "gnss-fix";
-    case StreamKind::kStarTracker:
-      return "star-tracker";
-  }
-  return "?";
-}
-
-namespace {
-const char* topicOf(StreamKind k) {
-  switch (k) {
-    case StreamKind::kImu:
-      return bus::topic::kImuIncrement;
-    case StreamKind::kImuRaw:
-      return bus::topic::kImuRaw;
-    case StreamKind::kGnssObservations:
-      return bus::topic::kGnssObservations;
-    case StreamKind::kGnssFix:
-      return bus::topic::kGnssFix;
-    case StreamKind::kStarTracker:
-      return bus::topic::kStarTracker;
-  }
-  return bus::topic::kImuIncrement;
-}
-}  // namespace
 
 FaultPipeline::FaultPipeline(const FaultManagerConfig& config, bus::HealthCounters& health,
                              Sinks sinks, std::uint64_t run_id)
@@ -84,7 +35,7 @@ void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std
     tracker.reset(sensor_id);
     o = tracker.check(sensor_id, seq, time_gps_ns);
   }
-  auto& counters = health_.stream(topicOf(kind));
+  auto& counters = health_.stream(bus::streamInfo(kind).topic);
   ++counters.accepted;  // observed, not validated: a monitor
   counters.sequence_gaps += o.missing;
   if (auto e = watchdog_.onSample({kind, sensor_id}, time_gps_ns, wall_now_ns)) onWatchdogEvent(*e);
@@ -115,15 +66,15 @@ void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id,
   if (!watchdog_.onEnded({kind, sensor_id}, end_time_gps_ns)) return;
   trackers_[kind].reset(sensor_id);
   ++ended_;
-  spdlog::info("{} stream {} ended (its writer disposed it): not a loss", kindName(kind),
-               sensor_id);
+  spdlog::info("{} stream {} ended (its writer disposed it): not a loss",
+               bus::streamInfo(kind).name, sensor_id);
 }
 
 void FaultPipeline::onWatchdogEvent(const WatchdogEvent& e) {
   navbus::FaultDecision d;
   d.time_gps_ns(e.last_time_gps_ns);
   d.event(e.lost ? navbus::EVENT_STREAM_LOST : navbus::EVENT_STREAM_RESTORED);
-  d.source(toSource(e.key.kind));
+  d.source(bus::streamInfo(e.key.kind).fault_source);
   d.sensor_id(e.key.sensor_id);
   d.shape(navbus::SHAPE_NONE);
   d.test_statistic(e.silence_s);
@@ -132,8 +83,9 @@ void FaultPipeline::onWatchdogEvent(const WatchdogEvent& e) {
   d.detector("watchdog");
   const std::uint32_t id = decide(d);
   (e.lost ? lost_ : restored_)++;
-  spdlog::warn("decision {}: {} stream {} {} (silent {:.3f} s)", id, kindName(e.key.kind),
-               e.key.sensor_id, e.lost ? "LOST" : "RESTORED", e.silence_s);
+  spdlog::warn("decision {}: {} stream {} {} (silent {:.3f} s)", id,
+               bus::streamInfo(e.key.kind).name, e.key.sensor_id, e.lost ? "LOST" : "RESTORED",
+               e.silence_s);
   navbus::FilterCommand c;
   c.kind(e.lost ? navbus::CMD_EXCLUDE_STREAM : navbus::CMD_READMIT_STREAM);
   c.decision_id(id);
@@ -148,7 +100,7 @@ void FaultPipeline::onSecondWriter(StreamKind kind, std::uint32_t sensor_id,
   navbus::FaultDecision d;
   d.time_gps_ns(time_gps_ns);
   d.event(navbus::EVENT_FAULT_DETECTED);
-  d.source(toSource(kind));
+  d.source(bus::streamInfo(kind).fault_source);
   d.sensor_id(sensor_id);
   d.shape(navbus::SHAPE_NONE);
   d.test_statistic(2.0);  // writers publishing the sensor id
@@ -158,7 +110,7 @@ void FaultPipeline::onSecondWriter(StreamKind kind, std::uint32_t sensor_id,
   const std::uint32_t id = decide(d);
   ++second_writers_;
   spdlog::warn("decision {}: a second writer publishes {} stream {} while its owner is alive", id,
-               kindName(kind), sensor_id);
+               bus::streamInfo(kind).name, sensor_id);
 }
 
 bool FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {

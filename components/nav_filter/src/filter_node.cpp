@@ -4,10 +4,7 @@
 #include <chrono>
 
 #include <navbus_idl/FaultPubSubTypes.h>
-#include <navbus_idl/GnssPubSubTypes.h>
 #include <navbus_idl/HealthPubSubTypes.h>
-#include <navbus_idl/ImuPubSubTypes.h>
-#include <navbus_idl/StarTrackerPubSubTypes.h>
 
 #include <spdlog/spdlog.h>
 
@@ -58,33 +55,21 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
            [this](const navbus::NavigationSolution& s) { low_latency_writer_.write(s); }}),
       not_producing_ns_(
           std::max(kNotProducingMinNs, kNotProducingPeriods * config.engine.solution_period_ns)),
-      imu_writers_(bus::topic::kImuIncrement, p.health().stream(bus::topic::kImuIncrement)),
-      imu_block_writers_(bus::topic::kImuIncrementBlock,
-                         p.health().stream(bus::topic::kImuIncrementBlock)),
-      gnss_obs_writers_(bus::topic::kGnssObservations,
-                        p.health().stream(bus::topic::kGnssObservations)),
-      gnss_fix_writers_(bus::topic::kGnssFix, p.health().stream(bus::topic::kGnssFix)),
-      star_writers_(bus::topic::kStarTracker, p.health().stream(bus::topic::kStarTracker)) {
+      sensors_(p, {[this](bus::StreamKind kind, std::uint32_t id) {
+                 pipeline_.onStreamEnded(kind, id);
+                 if (kind == bus::StreamKind::kImu && on_imu_ended_) on_imu_ended_();
+               }}) {
   using namespace bus;
-  subscribeSensor<navbus::ImuIncrementPubSubType>(
-      topic::kImuIncrement, profile::kSensorReader, kRankImu, imu_writers_,
-      [](const auto& m) { return m.sensor_id(); }, [this](const auto& m) { pipeline_.onImu(m); });
-  subscribeSensor<navbus::ImuIncrementBlockPubSubType>(
-      topic::kImuIncrementBlock, profile::kSensorReader, kRankImu, imu_block_writers_,
-      [](const auto& m) { return m.sensor_id(); },
-      [this](const auto& m) { pipeline_.onImuBlock(m); });
-  subscribeSensor<navbus::GnssObservationEpochPubSubType>(
-      topic::kGnssObservations, profile::kMeasurementReader, kRankGnssObs, gnss_obs_writers_,
-      [](const auto& m) { return m.receiver_id(); },
-      [this](const auto& m) { pipeline_.onGnssObservations(m); });
-  subscribeSensor<navbus::GnssFixPubSubType>(
-      topic::kGnssFix, profile::kMeasurementReader, kRankGnssFix, gnss_fix_writers_,
-      [](const auto& m) { return m.receiver_id(); },
-      [this](const auto& m) { pipeline_.onGnssFix(m); });
-  subscribeSensor<navbus::StarTrackerAttitudePubSubType>(
-      topic::kStarTracker, profile::kMeasurementReader, kRankStarTracker, star_writers_,
-      [](const auto& m) { return m.tracker_id(); },
-      [this](const auto& m) { pipeline_.onStarTracker(m); });
+  sensors_.subscribe<navbus::ImuIncrement>(profile::kSensorReader,
+                                           [this](const auto& m) { pipeline_.onImu(m); });
+  sensors_.subscribe<navbus::ImuIncrementBlock>(profile::kSensorReader,
+                                                [this](const auto& m) { pipeline_.onImuBlock(m); });
+  sensors_.subscribe<navbus::GnssObservationEpoch>(
+      profile::kMeasurementReader, [this](const auto& m) { pipeline_.onGnssObservations(m); });
+  sensors_.subscribe<navbus::GnssFix>(profile::kMeasurementReader,
+                                      [this](const auto& m) { pipeline_.onGnssFix(m); });
+  sensors_.subscribe<navbus::StarTrackerAttitude>(
+      profile::kMeasurementReader, [this](const auto& m) { pipeline_.onStarTracker(m); });
   p.subscribe<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader,
                                                [this](const auto& d, const auto&) {
                                                  pipeline_.onDecision(d);
@@ -106,28 +91,6 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   p.addTimer(std::chrono::nanoseconds(config.engine.solution_period_ns),
              [this] { pipeline_.publishHeldSolution(); });
   updateState();
-}
-
-template <class PubSubType, class IdFn, class Handler>
-void FilterNode::subscribeSensor(const std::string& topic, const std::string& profile,
-                                 StreamRank rank, bus::WriterGate& writers, IdFn id,
-                                 Handler handler) {
-  bus::ReaderCallbacks callbacks;
-  callbacks.on_disposed = [this, rank](const eprosima::fastrtps::rtps::InstanceHandle_t& h) {
-    auto it = sensor_instances_.find({rank, h});
-    if (it == sensor_instances_.end()) return;
-    pipeline_.onStreamEnded(rank, it->second);
-    if (rank == kRankImu && on_imu_ended_) on_imu_ended_();
-  };
-  participant_.subscribe<PubSubType>(
-      topic, profile,
-      [this, rank, &writers, id, handler](const typename PubSubType::type& m,
-                                          const eprosima::fastdds::dds::SampleInfo& info) {
-        if (!writers.admit(id(m), info)) return;
-        sensor_instances_[{rank, info.instance_handle}] = id(m);
-        handler(m);
-      },
-      callbacks);
 }
 
 void FilterNode::watchFaultMonitor(const FaultMonitorWatch& watch) {

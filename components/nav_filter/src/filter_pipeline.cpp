@@ -18,6 +18,17 @@ namespace navbus::nav_filter {
 
 namespace {
 
+constexpr int rankOf(bus::StreamKind kind) {
+  return bus::streamInfo(kind).merge_rank;
+}
+constexpr int kRankImu = rankOf(bus::StreamKind::kImu);
+constexpr int kRankGnssObs = rankOf(bus::StreamKind::kGnssObservations);
+constexpr int kRankGnssFix = rankOf(bus::StreamKind::kGnssFix);
+constexpr int kRankStarTracker = rankOf(bus::StreamKind::kStarTracker);
+static_assert(kRankCommand > kRankImu && kRankCommand > kRankGnssObs &&
+                  kRankCommand > kRankGnssFix && kRankCommand > kRankStarTracker,
+              "a command follows every measurement of its data time");
+
 std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const FilterConfig& c) {
   std::vector<InputSequencer<FilterInput>::ExpectedStream> s;
   s.push_back({{kRankImu, c.imu.id}, c.imu.period_ns});
@@ -162,13 +173,11 @@ void FilterPipeline::startNewRun() {
       new_runs_, dropped);
 }
 
-void FilterPipeline::onStreamEnded(StreamRank rank, std::uint32_t id) {
-  static constexpr std::array<const char*, 4> kTopics{
-      bus::topic::kImuIncrement, bus::topic::kGnssObservations, bus::topic::kGnssFix,
-      bus::topic::kStarTracker};
-  if (!sequencer_.setActive({rank, id}, false)) return;  // a stream this filter does not use
-  spdlog::info("{} id {} ended (its writer disposed it): no longer waited for",
-               rank < static_cast<int>(kTopics.size()) ? kTopics[rank] : "command", id);
+void FilterPipeline::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
+  const bus::StreamKindInfo& stream = bus::streamInfo(kind);
+  if (stream.merge_rank == bus::kNotMerged) return;
+  if (!sequencer_.setActive({stream.merge_rank, id}, false)) return;  // a stream not in use
+  spdlog::info("{} id {} ended (its writer disposed it): no longer waited for", stream.topic, id);
 }
 
 void FilterPipeline::pump(std::int64_t now_ns) {

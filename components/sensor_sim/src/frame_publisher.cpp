@@ -6,7 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "navbus/bus/conversions.hpp"
-#include "navbus/bus/topics.hpp"
+#include "navbus/bus/streams.hpp"
 #include "navbus/core/math/earth.hpp"
 
 namespace navbus::sensor_sim {
@@ -87,34 +87,27 @@ FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& c
     : participant_(participant),
       config_(config),
       increments_per_block_(sensor_sim::incrementsPerBlock(config)) {
-  using namespace bus;
-  // Fast pacing writes asynchronously (several samples per datagram); real time synchronously
-  // (no thread hop in the latency). qos/navbus_qos.xml says what each measured.
-  const bool fast = config.pacing == Pacing::kFast;
-  const char* sensor_profile = fast ? profile::kSensorWriterFastPacing : profile::kSensorWriter;
-  const char* measurement_profile =
-      fast ? profile::kMeasurementWriterFastPacing : profile::kMeasurementWriter;
   if (increments_per_block_ > 0) {
     batcher_.emplace(increments_per_block_);
-    imu_blocks_ = participant.createWriter<navbus::ImuIncrementBlockPubSubType>(
-        topic::kImuIncrementBlock, sensor_profile);
+    imu_blocks_ = createWriter<navbus::ImuIncrementBlock>();
   } else {
-    imu_ = participant.createWriter<navbus::ImuIncrementPubSubType>(topic::kImuIncrement,
-                                                                    sensor_profile);
+    imu_ = createWriter<navbus::ImuIncrement>();
   }
-  if (config.publish_raw) {
-    raw_ = participant.createWriter<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, sensor_profile);
-  }
+  if (config.publish_raw) raw_ = createWriter<navbus::ImuRawBlock>();
   if (config.publish_gnss) {
-    gnss_ = participant.createWriter<navbus::GnssObservationEpochPubSubType>(
-        topic::kGnssObservations, measurement_profile);
-    fix_ =
-        participant.createWriter<navbus::GnssFixPubSubType>(topic::kGnssFix, measurement_profile);
+    gnss_ = createWriter<navbus::GnssObservationEpoch>();
+    fix_ = createWriter<navbus::GnssFix>();
   }
-  if (config.publish_star_tracker) {
-    star_ = participant.createWriter<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker,
-                                                                            measurement_profile);
-  }
+  if (config.publish_star_tracker) star_ = createWriter<navbus::StarTrackerAttitude>();
+}
+
+template <class Message>
+bus::Writer<Message> FramePublisher::createWriter() {
+  // Fast pacing writes asynchronously (several samples per datagram); real time synchronously
+  // (no thread hop in the latency). qos/navbus_qos.xml says what each measured.
+  const bus::SensorTopic& row = bus::SensorMessage<Message>::kTopic;
+  return participant_.createWriter<typename bus::SensorMessage<Message>::PubSubType>(
+      row.topic, config_.pacing == Pacing::kFast ? row.fast_writer_profile : row.writer_profile);
 }
 
 template <class Sample>

@@ -6,13 +6,10 @@
 #include <map>
 #include <memory>
 
-#include <navbus_idl/GnssPubSubTypes.h>
-#include <navbus_idl/ImuPubSubTypes.h>
-#include <navbus_idl/StarTrackerPubSubTypes.h>
 #include <spdlog/spdlog.h>
 
 #include "navbus/bus/app.hpp"
-#include "navbus/bus/topics.hpp"
+#include "navbus/bus/streams.hpp"
 #include "navbus/records/csv_messages.hpp"
 #include "navbus/tool/spin.hpp"
 #include "navbus/tool/topic_registry.hpp"
@@ -104,30 +101,15 @@ class TypedStream : public Stream {
 };
 
 std::unique_ptr<Stream> loadStream(const std::string& topic, const std::filesystem::path& file) {
-  using namespace bus;
   const records::CsvTable table = records::readCsv(file);
-  if (topic == topic::kImuIncrement) {
-    return std::make_unique<TypedStream<ImuIncrementPubSubType>>(topic, profile::kSensorWriter,
-                                                                 table);
-  }
-  if (topic == topic::kImuIncrementBlock) {
-    return std::make_unique<TypedStream<ImuIncrementBlockPubSubType>>(topic, profile::kSensorWriter,
-                                                                      table);
-  }
-  if (topic == topic::kImuRaw) {
-    return std::make_unique<TypedStream<ImuRawBlockPubSubType>>(topic, profile::kSensorWriter,
-                                                                table);
-  }
-  if (topic == topic::kGnssObservations) {
-    return std::make_unique<TypedStream<GnssObservationEpochPubSubType>>(
-        topic, profile::kMeasurementWriter, table);
-  }
-  if (topic == topic::kGnssFix) {
-    return std::make_unique<TypedStream<GnssFixPubSubType>>(topic, profile::kMeasurementWriter,
-                                                            table);
-  }
-  return std::make_unique<TypedStream<StarTrackerAttitudePubSubType>>(
-      topic, profile::kMeasurementWriter, table);
+  std::unique_ptr<Stream> stream;
+  bus::forEachSensorMessage([&](auto tag) {
+    using Traits = bus::SensorMessage<typename decltype(tag)::type>;
+    if (topic != Traits::kTopic.topic) return;
+    stream = std::make_unique<TypedStream<typename Traits::PubSubType>>(
+        topic, Traits::kTopic.writer_profile, table);
+  });
+  return stream;
 }
 
 std::vector<std::unique_ptr<Stream>> loadStreams(const ReplayOptions& o) {
@@ -200,9 +182,11 @@ std::vector<Event> schedule(const std::vector<std::unique_ptr<Stream>>& streams,
 }  // namespace
 
 const std::vector<std::string>& replayableTopics() {
-  using namespace bus::topic;
-  static const std::vector<std::string> topics{kImuIncrement,     kImuIncrementBlock, kImuRaw,
-                                               kGnssObservations, kGnssFix,           kStarTracker};
+  static const std::vector<std::string> topics = [] {
+    std::vector<std::string> t;
+    for (const bus::SensorTopic& row : bus::kSensorTopics) t.emplace_back(row.topic);
+    return t;
+  }();
   return topics;
 }
 

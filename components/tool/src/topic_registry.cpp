@@ -1,13 +1,10 @@
 #include "navbus/tool/topic_registry.hpp"
 
 #include <navbus_idl/FaultPubSubTypes.h>
-#include <navbus_idl/GnssPubSubTypes.h>
 #include <navbus_idl/HealthPubSubTypes.h>
-#include <navbus_idl/ImuPubSubTypes.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
-#include <navbus_idl/StarTrackerPubSubTypes.h>
 
-#include "navbus/bus/topics.hpp"
+#include "navbus/bus/streams.hpp"
 #include "navbus/records/formatters.hpp"
 
 namespace navbus::tool {
@@ -28,28 +25,32 @@ TopicEntry entry(const char* topic, const char* profile) {
         });
       }};
 }
+
+std::vector<TopicEntry> makeRegistry() {
+  using namespace bus;
+  std::vector<TopicEntry> registry;
+  forEachSensorMessage([&registry](auto tag) {
+    using Traits = SensorMessage<typename decltype(tag)::type>;
+    registry.push_back(
+        entry<typename Traits::PubSubType>(Traits::kTopic.topic, Traits::kTopic.reader_profile));
+  });
+  registry.push_back(
+      entry<navbus::NavigationSolutionPubSubType>(topic::kNavSolution, profile::kSolutionReader));
+  registry.push_back(entry<navbus::NavigationSolutionPubSubType>(
+      topic::kNavSolutionLowLatency, profile::kLowLatencySolutionReader));
+  registry.push_back(entry<navbus::FilterDiagnosticsPubSubType>(topic::kFilterDiagnostics,
+                                                                profile::kDiagnosticsReader));
+  registry.push_back(
+      entry<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader));
+  registry.push_back(
+      entry<navbus::FilterCommandPubSubType>(topic::kFilterCommand, profile::kDecisionReader));
+  registry.push_back(entry<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthReader));
+  return registry;
+}
 }  // namespace
 
 const std::vector<TopicEntry>& topicRegistry() {
-  using namespace bus;
-  static const std::vector<TopicEntry> registry = {
-      entry<navbus::ImuIncrementPubSubType>(topic::kImuIncrement, profile::kSensorReader),
-      entry<navbus::ImuIncrementBlockPubSubType>(topic::kImuIncrementBlock, profile::kSensorReader),
-      entry<navbus::ImuRawBlockPubSubType>(topic::kImuRaw, profile::kSensorReader),
-      entry<navbus::GnssObservationEpochPubSubType>(topic::kGnssObservations,
-                                                    profile::kMeasurementReader),
-      entry<navbus::GnssFixPubSubType>(topic::kGnssFix, profile::kMeasurementReader),
-      entry<navbus::StarTrackerAttitudePubSubType>(topic::kStarTracker,
-                                                   profile::kMeasurementReader),
-      entry<navbus::NavigationSolutionPubSubType>(topic::kNavSolution, profile::kSolutionReader),
-      entry<navbus::NavigationSolutionPubSubType>(topic::kNavSolutionLowLatency,
-                                                  profile::kLowLatencySolutionReader),
-      entry<navbus::FilterDiagnosticsPubSubType>(topic::kFilterDiagnostics,
-                                                 profile::kDiagnosticsReader),
-      entry<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader),
-      entry<navbus::FilterCommandPubSubType>(topic::kFilterCommand, profile::kDecisionReader),
-      entry<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthReader),
-  };
+  static const std::vector<TopicEntry> registry = makeRegistry();
   return registry;
 }
 

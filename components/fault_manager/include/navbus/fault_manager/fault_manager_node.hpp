@@ -5,14 +5,12 @@
 
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <string>
 
-#include <fastdds/rtps/common/InstanceHandle.h>
 #include <navbus_idl/FaultPubSubTypes.h>
 
 #include "navbus/bus/participant.hpp"
-#include "navbus/bus/writer_gate.hpp"
+#include "navbus/bus/sensor_readers.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
 
 namespace navbus::fault_manager {
@@ -25,20 +23,17 @@ class FaultManagerNode {
   void setOnImuEnded(std::function<void()> fn) { on_imu_ended_ = std::move(fn); }
 
  private:
-  template <class PubSubType, class IdFn, class TimeFn>
-  void watch(const std::string& topic, const std::string& profile, StreamKind kind, IdFn id,
-             TimeFn time);
+  /// Watches the sensor topic of `Message` with the reader `profile` (its deadline).
+  template <class Message>
+  void watch(const char* profile);
+  bus::SensorReaders::Events streamEvents();
 
   bus::Participant& participant_;
   std::function<void()> on_imu_ended_;
   bus::Writer<navbus::FaultDecision> decision_writer_;
   bus::Writer<navbus::FilterCommand> command_writer_;
   FaultPipeline pipeline_;
-  /// DDS instance handle -> sensor id, per stream kind (deadline statuses name the instance).
-  std::map<std::pair<StreamKind, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>
-      instances_;
-  /// One writer per sensor id on each watched stream (bus::WriterGate).
-  std::map<std::string, bus::WriterGate> writers_;  ///< per topic
+  bus::SensorReaders sensors_;  ///< the watched sensor streams (owning writers only)
 };
 
 }  // namespace navbus::fault_manager

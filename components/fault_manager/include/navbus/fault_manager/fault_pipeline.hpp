@@ -90,8 +90,4 @@ class FaultPipeline : private FaultOutput {
   std::uint64_t lost_{0}, restored_{0}, ended_{0}, other_vehicles_{0};
 };
 
-/// The IDL source of a watched stream kind, and its name for logs.
-navbus::FaultSource toSource(StreamKind kind);
-const char* kindName(StreamKind kind);
-
 }  // namespace navbus::fault_manager

@@ -9,10 +9,12 @@
 #include <tuple>
 #include <vector>
 
+#include "navbus/bus/stream_kind.hpp"
+
 namespace navbus::fault_manager {
 
-/// Which stream (mirrors navbus::FaultSource for the watchdog sources).
-enum class StreamKind { kImu, kImuRaw, kGnssObservations, kGnssFix, kStarTracker };
+/// Which stream (bus/streams.hpp has its topic, name and fault source).
+using bus::StreamKind;
 
 struct StreamKey {
   StreamKind kind;

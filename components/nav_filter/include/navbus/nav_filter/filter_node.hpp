@@ -5,14 +5,13 @@
 
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <string>
 #include <utility>
 
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "navbus/bus/participant.hpp"
-#include "navbus/bus/writer_gate.hpp"
+#include "navbus/bus/sensor_readers.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/nav_filter/monitor_liveness.hpp"
@@ -37,12 +36,6 @@ class FilterNode {
   void updateState();
   /// Follows the configured fault monitor's health reports (FilterConfig::fault_monitor).
   void watchFaultMonitor(const FaultMonitorWatch& watch);
-  /// Subscribes a sensor stream: samples of the stream's owning writer (one writer per sensor
-  /// id) go to `handler`; the disposal of an instance (its writer announced the end of the
-  /// data) ends that stream in the pipeline's ordered merge.
-  template <class PubSubType, class IdFn, class Handler>
-  void subscribeSensor(const std::string& topic, const std::string& profile, StreamRank rank,
-                       bus::WriterGate& writers, IdFn id, Handler handler);
   static constexpr int kNotProducingPeriods = 3;
   static constexpr std::int64_t kNotProducingMinNs = 1'000'000'000;
 
@@ -54,13 +47,7 @@ class FilterNode {
   FilterPipeline pipeline_;
   std::int64_t not_producing_ns_;      ///< silence of the solution output that is "not producing"
   std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)
-  /// One writer per sensor id on each sensor stream (a second writer's samples are kept out).
-  bus::WriterGate imu_writers_, imu_block_writers_, gnss_obs_writers_, gnss_fix_writers_,
-      star_writers_;
-  /// The sensor id of each stream instance seen (rank, instance handle): disposals carry only
-  /// the handle.
-  std::map<std::pair<StreamRank, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>
-      sensor_instances_;
+  bus::SensorReaders sensors_;         ///< the sensor streams' readers (owning writers only)
   std::optional<MonitorLiveness> monitor_;  ///< the fault monitor's liveness, when configured
 };
 

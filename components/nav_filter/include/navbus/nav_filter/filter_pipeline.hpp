@@ -20,6 +20,7 @@
 #include <navbus_idl/StarTracker.h>
 
 #include "navbus/bus/health.hpp"
+#include "navbus/bus/streams.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
 #include "navbus/core/ins/output_predictor.hpp"
@@ -31,15 +32,9 @@
 
 namespace navbus::nav_filter {
 
-/// Stream ranks: at equal times the increment is integrated before measurements are used, and
-/// a command follows the measurements of its data time (the epoch its decision was taken at).
-enum StreamRank : int {
-  kRankImu = 0,
-  kRankGnssObs = 1,
-  kRankGnssFix = 2,
-  kRankStarTracker = 3,
-  kRankCommand = 4
-};
+/// A command follows the measurements of its data time (the epoch its decision was taken at)
+/// in the ordered merge; the sensor streams' ranks are in bus/streams.hpp.
+inline constexpr int kRankCommand = 4;
 
 /// A validated GNSS observation epoch: satellite clock corrections applied.
 struct GnssEpochInput {
@@ -79,7 +74,7 @@ class FilterPipeline {
   /// The writer of a stream announced the end of its data (disposed the instance): the stream
   /// no longer holds the ordered merge back, so what it preceded is released at once rather
   /// than after the bounded wait. Offline, flush() is the same end. Logged (streams in use).
-  void onStreamEnded(StreamRank rank, std::uint32_t id);
+  void onStreamEnded(bus::StreamKind kind, std::uint32_t id);
   /// Decisions are facts: counted and logged, never acted on (commands are).
   void onDecision(const navbus::FaultDecision& d);
   /// A command: stream commands act at once; engine commands enter the deterministic order at

@@ -102,6 +102,9 @@ class FramePublisher {
  private:
   template <class Sample>
   bool writeReliably(bus::Writer<Sample>& writer, const Sample& sample);
+  /// The writer of a sensor topic (bus/streams.hpp), with the pacing's profile.
+  template <class Message>
+  bus::Writer<Message> createWriter();
   bool writeIncrement(const navbus::ImuIncrement& increment);
   bool writeRaw(const navbus::ImuRawBlock& raw);
   bool batchRaw(const navbus::ImuRawBlock& raw);
