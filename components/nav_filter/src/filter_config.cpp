@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/bus/key_reader.hpp"
 #include "navbus/core/filter/innovation_window.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
@@ -12,6 +13,18 @@
 namespace navbus::nav_filter {
 
 namespace {
+/// File units of the filter's configuration.
+constexpr bus::FileUnit kMicroG{[](double v) { return v * units::kMicroG; }};
+constexpr bus::FileUnit kMilliG{[](double v) { return v * units::kMilliG; }};
+constexpr bus::FileUnit kMilliRad{[](double v) { return v * 1e-3; }};
+constexpr bus::FileUnit kDegree{[](double v) { return v * units::kDeg; }};
+constexpr bus::FileUnit kArcsecond{[](double v) { return v * units::kArcsec; }};
+constexpr bus::FileUnit kDegPerHour{[](double v) { return v * units::kDegPerHour; }};
+/// The EKF's gyro bias sigma has always converted as v * kDeg / 3600 (bit for bit).
+constexpr bus::FileUnit kGyroBiasDegPerHour{[](double v) { return v * units::kDeg / 3600.0; }};
+constexpr bus::FileUnit kDegPerSqrtHour{[](double v) { return v * units::kDeg / 60.0; }};
+constexpr bus::Range kAnyNonNegative{0.0, 1e300};
+
 std::int64_t seconds(double s) {
   return std::llround(s * 1e9);
 }
@@ -33,21 +46,6 @@ std::optional<InputConfig> input(const YAML::Node& inputs, const std::string& ke
 }  // namespace
 
 namespace {
-template <class Enum>
-Enum choice(const YAML::Node& node, const std::string& where, const std::string& key,
-            const std::string& fallback, std::initializer_list<std::pair<const char*, Enum>> opts) {
-  const std::string v = bus::get<std::string>(node, where, key, fallback);
-  std::string names;
-  for (const auto& [name, value] : opts) {
-    if (v == name) return value;
-    names += names.empty() ? name : std::string(" | ") + name;
-  }
-  const std::string full = where.empty() ? key : where + "." + key;
-  throw bus::ConfigError("configuration " + full + " = '" + v + "' is not one of " + names);
-}
-}  // namespace
-
-namespace {
 void parseInitialState(const YAML::Node& init, core::NavState& s) {
   bus::checkKeys(init, "initial_state",
                  {"latitude_deg", "longitude_deg", "height_m", "vel_ned_mps", "roll_deg",
@@ -62,10 +60,6 @@ void parseInitialState(const YAML::Node& init, core::NavState& s) {
 /// (bias sigmas, noise densities), and "at rest" is multi_dimensional.stationary: one place
 /// each.
 void parseAlignment(const YAML::Node& node, core::EngineConfig& e) {
-  const std::string w = "alignment";
-  bus::checkKeys(node, w,
-                 {"static_window_s", "min_static_window_s", "max_heading_sigma_deg",
-                  "course_min_speed_mps", "course_sigma_deg", "course_check_heading_sigma_deg"});
   core::InitialAlignmentConfig& a = e.alignment;
   const core::FilterTuning& t = e.tuning;
   a.budget.accel_bias_sigma_mps2 = t.accel_bias_sigma_mps2;
@@ -74,55 +68,35 @@ void parseAlignment(const YAML::Node& node, core::EngineConfig& e) {
   a.budget.angle_random_walk_rad_per_sqrts = t.gyro_noise_radps_per_sqrthz;
   a.rest = e.mdf.stationarity;
   a.imu_period_s = e.imu_period_s;
-  a.static_window_s =
-      bus::checkRange(bus::get<double>(node, w, "static_window_s", a.static_window_s), 1.0, 3600.0,
-                      "alignment.static_window_s");
-  a.min_static_window_s =
-      bus::checkRange(bus::get<double>(node, w, "min_static_window_s", a.min_static_window_s), 0.1,
-                      a.static_window_s, "alignment.min_static_window_s");
-  a.max_heading_sigma_rad = bus::checkRange(bus::get<double>(node, w, "max_heading_sigma_deg",
-                                                             a.max_heading_sigma_rad / units::kDeg),
-                                            0.0, 180.0, "alignment.max_heading_sigma_deg") *
-                            units::kDeg;
-  a.course_min_speed_mps =
-      bus::checkRange(bus::get<double>(node, w, "course_min_speed_mps", a.course_min_speed_mps),
-                      0.1, 1e4, "alignment.course_min_speed_mps");
-  a.course_sigma_rad = bus::checkRange(bus::get<double>(node, w, "course_sigma_deg",
-                                                        a.course_sigma_rad / units::kDeg),
-                                       1e-3, 90.0, "alignment.course_sigma_deg") *
-                       units::kDeg;
-  a.course_check_heading_sigma_rad =
-      bus::checkRange(bus::get<double>(node, w, "course_check_heading_sigma_deg",
-                                       a.course_check_heading_sigma_rad / units::kDeg),
-                      0.0, 180.0, "alignment.course_check_heading_sigma_deg") *
-      units::kDeg;
+  bus::KeyReader r(node, "alignment");
+  r.number("static_window_s", a.static_window_s, {1.0, 3600.0});
+  r.number("min_static_window_s", a.min_static_window_s, {0.1, a.static_window_s})
+      .number("max_heading_sigma_deg", a.max_heading_sigma_rad, {0.0, 180.0}, kDegree)
+      .number("course_min_speed_mps", a.course_min_speed_mps, {0.1, 1e4})
+      .number("course_sigma_deg", a.course_sigma_rad, {1e-3, 90.0}, kDegree)
+      .number("course_check_heading_sigma_deg", a.course_check_heading_sigma_rad, {0.0, 180.0},
+              kDegree)
+      .finish();
 }
 
 /// Protection levels (tightly coupled): the risks, the alert limits and the GLR the fault
 /// manager runs (its statistics keys, as in the fault manager's `glr` block).
 void parseIntegrity(const YAML::Node& node, core::EngineConfig& e) {
-  const std::string w = "integrity";
-  bus::checkKeys(node, w,
-                 {"enabled", "integrity_risk", "missed_detection_probability",
-                  "horizontal_alert_limit_m", "vertical_alert_limit_m", "detector"});
   core::IntegrityConfig& i = e.integrity;
-  i.enabled = bus::get<bool>(node, w, "enabled", static_cast<bool>(node));
-  i.integrity_risk = bus::checkRange(bus::get<double>(node, w, "integrity_risk", i.integrity_risk),
-                                     1e-15, 0.1, "integrity.integrity_risk");
-  i.missed_detection_probability = bus::checkRange(
-      bus::get<double>(node, w, "missed_detection_probability", i.missed_detection_probability),
-      1e-12, 0.5, "integrity.missed_detection_probability");
-  i.horizontal_alert_limit_m = bus::checkRange(
-      bus::get<double>(node, w, "horizontal_alert_limit_m", i.horizontal_alert_limit_m), 0.01, 1e7,
-      "integrity.horizontal_alert_limit_m");
-  i.vertical_alert_limit_m =
-      bus::checkRange(bus::get<double>(node, w, "vertical_alert_limit_m", i.vertical_alert_limit_m),
-                      0.01, 1e7, "integrity.vertical_alert_limit_m");
+  i.enabled = static_cast<bool>(node);  // a block present enables it unless it says otherwise
+  bus::KeyReader r(node, "integrity");
+  r.value("enabled", i.enabled)
+      .number("integrity_risk", i.integrity_risk, {1e-15, 0.1})
+      .number("missed_detection_probability", i.missed_detection_probability, {1e-12, 0.5})
+      .number("horizontal_alert_limit_m", i.horizontal_alert_limit_m, {0.01, 1e7})
+      .number("vertical_alert_limit_m", i.vertical_alert_limit_m, {0.01, 1e7})
+      .nested({"detector"})
+      .finish();
   const YAML::Node d = node ? node["detector"] : YAML::Node();
-  bus::checkKeys(d, w + ".detector",
+  bus::checkKeys(d, "integrity.detector",
                  {"window_epochs", "threshold", "ambiguity_margin", "ambiguity_correlation",
                   "rank_tolerance", "hypotheses"});
-  bus::parseGlrStatistics(d, w + ".detector", i.detector);
+  bus::parseGlrStatistics(d, "integrity.detector", i.detector);
   if (i.enabled && e.aiding != core::AidingMode::kTightlyCoupled)
     throw bus::ConfigError(
         "configuration integrity.enabled: true needs mode: tightly_coupled (the protection "
@@ -130,97 +104,54 @@ void parseIntegrity(const YAML::Node& node, core::EngineConfig& e) {
 }
 }  // namespace
 
-FilterConfig parseFilterConfig(const YAML::Node& root) {
-  FilterConfig c;
-  bus::checkKeys(root, "",
-                 {"vehicle_id",
-                  "solution_rate_hz",
-                  "sequencer_max_wait_s",
-                  "recovery",
-                  "solution_writer_profile",
-                  "initial_state",
-                  "inputs",
-                  "mode",
-                  "fusion",
-                  "star_tracker_updates",
-                  "ekf",
-                  "failed_axis",
-                  "adaptive",
-                  "federated",
-                  "multi_dimensional",
-                  "command_issuers",
-                  "issuer_identities",
-                  "time_jump",
-                  "fault_monitor",
-                  "alignment",
-                  "integrity",
-                  "low_latency_output"},
-                 bus::kParticipantKeys);
-  core::EngineConfig& e = c.engine;
-  c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", 1);
-  const double rate = bus::checkRange(bus::get<double>(root, "", "solution_rate_hz", 10.0), 1.0,
-                                      1000.0, "solution_rate_hz");
-  e.solution_period_ns = seconds(1.0 / rate);
-  c.sequencer_max_wait_ns =
-      seconds(bus::checkRange(bus::get<double>(root, "", "sequencer_max_wait_s", 0.5), 0.001, 60.0,
-                              "sequencer_max_wait_s"));
+namespace {
 
-  const YAML::Node low = root["low_latency_output"];
-  bus::checkKeys(low, "low_latency_output", {"enabled", "max_buffered_increments"});
-  c.low_latency_output = bus::get<bool>(low, "low_latency_output", "enabled", false);
-  c.low_latency_max_buffered = static_cast<std::size_t>(
-      bus::checkRange(bus::get<double>(low, "low_latency_output", "max_buffered_increments", 400),
-                      1.0, 100000.0, "low_latency_output.max_buffered_increments"));
+void parseLowLatency(const YAML::Node& node, FilterConfig& c) {
+  bus::KeyReader r(node, "low_latency_output");
+  r.value("enabled", c.low_latency_output)
+      .integer("max_buffered_increments", c.low_latency_max_buffered, {1.0, 100000.0})
+      .finish();
+}
 
-  const YAML::Node rec = root["recovery"];
-  bus::checkKeys(rec, "recovery",
-                 {"history_s", "snapshot_period_s", "exclusion_margin_s",
-                  "max_accel_compensation_mg", "max_gyro_compensation_deg_per_h"});
-  c.recovery_history_ns = seconds(bus::checkRange(
-      bus::get<double>(rec, "recovery", "history_s", 40.0), 0.0, 600.0, "recovery.history_s"));
-  c.recovery_snapshot_period_ns =
-      seconds(bus::checkRange(bus::get<double>(rec, "recovery", "snapshot_period_s", 1.0), 0.01,
-                              60.0, "recovery.snapshot_period_s"));
-  c.recovery_onset_margin_ns =
-      seconds(bus::checkRange(bus::get<double>(rec, "recovery", "exclusion_margin_s", 5.0), 0.0,
-                              60.0, "recovery.exclusion_margin_s"));
-  c.max_accel_compensation_mps2 =
-      bus::checkRange(bus::get<double>(rec, "recovery", "max_accel_compensation_mg", 50.0), 0.0,
-                      1e4, "recovery.max_accel_compensation_mg") *
-      units::kMilliG;
-  c.max_gyro_compensation_radps =
-      bus::checkRange(bus::get<double>(rec, "recovery", "max_gyro_compensation_deg_per_h", 200.0),
-                      0.0, 1e6, "recovery.max_gyro_compensation_deg_per_h") *
-      units::kDegPerHour;
-  c.solution_writer_profile =
-      bus::get<std::string>(root, "", "solution_writer_profile", c.solution_writer_profile);
-  c.command_issuers =
-      bus::get<std::vector<std::string>>(root, "", "command_issuers", c.command_issuers);
-  const YAML::Node jump = root["time_jump"];
-  bus::checkKeys(jump, "time_jump", {"tolerance_s", "confirmations"});
-  c.time_jump.tolerance_ns = static_cast<std::uint64_t>(
-      seconds(bus::checkRange(bus::get<double>(jump, "time_jump", "tolerance_s", 2.0), 0.0, 86400.0,
-                              "time_jump.tolerance_s")));
-  c.time_jump.confirmations = static_cast<int>(bus::checkRange(
-      bus::get<int>(jump, "time_jump", "confirmations", 3), 1, 1000, "time_jump.confirmations"));
+void parseRecovery(const YAML::Node& node, FilterConfig& c) {
+  bus::KeyReader r(node, "recovery");
+  r.seconds("history_s", c.recovery_history_ns, {0.0, 600.0})
+      .seconds("snapshot_period_s", c.recovery_snapshot_period_ns, {0.01, 60.0})
+      .seconds("exclusion_margin_s", c.recovery_onset_margin_ns, {0.0, 60.0})
+      .number("max_accel_compensation_mg", c.max_accel_compensation_mps2, {0.0, 1e4}, kMilliG)
+      .number("max_gyro_compensation_deg_per_h", c.max_gyro_compensation_radps, {0.0, 1e6},
+              kDegPerHour)
+      .finish();
+}
+
+void parseTimeJump(const YAML::Node& node, bus::TimeJumpRule& rule) {
+  bus::KeyReader r(node, "time_jump");
+  std::int64_t tolerance_ns = static_cast<std::int64_t>(rule.tolerance_ns);
+  r.seconds("tolerance_s", tolerance_ns, {0.0, 86400.0})
+      .integer("confirmations", rule.confirmations, {1.0, 1000.0})
+      .finish();
+  rule.tolerance_ns = static_cast<std::uint64_t>(tolerance_ns);
+}
+
+/// Who may command the filter, who they must be under DDS Security, and whose health reports
+/// show that faults are monitored.
+void parseAuthorities(const YAML::Node& root, FilterConfig& c) {
   for (const std::string& issuer : c.command_issuers) {
     if (issuer.empty() || issuer.size() > 64)
       throw bus::ConfigError("configuration command_issuers: '" + issuer +
                              "' must have 1 to 64 characters (FilterCommand.issuer)");
   }
-  c.issuer_identities = bus::get<std::map<std::string, std::string>>(root, "", "issuer_identities",
-                                                                     c.issuer_identities);
   for (const std::string& issuer : c.command_issuers)
     c.issuer_identities.emplace(issuer, "navbus-" + issuer);
   if (const YAML::Node fm = root["fault_monitor"]) {
-    bus::checkKeys(fm, "fault_monitor", {"participant", "identity", "timeout_s"});
     FaultMonitorWatch w;
     if (auto it = c.issuer_identities.find("fault-manager"); it != c.issuer_identities.end())
       w.identity = it->second;
-    w.participant = bus::get<std::string>(fm, "fault_monitor", "participant", w.participant);
-    w.identity = bus::get<std::string>(fm, "fault_monitor", "identity", w.identity);
-    w.timeout_ns = seconds(bus::checkRange(bus::get<double>(fm, "fault_monitor", "timeout_s", 3.0),
-                                           0.1, 3600.0, "fault_monitor.timeout_s"));
+    bus::KeyReader r(fm, "fault_monitor");
+    r.value("participant", w.participant)
+        .value("identity", w.identity)
+        .seconds("timeout_s", w.timeout_ns, {0.1, 3600.0})
+        .finish();
     c.fault_monitor = w;
   }
   for (const auto& [issuer, name] : c.issuer_identities) {
@@ -229,9 +160,11 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       throw bus::ConfigError("configuration issuer_identities: '" + issuer +
                              "' is not one of command_issuers");
   }
-  // No initial_state, or `initial_state: align` (to override an extended file's state): the
-  // filter aligns from its inputs.
-  const YAML::Node init = root["initial_state"];
+}
+
+/// No initial_state, or `initial_state: align` (to override an extended file's state): the
+/// filter aligns from its inputs.
+void parseStart(const YAML::Node& init, core::EngineConfig& e) {
   const bool align = !init || (init.IsScalar() && init.Scalar() == "align");
   e.start = align ? core::StartSource::kAligned : core::StartSource::kConfigured;
   if (init && init.IsScalar() && !align) {
@@ -239,26 +172,21 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
                            "': expected a state (latitude_deg, ...) or 'align'");
   }
   if (!align) parseInitialState(init, e.initial_state);
+}
 
-  const YAML::Node inputs = root["inputs"];
+void parseInputs(const YAML::Node& inputs, FilterConfig& c) {
   if (!inputs) throw bus::ConfigError("configuration inputs is missing");
   bus::checkKeys(inputs, "inputs", {"imu", "gnss_observations", "gnss_fix", "star_tracker"});
   c.imu = *input(inputs, "imu", true);
-  e.imu_period_s = 1e-9 * static_cast<double>(c.imu.period_ns);
+  c.engine.imu_period_s = 1e-9 * static_cast<double>(c.imu.period_ns);
   c.gnss_observations = input(inputs, "gnss_observations", false);
   c.gnss_fix = input(inputs, "gnss_fix", false);
   c.star_tracker = input(inputs, "star_tracker", false);
+}
 
-  e.aiding = choice<core::AidingMode>(root, "", "mode", "inertial_only",
-                                      {{"inertial_only", core::AidingMode::kInertialOnly},
-                                       {"tightly_coupled", core::AidingMode::kTightlyCoupled},
-                                       {"loosely_coupled", core::AidingMode::kLooselyCoupled},
-                                       {"multi_dimensional", core::AidingMode::kMultiDimensional}});
-  e.fusion = choice<core::FusionStructure>(root, "", "fusion", "centralized",
-                                           {{"centralized", core::FusionStructure::kCentralized},
-                                            {"federated", core::FusionStructure::kFederated},
-                                            {"adaptive", core::FusionStructure::kAdaptive}});
-  e.use_star_tracker = bus::get<bool>(root, "", "star_tracker_updates", false);
+/// What the mode and fusion structure need of the inputs, checked with the engine's own rule.
+void checkModeAgainstInputs(const YAML::Node& root, const FilterConfig& c) {
+  const core::EngineConfig& e = c.engine;
   if (e.aiding == core::AidingMode::kTightlyCoupled && !c.gnss_observations) {
     throw bus::ConfigError("configuration mode = tightly_coupled needs inputs.gnss_observations");
   }
@@ -277,57 +205,48 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   if (e.use_star_tracker && !c.star_tracker) {
     throw bus::ConfigError("configuration star_tracker_updates = true needs inputs.star_tracker");
   }
-  {
-    // Check the structure against the mode once, with the engine's own rule.
-    core::EngineConfig probe = e;
-    probe.fusion = core::FusionStructure::kCentralized;
-    core::NavigationEngine engine(probe);
-    if (e.aiding != core::AidingMode::kInertialOnly && !engine.selectFusion(e.fusion)) {
-      throw bus::ConfigError(
-          "configuration fusion = '" + bus::get<std::string>(root, "", "fusion", "centralized") +
-          "' does not apply to mode '" + bus::get<std::string>(root, "", "mode", "") +
-          "' (federated needs star_tracker_updates; adaptive needs "
-          "loosely_coupled)");
-    }
+  core::EngineConfig probe = e;
+  probe.fusion = core::FusionStructure::kCentralized;
+  core::NavigationEngine engine(probe);
+  if (e.aiding != core::AidingMode::kInertialOnly && !engine.selectFusion(e.fusion)) {
+    throw bus::ConfigError(
+        "configuration fusion = '" + bus::get<std::string>(root, "", "fusion", "centralized") +
+        "' does not apply to mode '" + bus::get<std::string>(root, "", "mode", "") +
+        "' (federated needs star_tracker_updates; adaptive needs "
+        "loosely_coupled)");
   }
+}
 
-  // EKF parameters, in the units of the papers' error budgets.
-  const YAML::Node tc = root["ekf"];
-  bus::checkKeys(
-      tc, "ekf",
-      {"gravity", "accel_noise_ug_per_sqrthz", "gyro_arw_deg_per_sqrth",
-       "clock_bias_noise_m_per_sqrts", "clock_drift_noise_mps_per_sqrts",
-       "initial_position_sigma_m", "initial_velocity_sigma_mps", "initial_level_sigma_mrad",
-       "initial_heading_sigma_mrad", "accel_bias_sigma_ug", "gyro_bias_sigma_deg_per_h",
-       "initial_clock_bias_sigma_m", "initial_clock_drift_sigma_mps", "gate_sigma",
-       "initial_clock_bias_m", "initial_clock_drift_mps", "star_tracker_bias_sigma_arcsec",
-       "star_tracker_bias_correlation_time_s"});
-  using units::kArcsec;
-  using units::kDeg;
-  using units::kMicroG;
-  auto& t = e.tuning;
-  const std::string w = "ekf";
-  t.gravity =
-      choice<core::earth::GravityModel>(tc, w, "gravity", "wgs84",
-                                        {{"wgs84", core::earth::GravityModel::kWgs84Normal},
-                                         {"point_mass", core::earth::GravityModel::kPointMass}});
-  t.accel_noise_mps2_per_sqrthz =
-      bus::get<double>(tc, w, "accel_noise_ug_per_sqrthz", 10.0) * kMicroG;
-  t.gyro_noise_radps_per_sqrthz =
-      bus::get<double>(tc, w, "gyro_arw_deg_per_sqrth", 0.001) * kDeg / 60.0;
-  t.clock_bias_noise_m_per_sqrts = bus::get<double>(tc, w, "clock_bias_noise_m_per_sqrts", 0.1);
-  t.clock_drift_noise_mps_per_sqrts =
-      bus::get<double>(tc, w, "clock_drift_noise_mps_per_sqrts", 0.01);
-  t.pos_sigma_m = bus::get<double>(tc, w, "initial_position_sigma_m", 40.0);
-  t.vel_sigma_mps = bus::get<double>(tc, w, "initial_velocity_sigma_mps", 1.0);
-  t.level_sigma_rad = bus::get<double>(tc, w, "initial_level_sigma_mrad", 1.0) * 1e-3;
-  t.heading_sigma_rad = bus::get<double>(tc, w, "initial_heading_sigma_mrad", 5.0) * 1e-3;
-  t.accel_bias_sigma_mps2 = bus::get<double>(tc, w, "accel_bias_sigma_ug", 1000.0) * kMicroG;
-  t.gyro_bias_sigma_radps =
-      bus::get<double>(tc, w, "gyro_bias_sigma_deg_per_h", 1.0) * kDeg / 3600.0;
-  t.clock_bias_sigma_m = bus::get<double>(tc, w, "initial_clock_bias_sigma_m", 3000.0);
-  t.clock_drift_sigma_mps = bus::get<double>(tc, w, "initial_clock_drift_sigma_mps", 1.0);
-  t.gate_sigma = bus::get<double>(tc, w, "gate_sigma", 5.0);
+/// EKF parameters, in the units of the papers' error budgets.
+void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
+  core::FilterTuning& t = e.tuning;
+  bus::KeyReader r(node, "ekf");
+  r.choice("gravity", t.gravity,
+           {{"wgs84", core::earth::GravityModel::kWgs84Normal},
+            {"point_mass", core::earth::GravityModel::kPointMass}})
+      .number("accel_noise_ug_per_sqrthz", t.accel_noise_mps2_per_sqrthz, kAnyNonNegative, kMicroG)
+      .number("gyro_arw_deg_per_sqrth", t.gyro_noise_radps_per_sqrthz, kAnyNonNegative,
+              kDegPerSqrtHour)
+      .number("clock_bias_noise_m_per_sqrts", t.clock_bias_noise_m_per_sqrts, kAnyNonNegative)
+      .number("clock_drift_noise_mps_per_sqrts", t.clock_drift_noise_mps_per_sqrts, kAnyNonNegative)
+      .number("initial_position_sigma_m", t.pos_sigma_m, kAnyNonNegative)
+      .number("initial_velocity_sigma_mps", t.vel_sigma_mps, kAnyNonNegative)
+      .number("initial_level_sigma_mrad", t.level_sigma_rad, kAnyNonNegative, kMilliRad)
+      .number("initial_heading_sigma_mrad", t.heading_sigma_rad, kAnyNonNegative, kMilliRad)
+      .number("accel_bias_sigma_ug", t.accel_bias_sigma_mps2, kAnyNonNegative, kMicroG)
+      .number("gyro_bias_sigma_deg_per_h", t.gyro_bias_sigma_radps, kAnyNonNegative,
+              kGyroBiasDegPerHour)
+      .number("initial_clock_bias_sigma_m", t.clock_bias_sigma_m, kAnyNonNegative)
+      .number("initial_clock_drift_sigma_mps", t.clock_drift_sigma_mps, kAnyNonNegative)
+      .number("gate_sigma", t.gate_sigma, kAnyNonNegative)
+      // The star tracker's Gauss-Markov bias, modelled as states when its sigma is positive.
+      .number("star_tracker_bias_sigma_arcsec", t.star_tracker_bias_sigma_rad, {0.0, 3600.0},
+              kArcsecond)
+      .number("star_tracker_bias_correlation_time_s", t.star_tracker_bias_correlation_time_s,
+              {1.0, 1e7})
+      .number("initial_clock_bias_m", e.initial_clock_bias_m, {-1e9, 1e9})
+      .number("initial_clock_drift_mps", e.initial_clock_drift_mps, {-1e6, 1e6})
+      .finish();
   if (t.gate_sigma != 0.0) bus::checkRange(t.gate_sigma, 1.0, 1e3, "ekf.gate_sigma (0: off)");
   for (const auto& [key, value] :
        {std::pair<const char*, double>{"initial_position_sigma_m", t.pos_sigma_m},
@@ -338,111 +257,108 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
         {"gyro_bias_sigma_deg_per_h", t.gyro_bias_sigma_radps},
         {"initial_clock_bias_sigma_m", t.clock_bias_sigma_m},
         {"initial_clock_drift_sigma_mps", t.clock_drift_sigma_mps}}) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
+    if (!(value > 0.0)) {
       throw bus::ConfigError("configuration ekf." + std::string(key) +
-                             " must be positive and finite (covariance), got " +
-                             std::to_string(value));
+                             " must be positive (covariance), got " + std::to_string(value));
     }
   }
-  // The star tracker's Gauss-Markov bias, modelled as states when its sigma is positive.
-  t.star_tracker_bias_sigma_rad =
-      bus::checkRange(bus::get<double>(tc, w, "star_tracker_bias_sigma_arcsec",
-                                       t.star_tracker_bias_sigma_rad / kArcsec),
-                      0.0, 3600.0, "ekf.star_tracker_bias_sigma_arcsec (0: not modelled)") *
-      kArcsec;
-  t.star_tracker_bias_correlation_time_s =
-      bus::checkRange(bus::get<double>(tc, w, "star_tracker_bias_correlation_time_s",
-                                       t.star_tracker_bias_correlation_time_s),
-                      1.0, 1e7, "ekf.star_tracker_bias_correlation_time_s");
   if (t.star_tracker_bias_sigma_rad > 0.0 && !e.use_star_tracker) {
     throw bus::ConfigError(
         "configuration ekf.star_tracker_bias_sigma_arcsec needs star_tracker_updates = true");
   }
-  e.initial_clock_bias_m = bus::get<double>(tc, w, "initial_clock_bias_m", 0.0);
-  e.initial_clock_drift_mps = bus::get<double>(tc, w, "initial_clock_drift_mps", 0.0);
+}
 
-  // A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its error is a random-walk bias.
-  const YAML::Node fa = root["failed_axis"];
-  bus::checkKeys(fa, "failed_axis",
-                 {"accel_bias_sigma_mg", "accel_bias_rw_mg_per_sqrts", "gyro_bias_sigma_dps",
-                  "gyro_bias_rw_dps_per_sqrts"});
-  const std::string wf = "failed_axis";
-  auto positive = [](double v, const std::string& key) {
-    return bus::checkRange(v, 1e-12, 1e12, "failed_axis." + key);
-  };
-  t.failed_accel_bias_sigma_mps2 =
-      positive(bus::get<double>(fa, wf, "accel_bias_sigma_mg",
-                                t.failed_accel_bias_sigma_mps2 / units::kMilliG),
-               "accel_bias_sigma_mg") *
-      units::kMilliG;
-  t.failed_accel_bias_rw_mps2_per_sqrts =
-      positive(bus::get<double>(fa, wf, "accel_bias_rw_mg_per_sqrts",
-                                t.failed_accel_bias_rw_mps2_per_sqrts / units::kMilliG),
-               "accel_bias_rw_mg_per_sqrts") *
-      units::kMilliG;
-  t.failed_gyro_bias_sigma_radps = positive(bus::get<double>(fa, wf, "gyro_bias_sigma_dps",
-                                                             t.failed_gyro_bias_sigma_radps / kDeg),
-                                            "gyro_bias_sigma_dps") *
-                                   kDeg;
-  t.failed_gyro_bias_rw_radps_per_sqrts =
-      positive(bus::get<double>(fa, wf, "gyro_bias_rw_dps_per_sqrts",
-                                t.failed_gyro_bias_rw_radps_per_sqrts / kDeg),
-               "gyro_bias_rw_dps_per_sqrts") *
-      kDeg;
+/// A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its error is a random-walk bias.
+void parseFailedAxis(const YAML::Node& node, core::FilterTuning& t) {
+  constexpr bus::Range kPositive{1e-12, 1e12};
+  bus::KeyReader r(node, "failed_axis");
+  r.number("accel_bias_sigma_mg", t.failed_accel_bias_sigma_mps2, kPositive, kMilliG)
+      .number("accel_bias_rw_mg_per_sqrts", t.failed_accel_bias_rw_mps2_per_sqrts, kPositive,
+              kMilliG)
+      .number("gyro_bias_sigma_dps", t.failed_gyro_bias_sigma_radps, kPositive, kDegree)
+      .number("gyro_bias_rw_dps_per_sqrts", t.failed_gyro_bias_rw_radps_per_sqrts, kPositive,
+              kDegree)
+      .finish();
+}
 
-  const YAML::Node ad = root["adaptive"];
-  bus::checkKeys(ad, "adaptive",
-                 {"window", "floor_position_m", "floor_velocity_mps", "floor_attitude_arcsec",
-                  "floor_at_reported"});
-  bus::checkKeys(root["federated"], "federated", {"share"});
-  const std::string wa = "adaptive";
-  t.adaptive_window =
-      static_cast<int>(bus::checkRange(bus::get<double>(ad, wa, "window", 50), 2,
-                                       core::InnovationWindow<3>::kMaxLength, "adaptive.window"));
-  t.adaptive_floor_position_m = bus::get<double>(ad, wa, "floor_position_m", 0.3);
-  t.adaptive_floor_velocity_mps = bus::get<double>(ad, wa, "floor_velocity_mps", 0.01);
-  t.adaptive_floor_attitude_rad = bus::get<double>(ad, wa, "floor_attitude_arcsec", 0.2) * kArcsec;
-  t.adaptive_floor_at_reported =
-      bus::get<bool>(ad, wa, "floor_at_reported", t.adaptive_floor_at_reported);
-  t.federated_share =
-      bus::checkRange(bus::get<double>(root["federated"], "federated", "share", 2.0), 1.0, 100.0,
-                      "federated.share");
+/// The adaptive (seed 001 eqs. 30-34) and federated structures.
+void parseFusionTuning(const YAML::Node& root, core::FilterTuning& t) {
+  bus::KeyReader adaptive(root["adaptive"], "adaptive");
+  adaptive
+      .integer("window", t.adaptive_window,
+               {2.0, static_cast<double>(core::InnovationWindow<3>::kMaxLength)})
+      .number("floor_position_m", t.adaptive_floor_position_m, kAnyNonNegative)
+      .number("floor_velocity_mps", t.adaptive_floor_velocity_mps, kAnyNonNegative)
+      .number("floor_attitude_arcsec", t.adaptive_floor_attitude_rad, kAnyNonNegative, kArcsecond)
+      .value("floor_at_reported", t.adaptive_floor_at_reported)
+      .finish();
+  bus::KeyReader federated(root["federated"], "federated");
+  federated.number("share", t.federated_share, {1.0, 100.0}).finish();
+}
 
-  const YAML::Node md = root["multi_dimensional"];
-  bus::checkKeys(md, "multi_dimensional",
-                 {"policy", "recovery_s", "gnss_timeout_s", "constraint_rate_hz", "zupt_sigma_mps",
-                  "nhc_sigma_mps", "stationary", "unestimated_states", "resets"});
-  const std::string wm = "multi_dimensional";
-  auto& m = e.mdf;
-  m.policy = choice<core::MdfPolicy>(md, wm, "policy", "mdf",
-                                     {{"mdf", core::MdfPolicy::kMultiDimensional},
-                                      {"continue", core::MdfPolicy::kContinue},
-                                      {"reset_all", core::MdfPolicy::kResetAll}});
-  m.unestimated = choice<core::ReducedStates>(
-      md, wm, "unestimated_states", "consider",
-      {{"consider", core::ReducedStates::kConsidered}, {"drop", core::ReducedStates::kDropped}});
-  m.reset_form = choice<core::ResetForm>(
-      md, wm, "resets", "inflate",
-      {{"inflate", core::ResetForm::kInflate}, {"paper", core::ResetForm::kPaper}});
-  m.recovery_s = bus::checkRange(bus::get<double>(md, wm, "recovery_s", 5.0), 0.0, 600.0,
-                                 "multi_dimensional.recovery_s");
-  m.gnss_timeout_s = bus::checkRange(bus::get<double>(md, wm, "gnss_timeout_s", 1.5), 0.01, 600.0,
-                                     "multi_dimensional.gnss_timeout_s");
-  m.constraint_period_s =
-      1.0 / bus::checkRange(bus::get<double>(md, wm, "constraint_rate_hz", 10.0), 0.1, 1000.0,
-                            "multi_dimensional.constraint_rate_hz");
-  m.zupt_sigma_mps = bus::checkRange(bus::get<double>(md, wm, "zupt_sigma_mps", 0.01), 1e-6, 10.0,
-                                     "multi_dimensional.zupt_sigma_mps");
-  m.nhc_sigma_mps = bus::checkRange(bus::get<double>(md, wm, "nhc_sigma_mps", 0.1), 1e-6, 10.0,
-                                    "multi_dimensional.nhc_sigma_mps");
-  const YAML::Node st = md ? md["stationary"] : YAML::Node();
-  const std::string ws = "multi_dimensional.stationary";
-  bus::checkKeys(st, ws, {"window_s", "accel_std_mps2", "gyro_std_dps", "speed_mps"});
-  m.stationarity.window_s =
-      bus::checkRange(bus::get<double>(st, ws, "window_s", 1.0), 0.05, 10.0, ws + ".window_s");
-  m.stationarity.accel_std_mps2 = bus::get<double>(st, ws, "accel_std_mps2", 0.03);
-  m.stationarity.gyro_std_radps = bus::get<double>(st, ws, "gyro_std_dps", 0.3) * kDeg;
-  m.stationarity.speed_mps = bus::get<double>(st, ws, "speed_mps", 0.3);
+/// The multi-dimensional switching filter (seed 004) and its stationarity detector.
+void parseMultiDimensional(const YAML::Node& node, core::MdfConfig& m) {
+  bus::KeyReader r(node, "multi_dimensional");
+  r.choice("policy", m.policy,
+           {{"mdf", core::MdfPolicy::kMultiDimensional},
+            {"continue", core::MdfPolicy::kContinue},
+            {"reset_all", core::MdfPolicy::kResetAll}})
+      .choice(
+          "unestimated_states", m.unestimated,
+          {{"consider", core::ReducedStates::kConsidered}, {"drop", core::ReducedStates::kDropped}})
+      .choice("resets", m.reset_form,
+              {{"inflate", core::ResetForm::kInflate}, {"paper", core::ResetForm::kPaper}})
+      .number("recovery_s", m.recovery_s, {0.0, 600.0})
+      .number("gnss_timeout_s", m.gnss_timeout_s, {0.01, 600.0})
+      .rateHz("constraint_rate_hz", m.constraint_period_s, {0.1, 1000.0})
+      .number("zupt_sigma_mps", m.zupt_sigma_mps, {1e-6, 10.0})
+      .number("nhc_sigma_mps", m.nhc_sigma_mps, {1e-6, 10.0})
+      .nested({"stationary"})
+      .finish();
+  bus::KeyReader st(node ? node["stationary"] : YAML::Node(), "multi_dimensional.stationary");
+  st.number("window_s", m.stationarity.window_s, {0.05, 10.0})
+      .number("accel_std_mps2", m.stationarity.accel_std_mps2, kAnyNonNegative)
+      .number("gyro_std_dps", m.stationarity.gyro_std_radps, kAnyNonNegative, kDegree)
+      .number("speed_mps", m.stationarity.speed_mps, kAnyNonNegative)
+      .finish();
+}
+}  // namespace
+
+FilterConfig parseFilterConfig(const YAML::Node& root) {
+  FilterConfig c;
+  core::EngineConfig& e = c.engine;
+  bus::KeyReader top(root, "");
+  top.value("vehicle_id", c.vehicle_id)
+      .rateHz("solution_rate_hz", e.solution_period_ns, {1.0, 1000.0})
+      .seconds("sequencer_max_wait_s", c.sequencer_max_wait_ns, {0.001, 60.0})
+      .value("solution_writer_profile", c.solution_writer_profile)
+      .value("command_issuers", c.command_issuers)
+      .value("issuer_identities", c.issuer_identities)
+      .choice("mode", e.aiding,
+              {{"inertial_only", core::AidingMode::kInertialOnly},
+               {"tightly_coupled", core::AidingMode::kTightlyCoupled},
+               {"loosely_coupled", core::AidingMode::kLooselyCoupled},
+               {"multi_dimensional", core::AidingMode::kMultiDimensional}})
+      .choice("fusion", e.fusion,
+              {{"centralized", core::FusionStructure::kCentralized},
+               {"federated", core::FusionStructure::kFederated},
+               {"adaptive", core::FusionStructure::kAdaptive}})
+      .value("star_tracker_updates", e.use_star_tracker)
+      .nested({"low_latency_output", "recovery", "time_jump", "fault_monitor", "initial_state",
+               "inputs", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional",
+               "alignment", "integrity"})
+      .finish(bus::kParticipantKeys);
+  parseLowLatency(root["low_latency_output"], c);
+  parseRecovery(root["recovery"], c);
+  parseTimeJump(root["time_jump"], c.time_jump);
+  parseAuthorities(root, c);
+  parseStart(root["initial_state"], e);
+  parseInputs(root["inputs"], c);
+  checkModeAgainstInputs(root, c);
+  parseEkf(root["ekf"], e);
+  parseFailedAxis(root["failed_axis"], e.tuning);
+  parseFusionTuning(root, e.tuning);
+  parseMultiDimensional(root["multi_dimensional"], e.mdf);
   parseAlignment(root["alignment"], e);
   parseIntegrity(root["integrity"], e);
   return c;

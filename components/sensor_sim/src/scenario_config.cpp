@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/bus/key_reader.hpp"
 #include "navbus/core/math/units.hpp"
 
 namespace navbus::sensor_sim {
@@ -234,111 +235,80 @@ sim::FaultSchedule parseFaults(const YAML::Node& list) {
 }
 }  // namespace
 
-SimConfig parseSimConfig(const YAML::Node& root) {
-  SimConfig c;
-  auto& s = c.scenario;
-  checkKeys(root, "",
-            {"name", "seed", "vehicle", "orbit", "gravity", "timing", "imu", "dither", "vibration",
-             "gnss", "star_tracker", "faults", "ids", "publish"},
-            bus::kParticipantKeys);
-  s.name = get<std::string>(root, "", "name", "default");
-  s.seed = get<std::uint64_t>(root, "", "seed", 1);
+namespace {
+constexpr bus::FileUnit kDegree{[](double v) { return v * kDeg; }};
+constexpr bus::FileUnit kArcsecond{[](double v) { return v * kArcsec; }};
+constexpr bus::FileUnit kMilliG{[](double v) { return v * units::kMilliG; }};
+constexpr bus::FileUnit kMilliGravity{[](double v) { return v * 1e-3 * kG; }};
+constexpr bus::FileUnit kKilometre{[](double v) { return v * 1e3; }};
+constexpr bus::FileUnit kMicroGPerSqrtHour{[](double v) { return v * kMicroG / 60.0; }};
+constexpr bus::FileUnit kMicroRad{[](double v) { return v * 1e-6; }};
+constexpr bus::Range kAny{-1e300, 1e300};
 
-  const YAML::Node veh = root["vehicle"];
-  const YAML::Node orbit = root["orbit"];
-  if (veh && orbit) throw ConfigError("configuration has both vehicle and orbit; choose one");
-  if (orbit) {
-    checkKeys(orbit, "orbit", {"altitude_km", "inclination_deg", "latitude_deg", "longitude_deg"});
-    s.orbit = true;
-    s.orbit_start.altitude_m = checkRange(bus::require<double>(orbit, "orbit", "altitude_km"), 100,
-                                          50000, "orbit.altitude_km") *
-                               1e3;
-    s.orbit_start.inclination_rad =
-        checkRange(bus::require<double>(orbit, "orbit", "inclination_deg"), 0, 180,
-                   "orbit.inclination_deg") *
-        kDeg;
-    s.orbit_start.latitude_rad = checkRange(bus::require<double>(orbit, "orbit", "latitude_deg"),
-                                            -90, 90, "orbit.latitude_deg") *
-                                 kDeg;
-    s.orbit_start.longitude_rad = checkRange(bus::require<double>(orbit, "orbit", "longitude_deg"),
-                                             -180, 180, "orbit.longitude_deg") *
-                                  kDeg;
-    if (std::abs(s.orbit_start.latitude_rad) > s.orbit_start.inclination_rad) {
-      throw ConfigError("configuration orbit.latitude_deg exceeds orbit.inclination_deg");
-    }
-    s.gravity = core::earth::GravityModel::kPointMass;  // seed 001: spherical Earth
-  } else {
-    checkKeys(veh, "vehicle",
-              {"latitude_deg", "longitude_deg", "height_m", "roll_deg", "pitch_deg", "yaw_deg",
-               "speed_mps", "heading_deg", "flight_path_deg", "segments"});
-    const core::earth::Geodetic default_site{36.5 * kDeg, 127.5 * kDeg, 100.0};  // seed 000
-    s.vehicle.position = bus::getGeodeticDeg(veh, "vehicle", &default_site);
-    s.vehicle.roll_pitch_yaw_rad = bus::getRollPitchYawDeg(veh, "vehicle");
-    s.vehicle.speed_mps =
-        checkRange(get<double>(veh, "vehicle", "speed_mps", 0.0), 0, 1e4, "vehicle.speed_mps");
-    s.vehicle.heading_rad =
-        get<double>(veh, "vehicle", "heading_deg", s.vehicle.roll_pitch_yaw_rad.z() / kDeg) * kDeg;
-    s.vehicle.flight_path_rad = get<double>(veh, "vehicle", "flight_path_deg", 0.0) * kDeg;
-    s.segments = parseSegments(child(veh, "segments"));
+void parseOrbit(const YAML::Node& orbit, sim::ScenarioConfig& s) {
+  s.orbit = true;
+  bus::KeyReader r(orbit, "orbit");
+  for (const char* key : {"altitude_km", "inclination_deg", "latitude_deg", "longitude_deg"}) {
+    if (!r.present(key))
+      throw ConfigError("configuration orbit." + std::string(key) + " is missing");
   }
-  const std::string gravity =
-      get<std::string>(root, "", "gravity", s.orbit ? "point_mass" : "wgs84");
-  if (gravity == "wgs84")
-    s.gravity = core::earth::GravityModel::kWgs84Normal;
-  else if (gravity == "point_mass")
-    s.gravity = core::earth::GravityModel::kPointMass;
-  else
-    throw ConfigError("configuration gravity = '" + gravity + "' is not wgs84 or point_mass");
+  r.number("altitude_km", s.orbit_start.altitude_m, {100, 50000}, kKilometre)
+      .number("inclination_deg", s.orbit_start.inclination_rad, {0, 180}, kDegree)
+      .number("latitude_deg", s.orbit_start.latitude_rad, {-90, 90}, kDegree)
+      .number("longitude_deg", s.orbit_start.longitude_rad, {-180, 180}, kDegree)
+      .finish();
+  if (std::abs(s.orbit_start.latitude_rad) > s.orbit_start.inclination_rad) {
+    throw ConfigError("configuration orbit.latitude_deg exceeds orbit.inclination_deg");
+  }
+  s.gravity = core::earth::GravityModel::kPointMass;  // seed 001: spherical Earth
+}
 
-  const YAML::Node timing = root["timing"];
-  checkKeys(timing, "timing",
-            {"start", "duration_s", "pacing", "fast_pacing_block_s", "wait_for_readers_s",
-             "min_readers", "imu_rate_hz", "raw_rate_hz", "gnss_rate_hz", "star_tracker_rate_hz"});
+void parseVehicle(const YAML::Node& veh, sim::ScenarioConfig& s) {
+  const core::earth::Geodetic default_site = s.vehicle.position;
+  s.vehicle.position = bus::getGeodeticDeg(veh, "vehicle", &default_site);
+  s.vehicle.roll_pitch_yaw_rad = bus::getRollPitchYawDeg(veh, "vehicle");
+  s.vehicle.heading_rad = s.vehicle.roll_pitch_yaw_rad.z();  // along the body unless given
+  bus::KeyReader r(veh, "vehicle");
+  r.nested({"latitude_deg", "longitude_deg", "height_m", "roll_deg", "pitch_deg", "yaw_deg",
+            "segments"})
+      .number("speed_mps", s.vehicle.speed_mps, {0, 1e4})
+      .number("heading_deg", s.vehicle.heading_rad, kAny, kDegree)
+      .number("flight_path_deg", s.vehicle.flight_path_rad, kAny, kDegree)
+      .finish();
+  s.segments = parseSegments(child(veh, "segments"));
+}
+
+/// "now" or GPS nanoseconds.
+void parseStart(const YAML::Node& timing, SimConfig& c) {
   const std::string start = get<std::string>(timing, "timing", "start", "now");
-  if (start == "now") {
-    c.start_now = true;
-  } else {
-    c.start_now = false;
-    try {
-      s.start_time_ns = static_cast<std::int64_t>(std::stoull(start));
-    } catch (const std::exception&) {
-      throw ConfigError("configuration timing.start = '" + start +
-                        "' is neither 'now' nor GPS nanoseconds");
-    }
+  c.start_now = start == "now";
+  if (c.start_now) return;
+  try {
+    c.scenario.start_time_ns = static_cast<std::int64_t>(std::stoull(start));
+  } catch (const std::exception&) {
+    throw ConfigError("configuration timing.start = '" + start +
+                      "' is neither 'now' nor GPS nanoseconds");
   }
-  c.duration_s =
-      checkRange(get<double>(timing, "timing", "duration_s", 0.0), 0, 1e7, "timing.duration_s");
-  const std::string pacing = get<std::string>(timing, "timing", "pacing", "realtime");
-  if (pacing == "realtime")
-    c.pacing = Pacing::kRealTime;
-  else if (pacing == "fast")
-    c.pacing = Pacing::kFast;
-  else
-    throw ConfigError("configuration timing.pacing = '" + pacing + "' is not realtime or fast");
-  c.fast_pacing_block_s =
-      get<double>(timing, "timing", "fast_pacing_block_s", SimConfig{}.fast_pacing_block_s);
-  c.wait_for_readers_s = checkRange(get<double>(timing, "timing", "wait_for_readers_s", 10.0), 0,
-                                    3600, "timing.wait_for_readers_s");
-  const YAML::Node wait = child(timing, "min_readers");
-  checkKeys(wait, "timing.min_readers", {"imu", "raw_imu", "gnss", "star_tracker"});
-  auto readers = [&](const char* key, int fallback) {
-    return static_cast<int>(checkRange(get<int>(wait, "timing.min_readers", key, fallback), 0, 64,
-                                       std::string("timing.min_readers.") + key));
-  };
-  c.min_readers.imu = readers("imu", 1);
-  c.min_readers.raw_imu = readers("raw_imu", 0);
-  c.min_readers.gnss = readers("gnss", 1);
-  c.min_readers.star_tracker = readers("star_tracker", 1);
-  const double imu_hz = checkRange(get<double>(timing, "timing", "imu_rate_hz", 100.0), 1, 2000,
-                                   "timing.imu_rate_hz");
+}
+
+/// Sample rates: the IMU's period in whole nanoseconds, the others whole multiples of it.
+/// Returns the raw rate [Hz] (the dither and vibration bands are checked against it).
+double parseRates(bus::KeyReader& r, sim::ScenarioConfig& s) {
+  double imu_hz = 1e9 / static_cast<double>(s.imu_period_ns);
+  double raw_hz = imu_hz * s.raw_samples_per_increment;
+  double gnss_hz = s.gnss_every_n_increments > 0 ? imu_hz / s.gnss_every_n_increments : 0.0;
+  double st_hz =
+      s.star_tracker_every_n_increments > 0 ? imu_hz / s.star_tracker_every_n_increments : 0.0;
+  r.number("imu_rate_hz", imu_hz, {1, 2000})
+      .number("raw_rate_hz", raw_hz, {1, 10000})
+      .number("gnss_rate_hz", gnss_hz, {0, 100})
+      .number("star_tracker_rate_hz", st_hz, {0, 100});
   const double period_ns = 1e9 / imu_hz;
   if (std::abs(period_ns - std::round(period_ns)) > 1e-6) {
     throw ConfigError("configuration timing.imu_rate_hz = " + std::to_string(imu_hz) +
                       " does not give an integer period in nanoseconds");
   }
   s.imu_period_ns = std::llround(period_ns);
-  const double raw_hz = checkRange(get<double>(timing, "timing", "raw_rate_hz", 2400.0), 1, 10000,
-                                   "timing.raw_rate_hz");
   s.raw_samples_per_increment =
       ratio(raw_hz, imu_hz, "timing.imu_rate_hz (raw_rate_hz / imu_rate_hz)");
   if (s.raw_samples_per_increment > 256) {
@@ -346,155 +316,159 @@ SimConfig parseSimConfig(const YAML::Node& root) {
                       std::to_string(s.raw_samples_per_increment) +
                       " exceeds 256 samples per block");
   }
-  const double gnss_hz =
-      checkRange(get<double>(timing, "timing", "gnss_rate_hz", 1.0), 0, 100, "timing.gnss_rate_hz");
   s.gnss_every_n_increments = gnss_hz > 0 ? ratio(imu_hz, gnss_hz, "timing.gnss_rate_hz") : 0;
-  const double st_hz = checkRange(get<double>(timing, "timing", "star_tracker_rate_hz", 5.0), 0,
-                                  100, "timing.star_tracker_rate_hz");
   s.star_tracker_every_n_increments =
       st_hz > 0 ? ratio(imu_hz, st_hz, "timing.star_tracker_rate_hz") : 0;
+  return raw_hz;
+}
 
-  const YAML::Node imu = root["imu"];
+double parseTiming(const YAML::Node& timing, SimConfig& c) {
+  parseStart(timing, c);
+  bus::KeyReader r(timing, "timing");
+  r.nested({"start", "min_readers"})
+      .number("duration_s", c.duration_s, {0, 1e7})
+      .choice("pacing", c.pacing, {{"realtime", Pacing::kRealTime}, {"fast", Pacing::kFast}})
+      .number("fast_pacing_block_s", c.fast_pacing_block_s, kAny)
+      .number("wait_for_readers_s", c.wait_for_readers_s, {0, 3600});
+  const double raw_hz = parseRates(r, c.scenario);
+  r.finish();
+  bus::KeyReader readers(child(timing, "min_readers"), "timing.min_readers");
+  readers.integer("imu", c.min_readers.imu, {0, 64})
+      .integer("raw_imu", c.min_readers.raw_imu, {0, 64})
+      .integer("gnss", c.min_readers.gnss, {0, 64})
+      .integer("star_tracker", c.min_readers.star_tracker, {0, 64})
+      .finish();
+  return raw_hz;
+}
+
+void parseImu(const YAML::Node& imu, sim::ImuSpec& spec) {
   checkImuKeys(imu);
-  parseTriad(imu, "accel_", kMicroG, kMicroG, kMicroG, "accel_noise_ug_per_sqrthz", s.imu.accel);
+  parseTriad(imu, "accel_", kMicroG, kMicroG, kMicroG, "accel_noise_ug_per_sqrthz", spec.accel);
   parseTriad(imu, "gyro_", kDegPerHour, kDegPerHour, kDeg / 60.0, "gyro_arw_deg_per_sqrth",
-             s.imu.gyro);
+             spec.gyro);
+  bus::KeyReader r(imu, "imu");
   // Seed 004 gives the gyro white noise as a rate density [deg/s/sqrt(Hz)]; same quantity.
-  if (imu && imu["gyro_noise_dps_per_sqrthz"]) {
-    s.imu.gyro.random_walk = get<double>(imu, "imu", "gyro_noise_dps_per_sqrthz", 0.0) * kDeg;
-  }
-  // Velocity random walk may also be given per sqrt(h) (seed 001: 10 ug/sqrt(h)).
-  if (imu && imu["accel_vrw_ug_per_sqrth"]) {
-    s.imu.accel.random_walk =
-        get<double>(imu, "imu", "accel_vrw_ug_per_sqrth", 0.0) * kMicroG / 60.0;
-  }
-  s.imu.gyro_g_sensitivity.diagonal() =
+  r.number("gyro_noise_dps_per_sqrthz", spec.gyro.random_walk, kAny, kDegree)
+      // Velocity random walk may also be given per sqrt(h) (seed 001: 10 ug/sqrt(h)).
+      .number("accel_vrw_ug_per_sqrth", spec.accel.random_walk, kAny, kMicroGPerSqrtHour)
+      .number("accel_quantum_mps", spec.accel.quantum, kAny)
+      .number("gyro_quantum_urad", spec.gyro.quantum, kAny, kMicroRad);
+  spec.gyro_g_sensitivity.diagonal() =
       bus::getVector3(imu, "imu", "gyro_g_sensitivity_deg_per_h_per_g", kDegPerHour / kG);
-  s.imu.accel.quantum = get<double>(imu, "imu", "accel_quantum_mps", 0.0);
-  s.imu.gyro.quantum = get<double>(imu, "imu", "gyro_quantum_urad", 0.0) * 1e-6;
+}
 
-  const YAML::Node dither = root["dither"];
-  checkKeys(dither, "dither",
-            {"enabled", "frequencies_hz", "peak_rate_min_dps", "peak_rate_max_dps",
-             "accel_cross_axis_mg", "accel_own_axis_mg", "trapping_rate_dps"});
-  s.dither = get<bool>(dither, "dither", "enabled", false);
-  s.dither_spec.frequency_hz =
-      bus::getVector3(dither, "dither", "frequencies_hz", 1.0, s.dither_spec.frequency_hz);
-  s.dither_spec.peak_rate_min_radps =
-      get<double>(dither, "dither", "peak_rate_min_dps", 70.0) * kDeg;
-  s.dither_spec.peak_rate_max_radps =
-      get<double>(dither, "dither", "peak_rate_max_dps", 130.0) * kDeg;
-  if (s.dither_spec.peak_rate_min_radps > s.dither_spec.peak_rate_max_radps) {
+void parseDither(const YAML::Node& dither, double raw_hz, sim::ScenarioConfig& s) {
+  sim::DitherSpec& d = s.dither_spec;
+  bus::KeyReader r(dither, "dither");
+  r.value("enabled", s.dither)
+      .nested({"frequencies_hz"})
+      .number("peak_rate_min_dps", d.peak_rate_min_radps, kAny, kDegree)
+      .number("peak_rate_max_dps", d.peak_rate_max_radps, kAny, kDegree)
+      .number("accel_cross_axis_mg", d.accel_cross_axis_mps2, kAny, kMilliGravity)
+      .number("accel_own_axis_mg", d.accel_own_axis_mps2, kAny, kMilliGravity)
+      .number("trapping_rate_dps", d.trapping_rate_radps, kAny, kDegree)
+      .finish();
+  d.frequency_hz = bus::getVector3(dither, "dither", "frequencies_hz", 1.0, d.frequency_hz);
+  if (d.peak_rate_min_radps > d.peak_rate_max_radps) {
     throw ConfigError("configuration dither.peak_rate_min_dps exceeds dither.peak_rate_max_dps");
   }
   for (int i = 0; i < 3; ++i) {
-    if (s.dither && s.dither_spec.frequency_hz[i] * 2 >= raw_hz) {
-      throw ConfigError("configuration dither.frequencies_hz[" + std::to_string(i) +
-                        "] = " + std::to_string(s.dither_spec.frequency_hz[i]) +
-                        " is above the raw Nyquist frequency");
+    if (s.dither && d.frequency_hz[i] * 2 >= raw_hz) {
+      throw ConfigError("configuration dither.frequencies_hz[" + std::to_string(i) + "] = " +
+                        std::to_string(d.frequency_hz[i]) + " is above the raw Nyquist frequency");
     }
   }
-  s.dither_spec.accel_cross_axis_mps2 =
-      get<double>(dither, "dither", "accel_cross_axis_mg", 5.0) * 1e-3 * kG;
-  s.dither_spec.accel_own_axis_mps2 =
-      get<double>(dither, "dither", "accel_own_axis_mg", 1.0) * 1e-3 * kG;
-  s.dither_spec.trapping_rate_radps =
-      get<double>(dither, "dither", "trapping_rate_dps", 0.5) * kDeg;
+}
 
-  const YAML::Node vib = root["vibration"];
-  checkKeys(vib, "vibration",
-            {"enabled", "accel_rms_mg", "gyro_rms_dps", "isolator_corner_hz", "moving_speed_mps"});
-  s.vibration.enabled = get<bool>(vib, "vibration", "enabled", false);
-  s.vibration.accel_rms_mps2 = checkRange(get<double>(vib, "vibration", "accel_rms_mg",
-                                                      s.vibration.accel_rms_mps2 / units::kMilliG),
-                                          0.0, 1e4, "vibration.accel_rms_mg") *
-                               units::kMilliG;
-  s.vibration.gyro_rms_radps =
-      checkRange(get<double>(vib, "vibration", "gyro_rms_dps", s.vibration.gyro_rms_radps / kDeg),
-                 0.0, 1e3, "vibration.gyro_rms_dps") *
-      kDeg;
-  s.vibration.isolator_corner_hz =
-      get<double>(vib, "vibration", "isolator_corner_hz", s.vibration.isolator_corner_hz);
-  if (s.vibration.enabled) {  // the corner must lie below the raw stream's Nyquist frequency
-    checkRange(s.vibration.isolator_corner_hz, 0.1, raw_hz / 2.0 * 0.9,
-               "vibration.isolator_corner_hz");
+void parseVibration(const YAML::Node& vib, double raw_hz, sim::VibrationSpec& v) {
+  bus::KeyReader r(vib, "vibration");
+  r.value("enabled", v.enabled)
+      .number("accel_rms_mg", v.accel_rms_mps2, {0.0, 1e4}, kMilliG)
+      .number("gyro_rms_dps", v.gyro_rms_radps, {0.0, 1e3}, kDegree)
+      .number("isolator_corner_hz", v.isolator_corner_hz, kAny)
+      .number("moving_speed_mps", v.moving_speed_mps, {0.0, 1e3})
+      .finish();
+  if (v.enabled) {  // the corner must lie below the raw stream's Nyquist frequency
+    checkRange(v.isolator_corner_hz, 0.1, raw_hz / 2.0 * 0.9, "vibration.isolator_corner_hz");
   }
-  s.vibration.moving_speed_mps =
-      checkRange(get<double>(vib, "vibration", "moving_speed_mps", s.vibration.moving_speed_mps),
-                 0.0, 1e3, "vibration.moving_speed_mps");
+}
 
-  const YAML::Node gnss = root["gnss"];
-  checkKeys(
-      gnss, "gnss",
-      {"planes", "satellites_per_plane", "eccentricity", "elevation_mask_deg", "max_satellites",
-       "fixed_satellites", "clock_bias_m", "clock_drift_mps", "clock_bias_noise_m_per_sqrts",
-       "clock_drift_noise_mps_per_sqrts", "pseudorange_sigma_m", "pseudorange_rate_sigma_mps",
-       "fix", "fix_position_sigma_m", "fix_velocity_sigma_mps"});
-  s.constellation.planes =
-      static_cast<int>(checkRange(get<int>(gnss, "gnss", "planes", 6), 1, 8, "gnss.planes"));
-  s.constellation.satellites_per_plane = static_cast<int>(checkRange(
-      get<int>(gnss, "gnss", "satellites_per_plane", 4), 1, 5, "gnss.satellites_per_plane"));
-  s.constellation.eccentricity =
-      checkRange(get<double>(gnss, "gnss", "eccentricity", 0.0), 0, 0.1, "gnss.eccentricity");
-  s.gnss.elevation_mask_rad = checkRange(get<double>(gnss, "gnss", "elevation_mask_deg", 5.0), -90,
-                                         60, "gnss.elevation_mask_deg") *
-                              kDeg;
-  s.gnss.max_satellites = static_cast<int>(
-      checkRange(get<int>(gnss, "gnss", "max_satellites", 12), 1, 32, "gnss.max_satellites"));
-  s.gnss.fixed_satellites = static_cast<int>(
-      checkRange(get<int>(gnss, "gnss", "fixed_satellites", 0), 0, 32, "gnss.fixed_satellites"));
-  s.gnss.clock_bias_m = get<double>(gnss, "gnss", "clock_bias_m", 3000.0);
-  s.gnss.clock_drift_mps = get<double>(gnss, "gnss", "clock_drift_mps", 1.0);
-  s.gnss.clock_bias_noise_m_per_sqrts =
-      checkRange(get<double>(gnss, "gnss", "clock_bias_noise_m_per_sqrts", 0.0), 0, 1e3,
-                 "gnss.clock_bias_noise_m_per_sqrts");
-  s.gnss.clock_drift_noise_mps_per_sqrts =
-      checkRange(get<double>(gnss, "gnss", "clock_drift_noise_mps_per_sqrts", 0.0), 0, 1e2,
-                 "gnss.clock_drift_noise_mps_per_sqrts");
-  s.gnss.pseudorange_sigma_m = checkRange(get<double>(gnss, "gnss", "pseudorange_sigma_m", 3.0),
-                                          1e-3, 1e3, "gnss.pseudorange_sigma_m");
-  s.gnss.pseudorange_rate_sigma_mps =
-      checkRange(get<double>(gnss, "gnss", "pseudorange_rate_sigma_mps", 0.05), 1e-4, 100,
-                 "gnss.pseudorange_rate_sigma_mps");
-  const std::string fix = get<std::string>(gnss, "gnss", "fix", "least_squares");
-  if (fix != "least_squares" && fix != "error_model") {
-    throw ConfigError("configuration gnss.fix = '" + fix + "' is not least_squares or error_model");
+void parseGnss(const YAML::Node& gnss, sim::ScenarioConfig& s) {
+  sim::GnssReceiverConfig& g = s.gnss;
+  bus::KeyReader r(gnss, "gnss");
+  r.integer("planes", s.constellation.planes, {1, 8})
+      .integer("satellites_per_plane", s.constellation.satellites_per_plane, {1, 5})
+      .number("eccentricity", s.constellation.eccentricity, {0, 0.1})
+      .number("elevation_mask_deg", g.elevation_mask_rad, {-90, 60}, kDegree)
+      .integer("max_satellites", g.max_satellites, {1, 32})
+      .integer("fixed_satellites", g.fixed_satellites, {0, 32})
+      .number("clock_bias_m", g.clock_bias_m, kAny)
+      .number("clock_drift_mps", g.clock_drift_mps, kAny)
+      .number("clock_bias_noise_m_per_sqrts", g.clock_bias_noise_m_per_sqrts, {0, 1e3})
+      .number("clock_drift_noise_mps_per_sqrts", g.clock_drift_noise_mps_per_sqrts, {0, 1e2})
+      .number("pseudorange_sigma_m", g.pseudorange_sigma_m, {1e-3, 1e3})
+      .number("pseudorange_rate_sigma_mps", g.pseudorange_rate_sigma_mps, {1e-4, 100})
+      .choice("fix", g.fix_least_squares, {{"least_squares", true}, {"error_model", false}})
+      .number("fix_position_sigma_m", g.fix_pos_sigma_m, {1e-3, 1e3})
+      .number("fix_velocity_sigma_mps", g.fix_vel_sigma_mps, {1e-4, 100})
+      .finish();
+}
+
+void parseStarTracker(const YAML::Node& st, sim::StarTrackerSpec& t) {
+  bus::KeyReader r(st, "star_tracker");
+  r.number("sigma_arcsec", t.noise_rad, {0, 3600}, kArcsecond)
+      .number("bias_arcsec", t.bias_rad, {0, 3600}, kArcsecond)
+      .number("bias_correlation_time_s", t.bias_correlation_time_s, {1e-3, 1e7})
+      .number("dropout_probability", t.dropout_probability, {0, 1})
+      .finish();
+}
+
+/// Instance keys, and which streams are published (GNSS and star tracker: when they have a
+/// rate, unless said otherwise).
+void parseOutputs(const YAML::Node& root, SimConfig& c) {
+  bus::KeyReader ids(root["ids"], "ids");
+  ids.value("imu", c.imu_sensor_id)
+      .value("gnss_receiver", c.gnss_receiver_id)
+      .value("star_tracker", c.star_tracker_id)
+      .finish();
+  c.publish_gnss = c.scenario.gnss_every_n_increments > 0;
+  c.publish_star_tracker = c.scenario.star_tracker_every_n_increments > 0;
+  bus::KeyReader publish(root["publish"], "publish");
+  publish.value("raw_imu", c.publish_raw)
+      .value("gnss", c.publish_gnss)
+      .value("star_tracker", c.publish_star_tracker)
+      .finish();
+}
+}  // namespace
+
+SimConfig parseSimConfig(const YAML::Node& root) {
+  SimConfig c;
+  sim::ScenarioConfig& s = c.scenario;
+  bus::KeyReader top(root, "");
+  top.value("name", s.name)
+      .value("seed", s.seed)
+      .nested({"vehicle", "orbit", "timing", "imu", "dither", "vibration", "gnss", "star_tracker",
+               "faults", "ids", "publish"});
+  const YAML::Node veh = root["vehicle"];
+  const YAML::Node orbit = root["orbit"];
+  if (veh && orbit) throw ConfigError("configuration has both vehicle and orbit; choose one");
+  if (orbit) {
+    parseOrbit(orbit, s);
+  } else {
+    parseVehicle(veh, s);
   }
-  s.gnss.fix_least_squares = fix == "least_squares";
-  s.gnss.fix_pos_sigma_m = checkRange(get<double>(gnss, "gnss", "fix_position_sigma_m", 2.5), 1e-3,
-                                      1e3, "gnss.fix_position_sigma_m");
-  s.gnss.fix_vel_sigma_mps = checkRange(get<double>(gnss, "gnss", "fix_velocity_sigma_mps", 0.1),
-                                        1e-4, 100, "gnss.fix_velocity_sigma_mps");
-
-  const YAML::Node st = root["star_tracker"];
-  checkKeys(st, "star_tracker",
-            {"sigma_arcsec", "bias_arcsec", "bias_correlation_time_s", "dropout_probability"});
-  s.star_tracker.noise_rad = checkRange(get<double>(st, "star_tracker", "sigma_arcsec", 0.3), 0,
-                                        3600, "star_tracker.sigma_arcsec") *
-                             kArcsec;
-  s.star_tracker.bias_rad = checkRange(get<double>(st, "star_tracker", "bias_arcsec", 0.0), 0, 3600,
-                                       "star_tracker.bias_arcsec") *
-                            kArcsec;
-  s.star_tracker.bias_correlation_time_s =
-      checkRange(get<double>(st, "star_tracker", "bias_correlation_time_s", 300.0), 1e-3, 1e7,
-                 "star_tracker.bias_correlation_time_s");
-  s.star_tracker.dropout_probability =
-      checkRange(get<double>(st, "star_tracker", "dropout_probability", 0.0), 0, 1,
-                 "star_tracker.dropout_probability");
-
+  top.choice("gravity", s.gravity,
+             {{"wgs84", core::earth::GravityModel::kWgs84Normal},
+              {"point_mass", core::earth::GravityModel::kPointMass}})
+      .finish(bus::kParticipantKeys);
+  const double raw_hz = parseTiming(root["timing"], c);
+  parseImu(root["imu"], s.imu);
+  parseDither(root["dither"], raw_hz, s);
+  parseVibration(root["vibration"], raw_hz, s.vibration);
+  parseGnss(root["gnss"], s);
+  parseStarTracker(root["star_tracker"], s.star_tracker);
   s.faults = parseFaults(root["faults"]);
-
-  const YAML::Node ids = root["ids"];
-  checkKeys(ids, "ids", {"imu", "gnss_receiver", "star_tracker"});
-  c.imu_sensor_id = get<std::uint32_t>(ids, "ids", "imu", 1);
-  c.gnss_receiver_id = get<std::uint32_t>(ids, "ids", "gnss_receiver", 1);
-  c.star_tracker_id = get<std::uint32_t>(ids, "ids", "star_tracker", 1);
-  const YAML::Node pub = root["publish"];
-  checkKeys(pub, "publish", {"raw_imu", "gnss", "star_tracker"});
-  c.publish_raw = get<bool>(pub, "publish", "raw_imu", true);
-  c.publish_gnss = get<bool>(pub, "publish", "gnss", s.gnss_every_n_increments > 0);
-  c.publish_star_tracker =
-      get<bool>(pub, "publish", "star_tracker", s.star_tracker_every_n_increments > 0);
+  parseOutputs(root, c);
   return c;
 }
 

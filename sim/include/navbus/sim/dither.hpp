@@ -12,16 +12,21 @@
 
 #include <Eigen/Core>
 
+#include "navbus/core/math/units.hpp"
+
 namespace navbus::sim {
 
 struct DitherSpec {
   Eigen::Vector3d frequency_hz{373.0, 441.0, 409.0};  ///< x, y, z gyros (unit tested in seed 003)
-  double peak_rate_min_radps{70.0 * M_PI / 180};
-  double peak_rate_max_radps{130.0 * M_PI / 180};
-  double accel_cross_axis_mps2{0.05};  ///< dither of another axis seen by an accelerometer
-  double accel_own_axis_mps2{0.01};    ///< own axis: weaker
-  double amplitude_knot_s{0.05};       ///< spacing of the random peak-rate knots
-  double trapping_rate_radps{0.5 * M_PI / 180};  ///< difference-frequency amplitude in gyro outputs
+  double peak_rate_min_radps{70.0 * units::kDeg};
+  double peak_rate_max_radps{130.0 * units::kDeg};
+  double accel_cross_axis_mps2{
+      5.0 * 1e-3 *
+      units::kStandardGravity};  ///< 5 mg  ///< dither of another axis seen by an accelerometer
+  double accel_own_axis_mps2{1.0 * 1e-3 * units::kStandardGravity};  ///< own axis: weaker
+  double amplitude_knot_s{0.05};  ///< spacing of the random peak-rate knots
+  double trapping_rate_radps{0.5 *
+                             units::kDeg};  ///< difference-frequency amplitude in gyro outputs
   std::uint64_t seed{1};
 };
 

@@ -5,14 +5,15 @@
 #include <random>
 #include <vector>
 
+#include "navbus/core/math/units.hpp"
 #include "navbus/sim/constellation.hpp"
 #include "navbus/sim/samples.hpp"
 
 namespace navbus::sim {
 
 struct GnssReceiverConfig {
-  double elevation_mask_rad{5.0 * M_PI / 180.0};
-  int max_satellites{32};       ///< keep at most this many (highest elevation first)
+  double elevation_mask_rad{5.0 * units::kDeg};
+  int max_satellites{12};       ///< keep at most this many (highest elevation first)
   int fixed_satellites{0};      ///< >0: track only the N highest at the first epoch (seed 000: 4)
   double clock_bias_m{3000.0};  ///< c * receiver clock bias at t = 0 (seed 000 eq. 3)
   double clock_drift_mps{1.0};  ///< c * receiver clock drift at t = 0

@@ -8,11 +8,13 @@
 
 #include <Eigen/Geometry>
 
+#include "navbus/core/math/units.hpp"
+
 namespace navbus::sim {
 
 struct StarTrackerSpec {
-  double noise_rad{0.3 / 3600.0 * M_PI / 180};  ///< white, 1 sigma per axis (0.3 arcsec)
-  double bias_rad{5.0 / 3600.0 * M_PI / 180};   ///< Gauss-Markov bias, 1 sigma per axis (5 arcsec)
+  double noise_rad{0.3 * units::kArcsec};  ///< white, 1 sigma per axis (0.3 arcsec)
+  double bias_rad{0.0};                    ///< Gauss-Markov bias, 1 sigma per axis
   double bias_correlation_time_s{300.0};
   double dropout_probability{0.0};  ///< per sample
 };

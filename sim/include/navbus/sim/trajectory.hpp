@@ -10,6 +10,7 @@
 
 #include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/math/earth.hpp"
+#include "navbus/core/math/units.hpp"
 
 namespace navbus::sim {
 
@@ -44,7 +45,7 @@ struct Segment {
 };
 
 struct VehicleStart {
-  core::earth::Geodetic position;
+  core::earth::Geodetic position{36.5 * units::kDeg, 127.5 * units::kDeg, 100.0};  ///< seed 000
   double speed_mps{0.0};
   double heading_rad{0.0};      ///< velocity track angle from north
   double flight_path_rad{0.0};  ///< velocity elevation

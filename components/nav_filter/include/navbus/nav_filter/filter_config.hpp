@@ -12,6 +12,7 @@
 #include "navbus/bus/topics.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/math/units.hpp"
 
 namespace navbus::nav_filter {
 
@@ -45,8 +46,8 @@ struct FilterConfig {
   std::int64_t recovery_onset_margin_ns{5'000'000'000};
   /// Largest bias a CMD_COMPENSATE_BIAS may add [m/s^2, rad/s]; beyond, refused. A
   /// CMD_RELEARN_BIAS whose bias_sigma exceeds it re-learns up to it (counted).
-  double max_accel_compensation_mps2{0.5};
-  double max_gyro_compensation_radps{1e-3};
+  double max_accel_compensation_mps2{50.0 * units::kMilliG};
+  double max_gyro_compensation_radps{200.0 * units::kDegPerHour};
   /// QoS profile of the solution writer (qos/navbus_qos.xml): navbus_solution_writer, or
   /// navbus_solution_writer_lossless for recording fast-paced runs.
   std::string solution_writer_profile{bus::profile::kSolutionWriter};

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "navbus/core/math/earth.hpp"
+#include "navbus/core/math/units.hpp"
 
 namespace navbus::core {
 
@@ -12,17 +13,17 @@ enum class FusionStructure { kCentralized, kFederated, kAdaptive };
 struct FilterTuning {
   earth::GravityModel gravity{earth::GravityModel::kWgs84Normal};
   // Process noise densities.
-  double accel_noise_mps2_per_sqrthz{1e-4};
-  double gyro_noise_radps_per_sqrthz{1e-6};
+  double accel_noise_mps2_per_sqrthz{10.0 * units::kMicroG};       ///< 10 ug/sqrt(Hz)
+  double gyro_noise_radps_per_sqrthz{0.001 * units::kDeg / 60.0};  ///< 0.001 deg/sqrt(h)
   double clock_bias_noise_m_per_sqrts{0.1};
   double clock_drift_noise_mps_per_sqrts{0.01};
   // Initial 1-sigma (also the values the covariance reset rules re-initialize to).
   double pos_sigma_m{40.0};
   double vel_sigma_mps{1.0};
   double level_sigma_rad{1e-3};
-  double heading_sigma_rad{5e-3};
-  double accel_bias_sigma_mps2{1e-2};
-  double gyro_bias_sigma_radps{5e-6};
+  double heading_sigma_rad{5.0 * 1e-3};
+  double accel_bias_sigma_mps2{1000.0 * units::kMicroG};     ///< 1000 ug
+  double gyro_bias_sigma_radps{1.0 * units::kDeg / 3600.0};  ///< 1 deg/h
   double clock_bias_sigma_m{3000.0};
   double clock_drift_sigma_mps{1.0};
   double gate_sigma{5.0};  ///< innovation gate in standard deviations; <= 0: no gate
@@ -35,7 +36,7 @@ struct FilterTuning {
   int adaptive_window{50};                ///< innovations per estimate [epochs]
   double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]
   double adaptive_floor_velocity_mps{0.01};
-  double adaptive_floor_attitude_rad{1e-6};
+  double adaptive_floor_attitude_rad{0.2 * units::kArcsec};
   bool adaptive_floor_at_reported{true};  ///< R never below the measurement's own R
   // A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its output error (a stuck value minus the true
   // specific force or rate) is modelled as a bias with this random walk, and its variance grows

@@ -3,6 +3,8 @@
 // counts as stationary, and the stage timing and constraint sigmas.
 #pragma once
 
+#include "navbus/core/math/units.hpp"
+
 namespace navbus::core {
 
 enum class MdfStage { kF1ZeroVelocity, kF2Gnss, kF3Recovery, kF4Constraint };
@@ -32,10 +34,10 @@ enum class ResetForm { kPaper, kInflate };
 enum class CovarianceReset { kNone, kFs, kFsA, kFsI, kAll };
 
 struct StationarityConfig {
-  double window_s{1.0};          ///< detection window
-  double accel_std_mps2{0.03};   ///< specific-force scatter below this ...
-  double gyro_std_radps{0.005};  ///< ... and angular-rate scatter below this ...
-  double speed_mps{0.3};         ///< ... and estimated ground speed below this: stationary
+  double window_s{1.0};                      ///< detection window
+  double accel_std_mps2{0.03};               ///< specific-force scatter below this ...
+  double gyro_std_radps{0.3 * units::kDeg};  ///< ... and angular-rate scatter below this ...
+  double speed_mps{0.3};  ///< ... and estimated ground speed below this: stationary
 };
 
 struct MdfConfig {
