@@ -442,6 +442,10 @@ void parseOutputs(const YAML::Node& root, SimConfig& c) {
 }  // namespace
 
 SimConfig parseSimConfig(const YAML::Node& root) {
+  bus::requireMapOrAbsent(root, "");
+  const YAML::Node veh = root["vehicle"];
+  const YAML::Node orbit = root["orbit"];
+  if (veh && orbit) throw ConfigError("configuration has both vehicle and orbit; choose one");
   SimConfig c;
   sim::ScenarioConfig& s = c.scenario;
   bus::KeyReader top(root, "");
@@ -449,9 +453,6 @@ SimConfig parseSimConfig(const YAML::Node& root) {
       .value("seed", s.seed)
       .nested({"vehicle", "orbit", "timing", "imu", "dither", "vibration", "gnss", "star_tracker",
                "faults", "ids", "publish"});
-  const YAML::Node veh = root["vehicle"];
-  const YAML::Node orbit = root["orbit"];
-  if (veh && orbit) throw ConfigError("configuration has both vehicle and orbit; choose one");
   if (orbit) {
     parseOrbit(orbit, s);
   } else {

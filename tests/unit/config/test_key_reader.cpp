@@ -1,6 +1,7 @@
 // bus::KeyReader: a block's keys read over member defaults, converted once, range-checked, and
 // any key nothing read refused; and the parsers built on it give the structs' own defaults for
 // every key a file leaves out (one place per default).
+#include <functional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -14,13 +15,14 @@ namespace {
 
 constexpr FileUnit kMilliG{[](double v) { return v * units::kMilliG; }};
 
-std::string errorOf(const std::function<void()>& fn) {
+/// Expects `fn` to throw a ConfigError whose message contains `part`.
+void expectError(const std::function<void()>& fn, const std::string& part) {
   try {
     fn();
+    ADD_FAILURE() << "no ConfigError; expected one saying '" << part << "'";
   } catch (const ConfigError& e) {
-    return e.what();
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
   }
-  return "";
 }
 
 struct Block {
@@ -59,21 +61,21 @@ TEST(KeyReader, PresentKeysAreConvertedOnce) {
 }
 
 TEST(KeyReader, ErrorsNameThePathAndTheValue) {
-  EXPECT_NE(errorOf([] { read("{accel_mg: 200}"); }).find("block.accel_mg = 200 is outside"),
-            std::string::npos);
-  EXPECT_NE(errorOf([] { read("{window: 2.5}"); }).find("block.window = 2.5"), std::string::npos);
-  EXPECT_NE(errorOf([] { read("{accel_mgg: 1}"); }).find("block.accel_mgg: unknown key"),
-            std::string::npos);
-  EXPECT_NE(errorOf([] { read("{wait_s: soon}"); }).find("block.wait_s"), std::string::npos);
+  expectError([] { read("{accel_mg: 200}"); }, "block.accel_mg = 200 is outside");
+  expectError([] { read("{window: 2.5}"); }, "block.window = 2.5");
+  expectError([] { read("{accel_mgg: 1}"); }, "block.accel_mgg: unknown key");
+  expectError([] { read("{wait_s: soon}"); }, "block.wait_s");
 }
 
 TEST(KeyReader, ChoiceListsTheNames) {
   enum class Mode { kA, kB };
   Mode m = Mode::kA;
-  const std::string e = errorOf([&m] {
-    KeyReader(YAML::Load("{mode: c}"), "").choice("mode", m, {{"a", Mode::kA}, {"b", Mode::kB}});
-  });
-  EXPECT_NE(e.find("mode = 'c' is not one of a | b"), std::string::npos) << e;
+  expectError(
+      [&m] {
+        KeyReader(YAML::Load("{mode: c}"), "")
+            .choice("mode", m, {{"a", Mode::kA}, {"b", Mode::kB}});
+      },
+      "mode = 'c' is not one of a | b");
 }
 
 TEST(OnePlacePerDefault, AFilterFileWithoutKeysGivesTheStructsDefaults) {
