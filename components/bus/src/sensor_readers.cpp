@@ -39,10 +39,12 @@ ReaderCallbacks SensorReaders::callbacks(StreamKind kind) {
             events_.deadline_missed(kind, *id);
         };
   }
-  if (events_.writers_gone) {
+  if (events_.writers_gone || events_.writers_alive) {
     callbacks.on_liveliness = [this,
                                kind](const eprosima::fastdds::dds::LivelinessChangedStatus& st) {
-      if (st.alive_count == 0 && st.alive_count_change < 0) events_.writers_gone(kind);
+      if (events_.writers_gone && st.alive_count == 0 && st.alive_count_change < 0)
+        events_.writers_gone(kind);
+      if (events_.writers_alive) events_.writers_alive(kind, st.alive_count > 0);
     };
   }
   return callbacks;

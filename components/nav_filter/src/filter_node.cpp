@@ -55,10 +55,7 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
            [this](const navbus::NavigationSolution& s) { low_latency_writer_.write(s); }}),
       not_producing_ns_(
           std::max(kNotProducingMinNs, kNotProducingPeriods * config.engine.solution_period_ns)),
-      sensors_(p, {[this](bus::StreamKind kind, std::uint32_t id) {
-                 pipeline_.onStreamEnded(kind, id);
-                 if (kind == bus::StreamKind::kImu && on_imu_ended_) on_imu_ended_();
-               }}) {
+      sensors_(p, sensorEvents()) {
   using namespace bus;
   sensors_.subscribe<navbus::ImuIncrement>(profile::kSensorReader,
                                            [this](const auto& m) { pipeline_.onImu(m); });
@@ -83,7 +80,7 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });
   if (config.fault_monitor) watchFaultMonitor(*config.fault_monitor);
-  p.addTimer(std::chrono::milliseconds(20), [this] {
+  p.addTimer(std::chrono::nanoseconds(kPumpPeriodNs), [this] {
     if (monitor_) pipeline_.setFaultMonitorAlive(monitor_->alive(steadyNowNs()));
     pump();
     updateState();
@@ -91,6 +88,18 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   p.addTimer(std::chrono::nanoseconds(config.engine.solution_period_ns),
              [this] { pipeline_.publishHeldSolution(); });
   updateState();
+}
+
+bus::SensorReaders::Events FilterNode::sensorEvents() {
+  bus::SensorReaders::Events events;
+  events.ended = [this](bus::StreamKind kind, std::uint32_t id) {
+    pipeline_.onStreamEnded(kind, id);
+    if (kind == bus::StreamKind::kImu && on_imu_ended_) on_imu_ended_();
+  };
+  events.writers_alive = [this](bus::StreamKind kind, bool alive) {
+    pipeline_.setWritersAlive(kind, alive);
+  };
+  return events;
 }
 
 void FilterNode::watchFaultMonitor(const FaultMonitorWatch& watch) {
@@ -114,7 +123,13 @@ void FilterNode::watchFaultMonitor(const FaultMonitorWatch& watch) {
 }
 
 void FilterNode::pump() {
-  pipeline_.pump(steadyNowNs());
+  const std::int64_t now = steadyNowNs();
+  // The loop runs at least every timer period; a much longer pause means this process was not
+  // running (SIGSTOP, a debugger, page-fault storms, CPU starvation or VM steal time).
+  if (last_pump_ns_ >= 0 && now - last_pump_ns_ > kStallNs)
+    pipeline_.resumedAfterStall(now, now - last_pump_ns_);
+  last_pump_ns_ = now;
+  pipeline_.pump(now);
 }
 
 void FilterNode::updateState() {

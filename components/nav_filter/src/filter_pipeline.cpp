@@ -4,7 +4,6 @@
 #include <array>
 
 #include <cmath>
-#include <sstream>
 #include <type_traits>
 
 #include <spdlog/spdlog.h>
@@ -12,6 +11,7 @@
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/nav_filter/engine_commands.hpp"
+#include "navbus/nav_filter/pipeline_summary.hpp"
 #include "navbus/nav_filter/solution_messages.hpp"
 
 namespace navbus::nav_filter {
@@ -65,10 +65,11 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
                            FilterInput input) {
+  if (sequencer_.late(id, time_ns) && mergeLate(id, time_ns, input)) return;
   switch (sequencer_.push(id, time_ns, std::move(input))) {
     case InputSequencer<FilterInput>::PushResult::kQueued:
       break;
-    case InputSequencer<FilterInput>::PushResult::kLate:
+    case InputSequencer<FilterInput>::PushResult::kLate:  // older than the history reaches
       gate.unaccept();
       gate.reject({navbus::REJECT_LATE, "time_gps_ns", static_cast<double>(time_ns)}, id.sensor_id);
       break;
@@ -89,7 +90,7 @@ bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, StreamId id
   if (!expected) {
     // A stream this configuration does not use (e.g. pseudoranges in loosely coupled mode):
     // counted in the summary, not validated, not a rejection of bad data.
-    ++unused_samples_;
+    ++counters_.unused_samples;
     return false;
   }
   if (!sequencer_.expects(id)) {
@@ -152,25 +153,27 @@ void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
 void FilterPipeline::startNewRun() {
   flush(last_pump_ns_);
   const std::size_t dropped = sequencer_.newRun({kRankImu, config_.imu.id});
-  solutions_earlier_runs_ += solution_seq_;
-  increments_earlier_runs_ += engine_.counters().imu_used;
+  counters_.solutions_earlier_runs += solution_seq_;
+  counters_.increments_earlier_runs += engine_.counters().imu_used;
   engine_ = core::NavigationEngine(config_.engine);
   history_ =
-      InputHistory<FilterInput>(config_.recovery_history_ns, config_.recovery_snapshot_period_ns);
+      InputHistory<MergedInput>(config_.recovery_history_ns, config_.recovery_snapshot_period_ns);
   replay_.clear();
   predictor_.reset();
   low_latency_seq_ = 0;
   first_input_ns_ = -1;
   solution_seq_ = 0;
   diagnostics_seq_ = 0;
+  published_up_to_ns_ = -1;
+  diagnosed_up_to_ns_ = -1;
   time_reference_.latest_ns = 0;
   for (bus::StreamGate* g : {&gnss_obs_gate_, &gnss_fix_gate_, &star_gate_})
     g->tracker().resetAll();
-  ++new_runs_;
+  ++counters_.new_runs;
   spdlog::warn(
       "the IMU source restarted at an earlier time: new run {} (the filter starts over; "
       "{} held inputs of the previous run could not be released)",
-      new_runs_, dropped);
+      counters_.new_runs, dropped);
 }
 
 void FilterPipeline::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
@@ -182,9 +185,17 @@ void FilterPipeline::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
 
 void FilterPipeline::pump(std::int64_t now_ns) {
   last_pump_ns_ = now_ns;
-  sequencer_.release(now_ns, [this](StreamId, std::int64_t time_ns, const FilterInput& in) {
-    process(time_ns, in);
+  sequencer_.release(now_ns, [this](StreamId id, std::int64_t time_ns, const FilterInput& in) {
+    process(id, time_ns, in);
   });
+}
+
+void FilterPipeline::resumedAfterStall(std::int64_t now_ns, std::int64_t stalled_ns) {
+  sequencer_.restartWait(now_ns);
+  ++counters_.stalls;
+  counters_.longest_stall_ns = std::max(counters_.longest_stall_ns, stalled_ns);
+  spdlog::warn("filter not running for {:.3f} s (stopped, starved of CPU): waits start again",
+               1e-9 * static_cast<double>(stalled_ns));
 }
 
 void FilterPipeline::flush(std::int64_t now_ns) {
@@ -196,23 +207,26 @@ void FilterPipeline::flush(std::int64_t now_ns) {
   }
 }
 
-std::int64_t FilterPipeline::timeOf(const FilterInput& input) {
-  return std::visit([](const auto& in) -> std::int64_t { return in.time_ns; }, input);
-}
-
-void FilterPipeline::process(std::int64_t time_ns, const FilterInput& input) {
-  if (const auto* cmd = std::get_if<CommandInput>(&input); cmd != nullptr && !replaying_) {
+void FilterPipeline::process(StreamId stream, std::int64_t time_ns, const FilterInput& input) {
+  if (const auto* cmd = std::get_if<CommandInput>(&input);
+      cmd != nullptr && !replaying_ && !cmd->reapply) {
     executeCommand(cmd->command);  // checks, records and applies it (or restores and replays)
     return;
   }
-  history_.record(time_ns, input, engine_);
+  history_.record(time_ns, {stream, time_ns, input}, engine_);
   if (first_input_ns_ < 0 && !std::holds_alternative<CommandInput>(input))
     first_input_ns_ = time_ns;
   if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {
-    if (engine_.addImu(*inc) && !replaying_) publishSolution();
+    if (engine_.addImu(*inc) && !replaying_ && time_ns > published_up_to_ns_) {
+      published_up_to_ns_ = time_ns;  // each solution time once, also after a rewind
+      publishSolution();
+    }
   } else if (const auto* epoch = std::get_if<GnssEpochInput>(&input)) {
-    if (engine_.addGnssEpoch(epoch->time_ns, epoch->satellites) && !replaying_)
+    if (engine_.addGnssEpoch(epoch->time_ns, epoch->satellites) && !replaying_ &&
+        time_ns > diagnosed_up_to_ns_) {
+      diagnosed_up_to_ns_ = time_ns;
       publishDiagnostics();
+    }
   } else if (const auto* fix = std::get_if<core::GnssFixMeasurement>(&input)) {
     engine_.addGnssFix(*fix);
   } else if (const auto* st = std::get_if<core::StarAttitudeMeasurement>(&input)) {
@@ -220,6 +234,27 @@ void FilterPipeline::process(std::int64_t time_ns, const FilterInput& input) {
   } else if (const auto* cmd = std::get_if<CommandInput>(&input)) {
     applyToEngine(cmd->command);  // re-processed after a rollback: checked when it first came
   }
+}
+
+bool FilterPipeline::countRecovery(bool restored) {
+  ++(restored ? counters_.onset_recoveries : counters_.onset_beyond_history);
+  return restored;
+}
+
+bool FilterPipeline::mergeLate(StreamId id, std::int64_t time_ns, FilterInput& input) {
+  const std::optional<std::int64_t> kept_up_to = history_.rewindBefore(time_ns, engine_, replay_);
+  if (!kept_up_to) return false;
+  for (MergedInput& item : replay_) {
+    if (auto* cmd = std::get_if<CommandInput>(&item.input)) cmd->reapply = true;
+  }
+  sequencer_.rewind(*kept_up_to, replay_);
+  replay_.clear();
+  ++counters_.rewinds;
+  if (sequencer_.push(id, time_ns, std::move(input)) !=
+      InputSequencer<FilterInput>::PushResult::kQueued)
+    return false;
+  ++counters_.late_merged;
+  return true;
 }
 
 void FilterPipeline::publishDiagnostics() {
@@ -246,7 +281,7 @@ void FilterPipeline::publishHeldSolution() {
 void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
   // Decisions are facts (idl/Fault.idl): the filter acts on commands only. It counts what it
   // saw so that the summary shows decisions that came without a command.
-  ++decisions_seen_;
+  ++counters_.decisions_seen;
   spdlog::info("decision {} ({}): event {} source {} sv {} axis {} statistic {:.4g} / {:.4g}",
                d.decision_id(), d.detector(), static_cast<int>(d.event()),
                static_cast<int>(d.source()), d.sv_id(), d.axis(), d.test_statistic(),
@@ -258,11 +293,28 @@ bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
   if (!flag) return false;
   flags_.applyStreamCommand(c, *flag);
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM && *flag == navbus::FAULT_IMU_STREAM_LOST) {
-    sequencer_.setActive({kRankImu, config_.imu.id}, false);
-    engine_.markInertialLost();
+    if (imu_writers_alive_) {  // a stalled or starved process between them: data will come
+      spdlog::warn("IMU declared lost while its writer is alive: flagged; the merge waits for it");
+    } else {
+      setImuLost();
+    }
   }
   publishHeldSolution();
   return true;
+}
+
+void FilterPipeline::setImuLost() {
+  sequencer_.setActive({kRankImu, config_.imu.id}, false);
+  engine_.markInertialLost();
+}
+
+void FilterPipeline::setWritersAlive(bus::StreamKind kind, bool alive) {
+  if (kind != bus::StreamKind::kImu || alive == imu_writers_alive_) return;
+  imu_writers_alive_ = alive;
+  if (!alive && (flags_.flags() & navbus::FAULT_IMU_STREAM_LOST) != 0) {
+    setImuLost();
+    publishHeldSolution();
+  }
 }
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c,
@@ -299,21 +351,23 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
     why = *refusal;
     reason = navbus::REJECT_OUT_OF_RANGE;
   } else if (history_.enabled() && answersFaultWithOnset(c) &&
-             history_.rollback(restorePoint(c, config_.recovery_onset_margin_ns), engine_,
-                               replay_)) {
+             countRecovery(history_.rollback(restorePoint(c, config_.recovery_onset_margin_ns),
+                                             engine_, replay_))) {
     // Restored to before the onset: the command applies there, and what followed is
     // re-processed without the fault (nothing is published meanwhile: those solutions went out).
     const std::int64_t restored_ns = engine_.state().time_ns;
-    history_.record(restored_ns, CommandInput{restored_ns, c}, engine_);
+    history_.record(restored_ns,
+                    {kRestoredCommandStream, restored_ns, CommandInput{restored_ns, c}}, engine_);
     applied = applyToEngine(c);
     replaying_ = true;
-    for (const FilterInput& item : replay_) process(timeOf(item), item);
+    for (const MergedInput& item : replay_) process(item.stream, item.time_ns, item.input);
     replaying_ = false;
     spdlog::warn("command {}: filter restored to {:.3f} s (onset {:.3f} s), {} inputs re-processed",
                  c.command_id(), 1e-9 * static_cast<double>(restored_ns),
                  1e-9 * static_cast<double>(c.onset_time_gps_ns()), replay_.size());
   } else {
-    history_.record(engine_.state().time_ns, CommandInput{engine_.state().time_ns, c}, engine_);
+    const std::int64_t now_ns = engine_.state().time_ns;
+    history_.record(now_ns, {{kRankCommand, 0}, now_ns, CommandInput{now_ns, c}}, engine_);
     applied = applyToEngine(c);
     why = "not available in the configured mode";
   }
@@ -334,42 +388,8 @@ bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
 }
 
 std::string FilterPipeline::summary() const {
-  const core::EngineCounters& n = engine_.counters();
-  const CommandCounters& k = commands_.counters();
-  std::ostringstream out;
-  out << "increments integrated " << n.imu_used << " refused by the engine " << n.imu_refused
-      << ", solutions published " << solution_seq_ << ", inertial gaps " << n.imu_gaps
-      << ", GNSS epochs fused " << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
-      << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
-      << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
-      << ", stage switches " << n.stage_switches << ", decisions seen " << decisions_seen_
-      << ", commands applied " << k.applied << " refused " << k.refused << " (unauthorized issuer "
-      << k.unauthorized << ", issuer not the writer's identity " << k.impersonated << ", stale "
-      << k.stale << ") late " << k.late << ", re-learn sigmas clamped to the compensation limit "
-      << k.relearn_clamped << ", sequencer timeouts " << sequencer_.timeouts() << ", pending "
-      << sequencer_.pending() << ", recoveries from onset " << history_.rollbacks()
-      << " (onset beyond history " << history_.outOfReach() << ")";
-  if (flags_.monitorLosses() > 0) {
-    out << ", fault monitor found not alive " << flags_.monitorLosses() << " time(s)"
-        << (flags_.faultMonitorAlive() ? "" : " (still not)");
-  }
-  if (config_.engine.start == core::StartSource::kAligned)
-    out << ", " << describeAlignment(engine_);
-  if (config_.engine.integrity.enabled) {
-    out << ", protection-level epochs " << engine_.protectionLevelEpochs() << " refused "
-        << engine_.protectionLevelEpochsRefused();
-  }
-  if (config_.low_latency_output) {
-    const core::OutputPredictorCounters& l = predictor_.counters();
-    out << ", low-latency outputs " << l.outputs << " (increments not after the anchor "
-        << l.before_anchor << ", out of order " << l.not_after_previous << ", gaps " << l.gaps
-        << ", beyond the buffer " << l.overflow << ")";
-  }
-  if (new_runs_ > 0) {
-    out << ", new runs after a source restart " << new_runs_ << " (before the latest: solutions "
-        << solutions_earlier_runs_ << ", increments " << increments_earlier_runs_ << ")";
-  }
-  return out.str();
+  return describePipeline({config_, engine_, commands_.counters(), flags_, predictor_.counters(),
+                           counters_, solution_seq_, sequencer_.timeouts(), sequencer_.pending()});
 }
 
 }  // namespace navbus::nav_filter

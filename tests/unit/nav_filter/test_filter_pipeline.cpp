@@ -66,6 +66,49 @@ TEST(FilterPipelineCommands, StaleCommandOfAnEarlierRunIsRefused) {
   EXPECT_EQ(commands->rejected.at(REJECT_STALE), 1u);
 }
 
+// An IMU stream declared lost while its writer is alive (the fault manager saw a silence a
+// stalled process caused) only flags the solutions: increments that come are integrated. Once
+// no writer is alive, the filter holds its last solution (inertial lost).
+TEST(FilterPipelineCommands, ImuDeclaredLostWhileItsWriterIsAliveOnlyFlags) {
+  const auto cfg = nav_filter::parseFilterConfig(
+      YAML::Load("initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
+                 "inputs: {imu: {id: 1, period_s: 0.01}}\n"));
+  bus::HealthCounters health("test");
+  std::vector<NavigationSolution> solutions;
+  nav_filter::FilterPipeline pipeline(
+      cfg, health, {[&](const NavigationSolution& s) { solutions.push_back(s); }, nullptr});
+  sim::ScenarioConfig src_cfg;
+  src_cfg.start_time_ns = 1'400'000'000'000'000'000;
+  sim::ScenarioSource src(src_cfg);
+  std::uint64_t seq = 0;
+  std::int64_t now = 0;
+  auto feed = [&](int n) {
+    for (int k = 0; k < n; ++k) {
+      pipeline.onImu(bus::toIdl(src.next().increment, 1, ++seq));
+      pipeline.pump(now += 10'000'000);
+    }
+  };
+  pipeline.setWritersAlive(bus::StreamKind::kImu, true);
+  feed(100);
+  FilterCommand lost;
+  lost.command_id(1);
+  lost.vehicle_id(1);
+  lost.kind(CMD_EXCLUDE_STREAM);
+  lost.sensor(SOURCE_IMU_STREAM);
+  lost.sensor_id(1);
+  lost.issuer("fault-manager");
+  lost.time_gps_ns(static_cast<std::uint64_t>(solutions.back().time_gps_ns()));
+  pipeline.onCommand(lost);
+  const std::size_t before = solutions.size();
+  feed(100);
+  ASSERT_EQ(solutions.size(), before + 10) << "the increments are integrated";
+  EXPECT_NE(solutions.back().mode(), MODE_INERTIAL_LOST);
+  EXPECT_NE(solutions.back().active_fault_flags() & FAULT_IMU_STREAM_LOST, 0u) << "and flagged";
+
+  pipeline.setWritersAlive(bus::StreamKind::kImu, false);
+  EXPECT_EQ(solutions.back().mode(), MODE_INERTIAL_LOST);
+}
+
 namespace {
 
 nav_filter::FilterConfig imuOnlyConfig() {

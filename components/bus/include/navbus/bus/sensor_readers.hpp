@@ -31,6 +31,8 @@ class SensorReaders {
     /// samples are kept out and counted either way).
     std::function<void(StreamKind, std::uint32_t sensor_id, std::uint64_t time_gps_ns)>
         second_writer{};
+    /// Whether any writer of the topic is alive, at each change of its liveliness.
+    std::function<void(StreamKind, bool alive)> writers_alive{};
   };
 
   SensorReaders(Participant& participant, Events events)

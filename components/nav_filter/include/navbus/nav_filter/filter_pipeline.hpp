@@ -28,6 +28,7 @@
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/input_history.hpp"
 #include "navbus/nav_filter/input_sequencer.hpp"
+#include "navbus/nav_filter/pipeline_summary.hpp"
 #include "navbus/nav_filter/solution_flags.hpp"
 
 namespace navbus::nav_filter {
@@ -46,10 +47,24 @@ struct GnssEpochInput {
 struct CommandInput {
   std::int64_t time_ns{0};
   navbus::FilterCommand command;
+  /// Processed again after a rewind: it was checked when it first came, and applies as then.
+  bool reapply{false};
 };
 
 using FilterInput = std::variant<core::ImuIncrement, GnssEpochInput, core::GnssFixMeasurement,
                                  core::StarAttitudeMeasurement, CommandInput>;
+
+/// An input as the ordered merge released it: kept in the history, so that it can be merged
+/// again in its place (InputSequencer::rewind).
+struct MergedInput {
+  StreamId stream;
+  std::int64_t time_ns;
+  FilterInput input;
+};
+
+/// The merge key of a command applied where the filter was restored to (before the onset of
+/// the fault it answers): first among the inputs of its time.
+inline constexpr StreamId kRestoredCommandStream{-1, 0};
 
 class FilterPipeline {
  public:
@@ -94,6 +109,15 @@ class FilterPipeline {
   /// Processes every input that can no longer be preceded by another; `now_ns` is the clock
   /// that bounds the wait for a silent stream (steady time on the bus, data time offline).
   void pump(std::int64_t now_ns);
+  /// The participant was not running for `stalled_ns` until `now_ns` (stopped, starved of
+  /// CPU): the bounded wait for a silent stream starts again, since nothing could arrive
+  /// meanwhile. Logged and counted.
+  void resumedAfterStall(std::int64_t now_ns, std::int64_t stalled_ns);
+  /// Whether any writer of the stream is alive (DDS liveliness). An IMU stream declared lost
+  /// (CMD_EXCLUDE_STREAM) while its writer is alive only flags the solutions: the merge keeps
+  /// waiting for its increments, which a stalled or starved process between them delays but
+  /// does not lose; once no writer is alive, the filter goes on without it.
+  void setWritersAlive(bus::StreamKind kind, bool alive);
   /// End of input (offline): releases everything still held, as the bounded wait would on
   /// the bus once every stream has fallen silent.
   void flush(std::int64_t now_ns);
@@ -107,7 +131,7 @@ class FilterPipeline {
   /// DEGRADED).
   bool degraded() const { return flags_.degraded(); }
   /// New runs started because the IMU source restarted at an earlier time.
-  std::uint64_t newRuns() const { return new_runs_; }
+  std::uint64_t newRuns() const { return counters_.new_runs; }
   const core::NavigationEngine& engine() const { return engine_; }
   std::string summary() const;
 
@@ -116,8 +140,12 @@ class FilterPipeline {
   bool admit(bus::StreamGate& gate, const Sample& msg, StreamId id,
              const std::optional<InputConfig>& expected);
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
-  void process(std::int64_t time_ns, const FilterInput& input);
-  static std::int64_t timeOf(const FilterInput& input);
+  void process(StreamId stream, std::int64_t time_ns, const FilterInput& input);
+  /// A sample whose place in the order was already passed: the engine is restored to before
+  /// it (input history) and what followed is merged again with it. False beyond the history.
+  bool mergeLate(StreamId id, std::int64_t time_ns, FilterInput& input);
+  /// Counts a restore to before a fault's onset (or one the history could not reach).
+  bool countRecovery(bool restored);
   bool applyToEngine(const navbus::FilterCommand& c);
   void executeCommand(const navbus::FilterCommand& c);
   /// The IMU source restarted at an earlier time (a restarted simulator replaying its
@@ -131,12 +159,14 @@ class FilterPipeline {
   /// Propagates the low-latency output with an arrived increment and publishes it.
   void publishLowLatency(const core::ImuIncrement& inc);
   bool applyStreamCommand(const navbus::FilterCommand& c);
+  /// The merge stops waiting for the IMU and the engine holds its last solution.
+  void setImuLost();
 
   FilterConfig config_;
   Sinks sinks_;
   InputSequencer<FilterInput> sequencer_;
-  InputHistory<FilterInput> history_;
-  std::deque<FilterInput> replay_;
+  InputHistory<MergedInput> history_;
+  std::deque<MergedInput> replay_;
   bool replaying_{false};
   core::NavigationEngine engine_;
   core::OutputPredictor predictor_;
@@ -153,14 +183,15 @@ class FilterPipeline {
   SolutionFlags flags_;  ///< stream-lost and fault-monitor flags of the solutions
   std::uint64_t solution_seq_{0};
   std::uint64_t diagnostics_seq_{0};
-  std::uint64_t decisions_seen_{0};
   std::int64_t first_input_ns_{-1};  ///< data time of the first input processed (-1: none yet)
   CommandGate commands_;             ///< who may command what; the command counters
-  std::uint64_t unused_samples_{0};  ///< samples of streams the configuration does not use
-  std::uint64_t new_runs_{0};
-  std::uint64_t solutions_earlier_runs_{0};   ///< published before the latest new run
-  std::uint64_t increments_earlier_runs_{0};  ///< integrated before the latest new run
-  std::int64_t last_pump_ns_{0};              ///< the clock of the latest pump
+  std::int64_t last_pump_ns_{0};     ///< the clock of the latest pump
+  PipelineCounters counters_;
+  bool imu_writers_alive_{false};  ///< known alive (DDS liveliness; offline: never known)
+  /// Data time of the latest solution and diagnostics published: what is processed again
+  /// after a rewind is not published twice.
+  std::int64_t published_up_to_ns_{-1};
+  std::int64_t diagnosed_up_to_ns_{-1};
 };
 
 }  // namespace navbus::nav_filter

@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <deque>
+#include <limits>
+#include <optional>
 #include <variant>
 
 #include <navbus_idl/Fault.h>
@@ -38,19 +40,23 @@ class InputHistory {
       // The engine owns heap storage: every snapshot slot the span needs is made at the first
       // snapshot, so that the history allocates nothing afterwards, not even while it fills.
       if (snapshots_.empty() && snapshots_.capacity() < maxSnapshots()) {
-        snapshots_.prefill(maxSnapshots(), [&] { return Snapshot{time_ns, first_item, engine}; });
+        snapshots_.prefill(maxSnapshots(), [&] {
+          return Snapshot{time_ns, latest_ns_, first_item, engine};
+        });
       }
       snapshots_.push_back_reusing(
           [&] {
-            return Snapshot{time_ns, first_item, engine};
+            return Snapshot{time_ns, latest_ns_, first_item, engine};
           },
           [&](Snapshot& s) {
             s.time_ns = time_ns;
+            s.inputs_up_to_ns = latest_ns_;
             s.first_item = first_item;
             s.engine = engine;  // copy-assigned: storage reused
           });
     }
     items_.push_back(item);
+    latest_ns_ = std::max(latest_ns_, time_ns);
     // Forget snapshots (and the items before them) older than the span, keeping one.
     while (snapshots_.size() > 1 && time_ns - snapshots_[1].time_ns >= span_ns_) {
       snapshots_.pop_front();
@@ -65,24 +71,23 @@ class InputHistory {
   /// returns the items processed since (to be re-processed by the caller, who records them
   /// again). False when the history does not reach back to the onset.
   bool rollback(std::int64_t onset_ns, core::NavigationEngine& engine, std::deque<Item>& replay) {
-    if (!enabled()) return false;
-    for (std::size_t i = snapshots_.size(); i-- > 0;) {
-      const Snapshot& s = snapshots_[i];
-      if (!s.engine.initialized() || s.engine.state().time_ns > onset_ns) continue;
-      engine = s.engine;
-      replay.clear();
-      const std::size_t from = s.first_item - first_index_;
-      for (std::size_t k = from; k < items_.size(); ++k) replay.push_back(items_[k]);
-      items_.truncate(from);
-      snapshots_.truncate(i);
-      ++rollbacks_;
-      return true;
-    }
-    ++out_of_reach_;
-    return false;
+    return restore(engine, replay, [onset_ns](const Snapshot& s) {
+      return s.engine.initialized() && s.engine.state().time_ns <= onset_ns;
+    });
   }
 
-  std::uint64_t rollbacks() const { return rollbacks_; }
+  /// Restores the engine to the latest snapshot taken before any input at or after `time_ns`
+  /// was processed, and returns the inputs processed since (to be merged again with an input
+  /// at `time_ns` that came late). Returns the latest data time of the inputs that stay
+  /// processed; nothing when the history does not reach back so far.
+  std::optional<std::int64_t> rewindBefore(std::int64_t time_ns, core::NavigationEngine& engine,
+                                           std::deque<Item>& replay) {
+    if (!restore(engine, replay,
+                 [time_ns](const Snapshot& s) { return s.inputs_up_to_ns < time_ns; }))
+      return std::nullopt;
+    return latest_ns_;
+  }
+
   /// The most snapshots the span holds: one per period, the one kept beyond the span and the
   /// one being taken (at most 4096).
   std::size_t maxSnapshots() const {
@@ -90,22 +95,43 @@ class InputHistory {
     return static_cast<std::size_t>(
         std::min<std::int64_t>(span_ns_ / snapshot_period_ns_ + 2, 4096));
   }
-  std::uint64_t outOfReach() const { return out_of_reach_; }
 
  private:
   struct Snapshot {
-    std::int64_t time_ns;    ///< data time of the first item after it
-    std::size_t first_item;  ///< absolute index of that item
+    std::int64_t time_ns;          ///< data time of the first item after it
+    std::int64_t inputs_up_to_ns;  ///< latest data time of the items before it
+    std::size_t first_item;        ///< absolute index of that item
     core::NavigationEngine engine;
   };
+
+  /// Restores the latest snapshot `usable` accepts; the items since go to `replay`.
+  template <class Usable>
+  bool restore(core::NavigationEngine& engine, std::deque<Item>& replay, Usable usable) {
+    if (!enabled()) return false;
+    for (std::size_t i = snapshots_.size(); i-- > 0;) {
+      const Snapshot& s = snapshots_[i];
+      if (!usable(s)) continue;
+      latest_ns_ = s.inputs_up_to_ns;
+      engine = s.engine;
+      replay.clear();
+      const std::size_t from = s.first_item - first_index_;
+      for (std::size_t k = from; k < items_.size(); ++k) replay.push_back(items_[k]);
+      items_.truncate(from);
+      snapshots_.truncate(i);
+      return true;
+    }
+    return false;
+  }
+
   std::int64_t span_ns_;
   std::int64_t snapshot_period_ns_;
   // Ring buffers: in the steady state (as many forgotten as recorded) nothing is allocated.
   core::RingBuffer<Snapshot> snapshots_;
   core::RingBuffer<Item> items_;
   std::size_t first_index_{0};  ///< absolute index of items_.front()
-  std::uint64_t rollbacks_{0};
-  std::uint64_t out_of_reach_{0};
+  /// Latest data time of the items recorded (the merge releases in time order, but a command
+  /// applied at once is recorded at the engine's time, which may be earlier).
+  std::int64_t latest_ns_{std::numeric_limits<std::int64_t>::min()};
 };
 
 }  // namespace navbus::nav_filter

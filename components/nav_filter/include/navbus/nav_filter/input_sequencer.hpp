@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <tuple>
 #include <utility>
@@ -68,6 +69,11 @@ class InputSequencer {
     it->second.last_time_ns = std::max(it->second.last_time_ns, time_ns);
     queue_.insert(pendingEnd(key), {key, std::move(payload)});  // after equal keys: arrival order
     return PushResult::kQueued;
+  }
+
+  /// True if a sample of `id` at `time_ns` comes after its place in the order was passed.
+  bool late(StreamId id, std::int64_t time_ns) const {
+    return released_any_ && !(last_released_ < Key{time_ns, id});
   }
 
   /// True if the stream is configured (push would not answer kUnexpected).
@@ -131,6 +137,29 @@ class InputSequencer {
       s.last_time_ns = 0;
     }
     return dropped;
+  }
+
+  /// Rewinds the order: `items` (id, time, payload), released before and handed back by the
+  /// caller, who restored its state to before them, are pending again, each in its place.
+  /// What the caller keeps processed ends at data time `kept_up_to_ns`: samples after it are
+  /// no longer late. A late sample within the caller's history is merged so rather than
+  /// refused, and the result is the one it would have been in time.
+  template <class Items>
+  void rewind(std::int64_t kept_up_to_ns, Items& items) {
+    for (auto& [id, time_ns, payload] : items) {
+      const Key key{time_ns, id};
+      queue_.insert(pendingEnd(key), {key, std::move(payload)});
+    }
+    last_released_ = Key{kept_up_to_ns, StreamId{std::numeric_limits<int>::max(),
+                                                 std::numeric_limits<std::uint32_t>::max()}};
+    head_blocked_since_ns_ = -1;
+  }
+
+  /// The caller was not running (stopped, starved of CPU) until `wall_now_ns`: no stream can
+  /// have delivered meanwhile, so the wait for the one holding the head starts again. Silence
+  /// counts only while the caller runs.
+  void restartWait(std::int64_t wall_now_ns) {
+    if (head_blocked_since_ns_ >= 0) head_blocked_since_ns_ = wall_now_ns;
   }
 
   std::size_t pending() const { return queue_.size() - head_; }

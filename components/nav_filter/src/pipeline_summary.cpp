@@ -1,0 +1,67 @@
+#include "navbus/nav_filter/pipeline_summary.hpp"
+
+#include <sstream>
+
+#include "navbus/nav_filter/solution_messages.hpp"
+
+namespace navbus::nav_filter {
+
+namespace {
+
+void describeCounts(const PipelineView& v, std::ostringstream& out) {
+  const core::EngineCounters& n = v.engine.counters();
+  const CommandCounters& k = v.commands;
+  const PipelineCounters& p = v.counters;
+  out << "increments integrated " << n.imu_used << " refused by the engine " << n.imu_refused
+      << ", solutions published " << v.solutions_published << ", inertial gaps " << n.imu_gaps
+      << ", GNSS epochs fused " << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
+      << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
+      << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
+      << ", stage switches " << n.stage_switches << ", decisions seen " << p.decisions_seen
+      << ", commands applied " << k.applied << " refused " << k.refused << " (unauthorized issuer "
+      << k.unauthorized << ", issuer not the writer's identity " << k.impersonated << ", stale "
+      << k.stale << ") late " << k.late << ", re-learn sigmas clamped to the compensation limit "
+      << k.relearn_clamped << ", sequencer timeouts " << v.sequencer_timeouts << ", pending "
+      << v.pending << ", recoveries from onset " << p.onset_recoveries << " (onset beyond history "
+      << p.onset_beyond_history << ")"
+      << ", late samples merged by rewinding " << p.late_merged << " (rewinds " << p.rewinds << ")";
+}
+
+void describeOptional(const PipelineView& v, std::ostringstream& out) {
+  const PipelineCounters& p = v.counters;
+  if (p.stalls > 0) {
+    out << ", stalls of the filter process " << p.stalls << " (longest "
+        << 1e-9 * static_cast<double>(p.longest_stall_ns) << " s)";
+  }
+  if (v.flags.monitorLosses() > 0) {
+    out << ", fault monitor found not alive " << v.flags.monitorLosses() << " time(s)"
+        << (v.flags.faultMonitorAlive() ? "" : " (still not)");
+  }
+  if (v.config.engine.start == core::StartSource::kAligned)
+    out << ", " << describeAlignment(v.engine);
+  if (v.config.engine.integrity.enabled) {
+    out << ", protection-level epochs " << v.engine.protectionLevelEpochs() << " refused "
+        << v.engine.protectionLevelEpochsRefused();
+  }
+  if (v.config.low_latency_output) {
+    const core::OutputPredictorCounters& l = v.low_latency;
+    out << ", low-latency outputs " << l.outputs << " (increments not after the anchor "
+        << l.before_anchor << ", out of order " << l.not_after_previous << ", gaps " << l.gaps
+        << ", beyond the buffer " << l.overflow << ")";
+  }
+  if (p.new_runs > 0) {
+    out << ", new runs after a source restart " << p.new_runs << " (before the latest: solutions "
+        << p.solutions_earlier_runs << ", increments " << p.increments_earlier_runs << ")";
+  }
+}
+
+}  // namespace
+
+std::string describePipeline(const PipelineView& v) {
+  std::ostringstream out;
+  describeCounts(v, out);
+  describeOptional(v, out);
+  return out.str();
+}
+
+}  // namespace navbus::nav_filter
