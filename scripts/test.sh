@@ -2,11 +2,19 @@
 # Installs what is missing, builds, and runs every test (ctest, two at a time), then the
 # README's demo command from a fresh clone of the committed tree (tests/fresh_clone), then the
 # sanitizer stage: the unit and integration tests and a slice of each fuzz target under
-# AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh, build-san/).
+# AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh, build-san/). Each
+# stage prints how long it took.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-bash scripts/build.sh
-(cd build && ctest --output-on-failure -j2 --timeout 300)
-bash tests/fresh_clone/run_demo.sh
-bash scripts/sanitize.sh
+start=$SECONDS
+stage() {
+  local name=$1 t0=$SECONDS
+  shift
+  "$@"
+  echo "stage '$name': $((SECONDS - t0)) s (total $((SECONDS - start)) s)"
+}
+stage install bash scripts/install-deps.sh
+stage build bash scripts/build.sh
+stage ctest bash -c 'cd build && ctest --output-on-failure -j2 --timeout 300'
+stage fresh-clone-demo bash tests/fresh_clone/run_demo.sh
+stage sanitizers bash scripts/sanitize.sh
