@@ -97,7 +97,7 @@ bus::SensorReaders::Events FilterNode::sensorEvents() {
     if (kind == bus::StreamKind::kImu && on_imu_ended_) on_imu_ended_();
   };
   events.writers_alive = [this](bus::StreamKind kind, bool alive) {
-    pipeline_.setWritersAlive(kind, alive);
+    pipeline_.setWritersAlive(kind, alive, steadyNowNs());
   };
   return events;
 }

@@ -185,6 +185,7 @@ void FilterPipeline::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
 
 void FilterPipeline::pump(std::int64_t now_ns) {
   last_pump_ns_ = now_ns;
+  checkImuWriters(now_ns);
   sequencer_.release(now_ns, [this](StreamId id, std::int64_t time_ns, const FilterInput& in) {
     process(id, time_ns, in);
   });
@@ -192,6 +193,7 @@ void FilterPipeline::pump(std::int64_t now_ns) {
 
 void FilterPipeline::resumedAfterStall(std::int64_t now_ns, std::int64_t stalled_ns) {
   sequencer_.restartWait(now_ns);
+  if (imu_writers_since_ns_ >= 0) imu_writers_since_ns_ = now_ns;
   ++counters_.stalls;
   counters_.longest_stall_ns = std::max(counters_.longest_stall_ns, stalled_ns);
   spdlog::warn("filter not running for {:.3f} s (stopped, starved of CPU): waits start again",
@@ -199,9 +201,7 @@ void FilterPipeline::resumedAfterStall(std::int64_t now_ns, std::int64_t stalled
 }
 
 void FilterPipeline::flush(std::int64_t now_ns) {
-  // Each round may set one silent stream aside after the bounded wait; there are at most as
-  // many rounds as streams.
-  for (int round = 0; round < 8 && sequencer_.pending() > 0; ++round) {
+  for (int round = 0; round < 8 && sequencer_.pending() > 0; ++round) {  // a stream a round
     now_ns += config_.sequencer_max_wait_ns;
     pump(now_ns);
   }
@@ -293,11 +293,10 @@ bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
   if (!flag) return false;
   flags_.applyStreamCommand(c, *flag);
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM && *flag == navbus::FAULT_IMU_STREAM_LOST) {
-    if (imu_writers_alive_) {  // a stalled or starved process between them: data will come
-      spdlog::warn("IMU declared lost while its writer is alive: flagged; the merge waits for it");
-    } else {
-      setImuLost();
-    }
+    if (imu_writers_since_ns_ == kWritersUnknown)
+      setImuLost();  // offline: nothing tells whether a writer lives
+    else             // a stalled or starved process between them: the data may still come
+      spdlog::warn("IMU declared lost: flagged; the merge waits until its writer is gone");
   }
   publishHeldSolution();
   return true;
@@ -308,13 +307,18 @@ void FilterPipeline::setImuLost() {
   engine_.markInertialLost();
 }
 
-void FilterPipeline::setWritersAlive(bus::StreamKind kind, bool alive) {
-  if (kind != bus::StreamKind::kImu || alive == imu_writers_alive_) return;
-  imu_writers_alive_ = alive;
-  if (!alive && (flags_.flags() & navbus::FAULT_IMU_STREAM_LOST) != 0) {
-    setImuLost();
-    publishHeldSolution();
-  }
+void FilterPipeline::setWritersAlive(bus::StreamKind kind, bool alive, std::int64_t now_ns) {
+  if (kind != bus::StreamKind::kImu) return;
+  if (alive || imu_writers_since_ns_ < 0) imu_writers_since_ns_ = alive ? kWritersAlive : now_ns;
+}
+
+void FilterPipeline::checkImuWriters(std::int64_t now_ns) {
+  if (imu_writers_since_ns_ < 0 || now_ns - imu_writers_since_ns_ < config_.sequencer_max_wait_ns)
+    return;
+  imu_writers_since_ns_ = kWritersUnknown;
+  if ((flags_.flags() & navbus::FAULT_IMU_STREAM_LOST) == 0) return;
+  setImuLost();
+  publishHeldSolution();
 }
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c,

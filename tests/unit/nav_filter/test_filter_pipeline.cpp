@@ -88,7 +88,7 @@ TEST(FilterPipelineCommands, ImuDeclaredLostWhileItsWriterIsAliveOnlyFlags) {
       pipeline.pump(now += 10'000'000);
     }
   };
-  pipeline.setWritersAlive(bus::StreamKind::kImu, true);
+  pipeline.setWritersAlive(bus::StreamKind::kImu, true, now);
   feed(100);
   FilterCommand lost;
   lost.command_id(1);
@@ -105,7 +105,10 @@ TEST(FilterPipelineCommands, ImuDeclaredLostWhileItsWriterIsAliveOnlyFlags) {
   EXPECT_NE(solutions.back().mode(), MODE_INERTIAL_LOST);
   EXPECT_NE(solutions.back().active_fault_flags() & FAULT_IMU_STREAM_LOST, 0u) << "and flagged";
 
-  pipeline.setWritersAlive(bus::StreamKind::kImu, false);
+  pipeline.setWritersAlive(bus::StreamKind::kImu, false, now);
+  pipeline.pump(now += cfg.sequencer_max_wait_ns / 2);
+  EXPECT_NE(solutions.back().mode(), MODE_INERTIAL_LOST) << "gone, but not long enough yet";
+  pipeline.pump(now += cfg.sequencer_max_wait_ns);
   EXPECT_EQ(solutions.back().mode(), MODE_INERTIAL_LOST);
 }
 

@@ -114,10 +114,12 @@ class FilterPipeline {
   /// meanwhile. Logged and counted.
   void resumedAfterStall(std::int64_t now_ns, std::int64_t stalled_ns);
   /// Whether any writer of the stream is alive (DDS liveliness). An IMU stream declared lost
-  /// (CMD_EXCLUDE_STREAM) while its writer is alive only flags the solutions: the merge keeps
+  /// (CMD_EXCLUDE_STREAM) while its writer lives only flags the solutions: the merge keeps
   /// waiting for its increments, which a stalled or starved process between them delays but
-  /// does not lose; once no writer is alive, the filter goes on without it.
-  void setWritersAlive(bus::StreamKind kind, bool alive);
+  /// does not lose. Once no writer has lived for `sequencer_max_wait_s` of running time (this
+  /// process's own stall, after which its liveliness view is stale, restarts the count), the
+  /// filter goes on without it. Without this information (offline) a declaration acts at once.
+  void setWritersAlive(bus::StreamKind kind, bool alive, std::int64_t now_ns);
   /// End of input (offline): releases everything still held, as the bounded wait would on
   /// the bus once every stream has fallen silent.
   void flush(std::int64_t now_ns);
@@ -161,6 +163,8 @@ class FilterPipeline {
   bool applyStreamCommand(const navbus::FilterCommand& c);
   /// The merge stops waiting for the IMU and the engine holds its last solution.
   void setImuLost();
+  /// Applies a declared IMU loss once its writers have been gone long enough.
+  void checkImuWriters(std::int64_t now_ns);
 
   FilterConfig config_;
   Sinks sinks_;
@@ -187,7 +191,9 @@ class FilterPipeline {
   CommandGate commands_;             ///< who may command what; the command counters
   std::int64_t last_pump_ns_{0};     ///< the clock of the latest pump
   PipelineCounters counters_;
-  bool imu_writers_alive_{false};  ///< known alive (DDS liveliness; offline: never known)
+  /// Since when no IMU writer lives [steady ns], or one of these.
+  static constexpr std::int64_t kWritersUnknown = -1, kWritersAlive = -2;
+  std::int64_t imu_writers_since_ns_{kWritersUnknown};
   /// Data time of the latest solution and diagnostics published: what is processed again
   /// after a rewind is not published twice.
   std::int64_t published_up_to_ns_{-1};
