@@ -188,18 +188,14 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
   constexpr int kDomain = 89;
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("fault-loop");
-  const std::string src = NAVBUS_SOURCE_DIR;
-  const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
-  const std::string sim_cfg = test::writeFile(
-      dir / "sim.yaml", "extends: " + src + "/sim/scenarios/seed000_aircraft.yaml\n" + domain +
-                            "timing: {duration_s: 35, pacing: realtime}\n"
-                            "faults:\n  - {type: pseudorange_ramp, sv_id: 13, start_s: 20, "
-                            "slope_mps: 25, saturation_m: 250}\n");
-  const std::string filter_cfg = test::writeFile(
-      dir / "filter.yaml", "extends: " + src + "/config/filter_seed000_tc.yaml\n" + domain +
-                               "solution_writer_profile: navbus_solution_writer_lossless\n");
-  const std::string fm_cfg =
-      test::writeFile(dir / "fm.yaml", "extends: " + src + "/config/fault_manager.yaml\n" + domain);
+  const test::Seed000Loop cfg =
+      test::writeSeed000Loop(dir, kDomain,
+                             "timing: {duration_s: 35, pacing: realtime}\n"
+                             "faults:\n  - {type: pseudorange_ramp, sv_id: 13, start_s: 20, "
+                             "slope_mps: 25, saturation_m: 250}\n");
+  const std::string& sim_cfg = cfg.sim;
+  const std::string& filter_cfg = cfg.filter;
+  const std::string& fm_cfg = cfg.fault_manager;
 
   test::ChildProcess offline(
       NAVBUS_TOOL_EXE,

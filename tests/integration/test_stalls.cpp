@@ -35,16 +35,11 @@ enum class Disturbance { kStops, kCpuHogs };
 void runWith(int domain, Disturbance disturbance) {
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("stalls-" + std::to_string(domain));
-  const std::string src = NAVBUS_SOURCE_DIR;
-  const std::string dom = "domain_id: " + std::to_string(domain) + "\n";
-  const std::string sim_cfg = test::writeFile(
-      dir / "sim.yaml", "extends: " + src + "/sim/scenarios/seed000_aircraft.yaml\n" + dom +
-                            "timing: {duration_s: 300, pacing: fast}\n");
-  const std::string filter_cfg = test::writeFile(
-      dir / "filter.yaml", "extends: " + src + "/config/filter_seed000_tc.yaml\n" + dom +
-                               "solution_writer_profile: navbus_solution_writer_lossless\n");
-  const std::string fm_cfg =
-      test::writeFile(dir / "fm.yaml", "extends: " + src + "/config/fault_manager.yaml\n" + dom);
+  const test::Seed000Loop cfg =
+      test::writeSeed000Loop(dir, domain, "timing: {duration_s: 300, pacing: fast}\n");
+  const std::string& sim_cfg = cfg.sim;
+  const std::string& filter_cfg = cfg.filter;
+  const std::string& fm_cfg = cfg.fault_manager;
 
   test::ChildProcess offline(
       NAVBUS_TOOL_EXE,
