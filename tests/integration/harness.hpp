@@ -205,6 +205,26 @@ inline Seed000Loop writeSeed000Loop(const std::filesystem::path& dir, int domain
           writeFile(dir / "fm.yaml", "extends: " + src + "/config/fault_manager.yaml\n" + dom)};
 }
 
+/// `navbus offline` on the loop's files from the configured start into `dir`/offline (log
+/// beside it), with `seed` when not empty; returns its exit code (nullopt: it did not end).
+inline std::optional<int> runOffline(const Seed000Loop& loop, const std::filesystem::path& dir,
+                                     const std::string& seed = "") {
+  std::vector<std::string> args{"offline",
+                                "--scenario",
+                                loop.sim,
+                                "--filter",
+                                loop.filter,
+                                "--fault-manager",
+                                loop.fault_manager,
+                                "--start",
+                                "config",
+                                "-o",
+                                (dir / "offline").string()};
+  if (!seed.empty()) args.insert(args.end(), {"--seed", seed});
+  ChildProcess offline(NAVBUS_TOOL_EXE, args, (dir / "offline.log").string());
+  return offline.wait(std::chrono::seconds(180));
+}
+
 inline sim::ScenarioSource testScenarioSource() {
   sim::ScenarioConfig c;
   c.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};

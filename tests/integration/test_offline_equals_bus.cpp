@@ -196,13 +196,7 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
   const std::string& sim_cfg = cfg.sim;
   const std::string& filter_cfg = cfg.filter;
   const std::string& fm_cfg = cfg.fault_manager;
-
-  test::ChildProcess offline(
-      NAVBUS_TOOL_EXE,
-      {"offline", "--scenario", sim_cfg, "--filter", filter_cfg, "--fault-manager", fm_cfg,
-       "--start", "config", "-o", (dir / "offline").string()},
-      (dir / "offline.log").string());
-  ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
+  ASSERT_EQ(test::runOffline(cfg, dir), 0) << test::readFile(dir / "offline.log");
   const std::vector<std::string> expected = test::csvDataRows(dir / "offline" / "solution.csv");
   ASSERT_EQ(expected.size(), 350u);
 

@@ -40,13 +40,7 @@ void runWith(int domain, Disturbance disturbance) {
   const std::string& sim_cfg = cfg.sim;
   const std::string& filter_cfg = cfg.filter;
   const std::string& fm_cfg = cfg.fault_manager;
-
-  test::ChildProcess offline(
-      NAVBUS_TOOL_EXE,
-      {"offline", "--scenario", sim_cfg, "--filter", filter_cfg, "--fault-manager", fm_cfg,
-       "--start", "config", "--seed", "3", "-o", (dir / "offline").string()},
-      (dir / "offline.log").string());
-  ASSERT_EQ(offline.wait(180s), 0) << test::readFile(dir / "offline.log");
+  ASSERT_EQ(test::runOffline(cfg, dir, "3"), 0) << test::readFile(dir / "offline.log");
   std::vector<std::string> expected;
   for (const std::string& row : test::csvDataRows(dir / "offline" / "solution.csv"))
     expected.push_back(stateColumns(row));
