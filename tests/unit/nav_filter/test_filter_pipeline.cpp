@@ -66,20 +66,33 @@ TEST(FilterPipelineCommands, StaleCommandOfAnEarlierRunIsRefused) {
   EXPECT_EQ(commands->rejected.at(REJECT_STALE), 1u);
 }
 
+namespace {
+
+nav_filter::FilterConfig imuOnlyConfig() {
+  return nav_filter::parseFilterConfig(
+      YAML::Load("initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
+                 "inputs: {imu: {id: 1, period_s: 0.01}}\n"));
+}
+
+sim::ScenarioConfig sourceConfig() {
+  sim::ScenarioConfig c;
+  c.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
+  c.start_time_ns = 1'400'000'000'000'000'000;
+  return c;
+}
+
+}  // namespace
+
 // An IMU stream declared lost while its writer is alive (the fault manager saw a silence a
 // stalled process caused) only flags the solutions: increments that come are integrated. Once
 // no writer is alive, the filter holds its last solution (inertial lost).
 TEST(FilterPipelineCommands, ImuDeclaredLostWhileItsWriterIsAliveOnlyFlags) {
-  const auto cfg = nav_filter::parseFilterConfig(
-      YAML::Load("initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
-                 "inputs: {imu: {id: 1, period_s: 0.01}}\n"));
+  const auto cfg = imuOnlyConfig();
   bus::HealthCounters health("test");
   std::vector<NavigationSolution> solutions;
   nav_filter::FilterPipeline pipeline(
       cfg, health, {[&](const NavigationSolution& s) { solutions.push_back(s); }, nullptr});
-  sim::ScenarioConfig src_cfg;
-  src_cfg.start_time_ns = 1'400'000'000'000'000'000;
-  sim::ScenarioSource src(src_cfg);
+  sim::ScenarioSource src(sourceConfig());
   std::uint64_t seq = 0;
   std::int64_t now = 0;
   auto feed = [&](int n) {
@@ -111,23 +124,6 @@ TEST(FilterPipelineCommands, ImuDeclaredLostWhileItsWriterIsAliveOnlyFlags) {
   pipeline.pump(now += cfg.sequencer_max_wait_ns);
   EXPECT_EQ(solutions.back().mode(), MODE_INERTIAL_LOST);
 }
-
-namespace {
-
-nav_filter::FilterConfig imuOnlyConfig() {
-  return nav_filter::parseFilterConfig(
-      YAML::Load("initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
-                 "inputs: {imu: {id: 1, period_s: 0.01}}\n"));
-}
-
-sim::ScenarioConfig sourceConfig() {
-  sim::ScenarioConfig c;
-  c.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
-  c.start_time_ns = 1'400'000'000'000'000'000;
-  return c;
-}
-
-}  // namespace
 
 // A simulator restarted with its scenario starting at a fixed time sends the same times
 // again, with its sequence restarting. The filter recognises the restart once the samples

@@ -60,10 +60,8 @@ class InputSequencer {
     if (it == streams_.end()) {
       return PushResult::kUnexpected;
     }
+    if (late(id, time_ns)) return PushResult::kLate;
     const Key key{time_ns, id};
-    if (released_any_ && !(last_released_ < key)) {
-      return PushResult::kLate;
-    }
     it->second.seen = true;
     it->second.active = true;
     it->second.last_time_ns = std::max(it->second.last_time_ns, time_ns);
