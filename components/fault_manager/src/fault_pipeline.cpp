@@ -149,8 +149,10 @@ std::string FaultPipeline::summary() const {
   out << "decisions published " << decisions() << " (stream lost " << lost_ << ", restored "
       << restored_ << ", second writers " << second_writers_
       << ", deadline events not confirmed by the silence " << watchdog_.unconfirmedDeadlines()
-      << "), streams ended as announced " << ended_ << ", commands published " << commands() << "; "
-      << glr_.summary();
+      << ", of streams paced ahead of real time " << watchdog_.deadlinesAheadOfRealTime()
+      << "), streams paced ahead of real time " << watchdog_.streamsAheadOfRealTime()
+      << " (judged by their writers only), streams ended as announced " << ended_
+      << ", commands published " << commands() << "; " << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
   if (filter_new_runs_ > 0)
     out << "; GLR restarted with the filter's new runs " << filter_new_runs_;

@@ -19,11 +19,25 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
     event = WatchdogEvent{key, false, time_gps_ns,
                           1e-9 * static_cast<double>(wall_now_ns - s.last_arrival_wall_ns)};
   }
+  if (inserted) {
+    s.first_time_gps_ns = time_gps_ns;
+    s.first_arrival_wall_ns = wall_now_ns;
+  }
   s.lost = false;
   s.suspect_deadline_ns = -1;
   s.last_time_gps_ns = time_gps_ns;
   s.last_arrival_wall_ns = wall_now_ns;
+  notePace(s);
   return event;
+}
+
+void StreamWatchdog::notePace(State& s) {
+  if (s.ahead_of_real_time || s.last_time_gps_ns < s.first_time_gps_ns) return;
+  const auto data_span_ns = static_cast<std::int64_t>(s.last_time_gps_ns - s.first_time_gps_ns);
+  const std::int64_t wall_span_ns = s.last_arrival_wall_ns - s.first_arrival_wall_ns;
+  if (data_span_ns - wall_span_ns <= kAheadOfRealTimeNs) return;
+  s.ahead_of_real_time = true;
+  ++streams_ahead_;
 }
 
 std::optional<WatchdogEvent> StreamWatchdog::markLost(const StreamKey& key, State& s,
@@ -42,6 +56,10 @@ std::optional<WatchdogEvent> StreamWatchdog::onDeadlineMissed(const StreamKey& k
   // A stream never seen cannot be lost: the deadline only counts for instances that exist.
   if (it == states_.end()) return std::nullopt;
   State& st = it->second;
+  if (st.ahead_of_real_time) {
+    ++deadlines_ahead_;
+    return std::nullopt;
+  }
   if (!st.lost && wall_now_ns - st.last_arrival_wall_ns < deadline_ns) {
     ++unconfirmed_;
     st.suspect_deadline_ns = deadline_ns;

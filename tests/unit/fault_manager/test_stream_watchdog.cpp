@@ -75,3 +75,28 @@ TEST(StreamWatchdog, DeadlineEventIsConfirmedByTheOwnSilence) {
   EXPECT_TRUE(w.onTick(1900 * kMs).empty());
   EXPECT_FALSE(w.isLost(imu));
 }
+
+TEST(StreamWatchdog, StreamPacedAheadOfRealTimeIsJudgedByItsWriterOnly) {
+  // A replay at full speed: 10 s of 100 Hz data in 0.1 s of wall time, then the writer waits
+  // for a slow reliable reader. Its silence is no loss; its writer going away is.
+  constexpr std::int64_t kS = 1000 * kMs;
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1};
+  for (int i = 0; i <= 1000; ++i)
+    EXPECT_FALSE(w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, i * 100'000));
+  EXPECT_EQ(w.streamsAheadOfRealTime(), 1u);
+  EXPECT_FALSE(w.onDeadlineMissed(imu, 1 * kS, 250 * kMs));
+  EXPECT_TRUE(w.onTick(5 * kS).empty());
+  EXPECT_EQ(w.deadlinesAheadOfRealTime(), 1u);
+  EXPECT_EQ(w.onWritersGone(StreamKind::kImu, 6 * kS).size(), 1u);
+
+  // The same stream in real time (data time and wall time advance together, a reception
+  // delayed by a 1.5 s stall of this participant included) stays watched by its deadline.
+  StreamWatchdog rt;
+  for (int i = 0; i <= 1000; ++i) {
+    const std::int64_t stall = i >= 300 && i < 450 ? (450 - i) * 10 * kMs : 0;
+    EXPECT_FALSE(rt.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, i * 10 * kMs + stall));
+  }
+  EXPECT_EQ(rt.streamsAheadOfRealTime(), 0u);
+  EXPECT_TRUE(rt.onDeadlineMissed(imu, 10 * kS + 250 * kMs, 250 * kMs));
+}

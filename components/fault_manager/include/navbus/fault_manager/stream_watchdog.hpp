@@ -1,6 +1,12 @@
 // Stream watchdog state machine: one state per (stream, sensor id). DDS supplies the timing
 // (a requested deadline missed, a writer's liveliness lost); this class decides when a stream
 // is lost and when it is back, once per transition. Pure logic, unit-tested.
+//
+// Wall-clock patience is for real-time streams only. A stream whose data time has run ahead
+// of this participant's clock (a simulator in fast pacing, `navbus replay` faster than real
+// time) is written as fast as its readers take it: its writer pauses whenever a reliable
+// reader falls behind (a stopped filter), so its silences say nothing about the sensor. Such a
+// stream is judged by its writer alone: an announced end, or liveliness lost.
 #pragma once
 
 #include <cstdint>
@@ -49,6 +55,15 @@ class StreamWatchdog {
   std::vector<WatchdogEvent> onTick(std::int64_t wall_now_ns);
   /// Deadline events not confirmed at once by the participant's own clock.
   std::uint64_t unconfirmedDeadlines() const { return unconfirmed_; }
+  /// Deadline events of streams paced ahead of real time (not a loss, see the file comment).
+  std::uint64_t deadlinesAheadOfRealTime() const { return deadlines_ahead_; }
+  /// Stream runs recognised as paced ahead of real time.
+  std::uint64_t streamsAheadOfRealTime() const { return streams_ahead_; }
+  /// How far a stream's data time must run ahead of the wall clock, both counted from its
+  /// first sample, before it counts as paced ahead of real time. A real-time stream cannot get
+  /// there unless this participant was stopped for longer than this when the first sample came
+  /// (its later samples would then look early by the length of that stop).
+  static constexpr std::int64_t kAheadOfRealTimeNs = 2'000'000'000;
   /// Every writer of a topic lost liveliness: all its streams that are alive are lost.
   std::vector<WatchdogEvent> onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
 
@@ -68,12 +83,18 @@ class StreamWatchdog {
     bool lost{false};
     std::uint64_t last_time_gps_ns{0};
     std::int64_t last_arrival_wall_ns{0};
-    std::int64_t suspect_deadline_ns{-1};  ///< a DDS deadline event awaits confirmation (-1: no)
+    std::int64_t suspect_deadline_ns{-1};   ///< a DDS deadline event awaits confirmation (-1: no)
+    std::uint64_t first_time_gps_ns{0};     ///< the run's first sample: sensor time
+    std::int64_t first_arrival_wall_ns{0};  ///< ... and when it arrived
+    bool ahead_of_real_time{false};         ///< once seen ahead, for the rest of the run
   };
+  void notePace(State& s);
   std::optional<WatchdogEvent> markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns);
   std::map<StreamKey, State> states_;
   std::map<StreamKey, std::uint64_t> ended_at_;  ///< announced ends, data time
   std::uint64_t unconfirmed_{0};
+  std::uint64_t deadlines_ahead_{0};
+  std::uint64_t streams_ahead_{0};
 };
 
 }  // namespace navbus::fault_manager
