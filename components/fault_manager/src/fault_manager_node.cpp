@@ -23,9 +23,12 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
           bus::topic::kFaultDecision, bus::profile::kDecisionWriter)),
       command_writer_(p.createWriter<navbus::FilterCommandPubSubType>(
           bus::topic::kFilterCommand, bus::profile::kDecisionWriter)),
+      progress_writer_(p.createWriter<navbus::FaultMonitorProgressPubSubType>(
+          bus::topic::kFaultProgress, bus::profile::kProgressWriter)),
       pipeline_(config, p.health(),
                 {[this](const navbus::FaultDecision& d) { decision_writer_.write(d); },
-                 [this](const navbus::FilterCommand& c) { command_writer_.write(c); }},
+                 [this](const navbus::FilterCommand& c) { command_writer_.write(c); },
+                 [this](const navbus::FaultMonitorProgress& r) { progress_writer_.write(r); }},
                 bus::wallTimeNowNs()),
       sensors_(p, streamEvents()) {
   using namespace bus;

@@ -9,6 +9,10 @@
 
 namespace navbus::fault_manager {
 
+namespace {
+constexpr const char* kIssuer = "fault-manager";  ///< FilterCommand.issuer of this participant
+}  // namespace
+
 FaultPipeline::FaultPipeline(const FaultManagerConfig& config, bus::HealthCounters& health,
                              Sinks sinks, std::uint64_t run_id)
     : config_(config),
@@ -118,7 +122,10 @@ bool FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
     ++other_vehicles_;
     return false;
   }
-  if (!diagnostics_gate_.admit(msg, msg.vehicle_id(), msg.seq(), msg.time_gps_ns())) return false;
+  if (!diagnostics_gate_.admit(msg, msg.vehicle_id(), msg.seq(), msg.time_gps_ns())) {
+    reportProgress(msg);
+    return false;
+  }
   if (diagnostics_gate_.sourceRestarted()) {
     // The filter started a new run at an earlier time: its statistics start over too.
     glr_ = GlrDetector(config_.glr);
@@ -126,7 +133,20 @@ bool FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
   }
   const std::uint64_t before = glr_.counters().epochs;
   glr_.onDiagnostics(msg, *this);
+  reportProgress(msg);
   return glr_.counters().epochs != before;
+}
+
+void FaultPipeline::reportProgress(const navbus::FilterDiagnostics& judged) {
+  if (!sinks_.progress) return;
+  navbus::FaultMonitorProgress p;
+  p.vehicle_id(config_.vehicle_id);
+  p.judged_up_to_gps_ns(judged.time_gps_ns());
+  p.diagnostics_seq(judged.seq());
+  p.last_command_id(next_command_id_ - 1);
+  p.issuer(kIssuer);
+  p.run_id(run_id_);
+  sinks_.progress(p);
 }
 
 std::uint32_t FaultPipeline::decide(navbus::FaultDecision& d) {
@@ -139,7 +159,7 @@ std::uint32_t FaultPipeline::decide(navbus::FaultDecision& d) {
 void FaultPipeline::command(navbus::FilterCommand& c) {
   c.command_id(next_command_id_++);
   c.vehicle_id(config_.vehicle_id);
-  c.issuer("fault-manager");
+  c.issuer(kIssuer);
   c.run_id(run_id_);
   if (sinks_.command) sinks_.command(c);
 }

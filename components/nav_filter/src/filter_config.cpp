@@ -151,6 +151,7 @@ void parseAuthorities(const YAML::Node& root, FilterConfig& c) {
     r.value("participant", w.participant)
         .value("identity", w.identity)
         .seconds("timeout_s", w.timeout_ns, {0.1, 3600.0})
+        .seconds("judgement_wait_s", w.judgement_wait_ns, {0.001, 3600.0})
         .finish();
     c.fault_monitor = w;
   }

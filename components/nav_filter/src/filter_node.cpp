@@ -76,6 +76,9 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
       topic::kFilterCommand, profile::kDecisionReader, [this](const auto& c, const auto& info) {
         pipeline_.onCommand(c, participant_.dds().writerIdentity(info));
       });
+  p.subscribe<navbus::FaultMonitorProgressPubSubType>(
+      topic::kFaultProgress, profile::kProgressReader,
+      [this](const auto& report, const auto&) { pipeline_.onFaultMonitorProgress(report); });
   // Bounded-wait release of inputs held for a silent stream, and the held solution while
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });

@@ -10,7 +10,6 @@
 
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/topics.hpp"
-#include "navbus/nav_filter/engine_commands.hpp"
 #include "navbus/nav_filter/pipeline_summary.hpp"
 #include "navbus/nav_filter/solution_messages.hpp"
 
@@ -37,7 +36,10 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   if (c.gnss_fix) s.push_back({{kRankGnssFix, c.gnss_fix->id}, c.gnss_fix->period_ns});
   if (c.star_tracker)
     s.push_back({{kRankStarTracker, c.star_tracker->id}, c.star_tracker->period_ns});
-  s.push_back({{kRankCommand, 0}, 0, true});
+  // The fault manager's commands: sporadic, and held for where a judgement is owed.
+  const bool monitored = c.fault_monitor.has_value();
+  s.push_back(
+      {kCommandStream, 0, true, monitored, monitored ? c.fault_monitor->judgement_wait_ns : 0});
   return s;
 }
 
@@ -65,7 +67,10 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
                            FilterInput input) {
-  if (sequencer_.late(id, time_ns) && mergeLate(id, time_ns, input)) return;
+  if (sequencer_.late(id, time_ns) && mergeLate(id, time_ns, input)) {
+    ++counters_.late_merged;
+    return;
+  }
   switch (sequencer_.push(id, time_ns, std::move(input))) {
     case InputSequencer<FilterInput>::PushResult::kQueued:
       break;
@@ -201,6 +206,7 @@ void FilterPipeline::resumedAfterStall(std::int64_t now_ns, std::int64_t stalled
 }
 
 void FilterPipeline::flush(std::int64_t now_ns) {
+  sequencer_.setActive(kCommandStream, false);  // nothing more will be judged
   for (int round = 0; round < 8 && sequencer_.pending() > 0; ++round) {  // a stream a round
     now_ns += config_.sequencer_max_wait_ns;
     pump(now_ns);
@@ -236,11 +242,6 @@ void FilterPipeline::process(StreamId stream, std::int64_t time_ns, const Filter
   }
 }
 
-bool FilterPipeline::countRecovery(bool restored) {
-  ++(restored ? counters_.onset_recoveries : counters_.onset_beyond_history);
-  return restored;
-}
-
 bool FilterPipeline::mergeLate(StreamId id, std::int64_t time_ns, FilterInput& input) {
   const std::optional<std::int64_t> kept_up_to = history_.rewindBefore(time_ns, engine_, replay_);
   if (!kept_up_to) return false;
@@ -253,12 +254,12 @@ bool FilterPipeline::mergeLate(StreamId id, std::int64_t time_ns, FilterInput& i
   if (sequencer_.push(id, time_ns, std::move(input)) !=
       InputSequencer<FilterInput>::PushResult::kQueued)
     return false;
-  ++counters_.late_merged;
   return true;
 }
 
 void FilterPipeline::publishDiagnostics() {
   if (!sinks_.diagnostics) return;
+  sequencer_.owe(kCommandStream, engine_.state().time_ns);  // a command may answer it
   sinks_.diagnostics(bus::toIdl(engine_.lastEpoch(), config_.vehicle_id, ++diagnostics_seq_,
                                 engine_.state().time_ns));
 }
@@ -278,122 +279,11 @@ void FilterPipeline::publishHeldSolution() {
   if (engine_.mode() == core::EngineMode::kInertialLost) publishSolution();
 }
 
-void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
-  // Decisions are facts (idl/Fault.idl): the filter acts on commands only. It counts what it
-  // saw so that the summary shows decisions that came without a command.
-  ++counters_.decisions_seen;
-  spdlog::info("decision {} ({}): event {} source {} sv {} axis {} statistic {:.4g} / {:.4g}",
-               d.decision_id(), d.detector(), static_cast<int>(d.event()),
-               static_cast<int>(d.source()), d.sv_id(), d.axis(), d.test_statistic(),
-               d.threshold());
-}
-
-bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
-  const std::optional<std::uint32_t> flag = SolutionFlags::streamFlag(c, config_.imu.id);
-  if (!flag) return false;
-  flags_.applyStreamCommand(c, *flag);
-  if (c.kind() == navbus::CMD_EXCLUDE_STREAM && *flag == navbus::FAULT_IMU_STREAM_LOST) {
-    if (imu_writers_since_ns_ == kWritersUnknown)
-      setImuLost();  // offline: nothing tells whether a writer lives
-    else             // a stalled or starved process between them: the data may still come
-      spdlog::warn("IMU declared lost: flagged; the merge waits until its writer is gone");
-  }
-  publishHeldSolution();
-  return true;
-}
-
-void FilterPipeline::setImuLost() {
-  sequencer_.setActive({kRankImu, config_.imu.id}, false);
-  engine_.markInertialLost();
-}
-
-void FilterPipeline::setWritersAlive(bus::StreamKind kind, bool alive, std::int64_t now_ns) {
-  if (kind != bus::StreamKind::kImu) return;
-  if (alive || imu_writers_since_ns_ < 0) imu_writers_since_ns_ = alive ? kWritersAlive : now_ns;
-}
-
-void FilterPipeline::checkImuWriters(std::int64_t now_ns) {
-  if (imu_writers_since_ns_ < 0 || now_ns - imu_writers_since_ns_ < config_.sequencer_max_wait_ns)
-    return;
-  imu_writers_since_ns_ = kWritersUnknown;
-  if ((flags_.flags() & navbus::FAULT_IMU_STREAM_LOST) == 0) return;
-  setImuLost();
-  publishHeldSolution();
-}
-
-void FilterPipeline::onCommand(const navbus::FilterCommand& c,
-                               const std::optional<std::string>& writer_identity) {
-  if (!commands_.addressedToThisVehicle(c)) return;  // for another vehicle: not ours
-  if (!commands_.authorized(c, writer_identity)) return;
-  if (c.kind() == navbus::CMD_EXCLUDE_STREAM || c.kind() == navbus::CMD_READMIT_STREAM) {
-    // About the merge itself (a lost stream must stop holding it): at once.
-    if (commands_.refuseIfStale(c, first_input_ns_)) return;
-    const bool applied = applyStreamCommand(c);
-    commands_.count(applied, navbus::REJECT_UNEXPECTED_SOURCE);
-    if (!applied)
-      spdlog::warn(
-          "command {} from '{}' refused: stream source {} id {} is not a stream of this "
-          "filter",
-          c.command_id(), c.issuer(), static_cast<int>(c.sensor()), c.sensor_id());
-    return;
-  }
-  const auto time_ns = static_cast<std::int64_t>(c.time_gps_ns());
-  if (time_ns > 0 && sequencer_.push({kRankCommand, 0}, time_ns, CommandInput{time_ns, c}) ==
-                         InputSequencer<FilterInput>::PushResult::kQueued) {
-    return;  // takes effect in order, at its data time
-  }
-  if (time_ns > 0) commands_.countLate();
-  executeCommand(c);
-}
-
-void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
-  if (commands_.refuseIfStale(c, first_input_ns_)) return;
-  std::string why;
-  bool applied = false;
-  navbus::RejectReason reason = navbus::REJECT_NOT_APPLICABLE;
-  if (auto refusal = commands_.check(c)) {
-    why = *refusal;
-    reason = navbus::REJECT_OUT_OF_RANGE;
-  } else if (history_.enabled() && answersFaultWithOnset(c) &&
-             countRecovery(history_.rollback(restorePoint(c, config_.recovery_onset_margin_ns),
-                                             engine_, replay_))) {
-    // Restored to before the onset: the command applies there, and what followed is
-    // re-processed without the fault (nothing is published meanwhile: those solutions went out).
-    const std::int64_t restored_ns = engine_.state().time_ns;
-    history_.record(restored_ns,
-                    {kRestoredCommandStream, restored_ns, CommandInput{restored_ns, c}}, engine_);
-    applied = applyToEngine(c);
-    replaying_ = true;
-    for (const MergedInput& item : replay_) process(item.stream, item.time_ns, item.input);
-    replaying_ = false;
-    spdlog::warn("command {}: filter restored to {:.3f} s (onset {:.3f} s), {} inputs re-processed",
-                 c.command_id(), 1e-9 * static_cast<double>(restored_ns),
-                 1e-9 * static_cast<double>(c.onset_time_gps_ns()), replay_.size());
-  } else {
-    const std::int64_t now_ns = engine_.state().time_ns;
-    history_.record(now_ns, {{kRankCommand, 0}, now_ns, CommandInput{now_ns, c}}, engine_);
-    applied = applyToEngine(c);
-    why = "not available in the configured mode";
-  }
-  commands_.count(applied, reason);
-  if (applied) {
-    spdlog::info("command {} from '{}' applied (kind {})", c.command_id(), c.issuer(),
-                 static_cast<int>(c.kind()));
-  } else {
-    spdlog::warn("command {} from '{}' refused: kind {}: {}", c.command_id(), c.issuer(),
-                 static_cast<int>(c.kind()), why);
-  }
-}
-
-bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
-  const double relearn_sigma =
-      c.kind() == navbus::CMD_RELEARN_BIAS ? commands_.relearnSigma(c) : 0.0;
-  return applyEngineCommand(engine_, c, relearn_sigma);
-}
-
 std::string FilterPipeline::summary() const {
   return describePipeline({config_, engine_, commands_.counters(), flags_, predictor_.counters(),
-                           counters_, solution_seq_, sequencer_.timeouts(), sequencer_.pending()});
+                           counters_, solution_seq_, sequencer_.timeouts(), sequencer_.pending(),
+                           judgements_.reports(), judgements_.heldForCommand(),
+                           sequencer_.judgementTimeouts()});
 }
 
 }  // namespace navbus::nav_filter

@@ -33,6 +33,10 @@ void describeOptional(const PipelineView& v, std::ostringstream& out) {
     out << ", stalls of the filter process " << p.stalls << " (longest "
         << 1e-9 * static_cast<double>(p.longest_stall_ns) << " s)";
   }
+  if (v.progress_reports > 0 || v.judgement_timeouts > 0) {
+    out << ", fault manager's progress reports " << v.progress_reports << " (before their command "
+        << v.progress_held << "), judgements waited for beyond the budget " << v.judgement_timeouts;
+  }
   if (v.flags.monitorLosses() > 0) {
     out << ", fault monitor found not alive " << v.flags.monitorLosses() << " time(s)"
         << (v.flags.faultMonitorAlive() ? "" : " (still not)");

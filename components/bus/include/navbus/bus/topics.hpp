@@ -17,6 +17,7 @@ inline constexpr const char* kNavSolutionLowLatency = "navbus/nav/solution_low_l
 inline constexpr const char* kFilterDiagnostics = "navbus/nav/diagnostics";
 inline constexpr const char* kFaultDecision = "navbus/fault/decision";
 inline constexpr const char* kFilterCommand = "navbus/filter/command";
+inline constexpr const char* kFaultProgress = "navbus/fault/progress";
 inline constexpr const char* kHealth = "navbus/health";
 // Latency and throughput probes of `navbus latency` (ImuIncrement samples, sensor stream
 // profiles unless the user names others).
@@ -44,6 +45,8 @@ inline constexpr const char* kLowLatencySolutionWriter = "navbus_low_latency_sol
 inline constexpr const char* kLowLatencySolutionReader = "navbus_low_latency_solution_reader";
 inline constexpr const char* kDecisionWriter = "navbus_decision_writer";
 inline constexpr const char* kDecisionReader = "navbus_decision_reader";
+inline constexpr const char* kProgressWriter = "navbus_progress_writer";
+inline constexpr const char* kProgressReader = "navbus_progress_reader";
 inline constexpr const char* kDiagnosticsWriter = "navbus_diagnostics_writer";
 inline constexpr const char* kDiagnosticsReader = "navbus_diagnostics_reader";
 inline constexpr const char* kHealthWriter = "navbus_health_writer";

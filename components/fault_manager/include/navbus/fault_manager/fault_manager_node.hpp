@@ -32,6 +32,7 @@ class FaultManagerNode {
   std::function<void()> on_imu_ended_;
   bus::Writer<navbus::FaultDecision> decision_writer_;
   bus::Writer<navbus::FilterCommand> command_writer_;
+  bus::Writer<navbus::FaultMonitorProgress> progress_writer_;  ///< how far diagnostics are judged
   FaultPipeline pipeline_;
   bus::SensorReaders sensors_;  ///< the watched sensor streams (owning writers only)
 };

@@ -30,6 +30,9 @@ class FaultPipeline : private FaultOutput {
   struct Sinks {
     std::function<void(const navbus::FaultDecision&)> decision;
     std::function<void(const navbus::FilterCommand&)> command;
+    /// How far the filter's diagnostics are judged: after every epoch of this vehicle, after
+    /// the epoch's commands (may be empty).
+    std::function<void(const navbus::FaultMonitorProgress&)> progress{};
   };
 
   /// `run_id` goes into every decision and command (the run's start time on the bus, 0
@@ -55,7 +58,9 @@ class FaultPipeline : private FaultOutput {
   void setDeadline(StreamKind kind, double deadline_s) { deadline_s_[kind] = deadline_s; }
 
   /// The monitored filter's diagnostics (validated here; other vehicles are ignored). True
-  /// when the GLR evaluated the epoch (its statistic is then glr().latest()).
+  /// when the GLR evaluated the epoch (its statistic is then glr().latest()). Every epoch of
+  /// this vehicle, used or refused, is reported judged (Sinks::progress) once its commands
+  /// are out.
   bool onDiagnostics(const navbus::FilterDiagnostics& msg);
   /// A raw IMU block, for the dither monitor (watchdog bookkeeping goes through
   /// onStreamSample as for every stream).
@@ -72,6 +77,7 @@ class FaultPipeline : private FaultOutput {
   std::uint32_t decide(navbus::FaultDecision& d) override;
   void command(navbus::FilterCommand& c) override;
   void onWatchdogEvent(const WatchdogEvent& e);
+  void reportProgress(const navbus::FilterDiagnostics& judged);
 
   FaultManagerConfig config_;
   bus::HealthCounters& health_;

@@ -28,6 +28,10 @@ struct FaultMonitorWatch {
   /// are ignored and counted as unauthorized).
   std::string identity{"navbus-fault-manager"};
   std::int64_t timeout_ns{3'000'000'000};  ///< silence after which it is not alive [ns]
+  /// How long the deterministic output waits for the monitor to judge a diagnostics epoch
+  /// (FaultMonitorProgress) before it goes on without [ns]: longer than the monitor's stalls
+  /// the output should ride through (a command that comes later is merged by rewinding).
+  std::int64_t judgement_wait_ns{5'000'000'000};
 };
 
 struct FilterConfig {

@@ -28,6 +28,7 @@
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/input_history.hpp"
 #include "navbus/nav_filter/input_sequencer.hpp"
+#include "navbus/nav_filter/judgement_tracker.hpp"
 #include "navbus/nav_filter/pipeline_summary.hpp"
 #include "navbus/nav_filter/solution_flags.hpp"
 
@@ -36,6 +37,8 @@ namespace navbus::nav_filter {
 /// A command follows the measurements of its data time (the epoch its decision was taken at)
 /// in the ordered merge; the sensor streams' ranks are in bus/streams.hpp.
 inline constexpr int kRankCommand = 4;
+/// The commands' place in the merge (one stream, whoever issues them).
+inline constexpr StreamId kCommandStream{kRankCommand, 0};
 
 /// A validated GNSS observation epoch: satellite clock corrections applied.
 struct GnssEpochInput {
@@ -126,9 +129,15 @@ class FilterPipeline {
   /// While inertial data is lost, the last solution is republished (held, not propagated).
   void publishHeldSolution();
 
+  /// How far the fault manager has judged the diagnostics. Once it reports, the ordered merge
+  /// holds what follows each diagnostics epoch until that epoch is judged (within
+  /// FaultMonitorWatch::judgement_wait_ns), so that a command answering it acts where offline
+  /// it does, before the next solution is published.
+  void onFaultMonitorProgress(const navbus::FaultMonitorProgress& report);
   /// Whether a fault monitor is alive (the participant watches its reports): while not,
-  /// solutions carry FAULT_NO_FAULT_MONITOR. Changes are logged and counted.
-  void setFaultMonitorAlive(bool alive) { flags_.setFaultMonitorAlive(alive); }
+  /// solutions carry FAULT_NO_FAULT_MONITOR and no judgement is waited for. Changes are logged
+  /// and counted.
+  void setFaultMonitorAlive(bool alive);
   /// Some stream is currently lost, or no fault monitor is alive (the participant reports
   /// DEGRADED).
   bool degraded() const { return flags_.degraded(); }
@@ -189,6 +198,7 @@ class FilterPipeline {
   std::uint64_t diagnostics_seq_{0};
   std::int64_t first_input_ns_{-1};  ///< data time of the first input processed (-1: none yet)
   CommandGate commands_;             ///< who may command what; the command counters
+  JudgementTracker judgements_;      ///< the fault manager's progress reports
   std::int64_t last_pump_ns_{0};     ///< the clock of the latest pump
   PipelineCounters counters_;
   /// Since when no IMU writer lives [steady ns], or one of these.

@@ -10,7 +10,11 @@
 // again: the bounded wait that keeps a dead sensor from stalling navigation (counted in
 // timeouts()). A stream is also set aside when it is declared lost. A sporadic stream (commands)
 // promises nothing and holds nothing back: its samples are ordered by their time when they
-// arrive before that time has been passed, and are late otherwise.
+// arrive before that time has been passed, and are late otherwise. A judging stream (the fault
+// manager's commands) is sporadic, except where a judgement is owed: once the caller has
+// handed its judge something up to a time (owe) and the judge has reported before (judged),
+// nothing later is released until the judge reports that time judged, or its own budget runs
+// out; so a command answering that data takes its place in the order as it would offline.
 // Pure logic: the caller supplies wall time.
 #pragma once
 
@@ -43,13 +47,18 @@ class InputSequencer {
     /// Sporadic: no promise at all (e.g. commands). Its samples take their place in the order
     /// when they arrive in time, but it never holds the others back.
     bool sporadic{false};
+    /// Judging (with sporadic): holds the others back behind an owed judgement (owe, judged).
+    bool judging{false};
+    /// How long this stream may hold the head back [wall ns] (0: the sequencer's max_wait).
+    std::int64_t max_wait_ns{0};
   };
   enum class PushResult { kQueued, kLate, kUnexpected };
 
-  InputSequencer(std::vector<ExpectedStream> expected, std::int64_t max_wait_ns)
-      : max_wait_ns_(max_wait_ns) {
+  InputSequencer(std::vector<ExpectedStream> expected, std::int64_t max_wait_ns) {
     for (const auto& e : expected) {
-      streams_.emplace(e.id, State{e.period_ns, e.sporadic});
+      State state{e.period_ns, e.sporadic, e.judging};
+      state.max_wait_ns = e.max_wait_ns > 0 ? e.max_wait_ns : max_wait_ns;
+      streams_.emplace(e.id, state);
     }
   }
 
@@ -62,8 +71,10 @@ class InputSequencer {
     }
     if (late(id, time_ns)) return PushResult::kLate;
     const Key key{time_ns, id};
-    it->second.seen = true;
-    it->second.active = true;
+    if (!it->second.judging) {  // a judging stream is seen and active by its reports
+      it->second.seen = true;
+      it->second.active = true;
+    }
     it->second.last_time_ns = std::max(it->second.last_time_ns, time_ns);
     queue_.insert(pendingEnd(key), {key, std::move(payload)});  // after equal keys: arrival order
     return PushResult::kQueued;
@@ -86,6 +97,24 @@ class InputSequencer {
     return true;
   }
 
+  /// The caller handed the judge of `id` data up to `time_ns` (a judging stream): nothing
+  /// later is released before it is judged, once the judge has reported at all.
+  void owe(StreamId id, std::int64_t time_ns) {
+    auto it = streams_.find(id);
+    if (it != streams_.end())
+      it->second.owed_up_to_ns = std::max(it->second.owed_up_to_ns, time_ns);
+  }
+  /// The judge of `id` reports everything up to `time_ns` judged (and every sample it sent
+  /// about it arrived): the stream is seen and holds the merge back again where owed.
+  void judged(StreamId id, std::int64_t time_ns) {
+    auto it = streams_.find(id);
+    if (it == streams_.end()) return;
+    State& s = it->second;
+    s.judged_up_to_ns = std::max(s.judged_up_to_ns, time_ns);
+    s.seen = true;
+    s.active = true;
+  }
+
   /// Hands every releasable sample, in order, to consume(id, time_ns, payload).
   void release(std::int64_t wall_now_ns,
                const std::function<void(StreamId, std::int64_t, const Payload&)>& consume) {
@@ -97,13 +126,9 @@ class InputSequencer {
           head_blocked_since_ns_ = wall_now_ns;
           blocked_key_ = key;
         }
-        if (wall_now_ns - head_blocked_since_ns_ < max_wait_ns_) {
+        if (!setAsideOverdue(wall_now_ns - head_blocked_since_ns_, blocking)) {
           compact();
           return;
-        }
-        ++timeouts_;
-        for (const StreamId& id : blocking) {
-          streams_.at(id).active = false;
         }
       }
       head_blocked_since_ns_ = -1;
@@ -133,6 +158,8 @@ class InputSequencer {
       s.seen = id == first;
       s.active = id == first;
       s.last_time_ns = 0;
+      s.owed_up_to_ns = -1;
+      s.judged_up_to_ns = -1;
     }
     return dropped;
   }
@@ -162,6 +189,8 @@ class InputSequencer {
 
   std::size_t pending() const { return queue_.size() - head_; }
   std::uint64_t timeouts() const { return timeouts_; }
+  /// Owed judgements not reported within the judging stream's budget.
+  std::uint64_t judgementTimeouts() const { return judgement_timeouts_; }
 
  private:
   struct Key {
@@ -175,17 +204,48 @@ class InputSequencer {
   struct State {
     std::int64_t period_ns;
     bool sporadic{false};
+    bool judging{false};
     bool seen{false};
     bool active{true};
     std::int64_t last_time_ns{0};
+    std::int64_t max_wait_ns{0};
+    std::int64_t owed_up_to_ns{-1};    ///< judging: data handed to the judge up to here
+    std::int64_t judged_up_to_ns{-1};  ///< judging: reported judged up to here
   };
+
+  /// Sets aside the streams among `blocking` that held the head for their budget; true if
+  /// none is left waiting.
+  bool setAsideOverdue(std::int64_t waited_ns, const std::vector<StreamId>& blocking) {
+    bool waiting = false;
+    bool set_aside = false;
+    for (const StreamId& id : blocking) {
+      State& s = streams_.at(id);
+      if (waited_ns < s.max_wait_ns) {
+        waiting = true;
+        continue;
+      }
+      s.active = false;
+      if (s.judging)
+        ++judgement_timeouts_;
+      else
+        set_aside = true;
+    }
+    if (set_aside) ++timeouts_;  // one bounded wait ran out (for one or more streams)
+    return !waiting;
+  }
 
   /// The expected, active streams that may still deliver a sample ordered before `key` (a
   /// buffer reused from call to call).
   const std::vector<StreamId>& blockingStreams(const Key& key) {
     blocking_.clear();
     for (const auto& [id, s] : streams_) {
-      if (id == key.stream || !s.active || s.sporadic) continue;
+      if (id == key.stream || !s.active) continue;
+      if (s.judging && s.seen && s.owed_up_to_ns > s.judged_up_to_ns &&
+          key.time_ns > s.judged_up_to_ns) {
+        blocking_.push_back(id);
+        continue;
+      }
+      if (s.sporadic) continue;
       const Key earliest_next{s.last_time_ns + s.period_ns, id};
       if (!s.seen || earliest_next < key) blocking_.push_back(id);
     }
@@ -216,12 +276,12 @@ class InputSequencer {
   std::vector<std::pair<Key, Payload>> queue_;
   std::size_t head_{0};
   std::vector<StreamId> blocking_;
-  std::int64_t max_wait_ns_;
   Key last_released_{0, {}};
   bool released_any_{false};
   std::int64_t head_blocked_since_ns_{-1};
   Key blocked_key_{0, {}};
   std::uint64_t timeouts_{0};
+  std::uint64_t judgement_timeouts_{0};
 };
 
 }  // namespace navbus::nav_filter

@@ -39,6 +39,9 @@ struct PipelineView {
   std::uint64_t solutions_published;
   std::uint64_t sequencer_timeouts;
   std::size_t pending;
+  std::uint64_t progress_reports;    ///< the fault manager's progress reports
+  std::uint64_t progress_held;       ///< ... that came before the command they name
+  std::uint64_t judgement_timeouts;  ///< owed judgements that did not come within the budget
 };
 
 std::string describePipeline(const PipelineView& v);

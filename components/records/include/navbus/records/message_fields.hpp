@@ -226,6 +226,15 @@ IfMessage<M, navbus::FilterCommand> visitFields(M& m, V& v) {
   v("run_id", m.run_id());
 }
 template <class M, class V>
+IfMessage<M, navbus::FaultMonitorProgress> visitFields(M& m, V& v) {
+  v("vehicle_id", m.vehicle_id());
+  v("judged_up_to_gps_ns", m.judged_up_to_gps_ns());
+  v("diagnostics_seq", m.diagnostics_seq());
+  v("last_command_id", m.last_command_id());
+  v("issuer", m.issuer());
+  v("run_id", m.run_id());
+}
+template <class M, class V>
 IfMessage<M, navbus::StreamHealth> visitFields(M& m, V& v) {
   v("topic", m.topic());
   v("received", m.received());

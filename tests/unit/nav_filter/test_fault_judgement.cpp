@@ -1,0 +1,200 @@
+// The fault manager in the loop, as the bus delivers it: its commands answer a diagnostics
+// epoch some time after the filter published it, and its progress reports (how far it has
+// judged) travel on another writer. The deterministic output waits for each epoch's judgement,
+// so every solution is the one `navbus offline` publishes (the command applied at once, in the
+// diagnostics callback); a command that comes after its place anyway is merged by rewinding
+// and leaves the full state as in time; a fault manager that stops reporting holds the output
+// for its budget only.
+#include <gtest/gtest.h>
+
+#include <deque>
+#include <utility>
+
+#include "pipeline_runs.hpp"
+
+using namespace navbus;
+using namespace navbus::test;
+
+namespace {
+
+constexpr std::size_t kFrames = 1500;      // 15 s of data, GNSS at 1 Hz
+constexpr std::size_t kDelayFrames = 150;  // the fault manager answers 1.5 s later
+/// The diagnostics epoch the command answers (the sixth).
+constexpr std::size_t kJudgedEpoch = 5;
+
+FilterCommand compensateGyroX(std::uint64_t time_gps_ns) {
+  FilterCommand c;
+  c.command_id(1);
+  c.vehicle_id(1);
+  c.kind(CMD_COMPENSATE_BIAS);
+  c.sensor(SOURCE_GYRO);
+  c.axis(0);
+  c.bias(2e-5);
+  c.bias_sigma(1e-6);
+  c.time_gps_ns(time_gps_ns);
+  c.issuer("fault-manager");
+  c.run_id(7);
+  return c;
+}
+
+FilterCommand relearnAccelYFromOnset(std::uint64_t time_gps_ns) {
+  FilterCommand c = compensateGyroX(time_gps_ns);
+  c.kind(CMD_RELEARN_BIAS);
+  c.sensor(SOURCE_ACCELEROMETER);
+  c.axis(1);
+  c.bias(0.0);
+  c.bias_sigma(1e-3);
+  c.onset_time_gps_ns(time_gps_ns - 3'000'000'000);
+  return c;
+}
+
+FaultMonitorProgress progress(const FilterDiagnostics& d, std::uint64_t last_command_id) {
+  FaultMonitorProgress p;
+  p.vehicle_id(1);
+  p.judged_up_to_gps_ns(d.time_gps_ns());
+  p.diagnostics_seq(d.seq());
+  p.last_command_id(last_command_id);
+  p.issuer("fault-manager");
+  p.run_id(7);
+  return p;
+}
+
+/// The reference: the command applied within the callback of the epoch it answers, as
+/// `navbus offline` runs the fault manager.
+void answerInTime(FilterRun& run, FilterCommand (*make)(std::uint64_t)) {
+  run.on_diagnostics = [&run, make](const FilterDiagnostics& d) {
+    if (run.diagnostics.size() == kJudgedEpoch + 1) run.pipeline->onCommand(make(d.time_gps_ns()));
+  };
+}
+
+/// A fault manager on the bus: it judges every epoch and answers kDelayFrames later, the
+/// command of the judged epoch `command_first_by` frames before (negative: after) its report.
+struct DelayedMonitor {
+  FilterRun& run;
+  FilterCommand (*make)(std::uint64_t);
+  long command_first_by{0};
+  std::deque<std::pair<std::size_t, std::function<void()>>> due;  ///< frame, delivery
+
+  void attach() {
+    run.on_diagnostics = [this](const FilterDiagnostics& d) {
+      const std::size_t at = frameNow + kDelayFrames;
+      const bool answers = run.diagnostics.size() == kJudgedEpoch + 1;
+      const std::uint64_t last_id = run.diagnostics.size() > kJudgedEpoch ? 1 : 0;
+      if (answers) {
+        const FilterCommand c = make(d.time_gps_ns());
+        schedule(static_cast<std::size_t>(static_cast<long>(at) - command_first_by),
+                 [this, c] { run.pipeline->onCommand(c); });
+      }
+      schedule(at, [this, p = progress(d, last_id)] { run.pipeline->onFaultMonitorProgress(p); });
+    };
+    run.before_frame = [this](std::size_t k) {
+      frameNow = k;
+      for (auto it = due.begin(); it != due.end();) {
+        if (it->first > k) {
+          ++it;
+          continue;
+        }
+        it->second();
+        it = due.erase(it);
+      }
+    };
+  }
+  void schedule(std::size_t frame, std::function<void()> f) {
+    due.emplace_back(frame, std::move(f));
+  }
+  std::size_t frameNow{0};
+};
+
+void expectSameSolutions(const FilterRun& a, const FilterRun& b) {
+  ASSERT_EQ(a.solutions.size(), b.solutions.size());
+  std::size_t differing = 0;
+  for (std::size_t k = 0; k < a.solutions.size(); ++k)
+    differing += sameBits(a.solutions[k], b.solutions[k]) ? 0 : 1;
+  EXPECT_EQ(differing, 0u) << "of " << a.solutions.size();
+}
+
+const std::string kMonitored =
+    "fault_monitor: {participant: navbus-fault-manager, judgement_wait_s: 1000}\n";
+
+}  // namespace
+
+TEST(FaultJudgement, TheOutputWaitsForEachEpochsJudgementAndEqualsOffline) {
+  const std::vector<Frame> all = frames(kFrames);
+  const auto config = tightlyCoupled(40.0, kMonitored);
+  for (const long command_first_by : {20L, 0L, -20L}) {  // the report may overtake the command
+    FilterRun offline(config), bus(config);
+    answerInTime(offline, compensateGyroX);
+    DelayedMonitor monitor{bus, compensateGyroX, command_first_by, {}};
+    monitor.attach();
+    offline.play(all);
+    bus.play(all);
+    expectSameSolutions(offline, bus);
+    expectSameEngine(offline.pipeline->engine(), bus.pipeline->engine());
+    const std::string summary = bus.pipeline->summary();
+    EXPECT_NE(summary.find("commands applied 1 refused 0"), std::string::npos) << summary;
+    EXPECT_NE(summary.find(") late 0"), std::string::npos) << summary;
+    EXPECT_NE(summary.find("beyond the budget 0"), std::string::npos) << summary;
+    if (command_first_by < 0) {
+      EXPECT_NE(summary.find("(before their command 1)"), std::string::npos) << summary;
+    }
+  }
+}
+
+TEST(FaultJudgement, WithoutWaitingTheOutputDiffersOnlyUntilTheCommandCame) {
+  // Not monitored (no fault_monitor): nothing waits, the command comes 1.5 s after its place.
+  const std::vector<Frame> all = frames(kFrames);
+  const auto config = tightlyCoupled(40.0);
+  FilterRun offline(config), bus(config);
+  answerInTime(offline, compensateGyroX);
+  DelayedMonitor monitor{bus, compensateGyroX, 0, {}};
+  monitor.attach();
+  offline.play(all);
+  bus.play(all);
+  ASSERT_EQ(offline.solutions.size(), bus.solutions.size());
+  std::size_t differing = 0;
+  for (std::size_t k = 0; k < offline.solutions.size(); ++k)
+    differing += sameBits(offline.solutions[k], bus.solutions[k]) ? 0 : 1;
+  EXPECT_GT(differing, 0u) << "the test would not see a missing wait";
+  EXPECT_LE(differing, kDelayFrames + 1) << "only those published before the command came";
+  EXPECT_NE(bus.pipeline->summary().find(") late 1"), std::string::npos) << bus.pipeline->summary();
+}
+
+class LateCommand : public ::testing::TestWithParam<FilterCommand (*)(std::uint64_t)> {};
+
+TEST_P(LateCommand, GivesTheFullInTimeStateBitForBit) {
+  const std::vector<Frame> all = frames(kFrames);
+  const auto config = tightlyCoupled(40.0);
+  FilterRun in_time(config), late(config);
+  answerInTime(in_time, GetParam());
+  DelayedMonitor monitor{late, GetParam(), 0, {}};
+  monitor.attach();
+  in_time.play(all);
+  late.play(all);
+  expectSameEngine(in_time.pipeline->engine(), late.pipeline->engine());
+  EXPECT_NE(late.pipeline->summary().find("commands applied 1 refused 0"), std::string::npos)
+      << late.pipeline->summary();
+}
+
+INSTANTIATE_TEST_SUITE_P(CompensateAndRelearnFromOnset, LateCommand,
+                         ::testing::Values(&compensateGyroX, &relearnAccelYFromOnset));
+
+TEST(FaultJudgement, AMonitorThatStopsReportingHoldsTheOutputForItsBudgetOnly) {
+  const std::vector<Frame> all = frames(kFrames);
+  const auto config = tightlyCoupled(
+      40.0, "fault_monitor: {participant: navbus-fault-manager, judgement_wait_s: 0.5}\n");
+  FilterRun reference(config), bus(config);
+  bus.on_diagnostics = [&bus](const FilterDiagnostics& d) {
+    if (bus.diagnostics.size() <= 2) bus.pipeline->onFaultMonitorProgress(progress(d, 0));
+  };  // judges the first two epochs at once, then falls silent
+  reference.play(all);
+  bus.play(all);
+  expectSameSolutions(reference, bus);  // nothing was commanded: the same solutions, later
+  const std::string summary = bus.pipeline->summary();
+  EXPECT_NE(summary.find("judgements waited for beyond the budget 1"), std::string::npos)
+      << "set aside once, not waited for at every epoch: " << summary;
+  const std::string reference_summary = reference.pipeline->summary();
+  const std::string timeouts = reference_summary.substr(
+      reference_summary.find("sequencer timeouts"), std::string("sequencer timeouts 0,").size());
+  EXPECT_NE(summary.find(timeouts), std::string::npos)
+      << "no other stream set aside than at the reference's end of data: " << summary;
+}
