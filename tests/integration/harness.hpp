@@ -188,17 +188,18 @@ struct SensorInputWriters {
 /// The simulator's default vehicle at the place and time filterConfig() starts the filter:
 /// 36.5 N, 127.5 E, 100 m, GPS time 1.4e18 ns.
 /// The seed-000 fault loop's three configuration files in `dir` for `domain`: the aircraft
-/// scenario with `sim_extra` (timing, faults), the tightly coupled filter writing every
-/// solution, the fault manager as shipped.
+/// scenario (or another seed-000 scenario of sim/scenarios) with `sim_extra` (timing, faults),
+/// the tightly coupled filter writing every solution, the fault manager as shipped.
 struct Seed000Loop {
   std::string sim, filter, fault_manager;
 };
 inline Seed000Loop writeSeed000Loop(const std::filesystem::path& dir, int domain,
-                                    const std::string& sim_extra) {
+                                    const std::string& sim_extra,
+                                    const std::string& scenario = "seed000_aircraft") {
   const std::string src = NAVBUS_SOURCE_DIR;
   const std::string dom = "domain_id: " + std::to_string(domain) + "\n";
   return {writeFile(dir / "sim.yaml",
-                    "extends: " + src + "/sim/scenarios/seed000_aircraft.yaml\n" + dom + sim_extra),
+                    "extends: " + src + "/sim/scenarios/" + scenario + ".yaml\n" + dom + sim_extra),
           writeFile(dir / "filter.yaml",
                     "extends: " + src + "/config/filter_seed000_tc.yaml\n" + dom +
                         "solution_writer_profile: navbus_solution_writer_lossless\n"),

@@ -1,12 +1,15 @@
-// The filter process stopped (SIGSTOP, as a debugger, a page-fault storm or VM steal time
-// would) or starved of CPU while the simulator publishes as fast as the readers take: no
-// increment is refused as late, every solution time is published once, and every solution
-// equals `navbus offline`'s (fault-free seed-000 flight, tightly coupled, with the fault
-// manager). docs/architecture.md, the ordered merge.
+// The seed-000 loop over the bus while the simulator publishes as fast as the readers take,
+// with the filter process stopped (SIGSTOP, as a debugger, a page-fault storm or VM steal time
+// would), the fault manager stopped, or both starved of CPU by two busy loops: no increment is
+// refused as late, every solution time is published once, and every solution and every
+// decision equals `navbus offline`'s (docs/architecture.md, the ordered merge and the fault
+// manager's judgement). Fault-free flight (ctest stalls) and the fault loop with an IMU step
+// and a pseudorange ramp (ctest fault_loop_load).
 #include <csignal>
 #include <map>
 
 #include <gtest/gtest.h>
+#include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "harness.hpp"
@@ -17,49 +20,76 @@ using namespace std::chrono_literals;
 
 namespace {
 
-enum class Disturbance { kStops, kCpuHogs };
+struct LoadCase {
+  int domain;
+  std::string scenario;  ///< seed-000 scenario file (sim/scenarios)
+  int duration_s;
+  int filter_stops;   ///< stops of the filter for 1.5 s, spread over the run
+  int monitor_stops;  ///< stops of the fault manager for 2 s, spread over the run
+  int cpu_hogs;       ///< busy loops beside the participants
+};
 
-void runWith(int domain, Disturbance disturbance) {
+/// A decision row without its run_id (the fault manager's start time; 0 offline).
+std::string withoutRunId(const std::string& row) {
+  return row.substr(0, row.rfind(','));
+}
+
+/// Stops `process` for `pause` while `me` keeps reading.
+void stopFor(test::ChildProcess& process, bus::Participant& me, std::chrono::milliseconds pause) {
+  process.signal(SIGSTOP);
+  const auto until = std::chrono::steady_clock::now() + pause;
+  while (std::chrono::steady_clock::now() < until) me.spinOnce(50ms);
+  process.signal(SIGCONT);
+}
+
+void run(const LoadCase& c) {
   test::cleanSharedMemory();
-  const auto dir = test::scratchDir("stalls-" + std::to_string(domain));
-  const test::Seed000Loop cfg =
-      test::writeSeed000Loop(dir, domain, "timing: {duration_s: 300, pacing: fast}\n");
-  const std::string& sim_cfg = cfg.sim;
-  const std::string& filter_cfg = cfg.filter;
-  const std::string& fm_cfg = cfg.fault_manager;
+  const auto dir = test::scratchDir("stalls-" + std::to_string(c.domain));
+  const test::Seed000Loop cfg = test::writeSeed000Loop(
+      dir, c.domain, "timing: {duration_s: " + std::to_string(c.duration_s) + ", pacing: fast}\n",
+      c.scenario);
   ASSERT_EQ(test::runOffline(cfg, dir, "3"), 0) << test::readFile(dir / "offline.log");
   const std::vector<std::string> expected = test::csvDataRows(dir / "offline" / "solution.csv");
+  std::vector<std::string> expected_decisions;
+  for (const std::string& row : test::csvDataRows(dir / "offline" / "decisions.csv"))
+    expected_decisions.push_back(withoutRunId(row));
   ASSERT_GT(expected.size(), 2000u);
 
   bus::ShutdownSignal shutdown;
-  bus::Participant me(test::testParticipant(domain, "stalls"), shutdown);
+  bus::Participant me(test::testParticipant(c.domain, "stalls"), shutdown);
   std::map<std::uint64_t, int> published;  // solution time -> how many times
-  std::vector<std::string> rows;
+  std::vector<std::string> rows, decisions;
   me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution,
                                              bus::profile::kSolutionReader,
                                              [&](const NavigationSolution& s, const auto&) {
                                                if (++published[s.time_gps_ns()] == 1)
                                                  rows.push_back(records::csvRows(s).at(0));
                                              });
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
+  me.subscribe<FaultDecisionPubSubType>(
+      bus::topic::kFaultDecision, bus::profile::kDecisionReader,
+      [&](const FaultDecision& d, const auto&) {
+        decisions.push_back(withoutRunId(records::csvRows(d).at(0)));
+      });
+  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg.filter}, (dir / "filter.log").string());
+  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", cfg.fault_manager},
+                        (dir / "fm.log").string());
   std::vector<std::unique_ptr<test::ChildProcess>> hogs;
-  if (disturbance == Disturbance::kCpuHogs) {
-    for (int k = 0; k < 2; ++k)
-      hogs.push_back(std::make_unique<test::ChildProcess>(
-          "/bin/sh", std::vector<std::string>{"-c", "while :; do :; done"}, "/dev/null"));
-  }
-  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg, "--seed", "3"},
+  for (int k = 0; k < c.cpu_hogs; ++k)
+    hogs.push_back(std::make_unique<test::ChildProcess>(
+        "/bin/sh", std::vector<std::string>{"-c", "while :; do :; done"}, "/dev/null"));
+  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", cfg.sim, "--seed", "3"},
                          (dir / "sim.log").string());
-  if (disturbance == Disturbance::kStops) {
-    // Stopped twice for 1.5 s while the data flows (a third of the way and two thirds in).
-    for (const std::size_t at : {expected.size() / 3, 2 * expected.size() / 3}) {
-      ASSERT_TRUE(test::spinUntil(me, 120s, [&] { return rows.size() >= at; }));
-      filter.signal(SIGSTOP);
-      const auto until = std::chrono::steady_clock::now() + 1500ms;
-      while (std::chrono::steady_clock::now() < until) me.spinOnce(50ms);
-      filter.signal(SIGCONT);
-    }
+  // The stops, spread evenly over the solutions as they come (the filter's first, then the
+  // fault manager's), while the data flows.
+  const int stops = c.filter_stops + c.monitor_stops;
+  for (int k = 0; k < stops; ++k) {
+    const std::size_t at =
+        expected.size() * static_cast<std::size_t>(k + 1) / static_cast<std::size_t>(stops + 1);
+    ASSERT_TRUE(test::spinUntil(me, 120s, [&] { return rows.size() >= at; }));
+    if (k < c.filter_stops)
+      stopFor(filter, me, 1500ms);
+    else
+      stopFor(fm, me, 2000ms);
   }
   while (sim.running()) me.spinOnce(50ms);
   EXPECT_EQ(sim.wait(1s), 0) << test::readFile(dir / "sim.log");
@@ -74,19 +104,23 @@ void runWith(int domain, Disturbance disturbance) {
   const std::string log = test::readFile(dir / "filter.log");
   EXPECT_EQ(log.find("rejected sample"), std::string::npos) << "nothing refused: " << log;
   EXPECT_NE(log.find("late samples merged by rewinding"), std::string::npos) << log;
-  if (disturbance == Disturbance::kStops) {
+  if (c.filter_stops > 0) {
     EXPECT_NE(log.find("stalls of the filter process"), std::string::npos) << log;
   }
+  EXPECT_NE(log.find("judgements waited for beyond the budget 0"), std::string::npos) << log;
   int repeated = 0;
   for (const auto& [time, n] : published) repeated += n > 1 ? 1 : 0;
   EXPECT_EQ(repeated, 0) << "each solution time once";
   ASSERT_EQ(rows.size(), expected.size()) << log;
   const std::size_t differing = test::countDiffering(rows, expected);
-  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(differing, 0u) << log << test::readFile(dir / "fm.log");
+  EXPECT_EQ(decisions, expected_decisions) << test::readFile(dir / "fm.log");
   std::printf(
-      "%s: %zu solutions, %zu differ from offline\n",
-      disturbance == Disturbance::kStops ? "filter stopped twice for 1.5 s" : "two CPU hogs",
-      rows.size(), differing);
+      "%s, %d s, filter stopped %d x 1.5 s, fault manager stopped %d x 2 s, %d CPU hogs: %zu "
+      "solutions, %zu differ from offline; decisions %zu (offline %zu), %s\n",
+      c.scenario.c_str(), c.duration_s, c.filter_stops, c.monitor_stops, c.cpu_hogs, rows.size(),
+      differing, decisions.size(), expected_decisions.size(),
+      decisions == expected_decisions ? "equal" : "DIFFERENT");
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }
@@ -94,9 +128,17 @@ void runWith(int domain, Disturbance disturbance) {
 }  // namespace
 
 TEST(Stalls, FilterStoppedTwiceEqualsOfflineOnEverySolution) {
-  runWith(102, Disturbance::kStops);
+  run({102, "seed000_aircraft", 300, 2, 0, 0});
 }
 
 TEST(Stalls, TwoCpuHogsEqualOfflineOnEverySolution) {
-  runWith(103, Disturbance::kCpuHogs);
+  run({103, "seed000_aircraft", 300, 0, 0, 2});
+}
+
+TEST(LoadedFaultLoop, GyroStepWithTheFilterStoppedAndTwoCpuHogsEqualsOffline) {
+  run({104, "seed000_gyro_step_10dph", 600, 2, 0, 2});
+}
+
+TEST(LoadedFaultLoop, PseudorangeRampWithTheFaultManagerStoppedEqualsOffline) {
+  run({105, "seed000_pseudorange_ramp", 720, 0, 2, 2});
 }

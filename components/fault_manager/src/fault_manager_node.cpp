@@ -41,7 +41,7 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   watch<navbus::StarTrackerAttitude>(profile::kMeasurementWatchdogReader);
   // Confirms suspect streams (a DDS deadline event before the own silence reached it) within
   // this period of their silence reaching the deadline.
-  p.addTimer(std::chrono::milliseconds(10), [this] { pipeline_.onWatchdogTick(steadyNowNs()); });
+  p.addTimer(std::chrono::milliseconds(10), [this] { pipeline_.onWatchdogTick(running()); });
   if (config.glr.enabled) {
     p.subscribe<navbus::FilterDiagnosticsPubSubType>(
         topic::kFilterDiagnostics, profile::kDiagnosticsReader,
@@ -49,18 +49,34 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   }
 }
 
+std::int64_t FaultManagerNode::running() {
+  const std::int64_t now = steadyNowNs();
+  if (const auto stalled = stalls_.running(now)) pipeline_.resumedAfterStall(now, *stalled);
+  return now;
+}
+
 bus::SensorReaders::Events FaultManagerNode::streamEvents() {
-  return {[this](StreamKind kind, std::uint32_t id) {
-            pipeline_.onStreamEnded(kind, id);
-            if (kind == StreamKind::kImu && on_imu_ended_) on_imu_ended_();
-          },
-          [this](StreamKind kind, std::uint32_t id) {
-            pipeline_.onDeadlineMissed(kind, id, steadyNowNs());
-          },
-          [this](StreamKind kind) { pipeline_.onWritersGone(kind, steadyNowNs()); },
-          [this](StreamKind kind, std::uint32_t id, std::uint64_t time_gps_ns) {
-            pipeline_.onSecondWriter(kind, id, time_gps_ns);
-          }};
+  // Each event first asks whether this process was stopped since its last turn: what DDS
+  // reports right after a stall (deadlines, liveliness) may be this process's own silence.
+  bus::SensorReaders::Events events;
+  events.ended = [this](StreamKind kind, std::uint32_t id) {
+    running();
+    pipeline_.onStreamEnded(kind, id);
+    if (kind == StreamKind::kImu && on_imu_ended_) on_imu_ended_();
+  };
+  events.deadline_missed = [this](StreamKind kind, std::uint32_t id) {
+    pipeline_.onDeadlineMissed(kind, id, running());
+  };
+  events.writers_gone = [this](StreamKind kind) { pipeline_.onWritersGone(kind, running()); };
+  events.second_writer = [this](StreamKind kind, std::uint32_t id, std::uint64_t time_gps_ns) {
+    running();
+    pipeline_.onSecondWriter(kind, id, time_gps_ns);
+  };
+  events.writers_alive = [this](StreamKind kind, bool alive) {
+    running();
+    if (alive) pipeline_.onWritersAlive(kind);
+  };
+  return events;
 }
 
 template <class Message>

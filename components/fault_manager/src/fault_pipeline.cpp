@@ -1,5 +1,6 @@
 #include "navbus/fault_manager/fault_pipeline.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
@@ -58,6 +59,17 @@ void FaultPipeline::onWatchdogTick(std::int64_t wall_now_ns) {
 
 void FaultPipeline::onWritersGone(StreamKind kind, std::int64_t wall_now_ns) {
   for (const auto& e : watchdog_.onWritersGone(kind, wall_now_ns)) onWatchdogEvent(e);
+}
+
+void FaultPipeline::resumedAfterStall(std::int64_t wall_now_ns, std::int64_t stalled_ns) {
+  watchdog_.resumedAfterStall(wall_now_ns);
+  ++stalls_;
+  longest_stall_ns_ = std::max(longest_stall_ns_, stalled_ns);
+  spdlog::warn(
+      "fault manager not running for {:.3f} s (stopped, starved of CPU): silences count "
+      "from now, lost liveliness is believed if it is not back within {:.0f} s",
+      1e-9 * static_cast<double>(stalled_ns),
+      1e-9 * static_cast<double>(StreamWatchdog::kLivelinessGraceNs));
 }
 
 void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id,
@@ -171,9 +183,13 @@ std::string FaultPipeline::summary() const {
       << ", deadline events not confirmed by the silence " << watchdog_.unconfirmedDeadlines()
       << ", of streams paced ahead of real time " << watchdog_.deadlinesAheadOfRealTime()
       << "), streams paced ahead of real time " << watchdog_.streamsAheadOfRealTime()
-      << " (judged by their writers only), streams ended as announced " << ended_
+      << " (judged by their writers only), liveliness losses after a stall that were stale "
+      << watchdog_.staleLivelinessEvents() << ", streams ended as announced " << ended_
       << ", commands published " << commands() << "; " << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
+  if (stalls_ > 0)
+    out << "; stalls of the fault manager process " << stalls_ << " (longest "
+        << 1e-9 * static_cast<double>(longest_stall_ns_) << " s)";
   if (filter_new_runs_ > 0)
     out << "; GLR restarted with the filter's new runs " << filter_new_runs_;
   if (other_vehicles_ > 0) out << "; diagnostics of other vehicles ignored " << other_vehicles_;

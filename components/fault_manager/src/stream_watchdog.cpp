@@ -70,6 +70,13 @@ std::optional<WatchdogEvent> StreamWatchdog::onDeadlineMissed(const StreamKey& k
 
 std::vector<WatchdogEvent> StreamWatchdog::onTick(std::int64_t wall_now_ns) {
   std::vector<WatchdogEvent> out;
+  if (wall_now_ns >= grace_until_ns_) {
+    for (auto& [kind, pending] : gone_pending_) {
+      if (!pending) continue;
+      pending = false;
+      for (const auto& e : markKindLost(kind, wall_now_ns)) out.push_back(e);
+    }
+  }
   for (auto& [key, s] : states_) {
     if (s.suspect_deadline_ns < 0 || wall_now_ns - s.last_arrival_wall_ns < s.suspect_deadline_ns)
       continue;
@@ -80,6 +87,29 @@ std::vector<WatchdogEvent> StreamWatchdog::onTick(std::int64_t wall_now_ns) {
 
 std::vector<WatchdogEvent> StreamWatchdog::onWritersGone(StreamKind kind,
                                                          std::int64_t wall_now_ns) {
+  if (wall_now_ns < grace_until_ns_) {
+    gone_pending_[kind] = true;  // perhaps only this participant's stale view: wait and see
+    return {};
+  }
+  return markKindLost(kind, wall_now_ns);
+}
+
+void StreamWatchdog::onWritersAlive(StreamKind kind) {
+  auto it = gone_pending_.find(kind);
+  if (it == gone_pending_.end() || !it->second) return;
+  it->second = false;
+  ++stale_liveliness_;
+}
+
+void StreamWatchdog::resumedAfterStall(std::int64_t wall_now_ns) {
+  grace_until_ns_ = wall_now_ns + kLivelinessGraceNs;
+  for (auto& [key, s] : states_) {
+    s.last_arrival_wall_ns = std::max(s.last_arrival_wall_ns, wall_now_ns);
+    s.suspect_deadline_ns = -1;
+  }
+}
+
+std::vector<WatchdogEvent> StreamWatchdog::markKindLost(StreamKind kind, std::int64_t wall_now_ns) {
   std::vector<WatchdogEvent> out;
   for (auto& [key, s] : states_) {
     if (key.kind != kind) continue;

@@ -83,7 +83,7 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });
   if (config.fault_monitor) watchFaultMonitor(*config.fault_monitor);
-  p.addTimer(std::chrono::nanoseconds(kPumpPeriodNs), [this] {
+  p.addTimer(std::chrono::nanoseconds(bus::StallDetector::kLoopPeriodNs), [this] {
     if (monitor_) pipeline_.setFaultMonitorAlive(monitor_->alive(steadyNowNs()));
     pump();
     updateState();
@@ -127,11 +127,8 @@ void FilterNode::watchFaultMonitor(const FaultMonitorWatch& watch) {
 
 void FilterNode::pump() {
   const std::int64_t now = steadyNowNs();
-  // The loop runs at least every timer period; a much longer pause means this process was not
-  // running (SIGSTOP, a debugger, page-fault storms, CPU starvation or VM steal time).
-  if (last_pump_ns_ >= 0 && now - last_pump_ns_ > kStallNs)
-    pipeline_.resumedAfterStall(now, now - last_pump_ns_);
-  last_pump_ns_ = now;
+  // The pump runs after every reader dispatch and at least every loop period.
+  if (const auto stalled = stalls_.running(now)) pipeline_.resumedAfterStall(now, *stalled);
   pipeline_.pump(now);
 }
 

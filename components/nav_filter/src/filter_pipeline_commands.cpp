@@ -66,11 +66,6 @@ void FilterPipeline::onFaultMonitorProgress(const navbus::FaultMonitorProgress& 
     sequencer_.judged(kCommandStream, *judged);
 }
 
-void FilterPipeline::setFaultMonitorAlive(bool alive) {
-  if (!alive && flags_.faultMonitorAlive()) sequencer_.setActive(kCommandStream, false);
-  flags_.setFaultMonitorAlive(alive);
-}
-
 void FilterPipeline::onCommand(const navbus::FilterCommand& c,
                                const std::optional<std::string>& writer_identity) {
   // Released by pump() only: the command below is queued before the judgement counts.

@@ -100,3 +100,32 @@ TEST(StreamWatchdog, StreamPacedAheadOfRealTimeIsJudgedByItsWriterOnly) {
   EXPECT_EQ(rt.streamsAheadOfRealTime(), 0u);
   EXPECT_TRUE(rt.onDeadlineMissed(imu, 10 * kS + 250 * kMs, 250 * kMs));
 }
+
+TEST(StreamWatchdog, AfterItsOwnStallTheWatchdogBelievesOnlyWhatPersists) {
+  // The fault manager stopped for 2 s: DDS then reports every writer's liveliness lost and
+  // every deadline missed, though only this process was silent.
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1};
+  const navbus::fault_manager::StreamKey gnss{StreamKind::kGnssObservations, 1};
+  EXPECT_FALSE(w.onSample(imu, 100, 0));
+  EXPECT_FALSE(w.onSample(gnss, 100, 0));
+  const std::int64_t resumed = 2000 * kMs;
+  w.resumedAfterStall(resumed);
+  EXPECT_TRUE(w.onWritersGone(StreamKind::kImu, resumed + 1 * kMs).empty());
+  EXPECT_TRUE(w.onWritersGone(StreamKind::kGnssObservations, resumed + 1 * kMs).empty());
+  // The silence counts from the resumption: a deadline event now is only suspect.
+  EXPECT_FALSE(w.onDeadlineMissed(imu, resumed + 2 * kMs, 250 * kMs));
+  // The IMU's writer is heard again; the receiver's is not.
+  w.onWritersAlive(StreamKind::kImu);
+  EXPECT_FALSE(w.onSample(imu, 200, resumed + 5 * kMs));
+  const auto events = w.onTick(resumed + StreamWatchdog::kLivelinessGraceNs);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].key.kind, StreamKind::kGnssObservations);
+  EXPECT_TRUE(events[0].lost);
+  EXPECT_FALSE(w.isLost(imu));
+  EXPECT_EQ(w.staleLivelinessEvents(), 1u);
+  // Outside a grace, a writer gone is believed at once.
+  EXPECT_EQ(
+      w.onWritersGone(StreamKind::kImu, resumed + 3 * StreamWatchdog::kLivelinessGraceNs).size(),
+      1u);
+}

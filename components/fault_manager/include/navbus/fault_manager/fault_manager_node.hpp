@@ -11,6 +11,7 @@
 
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/sensor_readers.hpp"
+#include "navbus/bus/stall_detector.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
 
 namespace navbus::fault_manager {
@@ -27,6 +28,9 @@ class FaultManagerNode {
   template <class Message>
   void watch(const char* profile);
   bus::SensorReaders::Events streamEvents();
+  /// The steady clock now, after telling the pipeline of a stall of this process that just
+  /// ended (bus::StallDetector).
+  std::int64_t running();
 
   bus::Participant& participant_;
   std::function<void()> on_imu_ended_;
@@ -34,6 +38,7 @@ class FaultManagerNode {
   bus::Writer<navbus::FilterCommand> command_writer_;
   bus::Writer<navbus::FaultMonitorProgress> progress_writer_;  ///< how far diagnostics are judged
   FaultPipeline pipeline_;
+  bus::StallDetector stalls_;   ///< pauses of this process between two turns of its loop
   bus::SensorReaders sensors_;  ///< the watched sensor streams (owning writers only)
 };
 

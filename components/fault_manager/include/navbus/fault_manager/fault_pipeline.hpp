@@ -46,6 +46,11 @@ class FaultPipeline : private FaultOutput {
                       std::uint64_t time_gps_ns, std::int64_t wall_now_ns);
   void onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id, std::int64_t wall_now_ns);
   void onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
+  /// A writer of the stream kind is alive (again).
+  void onWritersAlive(StreamKind kind) { watchdog_.onWritersAlive(kind); }
+  /// This participant was not running for `stalled_ns` until `wall_now_ns`: the watchdog's
+  /// view is stale (StreamWatchdog::resumedAfterStall). Logged and counted.
+  void resumedAfterStall(std::int64_t wall_now_ns, std::int64_t stalled_ns);
   /// Periodic: declares suspect streams whose own silence reached the deadline.
   void onWatchdogTick(std::int64_t wall_now_ns);
   /// The stream's writer announced its end (disposed the instance): no loss, counted.
@@ -89,6 +94,8 @@ class FaultPipeline : private FaultOutput {
   std::map<StreamKind, bus::SequenceTracker> trackers_;
   std::map<StreamKind, double> deadline_s_;
   std::uint64_t second_writers_{0};
+  std::uint64_t stalls_{0};  ///< pauses of this participant's process
+  std::int64_t longest_stall_ns_{0};
   std::uint64_t filter_new_runs_{0};  ///< the diagnostics' source restarted at an earlier time
   std::uint64_t run_id_{0};
   std::uint32_t next_decision_id_{1};

@@ -64,8 +64,21 @@ class StreamWatchdog {
   /// there unless this participant was stopped for longer than this when the first sample came
   /// (its later samples would then look early by the length of that stop).
   static constexpr std::int64_t kAheadOfRealTimeNs = 2'000'000'000;
-  /// Every writer of a topic lost liveliness: all its streams that are alive are lost.
+  /// Every writer of a topic lost liveliness: all its streams that are alive are lost; within
+  /// kLivelinessGraceNs after a stall of this participant, only once the grace has passed
+  /// without the writers alive again (onTick).
   std::vector<WatchdogEvent> onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
+  /// A writer of the topic is alive (again).
+  void onWritersAlive(StreamKind kind);
+  /// This participant was not running until `wall_now_ns` (bus::StallDetector): its view of
+  /// its peers is stale. Silence counts again from now, and a writer's liveliness lost is
+  /// believed only if it is not back within kLivelinessGraceNs.
+  void resumedAfterStall(std::int64_t wall_now_ns);
+  /// How long lost liveliness seen right after a stall waits for the writer to be heard:
+  /// twice the sensor writers' 1 s lease (qos/navbus_qos.xml).
+  static constexpr std::int64_t kLivelinessGraceNs = 2'000'000'000;
+  /// Writers-gone events after a stall that the writers' liveliness then contradicted.
+  std::uint64_t staleLivelinessEvents() const { return stale_liveliness_; }
 
   /// The stream's writer disposed it (an announced end) after data up to `end_time_gps_ns`
   /// (or its latest sample seen, if later): forgotten, so that its silence is no loss. Samples
@@ -89,11 +102,15 @@ class StreamWatchdog {
     bool ahead_of_real_time{false};         ///< once seen ahead, for the rest of the run
   };
   void notePace(State& s);
+  std::vector<WatchdogEvent> markKindLost(StreamKind kind, std::int64_t wall_now_ns);
   std::optional<WatchdogEvent> markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns);
   std::map<StreamKey, State> states_;
   std::map<StreamKey, std::uint64_t> ended_at_;  ///< announced ends, data time
   std::uint64_t unconfirmed_{0};
   std::uint64_t deadlines_ahead_{0};
+  std::int64_t grace_until_ns_{-1};          ///< after a stall: writers-gone events wait until here
+  std::map<StreamKind, bool> gone_pending_;  ///< writers gone during the grace (kind -> pending)
+  std::uint64_t stale_liveliness_{0};
   std::uint64_t streams_ahead_{0};
 };
 

@@ -12,6 +12,7 @@
 
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/sensor_readers.hpp"
+#include "navbus/bus/stall_detector.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/nav_filter/monitor_liveness.hpp"
@@ -38,10 +39,6 @@ class FilterNode {
   void watchFaultMonitor(const FaultMonitorWatch& watch);
   /// What the sensor readers tell the pipeline besides the samples: announced ends, liveliness.
   bus::SensorReaders::Events sensorEvents();
-  /// The pump runs after every reader dispatch and at least this often.
-  static constexpr std::int64_t kPumpPeriodNs = 20'000'000;
-  /// A pause of the pump this long is a stall of this process, not silence of the streams.
-  static constexpr std::int64_t kStallNs = 10 * kPumpPeriodNs;
   static constexpr int kNotProducingPeriods = 3;
   static constexpr std::int64_t kNotProducingMinNs = 1'000'000'000;
 
@@ -52,7 +49,7 @@ class FilterNode {
   bus::Writer<navbus::NavigationSolution> low_latency_writer_;  ///< when configured
   FilterPipeline pipeline_;
   std::int64_t not_producing_ns_;      ///< silence of the solution output that is "not producing"
-  std::int64_t last_pump_ns_{-1};      ///< steady time of the latest pump (-1: none yet)
+  bus::StallDetector stalls_;          ///< pauses of this process between two pumps
   std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)
   bus::SensorReaders sensors_;         ///< the sensor streams' readers (owning writers only)
   std::optional<MonitorLiveness> monitor_;  ///< the fault monitor's liveness, when configured

@@ -135,9 +135,10 @@ class FilterPipeline {
   /// it does, before the next solution is published.
   void onFaultMonitorProgress(const navbus::FaultMonitorProgress& report);
   /// Whether a fault monitor is alive (the participant watches its reports): while not,
-  /// solutions carry FAULT_NO_FAULT_MONITOR and no judgement is waited for. Changes are logged
-  /// and counted.
-  void setFaultMonitorAlive(bool alive);
+  /// solutions carry FAULT_NO_FAULT_MONITOR. Changes are logged and counted. (The wait for
+  /// its judgement does not follow this: a monitor stopped for longer than its health timeout
+  /// but within judgement_wait_ns is still waited for; a dead one costs one budget.)
+  void setFaultMonitorAlive(bool alive) { flags_.setFaultMonitorAlive(alive); }
   /// Some stream is currently lost, or no fault monitor is alive (the participant reports
   /// DEGRADED).
   bool degraded() const { return flags_.degraded(); }
