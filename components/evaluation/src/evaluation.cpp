@@ -285,7 +285,7 @@ void writeFaultRunsCsv(std::ofstream& f, const std::string& label,
       << (r.detected ? fmt(r.onset_s) : "") << "," << r.class_correct << "," << r.source_correct
       << "," << r.ambiguous << "," << r.false_alarms << ","
       << (std::isnan(r.recovery_s) ? "" : fmt(r.recovery_s)) << "," << records::csvQuote(r.decided)
-      << "\n";
+      << "," << r.decisions << "\n";
   }
 }
 
@@ -550,7 +550,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
     if (!fault_tables.empty()) {
       std::ofstream faults(o.csv_dir + "/faults.csv");
       faults << "configuration,seed,fault_s,detected,detection_s,delay_s,onset_s,class_correct,"
-                "source_correct,ambiguous,false_alarms,recovery_s,decided\n";
+                "source_correct,ambiguous,false_alarms,recovery_s,decided,decisions\n";
       for (const FaultTable& t : fault_tables) writeFaultRunsCsv(faults, t.label, t.fault, t.runs);
       ok = ok && static_cast<bool>(faults);
       written += ", faults.csv";

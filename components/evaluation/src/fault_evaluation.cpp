@@ -108,6 +108,7 @@ FaultRunOutcome evaluateRun(const OfflineResult& r, const std::optional<sim::Fau
   FaultRunOutcome out;
   out.seed = seed;
   const double fault_s = fault ? fault->start_s : 1e300;
+  out.decisions = static_cast<int>(r.decisions.size());
   for (const navbus::FaultDecision& d : r.decisions) {
     if (d.event() != navbus::EVENT_FAULT_DETECTED) continue;
     const double t =
@@ -157,8 +158,10 @@ void printFaultTable(const std::string& label, const std::optional<sim::Fault>& 
   int mag_n = 0, cmd_n = 0, recovered_10s = 0, recovered = 0;
   double sum_cmd = 0;
   std::vector<double> recovery;
+  int most_decisions = 0;
   for (const FaultRunOutcome& o : runs) {
     false_alarms += o.false_alarms;
+    most_decisions = std::max(most_decisions, o.decisions);
     if (!o.detected) continue;
     ++detected;
     sum_t += o.detection_s;
@@ -213,6 +216,7 @@ void printFaultTable(const std::string& label, const std::optional<sim::Fault>& 
   std::printf("  false alarms: %d in %.2f h of data (%.3f per hour)%s\n", false_alarms,
               n * hours_per_run, false_alarms / std::max(n * hours_per_run, 1e-9),
               fault ? " (before the fault)" : "");
+  std::printf("  most decisions in one run: %d\n", most_decisions);
   std::printf("  per run (seed: detection s, onset s, decision):");
   for (const FaultRunOutcome& o : runs) {
     if (o.detected) {

@@ -95,7 +95,7 @@ FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
   const YAML::Node g = root["glr"];
   checkKeys(g, "glr",
             {"enabled", "window_epochs", "threshold", "ambiguity_margin", "ambiguity_correlation",
-             "rank_tolerance", "hypotheses", "actions", "readmission"});
+             "rank_tolerance", "hypotheses", "actions", "readmission", "repeats"});
   GlrDetectorConfig& d = c.glr;
   core::GlrConfig& m = d.glr;
   d.enabled = bus::get<bool>(g, "glr", "enabled", d.enabled);
@@ -121,6 +121,14 @@ FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
                                     100.0, "glr.readmission.pass_sigma");
   d.readmit_after_s = bus::checkRange(bus::get<double>(r, "glr.readmission", "pass_time_s", 30.0),
                                       0.0, 86400.0, "glr.readmission.pass_time_s");
+  const YAML::Node rep = g ? g["repeats"] : YAML::Node();
+  checkKeys(rep, "glr.repeats", {"window_s", "escalate_after"});
+  d.repeats.window_s =
+      bus::checkRange(bus::get<double>(rep, "glr.repeats", "window_s", d.repeats.window_s), 1.0,
+                      86400.0, "glr.repeats.window_s");
+  d.repeats.escalate_after = static_cast<int>(bus::checkRange(
+      bus::get<double>(rep, "glr.repeats", "escalate_after", d.repeats.escalate_after), 1.0, 100.0,
+      "glr.repeats.escalate_after"));
   parseDither(root["dither"], c.dither);
   return c;
 }

@@ -63,7 +63,8 @@ bool GlrDetector::Quarantine::covers(int sv, bool is_rate) const {
          (is_rate ? scope == navbus::SCOPE_PSEUDORANGE_RATE : scope == navbus::SCOPE_PSEUDORANGE);
 }
 
-GlrDetector::GlrDetector(const GlrDetectorConfig& config) : config_(config), glr_(config.glr) {
+GlrDetector::GlrDetector(const GlrDetectorConfig& config)
+    : config_(config), repeats_(config.repeats), glr_(config.glr) {
   quarantine_.reserve(32);
 }
 
@@ -98,8 +99,7 @@ bool GlrDetector::onDiagnostics(const navbus::FilterDiagnostics& msg, FaultOutpu
   return true;
 }
 
-void GlrDetector::report(const core::GlrResult& r, FaultOutput& out) {
-  ++counters_.detections;
+navbus::FaultDecision GlrDetector::decision(const core::GlrResult& r) const {
   const core::GlrCandidate& best = r.candidates[0];
   navbus::FaultDecision d;
   d.time_gps_ns(static_cast<std::uint64_t>(epoch_.time_ns));
@@ -117,6 +117,24 @@ void GlrDetector::report(const core::GlrResult& r, FaultOutput& out) {
   for (int i = 0; i < r.candidate_count; ++i)
     d.candidates().push_back(toIdl(r.candidates[static_cast<std::size_t>(i)]));
   d.detector("glr");
+  return d;
+}
+
+void GlrDetector::report(const core::GlrResult& r, FaultOutput& out) {
+  ++counters_.detections;
+  const core::GlrCandidate& best = r.candidates[0];
+  std::vector<FaultSourceKey> sources;
+  for (int i = 0; i < std::min(r.candidate_count, 2); ++i) {
+    const navbus::FaultCandidate c = toIdl(r.candidates[static_cast<std::size_t>(i)]);
+    sources.push_back({static_cast<int>(c.source()), c.sv_id(), c.axis()});
+  }
+  const RepeatGuard::Verdict verdict = repeats_.onDetection(epoch_.time_ns, sources);
+  if (verdict == RepeatGuard::Verdict::kSuppress) {
+    ++counters_.suppressed;
+    glr_.reset();
+    return;
+  }
+  navbus::FaultDecision d = decision(r);
   const std::uint32_t id = out.decide(d);
   spdlog::warn("glr decision {}: {}{} at {:.3f} s, onset after {:.3f} s, l {:.1f} >= h {:.1f}", id,
                describe(best),
@@ -128,7 +146,9 @@ void GlrDetector::report(const core::GlrResult& r, FaultOutput& out) {
   c.decision_id(id);
   c.time_gps_ns(d.time_gps_ns());
   c.onset_time_gps_ns(d.onset_time_gps_ns());
-  if (r.source == core::GlrSourceClass::kSatellite && config_.exclude_satellites) {
+  if (verdict == RepeatGuard::Verdict::kEscalate) {
+    escalate(r, c, out);
+  } else if (r.source == core::GlrSourceClass::kSatellite && config_.exclude_satellites) {
     // Only the faulty measurement: a code fault (pseudorange step or ramp) leaves the rate
     // in use, a rate fault the pseudorange.
     const navbus::SatelliteScope scope = best.hypothesis.fault == core::GlrFault::kRateStep
@@ -139,7 +159,7 @@ void GlrDetector::report(const core::GlrResult& r, FaultOutput& out) {
     c.scope(scope);
     out.command(c);
     glr_.setQuarantined(best.hypothesis.sv_id, true);
-    quarantine_.push_back({best.hypothesis.sv_id, scope, -1});
+    quarantine_.push_back({best.hypothesis.sv_id, scope, -1, false});
     ++counters_.satellites_excluded;
   } else if (r.source == core::GlrSourceClass::kImu && (r.ambiguous || r.onset_censored) &&
              config_.compensate_imu) {
@@ -157,6 +177,31 @@ void GlrDetector::report(const core::GlrResult& r, FaultOutput& out) {
   }
   // The filter reconfigures: signatures of the old configuration no longer describe it.
   glr_.reset();
+}
+
+void GlrDetector::escalate(const core::GlrResult& r, navbus::FilterCommand c, FaultOutput& out) {
+  ++counters_.escalated;
+  spdlog::warn(
+      "glr decision {}: the same source decided {} times within {:.0f} s: escalated "
+      "(IMU axes failed, a satellite kept excluded); not decided again",
+      c.decision_id(), config_.repeats.escalate_after + 1, config_.repeats.window_s);
+  for (int i = 0; i < std::min(r.candidate_count, 2); ++i) {
+    const core::GlrCandidate& cand = r.candidates[static_cast<std::size_t>(i)];
+    if (toIdl(cand).source() == navbus::SOURCE_SATELLITE) {
+      if (!config_.exclude_satellites) continue;
+      c.kind(navbus::CMD_EXCLUDE_SATELLITE);
+      c.sv_id(static_cast<std::uint16_t>(cand.hypothesis.sv_id));
+      c.scope(navbus::SCOPE_ALL);
+      out.command(c);
+      glr_.setQuarantined(cand.hypothesis.sv_id, true);
+      quarantine_.push_back({cand.hypothesis.sv_id, navbus::SCOPE_ALL, -1, true});
+    } else if (config_.compensate_imu) {
+      c.kind(navbus::CMD_FAIL_SENSOR_AXIS);
+      c.sensor(toSource(cand.hypothesis.fault));
+      c.axis(static_cast<std::uint16_t>(cand.hypothesis.axis));
+      out.command(c);
+    }
+  }
 }
 
 void GlrDetector::relearn(const core::GlrResult& r, navbus::FilterCommand c, FaultOutput& out) {
@@ -266,7 +311,7 @@ void GlrDetector::checkReadmission(FaultOutput& out) {
       const double z = std::abs(epoch_.innovation[r]) / std::sqrt(epoch_.innovation_cov(r, r));
       passing = passing && z <= config_.readmit_sigma;
     }
-    if (!seen || !passing) {
+    if (it->permanent || !seen || !passing) {
       it->passing_since_ns = -1;
       ++it;
       continue;
@@ -306,7 +351,8 @@ std::string GlrDetector::summary() const {
   s << "glr: epochs " << c.epochs << ", refused " << c.refused << ", restarts " << c.restarts
     << ", detections " << c.detections << " (satellites excluded " << c.satellites_excluded
     << ", biases compensated " << c.biases_compensated << ", ambiguous " << c.ambiguous
-    << "), readmitted " << c.readmitted << ", max statistic " << c.max_statistic;
+    << "), readmitted " << c.readmitted << ", repeated decisions escalated " << c.escalated
+    << " (detections not decided again " << c.suppressed << "), max statistic " << c.max_statistic;
   return s.str();
 }
 

@@ -29,6 +29,7 @@ struct FaultRunOutcome {
   double magnitude_error{0.0};           ///< relative, (decided - true) / true, for the true source
   double commanded_error{std::nan("")};  ///< relative error of the compensation commanded, if any
   int false_alarms{0};                   ///< detections before the fault (all, if fault-free)
+  int decisions{0};                      ///< every decision of the run, any detector
   /// Decision -> the position error is back inside the 3-sigma envelope (every axis, the
   /// filter's own sigma: the fault-free runs are consistent) and stays there 30 s; NaN: never.
   double recovery_s{std::nan("")};

@@ -8,6 +8,7 @@
 
 #include "navbus/core/integrity/dither_monitor.hpp"
 #include "navbus/core/integrity/glr.hpp"
+#include "navbus/fault_manager/repeat_guard.hpp"
 
 namespace navbus::fault_manager {
 
@@ -24,6 +25,8 @@ struct GlrDetectorConfig {
   /// `readmit_after_s` of consecutive epochs.
   double readmit_sigma{3.0};
   double readmit_after_s{30.0};
+  /// Repeated decisions on one source escalate once (repeat_guard.hpp).
+  RepeatGuardConfig repeats;
 };
 
 struct DitherDetectorConfig {

@@ -3,7 +3,9 @@
 // statistic, threshold, magnitude, onset and the candidates) and the commands the
 // configuration asks for (exclude an isolated satellite, compensate an isolated IMU bias;
 // nothing for an ambiguous IMU isolation), and readmits an excluded satellite once its
-// residuals pass again for the configured time.
+// residuals pass again for the configured time. Repeated decisions on one source escalate
+// once (repeat_guard.hpp): its IMU axes are failed (CMD_FAIL_SENSOR_AXIS), a satellite stays
+// excluded.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +18,7 @@
 #include "navbus/core/integrity/glr.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/fault_manager/fault_output.hpp"
+#include "navbus/fault_manager/repeat_guard.hpp"
 
 namespace navbus::fault_manager {
 
@@ -42,7 +45,9 @@ class GlrDetector {
     std::uint64_t detections{0}, satellites_excluded{0}, biases_compensated{0};
     std::uint64_t ambiguous{0};  ///< IMU isolations not certain: biases re-learned instead
     std::uint64_t readmitted{0};
-    double max_statistic{0.0};  ///< largest statistic seen
+    std::uint64_t escalated{0};   ///< repeated decisions escalated (repeat_guard.hpp)
+    std::uint64_t suppressed{0};  ///< detections of escalated sources not decided again
+    double max_statistic{0.0};    ///< largest statistic seen
   };
   const Counters& counters() const { return counters_; }
   const core::GlrMonitor& monitor() const { return glr_; }
@@ -56,6 +61,9 @@ class GlrDetector {
   void removeQuarantinedRows();
   void refine(FaultOutput& out);
   void relearn(const core::GlrResult& r, navbus::FilterCommand c, FaultOutput& out);
+  /// What is left once re-learning or compensating has not cured a source.
+  void escalate(const core::GlrResult& r, navbus::FilterCommand c, FaultOutput& out);
+  navbus::FaultDecision decision(const core::GlrResult& r) const;
 
   struct Pending {
     bool active{false};
@@ -69,10 +77,12 @@ class GlrDetector {
     int sv_id;
     navbus::SatelliteScope scope;   ///< the measurements excluded
     std::int64_t passing_since_ns;  ///< -1: not passing
+    bool permanent{false};          ///< escalated: never readmitted
     bool covers(int sv, bool is_rate) const;
   };
 
   GlrDetectorConfig config_;
+  RepeatGuard repeats_;
   core::GlrMonitor glr_;
   core::GlrEpoch epoch_;
   std::uint64_t last_seq_{0};
