@@ -121,6 +121,9 @@ void parseRecovery(const YAML::Node& node, FilterConfig& c) {
       .number("max_accel_compensation_mg", c.max_accel_compensation_mps2, {0.0, 1e4}, kMilliG)
       .number("max_gyro_compensation_deg_per_h", c.max_gyro_compensation_radps, {0.0, 1e6},
               kDegPerHour)
+      .number("gap_max_bridged_s", c.engine.gap.max_bridged_s, {0.0, 3600.0})
+      .number("gap_accel_sigma_mps2", c.engine.gap.accel_sigma_mps2, {0.0, 1000.0})
+      .number("gap_rate_sigma_deg_per_s", c.engine.gap.rate_sigma_radps, {0.0, 1000.0}, kDegree)
       .finish();
 }
 

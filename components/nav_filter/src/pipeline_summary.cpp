@@ -14,6 +14,7 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
   const PipelineCounters& p = v.counters;
   out << "increments integrated " << n.imu_used << " refused by the engine " << n.imu_refused
       << ", solutions published " << v.solutions_published << ", inertial gaps " << n.imu_gaps
+      << " (propagated across " << n.gaps_bridged << ")"
       << ", GNSS epochs fused " << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
       << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
       << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated

@@ -156,14 +156,9 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
     start(s, config_.initial_clock_bias_m, config_.initial_clock_drift_mps,
           sigma.array().square().matrix().asDiagonal());
   } else if (start_ns - filter_->state().time_ns > interval_ns / 2) {
-    // Inertial data is missing between the state time and this interval: nothing can be
-    // propagated across the gap, so restart the integration and flag the solution.
-    filter_->restartAt(start_ns);
-    status_ |= kStatusImuGap;
-    ++counters_.imu_gaps;
-    next_output_ns_ = (start_ns / period + 1) * period;
-    next_constraint_ns_ = start_ns;
+    crossGap(start_ns);  // inertial data is missing between the state time and this interval
   }
+  last_increment_ = inc;
   // Seed 004's comparison cases stop the filter during an outage (the mechanization runs on);
   // it resumes with the covariance it had (case I) or a re-initialized one (case II).
   const bool suspended = config_.aiding == AidingMode::kMultiDimensional &&
@@ -191,6 +186,31 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
     return true;
   }
   return false;
+}
+
+void NavigationEngine::crossGap(std::int64_t start_ns) {
+  const std::int64_t from_ns = filter_->state().time_ns;
+  const double gap_s = 1e-9 * static_cast<double>(start_ns - from_ns);
+  const bool bridged = last_increment_.has_value() && gap_s <= config_.gap.max_bridged_s;
+  const double speed_mps = filter_->state().vel_ned_mps.norm();
+  if (bridged) {
+    for (const ImuIncrement& held : heldIncrements(*last_increment_, from_ns, start_ns))
+      filter_->propagate(held);
+    ++counters_.gaps_bridged;
+  } else {
+    filter_->restartAt(start_ns);  // nothing to hold: the solution stands where it was
+  }
+  const GapVariances v = gapVariances(config_.gap, gap_s, bridged, speed_mps);
+  for (int i = 0; i < 3; ++i) {
+    filter_->addVariance(layout::kPos.index + i, v.position_m2);
+    filter_->addVariance(layout::kVel.index + i, v.velocity_m2ps2);
+    filter_->addVariance(layout::kAtt.index + i, v.attitude_rad2);
+  }
+  status_ |= kStatusImuGap;
+  ++counters_.imu_gaps;
+  const std::int64_t period = config_.solution_period_ns;
+  next_output_ns_ = (start_ns / period + 1) * period;
+  next_constraint_ns_ = start_ns;
 }
 
 void NavigationEngine::start(const NavState& state, double clock_bias_m, double clock_drift_mps,

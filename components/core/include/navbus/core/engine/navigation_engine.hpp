@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,6 +18,7 @@
 #include "navbus/core/filter/filter_tuning.hpp"
 #include "navbus/core/filter/mdf_config.hpp"
 #include "navbus/core/gnss/gnss_measurement.hpp"
+#include "navbus/core/ins/gap_bridge.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/integrity/protection_level_config.hpp"
@@ -84,12 +86,14 @@ struct EngineConfig {
   double initial_clock_bias_m{0.0};
   double initial_clock_drift_mps{0.0};
   std::int64_t solution_period_ns{100'000'000};
+  GapBridgeConfig gap;  ///< propagation across inertial gaps (ins/gap_bridge.hpp)
   /// Protection levels from the GLR's statistics (tightly coupled mode only).
   IntegrityConfig integrity;
 };
 
 struct EngineCounters {
   std::uint64_t imu_used{0}, imu_gaps{0};
+  std::uint64_t gaps_bridged{0};  ///< of imu_gaps: propagated across with held inputs
   std::uint64_t imu_aligning{0};  ///< increments the alignment took before the filter started
   /// Increments refused: interval not positive and finite, or not after the state time (an
   /// embedding application may call the engine without the bus validation).
@@ -190,6 +194,10 @@ class NavigationEngine {
   void start(const NavState& state, double clock_bias_m, double clock_drift_mps,
              const StateMatrix& initial_covariance);
   void startFromAlignment();
+  /// Inertial data is missing from the state time to `start_ns`: propagated across with held
+  /// inputs, or restarted beyond GapBridgeConfig::max_bridged_s; the covariance grows for what
+  /// was not measured.
+  void crossGap(std::int64_t start_ns);
   StateMatrix alignedCovariance(const AlignedStart& a) const;
   /// While the course check is armed: the Earth-rate remainder's floor, and at rest the
   /// gyrocompass heading's (IntegratedFilter).
@@ -219,6 +227,8 @@ class NavigationEngine {
   std::uint8_t failed_axes_{0};  ///< bit i: accelerometer i (0-2), gyro i - 3 (3-5)
   std::int64_t next_output_ns_{0};
   std::int64_t last_fix_ns_{-1};
+  /// The latest increment integrated (compensated): held across a gap (ins/gap_bridge.hpp).
+  std::optional<ImuIncrement> last_increment_;
   std::int64_t next_constraint_ns_{0};
   bool course_check_armed_{false};             ///< checkHeadingFromCourse still to come
   double gyrocompass_heading_sigma_rad_{0.0};  ///< the aligned start's heading sigma
