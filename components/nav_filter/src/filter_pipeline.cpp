@@ -171,6 +171,7 @@ void FilterPipeline::startNewRun() {
   diagnostics_seq_ = 0;
   published_up_to_ns_ = -1;
   diagnosed_up_to_ns_ = -1;
+  judged_up_to_ns_ = -1;
   time_reference_.latest_ns = 0;
   for (bus::StreamGate* g : {&gnss_obs_gate_, &gnss_fix_gate_, &star_gate_})
     g->tracker().resetAll();
@@ -264,10 +265,18 @@ void FilterPipeline::publishDiagnostics() {
                                 engine_.state().time_ns));
 }
 
+bool FilterPipeline::monitored() const {
+  if (judgements_.reports() == 0 || diagnosed_up_to_ns_ < 0) return flags_.faultMonitorAlive();
+  return judged_up_to_ns_ >= diagnosed_up_to_ns_;
+}
+
 void FilterPipeline::publishSolution() {
   if (!engine_.initialized()) return;
-  const navbus::NavigationSolution sol = buildSolution(engine_, config_.vehicle_id, ++solution_seq_,
-                                                       flags_.flags(), flags_.faultMonitorAlive());
+  const bool monitored_now = monitored();
+  const std::uint32_t flags = (flags_.flags() & ~navbus::FAULT_NO_FAULT_MONITOR) |
+                              (monitored_now ? 0U : navbus::FAULT_NO_FAULT_MONITOR);
+  const navbus::NavigationSolution sol =
+      buildSolution(engine_, config_.vehicle_id, ++solution_seq_, flags, monitored_now);
   sinks_.solution(sol);
   if (config_.low_latency_output && sinks_.low_latency) {
     predictor_.setAnchor({engine_.state(), engine_.accelBias(), engine_.gyroBias()});

@@ -62,14 +62,18 @@ void FilterPipeline::checkImuWriters(std::int64_t now_ns) {
 
 void FilterPipeline::onFaultMonitorProgress(const navbus::FaultMonitorProgress& report) {
   if (report.vehicle_id() != config_.vehicle_id) return;
-  if (const auto judged = judgements_.onProgress(report))
-    sequencer_.judged(kCommandStream, *judged);
+  if (const auto judged = judgements_.onProgress(report)) noteJudged(*judged);
+}
+
+void FilterPipeline::noteJudged(std::int64_t judged_up_to_ns) {
+  sequencer_.judged(kCommandStream, judged_up_to_ns);
+  judged_up_to_ns_ = std::max(judged_up_to_ns_, judged_up_to_ns);
 }
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c,
                                const std::optional<std::string>& writer_identity) {
   // Released by pump() only: the command below is queued before the judgement counts.
-  if (const auto judged = judgements_.onCommand(c)) sequencer_.judged(kCommandStream, *judged);
+  if (const auto judged = judgements_.onCommand(c)) noteJudged(*judged);
   if (!commands_.addressedToThisVehicle(c)) return;  // for another vehicle: not ours
   if (!commands_.authorized(c, writer_identity)) return;
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM || c.kind() == navbus::CMD_READMIT_STREAM) {

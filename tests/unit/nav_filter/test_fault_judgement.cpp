@@ -73,11 +73,12 @@ struct DelayedMonitor {
   FilterRun& run;
   FilterCommand (*make)(std::uint64_t);
   long command_first_by{0};
+  std::size_t delay_frames{kDelayFrames};
   std::deque<std::pair<std::size_t, std::function<void()>>> due;  ///< frame, delivery
 
   void attach() {
     run.on_diagnostics = [this](const FilterDiagnostics& d) {
-      const std::size_t at = frameNow + kDelayFrames;
+      const std::size_t at = frameNow + delay_frames;
       const bool answers = run.diagnostics.size() == kJudgedEpoch + 1;
       const std::uint64_t last_id = run.diagnostics.size() > kJudgedEpoch ? 1 : 0;
       if (answers) {
@@ -124,7 +125,7 @@ TEST(FaultJudgement, TheOutputWaitsForEachEpochsJudgementAndEqualsOffline) {
   for (const long command_first_by : {20L, 0L, -20L}) {  // the report may overtake the command
     FilterRun offline(config), bus(config);
     answerInTime(offline, compensateGyroX);
-    DelayedMonitor monitor{bus, compensateGyroX, command_first_by, {}};
+    DelayedMonitor monitor{bus, compensateGyroX, command_first_by, kDelayFrames, {}};
     monitor.attach();
     offline.play(all);
     bus.play(all);
@@ -146,7 +147,7 @@ TEST(FaultJudgement, WithoutWaitingTheOutputDiffersOnlyUntilTheCommandCame) {
   const auto config = tightlyCoupled(40.0);
   FilterRun offline(config), bus(config);
   answerInTime(offline, compensateGyroX);
-  DelayedMonitor monitor{bus, compensateGyroX, 0, {}};
+  DelayedMonitor monitor{bus, compensateGyroX, 0, kDelayFrames, {}};
   monitor.attach();
   offline.play(all);
   bus.play(all);
@@ -159,6 +160,37 @@ TEST(FaultJudgement, WithoutWaitingTheOutputDiffersOnlyUntilTheCommandCame) {
   EXPECT_NE(bus.pipeline->summary().find(") late 1"), std::string::npos) << bus.pipeline->summary();
 }
 
+TEST(FaultJudgement, AJudgedEpochIsMonitoredWhateverTheParticipantsClockSaid) {
+  // The participant finds the fault manager not alive for 3 s of frames (its reports came
+  // late, the fault manager was stopped): the judgement came all the same, and the solutions
+  // say what offline says, flags and integrity included.
+  const std::vector<Frame> all = frames(kFrames);
+  const auto config = tightlyCoupled(40.0, kMonitored);
+  FilterRun offline(config), bus(config);
+  answerInTime(offline, compensateGyroX);
+  // Within an epoch (kDelayFrames would hold each epoch's successors for longer than an epoch,
+  // and the last ones would only be flushed, unjudged, at the end of the data).
+  DelayedMonitor monitor{bus, compensateGyroX, 0, 50, {}};
+  monitor.attach();
+  const auto deliver = bus.before_frame;
+  bus.before_frame = [&bus, deliver](std::size_t k) {
+    bus.pipeline->setFaultMonitorAlive(k < 400 || k >= 700);
+    deliver(k);
+  };
+  offline.play(all);
+  bus.play(all);
+  ASSERT_EQ(offline.solutions.size(), bus.solutions.size());
+  for (std::size_t k = 0; k < bus.solutions.size(); ++k) {
+    const NavigationSolution& a = offline.solutions[k];
+    const NavigationSolution& b = bus.solutions[k];
+    ASSERT_TRUE(sameBits(a, b)) << "solution " << k;
+    ASSERT_EQ(a.active_fault_flags(), b.active_fault_flags()) << "solution " << k;
+    ASSERT_EQ(a.integrity(), b.integrity()) << "solution " << k;
+    ASSERT_EQ(a.horizontal_protection_level_m(), b.horizontal_protection_level_m()) << k;
+  }
+  EXPECT_EQ(bus.solutions.back().active_fault_flags() & FAULT_NO_FAULT_MONITOR, 0u);
+}
+
 class LateCommand : public ::testing::TestWithParam<FilterCommand (*)(std::uint64_t)> {};
 
 TEST_P(LateCommand, GivesTheFullInTimeStateBitForBit) {
@@ -166,7 +198,7 @@ TEST_P(LateCommand, GivesTheFullInTimeStateBitForBit) {
   const auto config = tightlyCoupled(40.0);
   FilterRun in_time(config), late(config);
   answerInTime(in_time, GetParam());
-  DelayedMonitor monitor{late, GetParam(), 0, {}};
+  DelayedMonitor monitor{late, GetParam(), 0, kDelayFrames, {}};
   monitor.attach();
   in_time.play(all);
   late.play(all);
@@ -189,6 +221,17 @@ TEST(FaultJudgement, AMonitorThatStopsReportingHoldsTheOutputForItsBudgetOnly) {
   reference.play(all);
   bus.play(all);
   expectSameSolutions(reference, bus);  // nothing was commanded: the same solutions, later
+  // ... but those after the last judged epoch are not under its watch, and say so.
+  const std::uint64_t judged_ns = bus.diagnostics.at(1).time_gps_ns();
+  const std::uint64_t next_epoch_ns = bus.diagnostics.at(2).time_gps_ns();
+  for (const NavigationSolution& s : bus.solutions) {
+    const bool unjudged = s.time_gps_ns() > next_epoch_ns;
+    EXPECT_EQ((s.active_fault_flags() & FAULT_NO_FAULT_MONITOR) != 0, unjudged)
+        << "solution at " << s.time_gps_ns() << ", epochs judged up to " << judged_ns;
+    if (unjudged) {
+      ASSERT_EQ(s.integrity(), INTEGRITY_NOT_MONITORED);
+    }
+  }
   const std::string summary = bus.pipeline->summary();
   EXPECT_NE(summary.find("judgements waited for beyond the budget 1"), std::string::npos)
       << "set aside once, not waited for at every epoch: " << summary;

@@ -167,6 +167,13 @@ class FilterPipeline {
   /// sequence numbers restart with it, which tells subscribers the same.
   void startNewRun();
   void publishSolution();
+  /// Whether the solution about to be published is under a fault monitor's watch. Once the
+  /// fault manager reports its progress, that is a fact of the data: the latest diagnostics
+  /// epoch before the solution has been judged (the deterministic output waits for it, so
+  /// only a judgement that ran out of its budget makes it false), and the bus and offline
+  /// agree however the processes were scheduled. Before any report: the participant's view.
+  bool monitored() const;
+  void noteJudged(std::int64_t judged_up_to_ns);
   void publishDiagnostics();
   /// Propagates the low-latency output with an arrived increment and publishes it.
   void publishLowLatency(const core::ImuIncrement& inc);
@@ -209,6 +216,7 @@ class FilterPipeline {
   /// after a rewind is not published twice.
   std::int64_t published_up_to_ns_{-1};
   std::int64_t diagnosed_up_to_ns_{-1};
+  std::int64_t judged_up_to_ns_{-1};  ///< the fault manager's judgement counted up to here
 };
 
 }  // namespace navbus::nav_filter
