@@ -441,6 +441,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
     Stats st;
     std::vector<AlignmentOutcome> alignments;  ///< one per run, filters that aligned
     IntegrityTally integrity;                  ///< protection levels against the errors
+    HonestyTally honesty;                      ///< the filter's own claims
   };
   std::vector<Row> rows;
   struct FaultTable {
@@ -451,7 +452,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
   };
   std::vector<FaultTable> fault_tables;
   for (const Variant& v : variants) {
-    Row row{v.label, {}, {}, {}};
+    Row row{v.label, {}, {}, {}, {}};
     // Runs in parallel (one per core unless --threads), gathered in seed order.
     std::vector<OfflineResult> results(static_cast<std::size_t>(o.runs));
     std::vector<OfflineSetup> setups(static_cast<std::size_t>(o.runs));
@@ -491,6 +492,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
       accumulate(row.st, r, start + static_cast<std::int64_t>(std::llround(o.from_s * 1e9)), o,
                  start);
       row.integrity.add(r, o.first_seed + static_cast<std::uint64_t>(i));
+      row.honesty.add(r, setup.filter.engine.consistency.false_alarm_probability);
       if (setup.filter.engine.start == core::StartSource::kAligned)
         row.alignments.push_back(
             {r.aligned, r.aligned_start, r.aligned_start_error,
@@ -540,6 +542,9 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
   std::vector<std::pair<std::string, IntegrityTally>> integrity;
   for (const Row& r : rows) integrity.emplace_back(r.label, r.integrity);
   printIntegrityTable(integrity);
+  std::vector<std::pair<std::string, HonestyTally>> honesty;
+  for (const Row& r : rows) honesty.emplace_back(r.label, r.honesty);
+  printHonestyTable(honesty);
   if (!o.csv_dir.empty()) {
     std::filesystem::create_directories(o.csv_dir);
     std::ofstream nees(o.csv_dir + "/nees.csv");

@@ -70,6 +70,57 @@ void IntegrityTally::add(const OfflineResult& r, std::uint64_t seed) {
   }
 }
 
+void HonestyTally::add(const OfflineResult& r, double probability) {
+  design_probability = probability;
+  consistency.epochs_tested += r.consistency.epochs_tested;
+  consistency.epochs_inconsistent += r.consistency.epochs_inconsistent;
+  consistency.alarms += r.consistency.alarms;
+  consistency.reinitialisations += r.consistency.reinitialisations;
+  consistency.nis_sum += r.consistency.nis_sum;
+  consistency.rows += r.consistency.rows;
+  ++runs;
+  std::uint64_t beyond = 0;
+  for (const EpochError& e : r.errors) {
+    ++epochs;
+    if (!e.covariance_valid) {
+      ++flagged;
+      continue;
+    }
+    const double sigma = e.pos_sigma_ned_m.norm();
+    if (!(sigma > 0.0)) continue;
+    const double ratio = e.pos_ned_m.norm() / sigma;
+    max_unflagged_ratio = std::max(max_unflagged_ratio, ratio);
+    beyond += ratio > 5.0 ? 1 : 0;
+  }
+  unflagged_beyond_5_sigma += beyond;
+  runs_unflagged_beyond_5_sigma += beyond > 0 ? 1 : 0;
+}
+
+void printHonestyTable(const std::vector<std::pair<std::string, HonestyTally>>& rows) {
+  std::printf(
+      "\nhonesty: the consistency monitor (share of tested epochs whose window failed, against "
+      "its design probability) and epochs whose 3-D position error exceeds 5 x the 3-D sigma "
+      "while covariance_valid\n%-34s %8s %10s %12s %10s %8s %8s %9s %14s %10s\n",
+      "configuration", "NIS/row", "tested", "inconsistent", "rate", "design", "alarms", "flagged",
+      "runs >5 sigma", "max err/s");
+  for (const auto& [label, t] : rows) {
+    const double rate = t.consistency.epochs_tested > 0
+                            ? static_cast<double>(t.consistency.epochs_inconsistent) /
+                                  static_cast<double>(t.consistency.epochs_tested)
+                            : 0.0;
+    const double nis_per_row = t.consistency.rows > 0
+                                   ? t.consistency.nis_sum / static_cast<double>(t.consistency.rows)
+                                   : 0.0;
+    std::printf("%-34s %8.3f %10llu %12llu %10.2e %8.0e %8llu %9llu %8d of %3d %10.2f\n",
+                label.c_str(), nis_per_row,
+                static_cast<unsigned long long>(t.consistency.epochs_tested),
+                static_cast<unsigned long long>(t.consistency.epochs_inconsistent), rate,
+                t.design_probability, static_cast<unsigned long long>(t.consistency.alarms),
+                static_cast<unsigned long long>(t.flagged), t.runs_unflagged_beyond_5_sigma, t.runs,
+                t.max_unflagged_ratio);
+  }
+}
+
 void printIntegrityTable(const std::vector<std::pair<std::string, IntegrityTally>>& rows) {
   bool any = false;
   for (const auto& [label, t] : rows) any = any || t.epochs > 0;

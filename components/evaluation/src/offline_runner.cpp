@@ -126,6 +126,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
         blockNees(P, active, kStarTrackerBias, err.star_tracker_bias_err_b_rad);
     err.mode = static_cast<int>(sol.mode());
     err.integrity = static_cast<int>(sol.integrity());
+    err.covariance_valid = sol.covariance_valid();
     err.hpl_m = sol.horizontal_protection_level_m();
     err.vpl_m = sol.vertical_protection_level_m();
     result.errors.push_back(err);
@@ -190,6 +191,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   // End of data: whatever waits for a stream that will not speak again is released.
   pipeline.flush(sim.scenario.start_time_ns + total * period_ns);
   result.summary = pipeline.summary();
+  result.consistency = pipeline.engine().consistency().counters();
   if (faults) {
     result.fault_summary = faults->summary();
     result.max_glr_statistic = faults->glr().counters().max_statistic;

@@ -102,6 +102,16 @@ void parseIntegrity(const YAML::Node& node, core::EngineConfig& e) {
         "configuration integrity.enabled: true needs mode: tightly_coupled (the protection "
         "levels come from the GLR on pseudoranges)");
 }
+/// The filter's test of its own innovations (core/integrity/consistency_monitor.hpp).
+void parseConsistency(const YAML::Node& node, core::ConsistencyConfig& k) {
+  bus::KeyReader r(node, "consistency");
+  r.value("enabled", k.enabled)
+      .integer("window_epochs", k.window_epochs,
+               {1.0, static_cast<double>(core::ConsistencyMonitor::kMaxWindow)})
+      .number("false_alarm_probability", k.false_alarm_probability, {1e-15, 0.5})
+      .number("reinitialise_after_s", k.reinitialise_after_s, {0.0, 86400.0})
+      .finish();
+}
 }  // namespace
 
 namespace {
@@ -350,7 +360,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       .value("star_tracker_updates", e.use_star_tracker)
       .nested({"low_latency_output", "recovery", "time_jump", "fault_monitor", "initial_state",
                "inputs", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional",
-               "alignment", "integrity"})
+               "alignment", "integrity", "consistency"})
       .finish(bus::kParticipantKeys);
   parseLowLatency(root["low_latency_output"], c);
   parseRecovery(root["recovery"], c);
@@ -365,6 +375,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   parseMultiDimensional(root["multi_dimensional"], e.mdf);
   parseAlignment(root["alignment"], e);
   parseIntegrity(root["integrity"], e);
+  parseConsistency(root["consistency"], e.consistency);
   return c;
 }
 

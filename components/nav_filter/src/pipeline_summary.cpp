@@ -15,7 +15,11 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
   out << "increments integrated " << n.imu_used << " refused by the engine " << n.imu_refused
       << ", solutions published " << v.solutions_published << ", inertial gaps " << n.imu_gaps
       << " (propagated across " << n.gaps_bridged << ")"
-      << ", GNSS epochs fused " << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
+      << ", consistency: epochs tested " << v.engine.consistency().counters().epochs_tested
+      << " inconsistent " << v.engine.consistency().counters().epochs_inconsistent << " alarms "
+      << v.engine.consistency().counters().alarms << ", re-initialisations asked "
+      << n.reinitialisations_asked << " done " << n.reinitialisations_done << ", GNSS epochs fused "
+      << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
       << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
       << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
       << ", stage switches " << n.stage_switches << ", decisions seen " << p.decisions_seen

@@ -31,7 +31,7 @@ navbus::NavigationSolution buildSolution(const core::NavigationEngine& engine,
       std::sqrt(P(core::layout::kClockBias.index, core::layout::kClockBias.index)));
   sol.clock_drift_sigma_mps(
       std::sqrt(P(core::layout::kClockDrift.index, core::layout::kClockDrift.index)));
-  sol.covariance_valid(true);
+  sol.covariance_valid(engine.trustworthy());
   // Biases: estimated plus those compensated by command.
   sol.accel_bias_b_mps2(bus::toArray(engine.accelBias()));
   sol.gyro_bias_b_radps(bus::toArray(engine.gyroBias()));
@@ -42,7 +42,7 @@ navbus::NavigationSolution buildSolution(const core::NavigationEngine& engine,
   sol.start_source(toIdl(config.start, engine.alignedStart().attitude_source));
   if (fault_monitor_alive) {
     const core::ProtectionLevels pl = engine.protectionLevels();
-    sol.integrity(toIdl(pl.state));
+    sol.integrity(engine.trustworthy() ? toIdl(pl.state) : navbus::INTEGRITY_UNAVAILABLE);
     sol.horizontal_protection_level_m(pl.horizontal_m);
     sol.vertical_protection_level_m(pl.vertical_m);
   }
@@ -89,6 +89,7 @@ std::uint32_t faultFlags(std::uint32_t engine_status) {
   if (engine_status & core::kStatusSatelliteExcluded) f |= navbus::FAULT_SATELLITE_EXCLUDED;
   if (engine_status & core::kStatusBiasCompensated) f |= navbus::FAULT_SENSOR_AXIS;
   if (engine_status & core::kStatusAxisFailed) f |= navbus::FAULT_IMU_AXIS_FAILED;
+  if (engine_status & core::kStatusInconsistent) f |= navbus::FAULT_FILTER_INCONSISTENT;
   return f;
 }
 
@@ -130,6 +131,8 @@ navbus::FilterMode toIdl(core::EngineMode mode) {
       return navbus::MODE_AIDED_AXIS_FAILED;
     case core::EngineMode::kAligning:
       return navbus::MODE_ALIGNING;
+    case core::EngineMode::kReinitialising:
+      return navbus::MODE_REINITIALISING;
   }
   return navbus::MODE_INITIALIZING;
 }

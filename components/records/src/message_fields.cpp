@@ -26,6 +26,8 @@ const char* enumName(navbus::FilterMode v) {
       return "AIDED_AXIS_FAILED";
     case navbus::MODE_ALIGNING:
       return "ALIGNING";
+    case navbus::MODE_REINITIALISING:
+      return "REINITIALISING";
   }
   return "UNKNOWN";
 }

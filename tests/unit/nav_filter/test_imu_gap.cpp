@@ -2,8 +2,10 @@
 // and its GNSS together for 20 s (nothing measured at all). The engine propagates across the
 // gap holding the last specific force and rate, with the covariance grown for what was not
 // measured (core/ins/gap_bridge.hpp): after the gap the 3-D error stays within 3 sigma on at
-// least 99 % of the epochs. (A gap beyond max_bridged_s still restarts without propagating;
-// its covariance growth does not yet cover the jump: measured 60 of 800 epochs within 3 sigma.)
+// least 99 % of the epochs. A gap beyond max_bridged_s is not propagated: the solution says
+// it is not trustworthy (MODE_REINITIALISING, covariance_valid false) until the next GNSS epoch
+// re-initialises position, velocity and clock from its own pseudorange solution; every epoch
+// after the gap is then within 3 sigma or flagged.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,6 +29,8 @@ constexpr double kGapFromS = 600.0, kGapToS = 620.0, kEndS = 700.0;
 struct GapOutcome {
   int epochs_after{0};
   int within_3_sigma{0};
+  int flagged{0};  ///< covariance_valid false (re-initialising)
+  int flagged_and_outside{0};
   double worst_ratio{0.0};  ///< largest 3-D error / 3-D sigma after the gap
   double worst_error_m{0.0};
   std::string summary;
@@ -56,7 +60,13 @@ GapOutcome flyThroughGap(double max_bridged_s) {
          const auto& sig = s.pos_sigma_ned_m();
          const double sigma = std::sqrt(sig[0] * sig[0] + sig[1] * sig[1] + sig[2] * sig[2]);
          ++out.epochs_after;
-         out.within_3_sigma += e.norm() <= 3.0 * sigma ? 1 : 0;
+         const bool within = e.norm() <= 3.0 * sigma;
+         if (!s.covariance_valid()) {
+           ++out.flagged;
+           out.flagged_and_outside += within ? 0 : 1;
+           return;
+         }
+         out.within_3_sigma += within ? 1 : 0;
          out.worst_ratio = std::max(out.worst_ratio, e.norm() / sigma);
          out.worst_error_m = std::max(out.worst_error_m, e.norm());
        },
@@ -94,4 +104,19 @@ TEST(ImuGap, TwentySecondsPropagatedAcrossWithSigmasThatCoverTheError) {
       "20 s IMU and GNSS gap at 200 m/s, propagated across: %d of %d epochs after it within 3 "
       "sigma, largest error %.1f m, largest error / sigma %.2f\n",
       g.within_3_sigma, g.epochs_after, g.worst_error_m, g.worst_ratio);
+}
+
+TEST(ImuGap, BeyondTheBridgeTheSolutionSaysSoUntilReinitialised) {
+  const GapOutcome g = flyThroughGap(10.0);  // the 20 s gap is not propagated across
+  ASSERT_GT(g.epochs_after, 700);
+  EXPECT_GT(g.flagged, 0) << "the frozen solution must say it is not trustworthy";
+  EXPECT_LE(g.flagged, 12) << "re-initialised at the first GNSS epoch after the gap";
+  EXPECT_GE(g.within_3_sigma + g.flagged, static_cast<int>(0.99 * g.epochs_after)) << g.summary;
+  EXPECT_NE(g.summary.find("re-initialisations asked 1 done 1"), std::string::npos) << g.summary;
+  std::printf(
+      "20 s IMU and GNSS gap at 200 m/s beyond a 10 s bridge: %d epochs flagged re-initialising "
+      "(%d of them outside 3 sigma), then %d of %d within 3 sigma, largest error / sigma %.2f "
+      "(flagged ones included)\n",
+      g.flagged, g.flagged_and_outside, g.within_3_sigma, g.epochs_after - g.flagged,
+      g.worst_ratio);
 }

@@ -1,5 +1,7 @@
 #include "navbus/core/engine/navigation_engine.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "navbus/core/engine/initial_alignment.hpp"
@@ -35,6 +37,7 @@ NavigationEngine::NavigationEngine(const EngineConfig& config)
       stationarity_(std::in_place),
       stages_(std::in_place) {
   integrity_->configure(config.integrity);
+  consistency_.configure(config.consistency);
   used_.reserve(32);
   reset();
 }
@@ -112,6 +115,7 @@ void NavigationEngine::reset() {
   stationarity_->configure(config_.mdf.stationarity, config_.imu_period_s);
   stages_->configure(config_.mdf);
   stages_->restart();
+  consistency_.restart();
 }
 
 StateMask NavigationEngine::baseMask() const {
@@ -199,6 +203,7 @@ void NavigationEngine::crossGap(std::int64_t start_ns) {
     ++counters_.gaps_bridged;
   } else {
     filter_->restartAt(start_ns);  // nothing to hold: the solution stands where it was
+    askReinitialisation();         // ... and is not trustworthy until a GNSS solution
   }
   const GapVariances v = gapVariances(config_.gap, gap_s, bridged, speed_mps);
   for (int i = 0; i < 3; ++i) {
@@ -421,6 +426,10 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
     return false;
   }
   if (!any) return false;
+  if ((status_ & kStatusReinitialising) != 0) {
+    reinitialiseFromPseudoranges(time_ns);
+    return false;  // this epoch made the new start: nothing to diagnose
+  }
   if (course_check_armed_) floorBeforeCourseCheck();
   if (course_check_armed_ &&
       filter_->state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
@@ -428,9 +437,11 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
         pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_->state().position));
     if (pf.valid) checkHeadingFromCourse(pf.fix.vel_ned_mps, pf.fix.vel_sigma_ned_mps.x());
   }
-  for (const auto& rep : filter_->update(used_)) {
+  const std::vector<MeasurementReport>& reports = filter_->update(used_);
+  for (const auto& rep : reports) {
     counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
   }
+  checkConsistency(time_ns, reports);
   ++counters_.gnss_epochs_fused;
   mode_ = aidedMode();
   if (config_.integrity.enabled) integrity_->onEpoch(time_ns, filter_->lastEpoch());
@@ -451,6 +462,11 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
     return;
   }
   if (!filter_->initialized() || mode_ == EngineMode::kInertialLost) return;
+  if ((status_ & kStatusReinitialising) != 0 && config_.aiding != AidingMode::kTightlyCoupled &&
+      config_.aiding != AidingMode::kInertialOnly) {
+    reinitialiseFromFix(fix);
+    return;
+  }
   if (config_.aiding == AidingMode::kMultiDimensional) {
     last_fix_ns_ = fix.time_ns;
     if (!stationarity_->ready()) return;
@@ -474,6 +490,10 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
       filter_->update(velocityMeasurement(filter_->state(), fix.vel_ned_mps, fix.vel_sigma_ned_mps),
                       AidingKind::kVelocity);
   countGated(v.data(), 3);
+  std::array<ScalarUpdateResult, 6> rows{};
+  std::copy(p.begin(), p.end(), rows.begin());
+  std::copy(v.begin(), v.end(), rows.begin() + 3);
+  checkConsistency(fix.time_ns, rows.data(), 6);
   ++counters_.fixes_fused;
   if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();
 }

@@ -50,6 +50,13 @@ void ErrorState::setVariances(const StateBlock& block, double sigma) {
   for (int i = block.index; i < block.end(); ++i) P_(i, i) = sigma * sigma;
 }
 
+void ErrorState::resetState(int i, double sigma) {
+  P_.row(i).setZero();
+  P_.col(i).setZero();
+  P_(i, i) = sigma * sigma;
+  x_[i] = 0.0;
+}
+
 void ErrorState::setActive(const StateMask& active) {
   active_ = active;
   removeInactiveCoupling();

@@ -374,6 +374,32 @@ void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
   }
 }
 
+void IntegratedFilter::resetNavigation(const GnssFixMeasurement& fix) {
+  NavState s = ins_.state();
+  s.position = fix.position;
+  s.vel_ned_mps = fix.vel_ned_mps;
+  ins_.correct(s);
+  for (int i = 0; i < 3; ++i) {
+    resetState(layout::kPos.index + i, fix.pos_sigma_ned_m[i]);
+    resetState(layout::kVel.index + i, fix.vel_sigma_ned_mps[i]);
+  }
+}
+
+void IntegratedFilter::resetClock(double bias_m, double drift_mps, double bias_sigma_m,
+                                  double drift_sigma_mps) {
+  clock_bias_m_ = bias_m;
+  clock_drift_mps_ = drift_mps;
+  resetState(layout::kClockBias.index, bias_sigma_m);
+  resetState(layout::kClockDrift.index, drift_sigma_mps);
+}
+
+void IntegratedFilter::resetState(int i, double sigma) {
+  central_.resetState(i, sigma);
+  for (ErrorState& l : local_) {  // a local filter that does not carry the state keeps 0
+    if (l.P()(i, i) > 0.0) l.resetState(i, sigma * std::sqrt(tuning_.federated_share));
+  }
+}
+
 void IntegratedFilter::resetVariances(const StateBlock& block, double sigma) {
   central_.setVariances(block, sigma);
   for (ErrorState& l : local_) l.setVariances(block, sigma * std::sqrt(tuning_.federated_share));

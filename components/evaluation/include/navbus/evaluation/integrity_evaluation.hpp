@@ -31,6 +31,21 @@ struct IntegrityTally {
   void add(const OfflineResult& r, std::uint64_t seed);
 };
 
+/// Whether the filter's own claims hold: its consistency monitor's alarms (on fault-free runs
+/// the false-alarm rate, against its design probability) and the epochs whose 3-D position
+/// error exceeds 5 times the 3-D sigma while the solution says its covariance is valid.
+struct HonestyTally {
+  core::ConsistencyCounters consistency;  ///< summed over the runs
+  double design_probability{0.0};
+  std::uint64_t epochs{0}, flagged{0};  ///< solutions, of them covariance_valid false
+  std::uint64_t unflagged_beyond_5_sigma{0};
+  int runs{0}, runs_unflagged_beyond_5_sigma{0};
+  double max_unflagged_ratio{0.0};  ///< largest 3-D error / 3-D sigma, unflagged epochs
+
+  void add(const OfflineResult& r, double design_probability);
+};
+void printHonestyTable(const std::vector<std::pair<std::string, HonestyTally>>& rows);
+
 /// One table row per configuration (skips configurations without levels).
 void printIntegrityTable(const std::vector<std::pair<std::string, IntegrityTally>>& rows);
 

@@ -42,10 +42,11 @@ struct EpochError {
   /// accelerometer bias, gyro bias, star-tracker bias (NaN: a block the filter does not have).
   /// A bias's truth is the simulator's bias (scale factors and misalignments are not in it).
   Eigen::Matrix<double, kNeesBlocks, 1> nees_blocks{Eigen::Matrix<double, kNeesBlocks, 1>::Zero()};
-  int mode{0};        ///< navbus::FilterMode of the solution
-  int integrity{0};   ///< navbus::IntegrityState of the solution
-  double hpl_m{0.0};  ///< its horizontal protection level [m]
-  double vpl_m{0.0};  ///< its vertical protection level [m]
+  int mode{0};                  ///< navbus::FilterMode of the solution
+  int integrity{0};             ///< navbus::IntegrityState of the solution
+  double hpl_m{0.0};            ///< its horizontal protection level [m]
+  double vpl_m{0.0};            ///< its vertical protection level [m]
+  bool covariance_valid{true};  ///< the solution's own claim that its sigmas hold
 };
 
 struct OfflineSetup {
@@ -62,6 +63,7 @@ struct OfflineResult {
   std::uint64_t solutions{0};
   std::uint64_t solutions_without_truth{0};  ///< solution times between truth samples
   std::string summary;                       ///< the pipeline's counters
+  core::ConsistencyCounters consistency;     ///< the filter's test of its own innovations
   std::string fault_summary;                 ///< the fault pipeline's counters
   std::vector<navbus::FaultDecision> decisions;
   /// Per decision: how many solutions had been published when it was (an alarm covers the

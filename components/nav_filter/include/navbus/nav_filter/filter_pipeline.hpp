@@ -139,9 +139,9 @@ class FilterPipeline {
   /// its judgement does not follow this: a monitor stopped for longer than its health timeout
   /// but within judgement_wait_ns is still waited for; a dead one costs one budget.)
   void setFaultMonitorAlive(bool alive) { flags_.setFaultMonitorAlive(alive); }
-  /// Some stream is currently lost, or no fault monitor is alive (the participant reports
-  /// DEGRADED).
-  bool degraded() const { return flags_.degraded(); }
+  /// Some stream is currently lost, no fault monitor is alive, or the filter does not trust
+  /// its own covariance (the participant reports DEGRADED).
+  bool degraded() const { return flags_.degraded() || !engine_.trustworthy(); }
   /// New runs started because the IMU source restarted at an earlier time.
   std::uint64_t newRuns() const { return counters_.new_runs; }
   const core::NavigationEngine& engine() const { return engine_; }

@@ -21,6 +21,7 @@
 #include "navbus/core/ins/gap_bridge.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/ins/strapdown.hpp"
+#include "navbus/core/integrity/consistency_monitor.hpp"
 #include "navbus/core/integrity/protection_level_config.hpp"
 #include "navbus/core/math/indirect.hpp"
 
@@ -34,6 +35,7 @@ class StationarityDetector;
 class StageSelector;
 struct StageDecision;
 struct ScalarUpdateResult;
+struct MeasurementReport;
 
 enum class AidingMode {
   kInertialOnly,     ///< mechanization and covariance propagation, no updates
@@ -53,7 +55,11 @@ enum class EngineMode {
   kMdfF3,
   kMdfF4,
   kAidedAxisFailed,  ///< tightly or loosely coupled with a failed IMU axis
-  kAligning          ///< aligning from the inputs (InitialAligner): no solution yet
+  kAligning,         ///< aligning from the inputs (InitialAligner): no solution yet
+  /// The solution is not trustworthy until the next GNSS solution re-initialises position,
+  /// velocity (and the clock): after an inertial gap longer than the bridge, or when the
+  /// consistency monitor's alarm has lasted (integrity/consistency_monitor.hpp).
+  kReinitialising
 };
 
 /// Where the filter's start comes from.
@@ -68,6 +74,8 @@ enum EngineStatus : std::uint32_t {
   kStatusSatelliteExcluded = 1u << 1,
   kStatusBiasCompensated = 1u << 2,
   kStatusAxisFailed = 1u << 3,
+  kStatusInconsistent = 1u << 4,    ///< the consistency monitor's latest window failed its test
+  kStatusReinitialising = 1u << 5,  ///< waiting for a GNSS solution to re-initialise from
 };
 
 /// Which measurements of a satellite an exclusion concerns (bit mask).
@@ -89,6 +97,8 @@ struct EngineConfig {
   GapBridgeConfig gap;  ///< propagation across inertial gaps (ins/gap_bridge.hpp)
   /// Protection levels from the GLR's statistics (tightly coupled mode only).
   IntegrityConfig integrity;
+  /// The filter's test of its own innovations, and when it re-initialises.
+  ConsistencyConfig consistency;
 };
 
 struct EngineCounters {
@@ -105,6 +115,9 @@ struct EngineCounters {
   /// Headings measured again from the GNSS course after gyrocompassing
   /// (InitialAlignmentConfig::course_check_heading_sigma_rad).
   std::uint64_t course_heading_checks{0};
+  /// Re-initialisations from a GNSS solution: asked for (a gap beyond the bridge, a lasting
+  /// inconsistency) and done.
+  std::uint64_t reinitialisations_asked{0}, reinitialisations_done{0};
 };
 
 class NavigationEngine {
@@ -163,7 +176,15 @@ class NavigationEngine {
   Eigen::Vector3d starTrackerBias() const;
   double clockBias() const;   ///< receiver clock bias c*b [m]
   double clockDrift() const;  ///< receiver clock drift c*f [m/s]
-  EngineMode mode() const { return mode_; }
+  EngineMode mode() const {
+    return (status_ & kStatusReinitialising) != 0 ? EngineMode::kReinitialising : mode_;
+  }
+  /// False while the consistency monitor's window fails its test or the filter waits to
+  /// re-initialise: the covariance does not describe the error, whatever it says.
+  bool trustworthy() const {
+    return (status_ & (kStatusInconsistent | kStatusReinitialising)) == 0;
+  }
+  const ConsistencyMonitor& consistency() const { return consistency_; }
   FusionStructure fusion() const;
   const EngineConfig& config() const { return config_; }
   std::uint32_t status() const { return status_; }
@@ -210,6 +231,16 @@ class NavigationEngine {
   void checkHeadingFromCourse(const Eigen::Vector3d& gnss_vel_ned_mps,
                               double cross_track_sigma_mps);
   bool aligning() const;
+  /// One aiding epoch's normalized innovations to the consistency monitor; a lasting alarm
+  /// asks for re-initialisation (engine_consistency.cpp).
+  void checkConsistency(std::int64_t time_ns, const ScalarUpdateResult* rows, int n);
+  void checkConsistency(std::int64_t time_ns, const std::vector<MeasurementReport>& reports);
+  void askReinitialisation();
+  /// While re-initialisation is asked: from this epoch's pseudorange solution (false: not
+  /// possible, fewer than four satellites) or from a fix.
+  bool reinitialiseFromPseudoranges(std::int64_t time_ns);
+  void reinitialiseFromFix(const GnssFixMeasurement& fix);
+  void finishReinitialisation();
 
   EngineConfig config_;
   Indirect<IntegratedFilter> filter_;
@@ -217,6 +248,7 @@ class NavigationEngine {
   Indirect<GlrProtectionLevel> integrity_;
   Indirect<StationarityDetector> stationarity_;
   Indirect<StageSelector> stages_;
+  ConsistencyMonitor consistency_;
   EngineMode mode_{EngineMode::kInitializing};
   std::uint32_t status_{0};
   EngineCounters counters_;

@@ -42,6 +42,9 @@ class ErrorState {
   /// re-initialize the listed variances.
   void zeroOffDiagonal();
   void setVariances(const StateBlock& block, double sigma);
+  /// Forgets what was known of state i: its error and correlations are zeroed, its variance
+  /// set to sigma^2 (a re-initialisation from an independent measurement).
+  void resetState(int i, double sigma);
 
   /// Changes the active set (inactive states keep their variance, cross terms removed).
   void setActive(const StateMask& active);

@@ -17,6 +17,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "navbus/core/filter/aiding_inputs.hpp"
 #include "navbus/core/filter/aiding_measurements.hpp"
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 #include "navbus/core/filter/error_state.hpp"
@@ -85,6 +86,13 @@ class IntegratedFilter {
   void inflateVariances(const StateBlock& block, double sigma);
   /// Adds `variance` to one state's variance (a correction of uncertain size was applied).
   void addVariance(int state, double variance);
+  /// Re-initialisation from an independent GNSS solution: position and velocity are set to
+  /// the fix and their covariance rows replaced by its variances (no correlation with the
+  /// rest: what the filter knew of them no longer holds). Attitude, biases and clock keep
+  /// theirs.
+  void resetNavigation(const GnssFixMeasurement& fix);
+  /// The same for the receiver clock (bias [m], drift [m/s] and their sigmas).
+  void resetClock(double bias_m, double drift_mps, double bias_sigma_m, double drift_sigma_mps);
   /// The GNSS course against the INS course (NavigationEngine::checkHeadingFromCourse):
   ///   z = course_gnss - course_ins = -u_c . e_v / speed + noise,
   /// u_c the unit vector across the track: the cross-track velocity error, which the velocity
@@ -136,6 +144,7 @@ class IntegratedFilter {
   ErrorState& target(AidingKind kind);
   /// Applies the estimate after an update: centralized feedback, or master fusion + feedback.
   void closeUpdate();
+  void resetState(int i, double sigma);
   void feedback(const StateVector& dx);
   /// P's attitude rows and columns through the reset of a heading correction (before
   /// feedback): turned by R_D(dpsi) with the frame the INS computes.

@@ -1,0 +1,73 @@
+// The engine's honesty when its model stops fitting: the consistency monitor's verdict on
+// each aiding epoch, and the re-initialisation from an independent GNSS solution that a
+// lasting alarm or an inertial gap beyond the bridge asks for (navigation_engine.hpp,
+// EngineMode::kReinitialising).
+#include <cmath>
+
+#include "navbus/core/engine/initial_alignment.hpp"
+#include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/filter/integrated_filter.hpp"
+#include "navbus/core/integrity/glr_protection_level.hpp"
+#include "navbus/core/math/earth.hpp"
+
+namespace navbus::core {
+
+void NavigationEngine::checkConsistency(std::int64_t time_ns, const ScalarUpdateResult* rows,
+                                        int n) {
+  double nis = 0.0;
+  int dof = 0;
+  for (int i = 0; i < n; ++i) {
+    if (!(rows[i].innovation_var > 0.0)) continue;  // not offered (an inactive state's row)
+    nis += rows[i].innovation * rows[i].innovation / rows[i].innovation_var;
+    ++dof;
+  }
+  consistency_.onEpoch(time_ns, nis, dof);
+  if (consistency_.inconsistent()) {
+    status_ |= kStatusInconsistent;
+  } else {
+    status_ &= ~static_cast<std::uint32_t>(kStatusInconsistent);
+  }
+  if (consistency_.reinitialisationDue()) askReinitialisation();
+}
+
+void NavigationEngine::checkConsistency(std::int64_t time_ns,
+                                        const std::vector<MeasurementReport>& reports) {
+  std::array<ScalarUpdateResult, 2 * kMaxEpochSatellites> rows{};
+  int n = 0;
+  for (const MeasurementReport& r : reports) {
+    if (r.fused && n < static_cast<int>(rows.size()))
+      rows[static_cast<std::size_t>(n++)] = r.result;
+  }
+  checkConsistency(time_ns, rows.data(), n);
+}
+
+void NavigationEngine::askReinitialisation() {
+  if ((status_ & kStatusReinitialising) != 0) return;
+  status_ |= kStatusReinitialising;
+  ++counters_.reinitialisations_asked;
+}
+
+bool NavigationEngine::reinitialiseFromPseudoranges(std::int64_t time_ns) {
+  const PseudorangeFix pf =
+      pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_->state().position));
+  if (!pf.valid) return false;
+  filter_->resetNavigation(pf.fix);
+  filter_->resetClock(pf.clock_bias_m, pf.clock_drift_mps, pf.clock_bias_sigma_m,
+                      pf.clock_drift_sigma_mps);
+  finishReinitialisation();
+  return true;
+}
+
+void NavigationEngine::reinitialiseFromFix(const GnssFixMeasurement& fix) {
+  filter_->resetNavigation(fix);
+  finishReinitialisation();
+}
+
+void NavigationEngine::finishReinitialisation() {
+  status_ &= ~static_cast<std::uint32_t>(kStatusReinitialising | kStatusInconsistent);
+  consistency_.restart();
+  integrity_->reset();  // the hypotheses describe the filter before the new start
+  ++counters_.reinitialisations_done;
+}
+
+}  // namespace navbus::core
