@@ -176,8 +176,12 @@ TEST(KillLoop, EachParticipantKilledAndRestartedSurvivorsReportAndNothingLeftInS
       << test::readFile(dir / "filter2.log");
 
   const int rounds = 3 * roundsPerParticipant();
-  const unsigned seed = std::random_device{}();
-  std::printf("kill loop: %d rounds, random seed %u\n", rounds, seed);
+  // Seeded: a failure is replayed with the same kill delays (NAVBUS_KILL_LOOP_SEED picks
+  // another sequence).
+  const char* seed_env = std::getenv("NAVBUS_KILL_LOOP_SEED");
+  const unsigned seed =
+      seed_env != nullptr ? static_cast<unsigned>(std::strtoul(seed_env, nullptr, 10)) : 20261127u;
+  std::printf("kill loop: %d rounds, seed %u (NAVBUS_KILL_LOOP_SEED)\n", rounds, seed);
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> delay_ms(200, 1500);
   std::vector<double> resume_ms[3];

@@ -277,6 +277,7 @@ void FilterPipeline::publishSolution() {
                               (monitored_now ? 0U : navbus::FAULT_NO_FAULT_MONITOR);
   const navbus::NavigationSolution sol =
       buildSolution(engine_, config_.vehicle_id, ++solution_seq_, flags, monitored_now);
+  counters_.solutions_untrusted += sol.covariance_valid() ? 0 : 1;
   sinks_.solution(sol);
   if (config_.low_latency_output && sinks_.low_latency) {
     predictor_.setAnchor({engine_.state(), engine_.accelBias(), engine_.gyroBias()});

@@ -29,7 +29,8 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
       << k.relearn_clamped << ", sequencer timeouts " << v.sequencer_timeouts << ", pending "
       << v.pending << ", recoveries from onset " << p.onset_recoveries << " (onset beyond history "
       << p.onset_beyond_history << ")"
-      << ", late samples merged by rewinding " << p.late_merged << " (rewinds " << p.rewinds << ")";
+      << ", late samples merged by rewinding " << p.late_merged << " (rewinds " << p.rewinds << ")"
+      << ", solutions published not trustworthy " << p.solutions_untrusted;
 }
 
 void describeOptional(const PipelineView& v, std::ostringstream& out) {

@@ -24,6 +24,9 @@ struct PipelineCounters {
   std::uint64_t onset_beyond_history{0};     ///< ... the history could not reach
   std::uint64_t late_merged{0};              ///< samples after their place, merged by rewinding
   std::uint64_t rewinds{0};
+  /// Solutions published with covariance_valid false (inconsistent or re-initialising): kept
+  /// here, not in the engine, because a rollback re-processes the engine's own counters.
+  std::uint64_t solutions_untrusted{0};
   std::uint64_t stalls{0};  ///< pauses of the participant's own process
   std::int64_t longest_stall_ns{0};
 };
