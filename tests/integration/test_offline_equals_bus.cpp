@@ -257,6 +257,10 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
   // The filter acted on it in order (not late), from before the onset.
   EXPECT_NE(filter_log.find("late 0"), std::string::npos) << filter_log;
   EXPECT_NE(filter_log.find("recoveries from onset 1"), std::string::npos) << filter_log;
+  // ... and answered it over the bus: the fault manager knows its command was applied.
+  const std::string fm_log = test::readFile(dir / "fm.log");
+  EXPECT_NE(fm_log.find("(the filter applied 1, clamped 0, refused 0)"), std::string::npos)
+      << fm_log;
   // The solutions after the decision carry the exclusion flag.
   ASSERT_FALSE(solutions.empty());
   EXPECT_TRUE(solutions.back().active_fault_flags() & FAULT_SATELLITE_EXCLUDED);

@@ -155,7 +155,11 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
       if (faults->onDiagnostics(d)) result.glr_trace.push_back(faults->glr().latest());
     };
   }
-  nav_filter::FilterPipeline pipeline(setup.filter, health, {on_solution, on_diagnostics});
+  std::function<void(const navbus::FilterCommandOutcome&)> on_outcome;
+  if (faults)
+    on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };
+  nav_filter::FilterPipeline pipeline(setup.filter, health,
+                                      {on_solution, on_diagnostics, nullptr, on_outcome});
   pipeline_ptr = &pipeline;
   filter_ptr = &pipeline;
 

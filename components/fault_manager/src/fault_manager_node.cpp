@@ -42,6 +42,15 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   // Confirms suspect streams (a DDS deadline event before the own silence reached it) within
   // this period of their silence reaching the deadline.
   p.addTimer(std::chrono::milliseconds(10), [this] { pipeline_.onWatchdogTick(running()); });
+  p.subscribe<navbus::FilterCommandOutcomePubSubType>(
+      topic::kCommandOutcome, profile::kDecisionReader,
+      [this](const navbus::FilterCommandOutcome& o, const auto&) {
+        const bool was = pipeline_.degraded();
+        pipeline_.onCommandOutcome(o);
+        if (pipeline_.degraded() != was)
+          participant_.setState(pipeline_.degraded() ? navbus::STATE_DEGRADED
+                                                     : navbus::STATE_RUNNING);
+      });
   if (config.glr.enabled) {
     p.subscribe<navbus::FilterDiagnosticsPubSubType>(
         topic::kFilterDiagnostics, profile::kDiagnosticsReader,

@@ -22,7 +22,8 @@ FaultPipeline::FaultPipeline(const FaultManagerConfig& config, bus::HealthCounte
       glr_(config.glr),
       diagnostics_gate_(bus::topic::kFilterDiagnostics,
                         health.stream(bus::topic::kFilterDiagnostics)),
-      run_id_(run_id) {
+      run_id_(run_id),
+      outcomes_(kIssuer, run_id) {
   if (config.dither.enabled) dither_.emplace(config.dither);
 }
 
@@ -176,6 +177,14 @@ void FaultPipeline::command(navbus::FilterCommand& c) {
   if (sinks_.command) sinks_.command(c);
 }
 
+void FaultPipeline::onCommandOutcome(const navbus::FilterCommandOutcome& o) {
+  if (!outcomes_.onOutcome(o) || o.outcome() == navbus::OUTCOME_APPLIED) return;
+  spdlog::warn("command {} (kind {}) {} by the filter: {}{}", o.command_id(),
+               static_cast<int>(o.kind()),
+               o.outcome() == navbus::OUTCOME_CLAMPED ? "clamped" : "refused", o.detail(),
+               outcomes_.degraded() ? "; the fault loop is not closed (health DEGRADED)" : "");
+}
+
 std::string FaultPipeline::summary() const {
   std::ostringstream out;
   out << "decisions published " << decisions() << " (stream lost " << lost_ << ", restored "
@@ -185,7 +194,9 @@ std::string FaultPipeline::summary() const {
       << "), streams paced ahead of real time " << watchdog_.streamsAheadOfRealTime()
       << " (judged by their writers only), liveliness losses after a stall that were stale "
       << watchdog_.staleLivelinessEvents() << ", streams ended as announced " << ended_
-      << ", commands published " << commands() << "; " << glr_.summary();
+      << ", commands published " << commands() << " (the filter applied " << outcomes_.applied()
+      << ", clamped " << outcomes_.clamped() << ", refused " << outcomes_.refused() << ")"
+      << "; " << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
   if (stalls_ > 0)
     out << "; stalls of the fault manager process " << stalls_ << " (longest "

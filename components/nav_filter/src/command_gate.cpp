@@ -7,15 +7,18 @@
 
 namespace navbus::nav_filter {
 
-CommandGate::CommandGate(const FilterConfig& config, bus::StreamCounters& topic_counters)
+CommandGate::CommandGate(const FilterConfig& config, bus::StreamCounters& topic_counters,
+                         OutcomeSink outcome_sink)
     : vehicle_id_(config.vehicle_id),
       issuers_(config.command_issuers),
       issuer_identities_(config.issuer_identities),
       max_accel_compensation_mps2_(config.max_accel_compensation_mps2),
       max_gyro_compensation_radps_(config.max_gyro_compensation_radps),
-      topic_counters_(topic_counters) {}
+      topic_counters_(topic_counters),
+      outcome_sink_(std::move(outcome_sink)) {}
 
-void CommandGate::count(bool applied, navbus::RejectReason reason) {
+void CommandGate::report(const navbus::FilterCommand& c, bool applied, navbus::RejectReason reason,
+                         const std::string& detail) {
   if (applied) {
     ++counters_.applied;
     ++topic_counters_.accepted;
@@ -23,13 +26,28 @@ void CommandGate::count(bool applied, navbus::RejectReason reason) {
     ++counters_.refused;
     ++topic_counters_.rejected[reason];
   }
+  if (!outcome_sink_) return;
+  navbus::FilterCommandOutcome o;
+  o.vehicle_id(vehicle_id_);
+  o.command_id(c.command_id());
+  o.issuer(c.issuer());
+  o.run_id(c.run_id());
+  o.kind(c.kind());
+  const bool clamped =
+      applied && clamped_ &&
+      *clamped_ == std::make_tuple(c.issuer().to_string(), c.run_id(), c.command_id());
+  o.outcome(!applied ? navbus::OUTCOME_REFUSED
+                     : (clamped ? navbus::OUTCOME_CLAMPED : navbus::OUTCOME_APPLIED));
+  o.reason(applied ? navbus::REJECT_NOT_APPLICABLE : reason);
+  o.detail((clamped ? clamped_detail_ : detail).substr(0, 160));
+  outcome_sink_(o);
 }
 
 bool CommandGate::authorized(const navbus::FilterCommand& c,
                              const std::optional<std::string>& writer_identity) {
   const std::string issuer = c.issuer().to_string();
   if (std::find(issuers_.begin(), issuers_.end(), issuer) == issuers_.end()) {
-    count(false, navbus::REJECT_UNAUTHORIZED);
+    report(c, false, navbus::REJECT_UNAUTHORIZED, "issuer '" + issuer + "' not in command_issuers");
     ++counters_.unauthorized;
     spdlog::warn(
         "command {} (kind {}) from '{}' refused: not a configured issuer "
@@ -38,7 +56,9 @@ bool CommandGate::authorized(const navbus::FilterCommand& c,
     return false;
   }
   if (writer_identity && *writer_identity != issuer_identities_.at(issuer)) {
-    count(false, navbus::REJECT_UNAUTHORIZED);
+    report(c, false, navbus::REJECT_UNAUTHORIZED,
+           "written by identity '" + *writer_identity + "', not '" + issuer_identities_.at(issuer) +
+               "'");
     ++counters_.impersonated;
     spdlog::warn(
         "command {} (kind {}) claims issuer '{}' but was written by identity '{}' (expected "
@@ -53,7 +73,8 @@ bool CommandGate::authorized(const navbus::FilterCommand& c,
 bool CommandGate::refuseIfStale(const navbus::FilterCommand& c, std::int64_t first_input_ns) {
   const auto time_ns = static_cast<std::int64_t>(c.time_gps_ns());
   if (time_ns == 0 || (first_input_ns >= 0 && time_ns >= first_input_ns)) return false;
-  count(false, navbus::REJECT_STALE);
+  report(c, false, navbus::REJECT_STALE,
+         fmt::format("time_gps_ns {} before this run's first input", time_ns));
   ++counters_.stale;
   spdlog::warn(
       "command {} (kind {}, decision {}) from '{}' refused: stale, about data at {:.3f} s, "
@@ -108,6 +129,9 @@ double CommandGate::relearnSigma(const navbus::FilterCommand& c) {
   const double limit = compensationLimit(c.sensor() == navbus::SOURCE_ACCELEROMETER);
   if (c.bias_sigma() <= limit) return c.bias_sigma();
   ++counters_.relearn_clamped;
+  clamped_ = std::make_tuple(c.issuer().to_string(), c.run_id(), c.command_id());
+  clamped_detail_ =
+      fmt::format("bias_sigma {} clamped to the compensation limit {}", c.bias_sigma(), limit);
   spdlog::warn(
       "command {} from '{}': re-learn bias_sigma {} beyond the compensation limit {} (recovery."
       "max_{}_compensation): re-learned up to the limit; {} clamped so far",

@@ -40,6 +40,8 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
               ? p.createWriter<navbus::NavigationSolutionPubSubType>(
                     bus::topic::kNavSolutionLowLatency, bus::profile::kLowLatencySolutionWriter)
               : bus::Writer<navbus::NavigationSolution>()),
+      outcome_writer_(p.createWriter<navbus::FilterCommandOutcomePubSubType>(
+          bus::topic::kCommandOutcome, bus::profile::kDecisionWriter)),
       pipeline_(
           config, p.health(),
           {[this](const navbus::NavigationSolution& s) {
@@ -52,7 +54,8 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
                ? std::function<void(const navbus::FilterDiagnostics&)>(
                      [this](const navbus::FilterDiagnostics& d) { diagnostics_writer_.write(d); })
                : nullptr,
-           [this](const navbus::NavigationSolution& s) { low_latency_writer_.write(s); }}),
+           [this](const navbus::NavigationSolution& s) { low_latency_writer_.write(s); },
+           [this](const navbus::FilterCommandOutcome& o) { outcome_writer_.write(o); }}),
       not_producing_ns_(
           std::max(kNotProducingMinNs, kNotProducingPeriods * config.engine.solution_period_ns)),
       sensors_(p, sensorEvents()) {

@@ -63,7 +63,7 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
                      &time_reference_),
       star_gate_(bus::topic::kStarTracker, health.stream(bus::topic::kStarTracker),
                  config.time_jump, &time_reference_),
-      commands_(config, health.stream(bus::topic::kFilterCommand)) {}
+      commands_(config, health.stream(bus::topic::kFilterCommand), sinks_.command_outcome) {}
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
                            FilterInput input) {

@@ -80,7 +80,8 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c,
     // About the merge itself (a lost stream must stop holding it): at once.
     if (commands_.refuseIfStale(c, first_input_ns_)) return;
     const bool applied = applyStreamCommand(c);
-    commands_.count(applied, navbus::REJECT_UNEXPECTED_SOURCE);
+    commands_.report(c, applied, navbus::REJECT_UNEXPECTED_SOURCE,
+                     applied ? std::string() : "not a stream of this filter");
     if (!applied)
       spdlog::warn(
           "command {} from '{}' refused: stream source {} id {} is not a stream of this "
@@ -131,7 +132,7 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
     applied = applyToEngine(c);
     why = "not available in the configured mode";
   }
-  commands_.count(applied, reason);
+  commands_.report(c, applied, reason, why);
   if (applied) {
     spdlog::info("command {} from '{}' applied (kind {})", c.command_id(), c.issuer(),
                  static_cast<int>(c.kind()));

@@ -166,6 +166,17 @@ const char* enumName(navbus::CommandKind v) {
   }
   return "UNKNOWN";
 }
+const char* enumName(navbus::CommandOutcomeKind v) {
+  switch (v) {
+    case navbus::OUTCOME_APPLIED:
+      return "APPLIED";
+    case navbus::OUTCOME_CLAMPED:
+      return "CLAMPED";
+    case navbus::OUTCOME_REFUSED:
+      return "REFUSED";
+  }
+  return "UNKNOWN";
+}
 const char* enumName(navbus::ParticipantState v) {
   switch (v) {
     case navbus::STATE_STARTING:

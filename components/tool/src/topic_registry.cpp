@@ -44,6 +44,8 @@ std::vector<TopicEntry> makeRegistry() {
       entry<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader));
   registry.push_back(
       entry<navbus::FilterCommandPubSubType>(topic::kFilterCommand, profile::kDecisionReader));
+  registry.push_back(entry<navbus::FilterCommandOutcomePubSubType>(topic::kCommandOutcome,
+                                                                   profile::kDecisionReader));
   registry.push_back(entry<navbus::FaultMonitorProgressPubSubType>(topic::kFaultProgress,
                                                                    profile::kProgressReader));
   registry.push_back(entry<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthReader));

@@ -89,10 +89,42 @@ TEST(CommandGate, ClampsARelearnSigmaToTheCompensationLimitAndCountsIt) {
   nb::FilterCommand compensate = relearn(5e-3);
   compensate.kind(nb::CMD_COMPENSATE_BIAS);  // a compensation beyond the limit does not
   EXPECT_EQ(gate.check(compensate).value_or(""), "bias_sigma 0.005 outside 0..0.001");
-  gate.count(true);
-  gate.count(false, nb::REJECT_OUT_OF_RANGE);
+  gate.report(nb::FilterCommand{}, true);
+  gate.report(nb::FilterCommand{}, false, nb::REJECT_OUT_OF_RANGE);
   EXPECT_EQ(topic.accepted, 1u);
   EXPECT_EQ(topic.rejected.at(nb::REJECT_OUT_OF_RANGE), 1u);
   EXPECT_EQ(gate.counters().applied, 1u);
   EXPECT_EQ(gate.counters().refused, 1u);
+}
+
+TEST(CommandGate, AnswersEachCommandsIssuerAppliedClampedOrRefusedWithTheFieldAndValue) {
+  nb::bus::StreamCounters topic;
+  std::vector<nb::FilterCommandOutcome> outcomes;
+  CommandGate gate(gateConfig(), topic,
+                   [&outcomes](const nb::FilterCommandOutcome& o) { outcomes.push_back(o); });
+  nb::FilterCommand clamped = relearn(5e-3);
+  clamped.command_id(7);
+  clamped.run_id(42);
+  gate.relearnSigma(clamped);  // applied at the limit
+  gate.report(clamped, true);
+  nb::FilterCommand applied = relearn(2e-4);
+  applied.command_id(8);
+  gate.relearnSigma(applied);
+  gate.report(applied, true);
+  nb::FilterCommand stale = relearn(2e-4);
+  stale.command_id(9);
+  stale.time_gps_ns(1'000);
+  EXPECT_TRUE(gate.refuseIfStale(stale, 2'000));
+  ASSERT_EQ(outcomes.size(), 3u);
+  EXPECT_EQ(outcomes[0].command_id(), 7u);
+  EXPECT_EQ(outcomes[0].run_id(), 42u);
+  EXPECT_EQ(outcomes[0].issuer(), "fault-manager");
+  EXPECT_EQ(outcomes[0].outcome(), nb::OUTCOME_CLAMPED);
+  EXPECT_EQ(outcomes[0].detail(), "bias_sigma 0.005 clamped to the compensation limit 0.001");
+  EXPECT_EQ(outcomes[1].outcome(), nb::OUTCOME_APPLIED);
+  EXPECT_EQ(outcomes[1].detail(), "");
+  EXPECT_EQ(outcomes[2].outcome(), nb::OUTCOME_REFUSED);
+  EXPECT_EQ(outcomes[2].reason(), nb::REJECT_STALE);
+  EXPECT_NE(outcomes[2].detail().to_string().find("before this run's first input"),
+            std::string::npos);
 }

@@ -18,6 +18,7 @@ inline constexpr const char* kFilterDiagnostics = "navbus/nav/diagnostics";
 inline constexpr const char* kFaultDecision = "navbus/fault/decision";
 inline constexpr const char* kFilterCommand = "navbus/filter/command";
 inline constexpr const char* kFaultProgress = "navbus/fault/progress";
+inline constexpr const char* kCommandOutcome = "navbus/nav/command_outcome";
 inline constexpr const char* kHealth = "navbus/health";
 // Latency and throughput probes of `navbus latency` (ImuIncrement samples, sensor stream
 // profiles unless the user names others).

@@ -17,6 +17,7 @@
 
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/validation.hpp"
+#include "navbus/fault_manager/command_outcomes.hpp"
 #include "navbus/fault_manager/dither_detector.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/fault_manager/fault_output.hpp"
@@ -76,6 +77,12 @@ class FaultPipeline : private FaultOutput {
   const std::optional<DitherDetector>& dither() const { return dither_; }
   std::uint64_t decisions() const { return next_decision_id_ - 1; }
   std::uint64_t commands() const { return next_command_id_ - 1; }
+  /// The filter's answer to a command (its own are counted; others ignored). A refusal or a
+  /// clamp is logged, and the participant reports DEGRADED until a later command of this run
+  /// is applied (degraded()).
+  void onCommandOutcome(const navbus::FilterCommandOutcome& o);
+  /// The loop is not closed: the latest command was refused or clamped by the filter.
+  bool degraded() const { return outcomes_.degraded(); }
   std::string summary() const;
 
  private:
@@ -98,6 +105,7 @@ class FaultPipeline : private FaultOutput {
   std::int64_t longest_stall_ns_{0};
   std::uint64_t filter_new_runs_{0};  ///< the diagnostics' source restarted at an earlier time
   std::uint64_t run_id_{0};
+  CommandOutcomes outcomes_;
   std::uint32_t next_decision_id_{1};
   std::uint64_t next_command_id_{1};
   std::uint64_t lost_{0}, restored_{0}, ended_{0}, other_vehicles_{0};

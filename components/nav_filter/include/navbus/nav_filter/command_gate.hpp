@@ -4,14 +4,18 @@
 // run's first input is stale; every field is range-checked, a bias against the compensation
 // limits (recovery.max_*_compensation), and a re-learn's sigma is clamped to them. Every
 // command ends counted once in the health of the command topic, accepted or rejected with its
-// reason, and every refusal is logged with the field and value. DDS-free: it reads the IDL
+// reason, and every refusal is logged with the field and value; the issuer is answered with a
+// FilterCommandOutcome (applied, clamped or refused, with the field and value) through the
+// outcome sink. DDS-free: it reads the IDL
 // command, the pipeline feeds it and applies what passed (filter_pipeline.hpp).
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <navbus_idl/Fault.h>
@@ -34,8 +38,11 @@ struct CommandCounters {
 
 class CommandGate {
  public:
+  using OutcomeSink = std::function<void(const navbus::FilterCommandOutcome&)>;
+
   /// `topic_counters`: the health of the command topic (accepted, rejected by reason).
-  CommandGate(const FilterConfig& config, bus::StreamCounters& topic_counters);
+  CommandGate(const FilterConfig& config, bus::StreamCounters& topic_counters,
+              OutcomeSink outcome_sink = {});
 
   /// The command is for this filter's vehicle (others are not ours: ignored, not counted).
   bool addressedToThisVehicle(const navbus::FilterCommand& c) const {
@@ -51,11 +58,15 @@ class CommandGate {
   bool refuseIfStale(const navbus::FilterCommand& c, std::int64_t first_input_ns);
   /// Why the command's fields cannot be applied (field and value), or nothing.
   std::optional<std::string> check(const navbus::FilterCommand& c) const;
-  /// A re-learn's bias_sigma, at most the compensation limit (counted and logged when clamped).
+  /// A re-learn's bias_sigma, at most the compensation limit (counted and logged when clamped;
+  /// the command's outcome then says OUTCOME_CLAMPED).
   double relearnSigma(const navbus::FilterCommand& c);
 
-  /// Counts an outcome in the health of the command topic: accepted, or rejected for `reason`.
-  void count(bool applied, navbus::RejectReason reason = navbus::REJECT_NOT_APPLICABLE);
+  /// The command's outcome: counted in the health of the command topic (accepted, or rejected
+  /// for `reason`) and answered to its issuer; `detail` names the field and value refused.
+  void report(const navbus::FilterCommand& c, bool applied,
+              navbus::RejectReason reason = navbus::REJECT_NOT_APPLICABLE,
+              const std::string& detail = {});
   /// A command that arrived after its data time had been processed (applied at once).
   void countLate() { ++counters_.late; }
   const CommandCounters& counters() const { return counters_; }
@@ -72,7 +83,11 @@ class CommandGate {
   double max_accel_compensation_mps2_;
   double max_gyro_compensation_radps_;
   bus::StreamCounters& topic_counters_;
+  OutcomeSink outcome_sink_;
   CommandCounters counters_;
+  /// The latest command whose re-learn sigma was clamped (issuer, run, id), and by what.
+  std::optional<std::tuple<std::string, std::uint64_t, std::uint64_t>> clamped_;
+  std::string clamped_detail_;
 };
 
 }  // namespace navbus::nav_filter

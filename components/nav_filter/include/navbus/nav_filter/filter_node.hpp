@@ -47,6 +47,7 @@ class FilterNode {
   bus::Writer<navbus::NavigationSolution> solution_writer_;
   bus::Writer<navbus::FilterDiagnostics> diagnostics_writer_;
   bus::Writer<navbus::NavigationSolution> low_latency_writer_;  ///< when configured
+  bus::Writer<navbus::FilterCommandOutcome> outcome_writer_;    ///< answers to commands
   FilterPipeline pipeline_;
   std::int64_t not_producing_ns_;      ///< silence of the solution output that is "not producing"
   bus::StallDetector stalls_;          ///< pauses of this process between two pumps

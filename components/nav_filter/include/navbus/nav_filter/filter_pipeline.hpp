@@ -77,6 +77,8 @@ class FilterPipeline {
     /// The low-latency output (FilterConfig::low_latency_output): one per IMU increment as it
     /// arrives, before the ordered merge; may be empty.
     std::function<void(const navbus::NavigationSolution&)> low_latency{};
+    /// The answer to each command addressed to this filter (CommandGate); may be empty.
+    std::function<void(const navbus::FilterCommandOutcome&)> command_outcome{};
   };
 
   FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks);

@@ -35,6 +35,7 @@ const char* enumName(navbus::FaultEvent v);
 const char* enumName(navbus::FaultShape v);
 const char* enumName(navbus::SatelliteScope v);
 const char* enumName(navbus::CommandKind v);
+const char* enumName(navbus::CommandOutcomeKind v);
 const char* enumName(navbus::ParticipantState v);
 const char* enumName(navbus::MeasurementKind v);
 inline const char* enumName(navbus::RejectReason v) {
@@ -224,6 +225,17 @@ IfMessage<M, navbus::FilterCommand> visitFields(M& m, V& v) {
   v("mode", m.mode());
   v("issuer", m.issuer());
   v("run_id", m.run_id());
+}
+template <class M, class V>
+IfMessage<M, navbus::FilterCommandOutcome> visitFields(M& m, V& v) {
+  v("vehicle_id", m.vehicle_id());
+  v("command_id", m.command_id());
+  v("issuer", m.issuer());
+  v("run_id", m.run_id());
+  v("kind", m.kind());
+  v("outcome", m.outcome());
+  v("reason", m.reason());
+  v("detail", m.detail());
 }
 template <class M, class V>
 IfMessage<M, navbus::FaultMonitorProgress> visitFields(M& m, V& v) {

@@ -1,0 +1,44 @@
+// The fault manager learns whether its commands closed the loop: its own outcomes only, and
+// DEGRADED while the latest one was refused or clamped.
+#include <gtest/gtest.h>
+
+#include "navbus/fault_manager/command_outcomes.hpp"
+
+using navbus::fault_manager::CommandOutcomes;
+
+namespace {
+navbus::FilterCommandOutcome outcome(std::uint64_t id, navbus::CommandOutcomeKind kind,
+                                     const std::string& issuer = "fault-manager",
+                                     std::uint64_t run = 5) {
+  navbus::FilterCommandOutcome o;
+  o.command_id(id);
+  o.issuer(issuer);
+  o.run_id(run);
+  o.outcome(kind);
+  return o;
+}
+}  // namespace
+
+TEST(CommandOutcomes, ARefusedOrClampedCommandDegradesUntilALaterOneIsApplied) {
+  CommandOutcomes outcomes("fault-manager", 5);
+  EXPECT_TRUE(outcomes.onOutcome(outcome(1, navbus::OUTCOME_APPLIED)));
+  EXPECT_FALSE(outcomes.degraded());
+  EXPECT_TRUE(outcomes.onOutcome(outcome(2, navbus::OUTCOME_CLAMPED)));
+  EXPECT_TRUE(outcomes.degraded());
+  EXPECT_TRUE(outcomes.onOutcome(outcome(3, navbus::OUTCOME_REFUSED)));
+  EXPECT_TRUE(outcomes.onOutcome(outcome(1, navbus::OUTCOME_APPLIED)));  // an older one, late
+  EXPECT_TRUE(outcomes.degraded());
+  EXPECT_TRUE(outcomes.onOutcome(outcome(4, navbus::OUTCOME_APPLIED)));
+  EXPECT_FALSE(outcomes.degraded());
+  EXPECT_EQ(outcomes.applied(), 3u);
+  EXPECT_EQ(outcomes.clamped(), 1u);
+  EXPECT_EQ(outcomes.refused(), 1u);
+}
+
+TEST(CommandOutcomes, OtherIssuersAndEarlierRunsAreNotThisFaultManagers) {
+  CommandOutcomes outcomes("fault-manager", 5);
+  EXPECT_FALSE(outcomes.onOutcome(outcome(9, navbus::OUTCOME_REFUSED, "operator")));
+  EXPECT_FALSE(outcomes.onOutcome(outcome(9, navbus::OUTCOME_REFUSED, "fault-manager", 4)));
+  EXPECT_FALSE(outcomes.degraded());
+  EXPECT_EQ(outcomes.refused(), 0u);
+}
