@@ -12,15 +12,34 @@
 
 namespace navbus::core {
 
+namespace {
+/// Adds one row's normalized innovation squared (a row with no variance was not offered).
+void addRow(const ScalarUpdateResult& r, double& nis, int& dof) {
+  if (!(r.innovation_var > 0.0)) return;
+  nis += r.innovation * r.innovation / r.innovation_var;
+  ++dof;
+}
+}  // namespace
+
 void NavigationEngine::checkConsistency(std::int64_t time_ns, const ScalarUpdateResult* rows,
                                         int n) {
   double nis = 0.0;
   int dof = 0;
-  for (int i = 0; i < n; ++i) {
-    if (!(rows[i].innovation_var > 0.0)) continue;  // not offered (an inactive state's row)
-    nis += rows[i].innovation * rows[i].innovation / rows[i].innovation_var;
-    ++dof;
+  for (int i = 0; i < n; ++i) addRow(rows[i], nis, dof);
+  judgeConsistency(time_ns, nis, dof);
+}
+
+void NavigationEngine::checkConsistency(std::int64_t time_ns,
+                                        const std::vector<MeasurementReport>& reports) {
+  double nis = 0.0;
+  int dof = 0;
+  for (const MeasurementReport& r : reports) {
+    if (r.fused) addRow(r.result, nis, dof);
   }
+  judgeConsistency(time_ns, nis, dof);
+}
+
+void NavigationEngine::judgeConsistency(std::int64_t time_ns, double nis, int dof) {
   consistency_.onEpoch(time_ns, nis, dof);
   if (consistency_.inconsistent()) {
     status_ |= kStatusInconsistent;
@@ -28,17 +47,6 @@ void NavigationEngine::checkConsistency(std::int64_t time_ns, const ScalarUpdate
     status_ &= ~static_cast<std::uint32_t>(kStatusInconsistent);
   }
   if (consistency_.reinitialisationDue()) askReinitialisation();
-}
-
-void NavigationEngine::checkConsistency(std::int64_t time_ns,
-                                        const std::vector<MeasurementReport>& reports) {
-  std::array<ScalarUpdateResult, 2 * kMaxEpochSatellites> rows{};
-  int n = 0;
-  for (const MeasurementReport& r : reports) {
-    if (r.fused && n < static_cast<int>(rows.size()))
-      rows[static_cast<std::size_t>(n++)] = r.result;
-  }
-  checkConsistency(time_ns, rows.data(), n);
 }
 
 void NavigationEngine::askReinitialisation() {

@@ -235,6 +235,7 @@ class NavigationEngine {
   /// asks for re-initialisation (engine_consistency.cpp).
   void checkConsistency(std::int64_t time_ns, const ScalarUpdateResult* rows, int n);
   void checkConsistency(std::int64_t time_ns, const std::vector<MeasurementReport>& reports);
+  void judgeConsistency(std::int64_t time_ns, double nis, int dof);
   void askReinitialisation();
   /// While re-initialisation is asked: from this epoch's pseudorange solution (false: not
   /// possible, fewer than four satellites) or from a fix.

@@ -4,10 +4,11 @@
 // measured: a change of specific force of `accel_sigma_mps2` (1-sigma, held for the whole gap)
 // gives velocity (sigma_a T)^2 and position (sigma_a T^2 / 2)^2; a change of rate of
 // `rate_sigma_radps` gives attitude (sigma_w T)^2 per axis. A gap longer than
-// `max_bridged_s` is not propagated: the integration restarts where the data resume, and the
+// `max_bridged_s` is not propagated: the integration restarts where the data resume, the
 // position variance grows by the distance the vehicle could have covered, (|v| T + sigma_a
-// T^2 / 2)^2, so the published sigmas cover the jump until the aiding pulls the solution in.
-// Either way the solution carries FAULT_IMU_GAP. Pure math.
+// T^2 / 2)^2, and the engine re-initialises from the next GNSS solution, flagged
+// (EngineMode::kReinitialising) until then. Either way the solution carries FAULT_IMU_GAP.
+// Pure math.
 #pragma once
 
 #include <cstdint>
