@@ -67,6 +67,7 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
                            FilterInput input) {
+  if (!ended_streams_.empty()) ended_streams_.erase(id);  // a sample after the end: a new run
   if (sequencer_.late(id, time_ns) && mergeLate(id, time_ns, input)) {
     ++counters_.late_merged;
     return;
@@ -186,6 +187,7 @@ void FilterPipeline::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
   const bus::StreamKindInfo& stream = bus::streamInfo(kind);
   if (stream.merge_rank == bus::kNotMerged) return;
   if (!sequencer_.setActive({stream.merge_rank, id}, false)) return;  // a stream not in use
+  ended_streams_.insert({stream.merge_rank, id});
   spdlog::info("{} id {} ended (its writer disposed it): no longer waited for", stream.topic, id);
 }
 

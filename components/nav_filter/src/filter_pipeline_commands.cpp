@@ -41,6 +41,19 @@ bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
   return true;
 }
 
+std::optional<std::string> FilterPipeline::endedAsAnnounced(const navbus::FilterCommand& c) const {
+  // The fault manager watches with best-effort readers, which may miss a writer's dispose;
+  // this filter's readers are reliable: a stream whose end it received is not lost.
+  if (c.kind() != navbus::CMD_EXCLUDE_STREAM) return std::nullopt;
+  for (const bus::StreamKindInfo& stream : bus::kStreamKinds) {
+    if (stream.fault_source != c.sensor() || stream.merge_rank == bus::kNotMerged) continue;
+    if (ended_streams_.count({stream.merge_rank, c.sensor_id()}) == 0) continue;
+    return fmt::format("{} id {} ended as announced (its writer disposed it after its last sample)",
+                       stream.topic, c.sensor_id());
+  }
+  return std::nullopt;
+}
+
 void FilterPipeline::setImuLost() {
   sequencer_.setActive({kRankImu, config_.imu.id}, false);
   engine_.markInertialLost();
@@ -79,6 +92,11 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c,
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM || c.kind() == navbus::CMD_READMIT_STREAM) {
     // About the merge itself (a lost stream must stop holding it): at once.
     if (commands_.refuseIfStale(c, first_input_ns_)) return;
+    if (const auto ended = endedAsAnnounced(c)) {
+      commands_.report(c, false, navbus::REJECT_NOT_APPLICABLE, *ended);
+      spdlog::warn("command {} from '{}' refused: {}", c.command_id(), c.issuer(), *ended);
+      return;
+    }
     const bool applied = applyStreamCommand(c);
     commands_.report(c, applied, navbus::REJECT_UNEXPECTED_SOURCE,
                      applied ? std::string() : "not a stream of this filter");

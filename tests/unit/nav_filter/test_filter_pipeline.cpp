@@ -125,6 +125,56 @@ TEST(FilterPipelineCommands, ImuDeclaredLostWhileItsWriterIsAliveOnlyFlags) {
   EXPECT_EQ(solutions.back().mode(), MODE_INERTIAL_LOST);
 }
 
+// The fault manager's watchdog reads best effort and may miss a writer's dispose; it then
+// declares the stream lost when the writer leaves (seen in a replay on a loaded machine). The
+// filter received the end on its reliable reader: the command is refused and answered, the
+// solutions stay unflagged. A sample after the end starts a new run that can be lost again.
+TEST(FilterPipelineCommands, AStreamThatEndedAsAnnouncedIsNotLost) {
+  const auto cfg = imuOnlyConfig();
+  bus::HealthCounters health("test");
+  std::vector<NavigationSolution> solutions;
+  std::vector<FilterCommandOutcome> outcomes;
+  nav_filter::FilterPipeline pipeline(
+      cfg, health,
+      {[&](const NavigationSolution& s) { solutions.push_back(s); }, nullptr, nullptr,
+       [&](const FilterCommandOutcome& o) { outcomes.push_back(o); }});
+  sim::ScenarioSource src(sourceConfig());
+  std::uint64_t seq = 0;
+  std::int64_t now = 0;
+  auto feed = [&](int n) {
+    for (int k = 0; k < n; ++k) {
+      pipeline.onImu(bus::toIdl(src.next().increment, 1, ++seq));
+      pipeline.pump(now += 10'000'000);
+    }
+  };
+  pipeline.setWritersAlive(bus::StreamKind::kImu, true, now);
+  feed(100);
+  pipeline.onStreamEnded(bus::StreamKind::kImu, 1);
+  FilterCommand lost;
+  lost.command_id(1);
+  lost.vehicle_id(1);
+  lost.kind(CMD_EXCLUDE_STREAM);
+  lost.sensor(SOURCE_IMU_STREAM);
+  lost.sensor_id(1);
+  lost.issuer("fault-manager");
+  lost.time_gps_ns(static_cast<std::uint64_t>(solutions.back().time_gps_ns()));
+  pipeline.onCommand(lost);
+  ASSERT_EQ(outcomes.size(), 1u);
+  EXPECT_EQ(outcomes.back().outcome(), OUTCOME_REFUSED);
+  EXPECT_NE(std::string(outcomes.back().detail().c_str()).find("ended as announced"),
+            std::string::npos)
+      << outcomes.back().detail();
+  feed(100);  // the stream starts again: a new run, whose loss holds
+  for (const auto& s : solutions) EXPECT_EQ(s.active_fault_flags() & FAULT_IMU_STREAM_LOST, 0u);
+  lost.command_id(2);
+  lost.time_gps_ns(static_cast<std::uint64_t>(solutions.back().time_gps_ns()));
+  pipeline.onCommand(lost);
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_EQ(outcomes.back().outcome(), OUTCOME_APPLIED);
+  feed(20);
+  EXPECT_NE(solutions.back().active_fault_flags() & FAULT_IMU_STREAM_LOST, 0u);
+}
+
 // A simulator restarted with its scenario starting at a fixed time sends the same times
 // again, with its sequence restarting. The filter recognises the restart once the samples
 // after the first continue from it, and starts over: its solutions go on, and from then on

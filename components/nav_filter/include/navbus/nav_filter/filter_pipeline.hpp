@@ -9,6 +9,7 @@
 #include <deque>
 #include <functional>
 #include <optional>
+#include <set>
 #include <string>
 #include <variant>
 #include <vector>
@@ -182,6 +183,8 @@ class FilterPipeline {
   bool applyStreamCommand(const navbus::FilterCommand& c);
   /// The merge stops waiting for the IMU and the engine holds its last solution.
   void setImuLost();
+  /// Why a stream-lost command does not hold here (the stream ended as announced), if so.
+  std::optional<std::string> endedAsAnnounced(const navbus::FilterCommand& c) const;
   /// Applies a declared IMU loss once its writers have been gone long enough.
   void checkImuWriters(std::int64_t now_ns);
 
@@ -204,6 +207,8 @@ class FilterPipeline {
   bus::StreamGate gnss_fix_gate_;
   bus::StreamGate star_gate_;
   SolutionFlags flags_;  ///< stream-lost and fault-monitor flags of the solutions
+  /// Merged streams whose writer announced their end (disposed), no sample since: not lost.
+  std::set<StreamId> ended_streams_;
   std::uint64_t solution_seq_{0};
   std::uint64_t diagnostics_seq_{0};
   std::int64_t first_input_ns_{-1};  ///< data time of the first input processed (-1: none yet)
