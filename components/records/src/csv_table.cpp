@@ -12,29 +12,19 @@ namespace {
 
 /// libcsv's callbacks collect the cells of the current row, then the row.
 struct Collector {
-  CsvTable* table;
-  std::vector<std::string> row;
-  std::size_t line{0};
-  std::string error;
+  std::vector<CsvRow>* rows;
+  std::vector<std::string> cells;
 };
 
 void onCell(void* data, std::size_t size, void* user) {
   auto* c = static_cast<Collector*>(user);
-  c->row.emplace_back(static_cast<const char*>(data), size);
+  c->cells.emplace_back(static_cast<const char*>(data), size);
 }
 
 void onRow(int, void* user) {
   auto* c = static_cast<Collector*>(user);
-  ++c->line;
-  if (c->line == 1) {
-    c->table->header = std::move(c->row);
-  } else if (c->error.empty() && c->row.size() != c->table->header.size()) {
-    c->error = "line " + std::to_string(c->line) + " has " + std::to_string(c->row.size()) +
-               " cells, the header " + std::to_string(c->table->header.size());
-  } else {
-    c->table->rows.push_back(std::move(c->row));
-  }
-  c->row.clear();
+  c->rows->push_back({c->rows->size() + 1, std::move(c->cells)});
+  c->cells.clear();
 }
 
 }  // namespace
@@ -45,16 +35,15 @@ std::size_t CsvTable::column(const std::string& name) const {
   throw bus::ConfigError(file + ": no column '" + name + "'");
 }
 
-CsvTable readCsv(const std::filesystem::path& path) {
-  CsvTable table;
-  table.file = path.string();
+std::vector<CsvRow> readCsvRows(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw bus::ConfigError(table.file + ": cannot be read");
+  if (!in) throw bus::ConfigError(path.string() + ": cannot be read");
   csv_parser parser{};
   if (csv_init(&parser, CSV_STRICT | CSV_STRICT_FINI) != 0) {
     throw bus::ConfigError("libcsv: cannot initialize its parser");
   }
-  Collector collector{&table, {}, 0, {}};
+  std::vector<CsvRow> rows;
+  Collector collector{&rows, {}};
   char buffer[1 << 16];
   bool parsed = true;
   while (parsed && in) {
@@ -66,11 +55,27 @@ CsvTable readCsv(const std::filesystem::path& path) {
   const std::string why = parsed ? "" : csv_strerror(csv_error(&parser));
   csv_free(&parser);
   if (!parsed) {
-    throw bus::ConfigError(table.file + ": not CSV after line " + std::to_string(collector.line) +
+    throw bus::ConfigError(path.string() + ": not CSV after line " + std::to_string(rows.size()) +
                            " (" + why + ")");
   }
-  if (!collector.error.empty()) throw bus::ConfigError(table.file + ": " + collector.error);
-  if (table.header.empty()) throw bus::ConfigError(table.file + ": no header line");
+  return rows;
+}
+
+CsvTable readCsv(const std::filesystem::path& path) {
+  CsvTable table;
+  table.file = path.string();
+  std::vector<CsvRow> rows = readCsvRows(path);
+  if (rows.empty()) throw bus::ConfigError(table.file + ": no header line");
+  table.header = std::move(rows.front().cells);
+  table.rows.reserve(rows.size() - 1);
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    if (rows[i].cells.size() != table.header.size()) {
+      throw bus::ConfigError(table.file + ": line " + std::to_string(rows[i].line) + " has " +
+                             std::to_string(rows[i].cells.size()) + " cells, the header " +
+                             std::to_string(table.header.size()));
+    }
+    table.rows.push_back(std::move(rows[i].cells));
+  }
   for (std::size_t i = 0; i < table.header.size(); ++i) table.index.emplace(table.header[i], i);
   return table;
 }

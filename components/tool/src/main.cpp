@@ -1,6 +1,6 @@
 // navbus: the user's tool for the bus (topics, echo, record, replay, command, health,
-// latency) and for offline work (offline, montecarlo, rinex). Each subcommand's options and run
-// are in *_commands.cpp; main registers them and runs the one chosen.
+// latency) and for offline work (offline, montecarlo, rinex, import). Each subcommand's options and
+// run are in *_commands.cpp; main registers them and runs the one chosen.
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
 #include "subcommand.hpp"
@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   nb::tool::cli::addInspectionSubcommands(subcommands);
   nb::tool::cli::addBusSubcommands(subcommands);
   nb::tool::cli::addEvaluationSubcommands(subcommands);
+  nb::tool::cli::addImportSubcommands(subcommands);
   for (const auto& s : subcommands) s->add(app);
 
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) -> int {

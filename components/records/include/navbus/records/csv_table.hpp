@@ -20,6 +20,17 @@ struct CsvTable {
   std::size_t column(const std::string& name) const;
 };
 
+/// One row of a CSV file as text cells, with its 1-based row number.
+struct CsvRow {
+  std::size_t line{0};
+  std::vector<std::string> cells;
+};
+
+/// Every row of a CSV file, header or not, whatever its cell count (a logger's file, whose
+/// first and last lines may be cut). Throws bus::ConfigError naming the file and the line if it
+/// cannot be read or is not CSV.
+std::vector<CsvRow> readCsvRows(const std::filesystem::path& path);
+
 /// Throws bus::ConfigError (navbus/bus/config.hpp) naming the file (and the line) if it cannot be
 /// read, is not CSV, or a row's cell count differs from the header's.
 CsvTable readCsv(const std::filesystem::path& path);

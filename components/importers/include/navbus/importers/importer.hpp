@@ -1,0 +1,23 @@
+// `navbus import`: a data set (dataset.hpp) into a navbus recording, the CSV files per topic
+// that `navbus record` writes and `navbus replay` and `navbus offline --recording` read.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "navbus/importers/dataset.hpp"
+
+namespace navbus::importers {
+
+struct ImportReport {
+  std::uint64_t imu_samples{0};
+  std::uint64_t imu_increments{0};
+  std::uint64_t imu_blocks{0};
+  std::uint64_t gnss_fixes{0};
+  std::string text;  ///< what was read, skipped and written, for the user
+};
+
+/// Writes the recording into `out_dir` (created). Throws bus::ConfigError for bad input.
+ImportReport importDataset(const DatasetDescription& dataset, const std::filesystem::path& out_dir);
+
+}  // namespace navbus::importers

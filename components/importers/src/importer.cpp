@@ -1,0 +1,75 @@
+#include "navbus/importers/importer.hpp"
+
+#include <fmt/format.h>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/bus/topics.hpp"
+#include "navbus/importers/imu_csv.hpp"
+#include "navbus/importers/imu_increments.hpp"
+#include "navbus/importers/rtklib_pos.hpp"
+#include "navbus/records/formatters.hpp"
+#include "navbus/tool/topic_registry.hpp"
+
+namespace navbus::importers {
+
+namespace {
+
+template <class T>
+void write(const std::filesystem::path& dir, const char* topic, const std::vector<T>& messages,
+           std::string& text) {
+  const std::filesystem::path path = dir / tool::recordFileName(topic);
+  if (!records::writeCsvFile(path.string(), messages))
+    throw bus::ConfigError(path.string() + ": cannot be written");
+  text += fmt::format("wrote {} samples of {} to {}\n", messages.size(), topic, path.string());
+}
+
+void importImu(const ImuCsvDescription& d, const std::filesystem::path& out_dir,
+               ImportReport& report) {
+  const ImuLog log = readImuCsv(d);
+  for (const auto& s : log.skipped) report.text += s + "\n";
+  for (const auto& s : log.notes) report.text += s + "\n";
+  const auto increments = incrementsFromSamples(log.samples, d.sensor_id);
+  const auto blocks = blocksOf(increments, d.block_s);
+  report.imu_samples = log.samples.size();
+  report.imu_increments = increments.size();
+  report.imu_blocks = blocks.size();
+  const double span_s =
+      1e-9 * static_cast<double>(log.samples.back().time_gps_ns - log.samples.front().time_gps_ns);
+  report.text += fmt::format(
+      "{}: {} samples over {:.3f} s ({:.1f} Hz, nominal {:g} Hz) -> {} increments (trapezoidal) "
+      "in {} blocks\n",
+      d.file.string(), log.samples.size(), span_s, static_cast<double>(increments.size()) / span_s,
+      d.sample_rate_hz, increments.size(), blocks.size());
+  write(out_dir, bus::topic::kImuIncrementBlock, blocks, report.text);
+}
+
+void importSolutions(const PosDescription& d, const std::filesystem::path& out_dir,
+                     ImportReport& report) {
+  const PosLog log = readPosFile(d);
+  report.gnss_fixes = log.fixes.size();
+  std::string qualities;
+  for (std::size_t q = 1; q < kQualityNames.size(); ++q) {
+    if (log.epochs_by_quality[q] == 0) continue;
+    qualities += fmt::format("{}{} {}", qualities.empty() ? "" : ", ", kQualityNames[q],
+                             log.epochs_by_quality[q]);
+    if (log.left_out_by_quality[q] > 0)
+      qualities += fmt::format(" ({} left out)", log.left_out_by_quality[q]);
+  }
+  report.text +=
+      fmt::format("{}: epochs {}; {} fixes{}\n", d.file.string(), qualities, log.fixes.size(),
+                  log.has_velocity ? "" : ", no velocity columns: position only");
+  write(out_dir, bus::topic::kGnssFix, log.fixes, report.text);
+}
+
+}  // namespace
+
+ImportReport importDataset(const DatasetDescription& dataset,
+                           const std::filesystem::path& out_dir) {
+  std::filesystem::create_directories(out_dir);
+  ImportReport report;
+  if (dataset.imu) importImu(*dataset.imu, out_dir, report);
+  if (dataset.gnss_solutions) importSolutions(*dataset.gnss_solutions, out_dir, report);
+  return report;
+}
+
+}  // namespace navbus::importers

@@ -1,0 +1,343 @@
+// navbus import's readers on the real logs (tests/data/real) and on every malformed case: a
+// cut first or last line is skipped and reported, any other bad field is an error naming the
+// file, the line and the column.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/core/math/units.hpp"
+#include "navbus/gnss_data/rinex2.hpp"
+#include "navbus/importers/dataset.hpp"
+#include "navbus/importers/importer.hpp"
+#include "navbus/importers/imu_csv.hpp"
+#include "navbus/importers/imu_increments.hpp"
+#include "navbus/importers/rtklib_pos.hpp"
+#include "navbus/importers/rtklib_time_tag.hpp"
+#include "navbus/records/csv_messages.hpp"
+
+using namespace navbus;
+using namespace navbus::importers;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kReal = fs::path(NAVBUS_SOURCE_DIR) / "tests/data/real";
+const fs::path kDatasets = fs::path(NAVBUS_CONFIG_DIR) / "datasets";
+
+std::int64_t gpsNs(int y, int mo, int d, int h, int mi, double s) {
+  return std::llround(gnss_data::gpsSecondsFromCalendar(y, mo, d, h, mi, 0.0)) * 1'000'000'000 +
+         std::llround(s * 1e9);
+}
+
+/// This process's scratch directory, removed when the tests end.
+struct ScratchDir {
+  fs::path dir = fs::temp_directory_path() / ("navbus-importers-" + std::to_string(getpid()));
+  ~ScratchDir() { fs::remove_all(dir); }
+};
+
+fs::path scratch(const std::string& name) {
+  static const ScratchDir scratch_dir;
+  fs::create_directories(scratch_dir.dir);
+  return scratch_dir.dir / name;
+}
+
+fs::path writeText(const std::string& name, const std::string& text) {
+  const fs::path p = scratch(name);
+  std::ofstream(p) << text;
+  return p;
+}
+
+/// The error text of `f`, or "" if it did not throw a ConfigError.
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const bus::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+ImuCsvDescription gpsSecondsCsv(const fs::path& file) {
+  ImuCsvDescription d;
+  d.file = file;
+  d.time_source = ImuTimeSource::kGpsSeconds;
+  d.sample_rate_hz = 100;
+  return d;
+}
+
+}  // namespace
+
+TEST(TimeTag, ReadsTheDrivesStartAndSpan) {
+  const TimeTag tag = readTimeTag(kReal / "drive_0708/imu_1934.csv.tag");
+  // README: start 2025-07-08 19:34:21.854 GPST, last tick 548,731 ms.
+  EXPECT_EQ(tag.start_gps_ns, gpsNs(2025, 7, 8, 19, 34, 21.854));
+  EXPECT_EQ(tag.lastTickMs(), 548'731u);
+  EXPECT_GT(tag.records.size(), 1000u);
+}
+
+TEST(TimeTag, RefusesAnotherFileAndATruncatedOne) {
+  EXPECT_NE(errorOf([] {
+              readTimeTag(kReal / "drive_0708/imu_1934.csv");
+            }).find("not an RTKLIB time-tag file"),
+            std::string::npos);
+  std::ifstream in(kReal / "drive_0708/imu_1934.csv.tag", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  bytes.resize(bytes.size() - 3);
+  const fs::path cut = scratch("cut.tag");
+  std::ofstream(cut, std::ios::binary) << bytes;
+  EXPECT_NE(errorOf([&] { readTimeTag(cut); }).find("not a whole number of 8-byte records"),
+            std::string::npos);
+}
+
+TEST(ImuCsv, TheDriveMapsItsDeviceClockOntoTheTimeTag) {
+  const auto d = readDatasetDescription(kDatasets / "drive_0708.yaml");
+  ASSERT_TRUE(d.imu);
+  const ImuLog log = readImuCsv(*d.imu);
+  EXPECT_TRUE(log.skipped.empty());
+  ASSERT_EQ(log.samples.size(), 54'860u);
+  const std::int64_t start = gpsNs(2025, 7, 8, 19, 34, 21.854);
+  EXPECT_EQ(log.samples.front().time_gps_ns, start - 125'000'000);
+  EXPECT_EQ(log.samples.back().time_gps_ns, start + 548'731'000'000 - 125'000'000);
+  // The first line: 0.119,0.027,1.013 g and -0.671,3.082,0.198 deg/s.
+  EXPECT_DOUBLE_EQ(log.samples.front().specific_force_s_mps2.z(), 1.013 * units::kStandardGravity);
+  EXPECT_DOUBLE_EQ(log.samples.front().rate_s_radps.y(), 3.082 * units::kDeg);
+}
+
+TEST(ImuCsv, TheWalksCutFirstAndLastLinesAreSkippedAndReported) {
+  const auto d = readDatasetDescription(kDatasets / "walk_0827.yaml");
+  const ImuLog log = readImuCsv(*d.imu);
+  ASSERT_EQ(log.skipped.size(), 2u);
+  EXPECT_NE(log.skipped[0].find("line 1 skipped, cut at the start"), std::string::npos)
+      << log.skipped[0];
+  EXPECT_NE(log.skipped[1].find("line 20457 skipped, cut at the end"), std::string::npos)
+      << log.skipped[1];
+  EXPECT_EQ(log.samples.size(), 20'455u);
+}
+
+TEST(ImuCsv, AMalformedLineInsideTheLogIsAnErrorNamingFileLineAndColumn) {
+  const std::string good = "0.1,0.0,1.0,0.5,0.0,0.0,";
+  auto text = [&](const std::string& middle) {
+    return good + "1.00\n" + good + "1.01\n" + middle + "\n" + good + "1.03\n";
+  };
+  const fs::path bad_number = writeText("bad_number.csv", text("0.1,0.0,x1.0,0.5,0.0,0.0,1.02"));
+  std::string e = errorOf([&] { readImuCsv(gpsSecondsCsv(bad_number)); });
+  EXPECT_NE(e.find("bad_number.csv line 3: column 2 (accel z): 'x1.0' is not a number"),
+            std::string::npos)
+      << e;
+  const fs::path short_line = writeText("short_line.csv", text("0.1,0.0,1.0,0.5,0.0,1.02"));
+  e = errorOf([&] { readImuCsv(gpsSecondsCsv(short_line)); });
+  EXPECT_NE(e.find("short_line.csv line 3: 6 cells, no column 6 (time)"), std::string::npos) << e;
+  const fs::path empty_cell = writeText("empty_cell.csv", text("0.1,0.0,1.0,,0.0,0.0,1.02"));
+  e = errorOf([&] { readImuCsv(gpsSecondsCsv(empty_cell)); });
+  EXPECT_NE(e.find("empty_cell.csv line 3: column 3 (gyro x): '' is not a number"),
+            std::string::npos)
+      << e;
+  const fs::path back = writeText("back.csv", text(good + "1.005"));
+  e = errorOf([&] { readImuCsv(gpsSecondsCsv(back)); });
+  EXPECT_NE(e.find("back.csv line 3: column 6 (time): 1.005 is not after line 2's 1.01"),
+            std::string::npos)
+      << e;
+  const fs::path inf = writeText("inf.csv", text("0.1,0.0,1.0,0.5,inf,0.0,1.02"));
+  e = errorOf([&] { readImuCsv(gpsSecondsCsv(inf)); });
+  EXPECT_NE(e.find("inf.csv line 3: column 4 (gyro y): 'inf' is not a number"), std::string::npos)
+      << e;
+  // The same faults on the first or last line are cuts: skipped, reported.
+  const fs::path cut = writeText("cut.csv", "0,1.0,0.5,0.0,0.0,1.00\n" + good + "1.01\n" + good +
+                                                "1.02\n" + "0.1,0.0,1.0,0.5,0.");
+  const ImuLog log = readImuCsv(gpsSecondsCsv(cut));
+  EXPECT_EQ(log.samples.size(), 2u);
+  EXPECT_EQ(log.skipped.size(), 2u);
+}
+
+TEST(ImuCsv, ADeviceClockThatDoesNotSpanTheTimeTagIsAnotherLog) {
+  ImuCsvDescription d;
+  d.file = writeText("short_log.csv", "0,0,1,0,0,0,1000\n0,0,1,0,0,0,2000\n");
+  d.time_source = ImuTimeSource::kDeviceTicks;
+  d.time_tag = kReal / "drive_0708/imu_1934.csv.tag";
+  d.sample_rate_hz = 100;
+  const std::string e = errorOf([&] { readImuCsv(d); });
+  EXPECT_NE(e.find("not the same log"), std::string::npos) << e;
+}
+
+TEST(ImuIncrements, TrapezoidalIntegralsOverTheSampleIntervals) {
+  // A rate ramping linearly in time: the trapezoid is its exact integral.
+  std::vector<ImuSample> samples;
+  for (int k = 0; k < 5; ++k) {
+    ImuSample s;
+    s.time_gps_ns = 1'000'000'000 + k * 10'000'000 + (k == 3 ? 2'000'000 : 0);  // jitter
+    const double t = 1e-9 * static_cast<double>(s.time_gps_ns);
+    s.rate_s_radps = Eigen::Vector3d(0.1 * t, -0.2, 0.0);
+    s.specific_force_s_mps2 = Eigen::Vector3d(0.0, 0.0, -9.8 + t);
+    samples.push_back(s);
+  }
+  const auto inc = incrementsFromSamples(samples, 7);
+  ASSERT_EQ(inc.size(), 4u);
+  for (std::size_t k = 0; k < inc.size(); ++k) {
+    const double t0 = 1e-9 * static_cast<double>(samples[k].time_gps_ns);
+    const double t1 = 1e-9 * static_cast<double>(samples[k + 1].time_gps_ns);
+    EXPECT_EQ(inc[k].sensor_id(), 7u);
+    EXPECT_EQ(inc[k].seq(), k + 1);
+    EXPECT_EQ(inc[k].time_gps_ns(), static_cast<std::uint64_t>(samples[k + 1].time_gps_ns));
+    EXPECT_EQ(inc[k].interval_ns(), samples[k + 1].time_gps_ns - samples[k].time_gps_ns);
+    EXPECT_NEAR(inc[k].delta_angle_b_rad()[0], 0.05 * (t1 * t1 - t0 * t0), 1e-15);
+    EXPECT_NEAR(inc[k].delta_angle_b_rad()[1], -0.2 * (t1 - t0), 1e-15);
+    EXPECT_NEAR(inc[k].delta_vel_b_mps()[2], -9.8 * (t1 - t0) + 0.5 * (t1 * t1 - t0 * t0), 1e-13);
+  }
+}
+
+TEST(ImuIncrements, BlocksSpanTheirTimeAndTheTopicsBound) {
+  std::vector<navbus::ImuIncrement> incs(300);
+  for (std::size_t k = 0; k < incs.size(); ++k) {
+    incs[k].sensor_id(1);
+    incs[k].seq(k + 1);
+    incs[k].interval_ns(10'000'000);
+    incs[k].time_gps_ns(1'000'000'000 + (k + 1) * 10'000'000);
+  }
+  const auto tenths = blocksOf(incs, 0.1);
+  ASSERT_EQ(tenths.size(), 30u);
+  for (std::size_t b = 0; b < tenths.size(); ++b) {
+    EXPECT_EQ(tenths[b].seq(), b + 1);
+    EXPECT_EQ(tenths[b].increments().size(), 10u);
+  }
+  const auto bounded = blocksOf(incs, 1.0);  // 100 per second, at most 64 a block
+  EXPECT_EQ(bounded.front().increments().size(), 64u);
+}
+
+TEST(RtklibPos, TheDrivesSolutionsWithTheirQualitiesAndEllipsoidalHeights) {
+  const auto d = readDatasetDescription(kDatasets / "drive_0708.yaml");
+  ASSERT_TRUE(d.gnss_solutions);
+  const PosLog log = readPosFile(*d.gnss_solutions);
+  EXPECT_EQ(log.epochs_by_quality[1], 2189u);
+  EXPECT_EQ(log.epochs_by_quality[2], 8u);
+  ASSERT_EQ(log.fixes.size(), 2197u);
+  EXPECT_TRUE(log.has_velocity);
+  const auto& first = log.fixes.front();
+  // 2025/07/08 19:34:18.499 (1 ms early) 40.0966268 -105.1474483 1601.474 (hMSL) ... vn 0.010
+  // ve -0.002 vu 0.009.
+  EXPECT_EQ(first.time_gps_ns(), static_cast<std::uint64_t>(gpsNs(2025, 7, 8, 19, 34, 18.5)));
+  EXPECT_DOUBLE_EQ(first.latitude_rad(), 40.0966268 * units::kDeg);
+  EXPECT_DOUBLE_EQ(first.height_m(), 1601.474 - 21.387);
+  EXPECT_DOUBLE_EQ(first.vel_ned_mps()[2], -0.009);
+  EXPECT_DOUBLE_EQ(first.pos_sigma_ned_m()[0], 0.02);  // 0.0099 m raised to the fix floor
+  EXPECT_EQ(first.num_satellites_used(), 21u);
+  for (std::size_t i = 1; i < log.fixes.size(); ++i)
+    ASSERT_EQ(log.fixes[i].time_gps_ns() - log.fixes[i - 1].time_gps_ns(), 250'000'000u);
+}
+
+TEST(RtklibPos, AQualityLeftOutIsCountedAndMissingVelocityMeansPositionOnly) {
+  const std::string header =
+      "%  GPST                  latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   "
+      "sde(m)   sdu(m)\n";
+  PosDescription d;
+  d.file =
+      writeText("no_velocity.pos", header +
+                                       "2374 243258.500   40.1 -105.1 1600.0 1 20 0.01 0.01 0.02\n"
+                                       "2374 243258.750   40.1 -105.1 1600.0 5 20 1.5 1.5 3.0\n");
+  d.quality[5].use = false;
+  const PosLog log = readPosFile(d);
+  ASSERT_EQ(log.fixes.size(), 1u);
+  EXPECT_EQ(log.left_out_by_quality[5], 1u);
+  EXPECT_FALSE(log.has_velocity);
+  EXPECT_EQ(log.fixes[0].vel_sigma_ned_mps()[0], d.velocity_sigma_when_absent_mps);
+  EXPECT_EQ(log.fixes[0].time_gps_ns(),
+            static_cast<std::uint64_t>(2374 * 604800'000'000'000LL + 243258'500'000'000LL));
+}
+
+TEST(RtklibPos, MalformedFilesAreErrorsNamingFileLineAndColumn) {
+  const std::string header =
+      "%  GPST                  latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   "
+      "sde(m)   sdu(m)\n";
+  auto error = [&](const std::string& name, const std::string& text) {
+    PosDescription d;
+    d.file = writeText(name, text);
+    return errorOf([&] { readPosFile(d); });
+  };
+  EXPECT_NE(error("q.pos", header + "2374 243258.5 40.1 -105.1 1600.0 9 20 0.01 0.01 0.02\n")
+                .find("q.pos line 2: Q: 9 is not an RTKLIB quality 1..6"),
+            std::string::npos);
+  EXPECT_NE(error("lat.pos", header + "2374 243258.5 4O.1 -105.1 1600.0 1 20 0.01 0.01 0.02\n")
+                .find("lat.pos line 2: latitude(deg): '4O.1' is not a number"),
+            std::string::npos);
+  EXPECT_NE(error("short.pos", header + "2374 243258.5 40.1 -105.1 1600.0 1 20 0.01 0.01\n")
+                .find("short.pos line 2: 9 fields, no sdu(m)"),
+            std::string::npos);
+  EXPECT_NE(
+      error("date.pos", header + "2025/13/08 19:34:18.5 40.1 -105.1 1600 1 20 0.01 0.01 0.02\n")
+          .find("date.pos line 2: date: '2025/13/08' is not yyyy/mm/dd"),
+      std::string::npos);
+  EXPECT_NE(error("week.pos", header + "2374 24325B.5 40.1 -105.1 1600 1 20 0.01 0.01 0.02\n")
+                .find("week.pos line 2: GPS seconds of week: '24325B.5' is not a number"),
+            std::string::npos);
+  EXPECT_NE(error("order.pos", header + "2374 243258.5 40.1 -105.1 1600 1 20 0.01 0.01 0.02\n" +
+                                   "2374 243258.5 40.1 -105.1 1600 1 20 0.01 0.01 0.02\n")
+                .find("order.pos line 3: time stamp not after the previous epoch's"),
+            std::string::npos);
+  EXPECT_NE(error("utc.pos",
+                  "%  UTC  latitude(deg) longitude(deg) height(m) Q ns sdn(m) sde(m) "
+                  "sdu(m)\n2374 243258.5 40.1 -105.1 1600 1 20 0.01 0.01 0.02\n")
+                .find("navbus reads GPST"),
+            std::string::npos);
+  EXPECT_NE(error("xyz.pos",
+                  "%  GPST  x-ecef(m) y-ecef(m) z-ecef(m) Q ns sdx(m) sdy(m) "
+                  "sdz(m)\n2374 243258.5 1 2 3 1 20 0.01 0.01 0.02\n")
+                .find("out-solformat = llh"),
+            std::string::npos);
+  EXPECT_NE(error("none.pos", "2374 243258.5 40.1 -105.1 1600 1 20 0.01 0.01 0.02\n")
+                .find("no '%' header line"),
+            std::string::npos);
+}
+
+TEST(Dataset, ErrorsNameTheKeyAndTheValue) {
+  auto error = [&](const std::string& name, const std::string& yaml) {
+    const fs::path p = writeText(name, yaml);
+    return errorOf([&] { readDatasetDescription(p); });
+  };
+  const std::string imu = "imu: {file: " + (kReal / "drive_0708/imu_1934.csv").string() +
+                          ", time_source: gps_seconds, sample_rate_hz: 100";
+  EXPECT_NE(error("typo.yaml", imu + ", acel_unit: g}\n").find("acel_unit"), std::string::npos);
+  EXPECT_NE(error("unit.yaml", imu + ", accel_unit: G}\n").find("'G' is not one of g | mg | mps2"),
+            std::string::npos);
+  EXPECT_NE(error("cols.yaml", imu + ", gyro_columns: [3, 4]}\n").find("needs 3 column numbers"),
+            std::string::npos);
+  EXPECT_NE(
+      error("nofile.yaml", "imu: {file: nowhere.csv, sample_rate_hz: 100}\n").find("imu.file = '"),
+      std::string::npos);
+  EXPECT_NE(error("notag.yaml", "imu: {file: " + (kReal / "drive_0708/imu_1934.csv").string() +
+                                    ", sample_rate_hz: 100}\n")
+                .find("imu.time_tag is missing"),
+            std::string::npos);
+  const std::string pos =
+      "gnss_solutions: {file: " + (kReal / "drive_0708/gnss_1934_sf.pos").string();
+  EXPECT_NE(error("msl.yaml", pos + ", height: msl}\n").find("geoid_separation_m is missing"),
+            std::string::npos);
+  EXPECT_NE(error("q.yaml", pos + ", quality: {fixed: {sigma_scale: 2}}}\n").find("fixed"),
+            std::string::npos);
+  EXPECT_NE(error("empty.yaml", "name: x\n").find("nothing to import"), std::string::npos);
+}
+
+TEST(Import, TheDriveBecomesARecordingThatReadsBack) {
+  const auto d = readDatasetDescription(kDatasets / "drive_0708.yaml");
+  const fs::path out = scratch("drive_recording");
+  const ImportReport report = importDataset(d, out);
+  EXPECT_EQ(report.imu_increments, 54'859u);
+  EXPECT_EQ(report.gnss_fixes, 2197u);
+  const auto block_table = records::readCsv(out / "navbus_imu_increment_block.csv");
+  const auto blocks = records::parseMessages<navbus::ImuIncrementBlock>(
+      block_table, records::messageRowRanges(block_table));
+  ASSERT_EQ(blocks.size(), report.imu_blocks);
+  std::size_t increments = 0;
+  for (const auto& b : blocks) increments += b.increments().size();
+  EXPECT_EQ(increments, report.imu_increments);
+  const auto fix_table = records::readCsv(out / "navbus_gnss_fix.csv");
+  const auto fixes =
+      records::parseMessages<navbus::GnssFix>(fix_table, records::messageRowRanges(fix_table));
+  ASSERT_EQ(fixes.size(), 2197u);
+  const PosLog direct = readPosFile(*d.gnss_solutions);
+  EXPECT_EQ(fixes.back().pos_ecef_m(), direct.fixes.back().pos_ecef_m()) << "bit for bit";
+}
