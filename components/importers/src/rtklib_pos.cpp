@@ -192,6 +192,7 @@ PosLog readPosFile(const PosDescription& d) {
     if (!log.fixes.empty() && fix.time_gps_ns() <= log.fixes.back().time_gps_ns())
       throw r.error("time stamp not after the previous epoch's");
     log.fixes.push_back(fix);
+    log.quality.push_back(static_cast<std::uint8_t>(quality));
   }
   if (!columns) throw bus::ConfigError(file + ": no solution epochs");
   return log;

@@ -336,6 +336,20 @@ void parseMultiDimensional(const YAML::Node& node, core::MdfConfig& m) {
       .number("speed_mps", m.stationarity.speed_mps, kAnyNonNegative)
       .finish();
 }
+/// The vehicle's geometry: how the IMU sits in the body, where the GNSS antenna is.
+void parseGeometry(const YAML::Node& node, FilterConfig& c) {
+  bus::KeyReader r(node, "geometry");
+  r.nested({"imu_mounting_rpy_deg", "antenna_lever_arm_b_m"}).finish();
+  if (!node) return;
+  const Eigen::Vector3d rpy = bus::getVector3(node, "geometry", "imu_mounting_rpy_deg", 1.0);
+  for (int i = 0; i < 3; ++i)
+    bus::checkRange(rpy[i], -360.0, 360.0, "geometry.imu_mounting_rpy_deg");
+  c.imu_mounting = core::ImuMounting::fromRollPitchYaw(rpy * units::kDeg);
+  const Eigen::Vector3d lever = bus::getVector3(node, "geometry", "antenna_lever_arm_b_m", 1.0);
+  for (int i = 0; i < 3; ++i)
+    bus::checkRange(lever[i], -100.0, 100.0, "geometry.antenna_lever_arm_b_m");
+  c.engine.antenna_lever_arm_b_m = lever;
+}
 }  // namespace
 
 FilterConfig parseFilterConfig(const YAML::Node& root) {
@@ -360,7 +374,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       .value("star_tracker_updates", e.use_star_tracker)
       .nested({"low_latency_output", "recovery", "time_jump", "fault_monitor", "initial_state",
                "inputs", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional",
-               "alignment", "integrity", "consistency"})
+               "alignment", "integrity", "consistency", "geometry"})
       .finish(bus::kParticipantKeys);
   parseLowLatency(root["low_latency_output"], c);
   parseRecovery(root["recovery"], c);
@@ -376,6 +390,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   parseAlignment(root["alignment"], e);
   parseIntegrity(root["integrity"], e);
   parseConsistency(root["consistency"], e.consistency);
+  parseGeometry(root["geometry"], c);
   return c;
 }
 

@@ -112,7 +112,7 @@ bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, StreamId id
 void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
   if (!admit(imu_gate_, msg, {kRankImu, msg.sensor_id()}, config_.imu)) return;
   if (imu_gate_.sourceRestarted()) startNewRun();
-  const core::ImuIncrement inc = bus::toCore(msg);
+  const core::ImuIncrement inc = config_.imu_mounting.toBody(bus::toCore(msg));
   queue(imu_gate_, {kRankImu, msg.sensor_id()}, inc.time_ns, inc);
   if (config_.low_latency_output && sinks_.low_latency) publishLowLatency(inc);
 }

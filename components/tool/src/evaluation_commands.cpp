@@ -3,8 +3,10 @@
 #include <map>
 #include <string>
 
+#include "navbus/bus/config.hpp"
 #include "navbus/evaluation/evaluation.hpp"
 #include "navbus/evaluation/real_data.hpp"
+#include "navbus/evaluation/recording_runner.hpp"
 #include "subcommand.hpp"
 
 namespace navbus::tool::cli {
@@ -18,10 +20,18 @@ class OfflineCommand final : public Subcommand {
   void add(CLI::App& app) override {
     cli_ = app.add_subcommand(
         "offline",
-        "run a scenario through the filter without DDS; write solution, truth, error CSV");
-    cli_->add_option("--scenario", offline.scenario, "scenario YAML (sim/scenarios)")
-        ->required()
-        ->check(CLI::ExistingFile);
+        "run a scenario (solution, truth, error CSV) or a recording (solution CSV) through the "
+        "filter without DDS");
+    auto* scenario =
+        cli_->add_option("--scenario", offline.scenario, "scenario YAML (sim/scenarios)")
+            ->check(CLI::ExistingFile);
+    auto* recording =
+        cli_->add_option("--recording", recording_.recording,
+                         "a recording directory instead of a scenario (navbus import, navbus "
+                         "record): its sensor topics in data-time order, as navbus replay sends "
+                         "them; --start, --seed and --duration do not apply")
+            ->check(CLI::ExistingDirectory);
+    scenario->excludes(recording);
     cli_->add_option("--filter", offline.filter, "navbus-filter YAML (config/)")
         ->required()
         ->check(CLI::ExistingFile);
@@ -44,11 +54,20 @@ class OfflineCommand final : public Subcommand {
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    if (!recording_.recording.empty()) {
+      recording_.filter = offline.filter;
+      recording_.fault_manager = offline.fault_manager;
+      recording_.out_dir = offline.out_dir;
+      return evaluation::runRecordingCommand(recording_);
+    }
+    if (offline.scenario.empty())
+      throw bus::ConfigError("navbus offline needs --scenario or --recording");
     return evaluation::runOfflineCommand(offline);
   }
 
  private:
   evaluation::OfflineOptions offline;
+  evaluation::RecordingOptions recording_;
 };
 
 class MonteCarloCommand final : public Subcommand {

@@ -1,5 +1,6 @@
 // navbus: the user's tool for the bus (topics, echo, record, replay, command, health,
-// latency) and for offline work (offline, montecarlo, rinex, import). Each subcommand's options and
+// latency) and for offline work (offline, montecarlo, rinex, import,
+// benchmark). Each subcommand's options and
 // run are in *_commands.cpp; main registers them and runs the one chosen.
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   nb::tool::cli::addInspectionSubcommands(subcommands);
   nb::tool::cli::addBusSubcommands(subcommands);
   nb::tool::cli::addEvaluationSubcommands(subcommands);
-  nb::tool::cli::addImportSubcommands(subcommands);
+  nb::tool::cli::addRealDataSubcommands(subcommands);
   for (const auto& s : subcommands) s->add(app);
 
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) -> int {

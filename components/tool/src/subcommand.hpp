@@ -19,7 +19,7 @@ class Subcommand {
   virtual void add(CLI::App& app) = 0;
   /// True when the command line chose this subcommand.
   bool chosen() const { return cli_ != nullptr && cli_->parsed(); }
-  /// False for offline work (offline, montecarlo, rinex, import): no DDS participant at all.
+  /// False for offline work (offline, montecarlo, rinex, import, benchmark): no DDS participant at all.
   virtual bool usesBus() const { return true; }
   /// Inspection tools (topics, echo, record) see every endpoint under a discovery server, not
   /// only their matches.
@@ -40,7 +40,7 @@ void addInspectionSubcommands(Subcommands& out);
 void addBusSubcommands(Subcommands& out);
 /// offline, montecarlo, rinex (evaluation_commands.cpp).
 void addEvaluationSubcommands(Subcommands& out);
-/// import (import_command.cpp).
-void addImportSubcommands(Subcommands& out);
+/// import, benchmark real-car (real_data_commands.cpp).
+void addRealDataSubcommands(Subcommands& out);
 
 }  // namespace navbus::tool::cli

@@ -455,6 +455,20 @@ ProtectionLevels NavigationEngine::protectionLevels() const {
   return integrity_->levels(filter_->covariance().block<3, 3>(kPos.index, kPos.index));
 }
 
+earth::Geodetic NavigationEngine::fixPositionAtStateTime(const GnssFixMeasurement& fix) const {
+  // The merge releases a fix after the last increment that ends before it: the state is up to
+  // one IMU interval older than the fix (real logs; the simulator's fixes fall on increments).
+  // The fix is moved back along its own velocity to the state's time (10 ms at 16 m/s: 16 cm).
+  const double dt_s = 1e-9 * static_cast<double>(filter_->state().time_ns - fix.time_ns);
+  if (dt_s == 0.0) return fix.position;
+  return earth::offsetNed(fix.position, fix.vel_ned_mps * dt_s);
+}
+
+Eigen::Vector3d NavigationEngine::bodyRate() const {
+  if (!last_increment_ || !(last_increment_->interval_s > 0.0)) return Eigen::Vector3d::Zero();
+  return last_increment_->delta_angle_b_rad / last_increment_->interval_s - filter_->gyroBias();
+}
+
 void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   if (aligning()) {
     aligner_->addGnssFix(fix);
@@ -482,13 +496,14 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
     floorBeforeCourseCheck();
     checkHeadingFromCourse(fix.vel_ned_mps, fix.vel_sigma_ned_mps.head<2>().maxCoeff());
   }
-  const auto p =
-      filter_->update(positionMeasurement(filter_->state(), fix.position, fix.pos_sigma_ned_m),
-                      AidingKind::kPosition);
+  const Eigen::Vector3d& lever_b = config_.antenna_lever_arm_b_m;
+  const auto p = filter_->update(positionMeasurement(filter_->state(), fixPositionAtStateTime(fix),
+                                                     fix.pos_sigma_ned_m, lever_b),
+                                 AidingKind::kPosition);
   countGated(p.data(), 3);
-  const auto v =
-      filter_->update(velocityMeasurement(filter_->state(), fix.vel_ned_mps, fix.vel_sigma_ned_mps),
-                      AidingKind::kVelocity);
+  const auto v = filter_->update(velocityMeasurement(filter_->state(), fix.vel_ned_mps,
+                                                     fix.vel_sigma_ned_mps, lever_b, bodyRate()),
+                                 AidingKind::kVelocity);
   countGated(v.data(), 3);
   std::array<ScalarUpdateResult, 6> rows{};
   std::copy(p.begin(), p.end(), rows.begin());

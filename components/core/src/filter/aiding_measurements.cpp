@@ -9,21 +9,28 @@ namespace navbus::core {
 using namespace layout;
 
 VectorMeasurement positionMeasurement(const NavState& ins, const earth::Geodetic& fix,
-                                      const Eigen::Vector3d& sigma) {
+                                      const Eigen::Vector3d& sigma,
+                                      const Eigen::Vector3d& lever_arm_b) {
   VectorMeasurement m;
-  m.z = earth::differenceNed(ins.position, fix);
+  const Eigen::Vector3d lever_n = ins.q_b_to_n * lever_arm_b;
+  m.z = earth::differenceNed(ins.position, fix) + lever_n;
   m.h.setZero();
   m.h.block<3, 3>(0, kPos.index).setIdentity();
+  m.h.block<3, 3>(0, kAtt.index) = skew(lever_n);
   m.r = sigma.array().square().matrix().asDiagonal();
   return m;
 }
 
 VectorMeasurement velocityMeasurement(const NavState& ins, const Eigen::Vector3d& fix_vel,
-                                      const Eigen::Vector3d& sigma) {
+                                      const Eigen::Vector3d& sigma,
+                                      const Eigen::Vector3d& lever_arm_b,
+                                      const Eigen::Vector3d& rate_nb_b) {
   VectorMeasurement m;
-  m.z = ins.vel_ned_mps - fix_vel;
+  const Eigen::Vector3d lever_vel_n = ins.q_b_to_n * rate_nb_b.cross(lever_arm_b);
+  m.z = ins.vel_ned_mps + lever_vel_n - fix_vel;
   m.h.setZero();
   m.h.block<3, 3>(0, kVel.index).setIdentity();
+  m.h.block<3, 3>(0, kAtt.index) = skew(lever_vel_n);
   m.r = sigma.array().square().matrix().asDiagonal();
   return m;
 }

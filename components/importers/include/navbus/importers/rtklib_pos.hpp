@@ -18,6 +18,7 @@ namespace navbus::importers {
 
 struct PosLog {
   std::vector<navbus::GnssFix> fixes;
+  std::vector<std::uint8_t> quality;  ///< RTKLIB Q of each fix (1 fix, 2 float, ...)
   std::array<std::uint64_t, kQualityNames.size()> epochs_by_quality{};    ///< read, per Q
   std::array<std::uint64_t, kQualityNames.size()> left_out_by_quality{};  ///< use: false
   bool has_velocity{false};

@@ -12,6 +12,7 @@
 #include "navbus/bus/topics.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/ins/imu_mounting.hpp"
 #include "navbus/core/math/units.hpp"
 
 namespace navbus::nav_filter {
@@ -75,6 +76,9 @@ struct FilterConfig {
   bool low_latency_output{false};
   /// Increments kept while the filter lags behind the newest one (at 200 Hz, 2 s).
   std::size_t low_latency_max_buffered{400};
+  /// How the IMU's axes sit in the body (`geometry.imu_mounting_rpy_deg`): every increment is
+  /// turned into body axes as it enters.
+  core::ImuMounting imu_mounting;
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid entry.

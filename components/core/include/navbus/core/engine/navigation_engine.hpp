@@ -99,6 +99,8 @@ struct EngineConfig {
   IntegrityConfig integrity;
   /// The filter's test of its own innovations, and when it re-initialises.
   ConsistencyConfig consistency;
+  /// The GNSS antenna's offset from the IMU [m, body axes]: fixes are of the antenna.
+  Eigen::Vector3d antenna_lever_arm_b_m{Eigen::Vector3d::Zero()};
 };
 
 struct EngineCounters {
@@ -262,6 +264,10 @@ class NavigationEngine {
   std::int64_t last_fix_ns_{-1};
   /// The latest increment integrated (compensated): held across a gap (ins/gap_bridge.hpp).
   std::optional<ImuIncrement> last_increment_;
+  /// The latest increment's bias-corrected angular rate [rad/s, body] (the antenna's velocity).
+  Eigen::Vector3d bodyRate() const;
+  /// The fix's position brought to the filter state's time along the fix's velocity.
+  earth::Geodetic fixPositionAtStateTime(const GnssFixMeasurement& fix) const;
   std::int64_t next_constraint_ns_{0};
   bool course_check_armed_{false};             ///< checkHeadingFromCourse still to come
   double gyrocompass_heading_sigma_rad_{0.0};  ///< the aligned start's heading sigma

@@ -21,13 +21,24 @@ struct AidingMeasurement {
 };
 using VectorMeasurement = AidingMeasurement<3>;
 
-/// GNSS position fix: z = (INS position - fix position) in NED metres (lever arm zero).
-VectorMeasurement positionMeasurement(const NavState& ins, const earth::Geodetic& fix,
-                                      const Eigen::Vector3d& sigma_ned_m);
+/// GNSS position fix of the antenna, at `lever_arm_b_m` from the IMU in body axes: z = (INS
+/// position + C_b_n l_b - fix position) in NED metres. With C_b_n,est = (I - [phi x]) C_b_n the
+/// antenna term's error is -phi x (C_b_n l) = [(C_b_n l) x] phi: H is I on the position error
+/// and [(C_b_n l) x] on the attitude error.
+VectorMeasurement positionMeasurement(
+    const NavState& ins, const earth::Geodetic& fix, const Eigen::Vector3d& sigma_ned_m,
+    const Eigen::Vector3d& lever_arm_b_m = Eigen::Vector3d::Zero());
 
-/// GNSS velocity: z = INS velocity - fix velocity [m/s, NED].
-VectorMeasurement velocityMeasurement(const NavState& ins, const Eigen::Vector3d& fix_vel_ned_mps,
-                                      const Eigen::Vector3d& sigma_ned_mps);
+/// GNSS velocity of the antenna: z = INS velocity + C_b_n (w_nb_b x l_b) - fix velocity [m/s,
+/// NED], w_nb_b the body's angular rate relative to NED (the gyro rate less the Earth and
+/// transport rates, which change the antenna term by under 1e-4 of it: neglected). H is I on
+/// the velocity error and [(C_b_n (w x l)) x] on the attitude error; the gyro-bias error's
+/// term (l x db, under 1e-4 m/s for a decimetre arm and 0.1 deg/s) is left out.
+VectorMeasurement velocityMeasurement(
+    const NavState& ins, const Eigen::Vector3d& fix_vel_ned_mps,
+    const Eigen::Vector3d& sigma_ned_mps,
+    const Eigen::Vector3d& lever_arm_b_m = Eigen::Vector3d::Zero(),
+    const Eigen::Vector3d& rate_nb_b_radps = Eigen::Vector3d::Zero());
 
 /// Star tracker: the measured body-to-ECI attitude brought into NED at the INS position and
 /// time; z = phi_INS - phi_ST (seed 001 eq. 17) as the small rotation between the INS attitude

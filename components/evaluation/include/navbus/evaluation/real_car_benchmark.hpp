@@ -1,0 +1,35 @@
+// `navbus benchmark real-car`: a real log with GNSS outages. The data set is imported, the
+// filter runs causally with the GNSS solutions withheld inside each outage, and the antenna
+// positions it gives are scored against the withheld fixed (RTK) epochs: the horizontal error
+// at the end of each outage, the largest inside it, the RMS over all outage epochs and the share
+// of outage epochs inside the filter's own 3-sigma; and, with GNSS available, the horizontal RMS
+// against the fixed epochs it fused.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace navbus::evaluation {
+
+/// One outage [start, end) in GPS seconds of week: a solution epoch t is withheld when
+/// start <= t < end (its time stamp as the solution file has it).
+struct Outage {
+  double start_sow{0.0};
+  double end_sow{0.0};
+};
+
+/// One outage line `START END` per line, `#` comments; throws bus::ConfigError naming the file
+/// and the line.
+std::vector<Outage> readOutages(const std::filesystem::path& file);
+
+struct RealCarOptions {
+  std::string dataset;  ///< data set YAML (config/datasets/)
+  std::string filter;   ///< navbus-filter YAML
+  std::string outages;  ///< outage list
+  std::string out_dir;  ///< solution.csv, outages.csv, the recording
+};
+
+int runRealCarBenchmark(const RealCarOptions& o);
+
+}  // namespace navbus::evaluation

@@ -1,0 +1,57 @@
+// A navbus recording (what `navbus record` or `navbus import` writes: a CSV file per topic)
+// run through navbus-filter's pipeline without DDS, and the fault manager's when configured:
+// the samples go in in data-time order, the pipeline's clock is the data time. Over the bus,
+// `navbus replay` of the same recording into the participants gives the same solutions.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <navbus_idl/Fault.h>
+#include <navbus_idl/Navigation.h>
+
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/nav_filter/filter_config.hpp"
+
+namespace navbus::evaluation {
+
+struct RecordingSetup {
+  std::filesystem::path dir;
+  nav_filter::FilterConfig filter;
+  std::optional<fault_manager::FaultManagerConfig> fault_manager;
+  /// GNSS fixes for which this is true are left out (GNSS outages of a benchmark); counted.
+  std::function<bool(const navbus::GnssFix&)> withhold{};
+};
+
+struct RecordingResult {
+  std::uint64_t solutions{0};
+  std::string inputs;  ///< what the recording held, per topic
+  std::uint64_t fixes_withheld{0};
+  std::string summary;  ///< the filter pipeline's counters
+  std::string fault_summary;
+  std::vector<navbus::FaultDecision> decisions;
+  std::vector<navbus::FilterCommand> commands;
+};
+
+using RecordedSolutionHook = std::function<void(const navbus::NavigationSolution&)>;
+
+/// Throws bus::ConfigError when the directory holds no recorded sensor topic or a file does
+/// not read as its topic.
+RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolutionHook& hook = {});
+
+struct RecordingOptions {
+  std::string recording;
+  std::string filter;
+  std::string fault_manager;
+  std::string out_dir;
+};
+
+/// `navbus offline --recording`: writes solution.csv (and decisions.csv, commands.csv with a
+/// fault manager) into out_dir; returns an exit code.
+int runRecordingCommand(const RecordingOptions& o);
+
+}  // namespace navbus::evaluation

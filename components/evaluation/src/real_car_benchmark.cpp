@@ -1,0 +1,217 @@
+#include "navbus/evaluation/real_car_benchmark.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "navbus/bus/app.hpp"
+#include "navbus/bus/config.hpp"
+#include "navbus/core/math/earth.hpp"
+#include "navbus/core/math/units.hpp"
+#include "navbus/evaluation/recording_runner.hpp"
+#include "navbus/importers/importer.hpp"
+#include "navbus/importers/rtklib_pos.hpp"
+
+namespace navbus::evaluation {
+
+namespace {
+
+namespace earth = core::earth;
+constexpr std::int64_t kWeekNs = 604'800'000'000'000;
+constexpr std::uint8_t kQualityFix = 1;
+
+std::int64_t secondsOfWeekNs(std::int64_t time_ns) {
+  return time_ns % kWeekNs;
+}
+
+/// The outage holding the epoch, or -1.
+int outageOf(std::int64_t time_ns, const std::vector<Outage>& outages) {
+  const std::int64_t sow_ns = secondsOfWeekNs(time_ns);
+  for (std::size_t i = 0; i < outages.size(); ++i) {
+    if (sow_ns >= std::llround(outages[i].start_sow * 1e9) &&
+        sow_ns < std::llround(outages[i].end_sow * 1e9))
+      return static_cast<int>(i);
+  }
+  return -1;
+}
+
+/// The antenna as the filter saw it at a solution epoch.
+struct AntennaPoint {
+  std::int64_t time_ns;
+  earth::Geodetic position;
+  Eigen::Vector3d vel_ned_mps;
+  double sigma_h_m;  ///< sqrt(sigma_N^2 + sigma_E^2)
+  double sigma_v_m;
+};
+
+AntennaPoint antennaOf(const navbus::NavigationSolution& s, const Eigen::Vector3d& lever_b) {
+  const Eigen::Quaterniond q(s.q_b_to_n()[0], s.q_b_to_n()[1], s.q_b_to_n()[2], s.q_b_to_n()[3]);
+  const earth::Geodetic imu{s.latitude_rad(), s.longitude_rad(), s.height_m()};
+  const auto& sd = s.pos_sigma_ned_m();
+  return {static_cast<std::int64_t>(s.time_gps_ns()), earth::offsetNed(imu, q * lever_b),
+          Eigen::Vector3d(s.vel_ned_mps()[0], s.vel_ned_mps()[1], s.vel_ned_mps()[2]),
+          std::hypot(sd[0], sd[1]), sd[2]};
+}
+
+/// Horizontal error [m] of the antenna against a reference at its time, from the solutions
+/// around it (linear in time between the two); nullopt outside the solutions.
+struct Judged {
+  double horizontal_m;
+  double sigma_h_m;
+};
+std::optional<Judged> judge(const std::vector<AntennaPoint>& points, std::int64_t t,
+                            const earth::Geodetic& reference) {
+  const auto after =
+      std::lower_bound(points.begin(), points.end(), t,
+                       [](const AntennaPoint& p, std::int64_t v) { return p.time_ns < v; });
+  if (after == points.end() || after == points.begin()) return std::nullopt;
+  const AntennaPoint& b = *after;
+  const AntennaPoint& a = *(after - 1);
+  const double w = static_cast<double>(t - a.time_ns) / static_cast<double>(b.time_ns - a.time_ns);
+  const Eigen::Vector3d ea = earth::differenceNed(a.position, reference);
+  const Eigen::Vector3d eb = earth::differenceNed(b.position, reference);
+  const Eigen::Vector3d e = (1.0 - w) * ea + w * eb;
+  return Judged{e.head<2>().norm(), (1.0 - w) * a.sigma_h_m + w * b.sigma_h_m};
+}
+
+struct OutageScore {
+  std::size_t epochs{0};
+  double end_error_m{0.0};
+  double max_error_m{0.0};
+  double sum_squares{0.0};
+  std::size_t inside_3_sigma{0};
+};
+
+}  // namespace
+
+std::vector<Outage> readOutages(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw bus::ConfigError(file.string() + ": cannot be read");
+  std::vector<Outage> out;
+  std::string text;
+  for (std::size_t line = 1; std::getline(in, text); ++line) {
+    text = text.substr(0, text.find('#'));
+    std::istringstream fields(text);
+    Outage o;
+    std::string rest;
+    if (!(fields >> o.start_sow)) {
+      if (text.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank, comment
+      throw bus::ConfigError(
+          fmt::format("{} line {}: '{}' is not `START END` (GPS seconds of "
+                      "week)",
+                      file.string(), line, text));
+    }
+    if (!(fields >> o.end_sow) || (fields >> rest))
+      throw bus::ConfigError(
+          fmt::format("{} line {}: '{}' is not `START END`", file.string(), line, text));
+    if (!(o.start_sow >= 0.0 && o.end_sow > o.start_sow && o.end_sow <= 604800.0))
+      throw bus::ConfigError(
+          fmt::format("{} line {}: outage {} .. {} is not within a week and "
+                      "of positive length",
+                      file.string(), line, o.start_sow, o.end_sow));
+    out.push_back(o);
+  }
+  if (out.empty()) throw bus::ConfigError(file.string() + ": no outage");
+  return out;
+}
+
+int runRealCarBenchmark(const RealCarOptions& o) {
+  const importers::DatasetDescription dataset = importers::readDatasetDescription(o.dataset);
+  if (!dataset.imu || !dataset.gnss_solutions)
+    throw bus::ConfigError(o.dataset + ": the benchmark needs imu and gnss_solutions");
+  const std::filesystem::path out_dir(o.out_dir);
+  const importers::ImportReport imported = importers::importDataset(dataset, out_dir / "recording");
+  const std::vector<Outage> outages = readOutages(o.outages);
+
+  RecordingSetup setup;
+  setup.dir = out_dir / "recording";
+  setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
+  setup.withhold = [&](const navbus::GnssFix& f) {
+    return outageOf(static_cast<std::int64_t>(f.time_gps_ns()), outages) >= 0;
+  };
+  const Eigen::Vector3d lever_b = setup.filter.engine.antenna_lever_arm_b_m;
+  std::vector<AntennaPoint> points;
+  std::ofstream sol(out_dir / "solution.csv");
+  if (!sol) throw bus::ConfigError("cannot write into " + o.out_dir);
+  sol << "gpst_s,lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m,mode,covariance_valid\n";
+  fmt::memory_buffer buffer;
+  const RecordingResult run = runRecording(setup, [&](const navbus::NavigationSolution& s) {
+    if (s.mode() == navbus::MODE_INITIALIZING || s.mode() == navbus::MODE_INERTIAL_LOST) return;
+    const AntennaPoint p = antennaOf(s, lever_b);
+    points.push_back(p);
+    fmt::format_to(fmt::appender(buffer), "{:.6f},{:.10f},{:.10f},{:.4f},{:.4f},{:.4f},{},{}\n",
+                   1e-9 * static_cast<double>(secondsOfWeekNs(p.time_ns)),
+                   p.position.latitude_rad / units::kDeg, p.position.longitude_rad / units::kDeg,
+                   p.position.height_m, p.sigma_h_m, p.sigma_v_m, static_cast<int>(s.mode()),
+                   s.covariance_valid() ? 1 : 0);
+  });
+  sol.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+
+  // The reference: the fixed epochs of the same file, read as the import read them.
+  const importers::PosLog reference = importers::readPosFile(*dataset.gnss_solutions);
+  std::vector<OutageScore> scores(outages.size());
+  double available_sum = 0.0;
+  std::size_t available = 0;
+  for (std::size_t i = 0; i < reference.fixes.size(); ++i) {
+    if (reference.quality[i] != kQualityFix) continue;
+    const navbus::GnssFix& f = reference.fixes[i];
+    const auto t = static_cast<std::int64_t>(f.time_gps_ns());
+    const auto judged = judge(points, t, {f.latitude_rad(), f.longitude_rad(), f.height_m()});
+    if (!judged) continue;
+    const int k = outageOf(t, outages);
+    if (k < 0) {
+      available_sum += judged->horizontal_m * judged->horizontal_m;
+      ++available;
+      continue;
+    }
+    OutageScore& s = scores[static_cast<std::size_t>(k)];
+    ++s.epochs;
+    s.end_error_m = judged->horizontal_m;  // the last one judged is the end
+    s.max_error_m = std::max(s.max_error_m, judged->horizontal_m);
+    s.sum_squares += judged->horizontal_m * judged->horizontal_m;
+    s.inside_3_sigma += judged->horizontal_m <= 3.0 * judged->sigma_h_m ? 1 : 0;
+  }
+
+  std::ofstream table(out_dir / "outages.csv");
+  table << "outage,start_sow,end_sow,epochs,end_error_m,max_error_m,rms_m,inside_3sigma\n";
+  std::string text = fmt::format("{}{}{} fixes withheld in {} outages\n", imported.text,
+                                 run.summary + "\n", run.fixes_withheld, outages.size());
+  text += "outage  start [s of week]  epochs  end error [m]  max error [m]  inside 3 sigma\n";
+  double end_sum = 0.0, end_worst = 0.0, all_squares = 0.0;
+  std::size_t scored = 0, all_epochs = 0, all_inside = 0;
+  for (std::size_t k = 0; k < outages.size(); ++k) {
+    const OutageScore& s = scores[k];
+    if (s.epochs == 0) continue;
+    ++scored;
+    end_sum += s.end_error_m;
+    end_worst = std::max(end_worst, s.end_error_m);
+    all_squares += s.sum_squares;
+    all_epochs += s.epochs;
+    all_inside += s.inside_3_sigma;
+    text += fmt::format("{:6}  {:17.3f}  {:6}  {:13.2f}  {:13.2f}  {:8}/{}\n", k + 1,
+                        outages[k].start_sow, s.epochs, s.end_error_m, s.max_error_m,
+                        s.inside_3_sigma, s.epochs);
+    table << fmt::format("{},{:.3f},{:.3f},{},{:.4f},{:.4f},{:.4f},{:.4f}\n", k + 1,
+                         outages[k].start_sow, outages[k].end_sow, s.epochs, s.end_error_m,
+                         s.max_error_m, std::sqrt(s.sum_squares / static_cast<double>(s.epochs)),
+                         static_cast<double>(s.inside_3_sigma) / static_cast<double>(s.epochs));
+  }
+  if (scored == 0) throw bus::ConfigError(o.outages + ": no fixed epoch falls in an outage");
+  text += fmt::format(
+      "outage end: mean {:.2f} m, worst {:.2f} m; RMS over {} outage epochs {:.2f} m; inside "
+      "the filter's 3 sigma {:.1f} %\nGNSS available: horizontal RMS against {} fixed epochs "
+      "{:.3f} m\nwritten: {}/solution.csv, {}/outages.csv\n",
+      end_sum / static_cast<double>(scored), end_worst, all_epochs,
+      std::sqrt(all_squares / static_cast<double>(all_epochs)),
+      100.0 * static_cast<double>(all_inside) / static_cast<double>(all_epochs), available,
+      available > 0 ? std::sqrt(available_sum / static_cast<double>(available)) : 0.0, o.out_dir,
+      o.out_dir);
+  std::fputs(text.c_str(), stdout);
+  return 0;
+}
+
+}  // namespace navbus::evaluation

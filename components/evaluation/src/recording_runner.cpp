@@ -1,0 +1,167 @@
+#include "navbus/evaluation/recording_runner.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <variant>
+
+#include <fmt/format.h>
+
+#include "navbus/bus/app.hpp"
+#include "navbus/bus/config.hpp"
+#include "navbus/bus/topics.hpp"
+#include "navbus/fault_manager/fault_pipeline.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/records/csv_messages.hpp"
+#include "navbus/records/formatters.hpp"
+
+namespace navbus::evaluation {
+
+namespace {
+
+using Sample =
+    std::variant<navbus::ImuIncrement, navbus::ImuIncrementBlock, navbus::GnssObservationEpoch,
+                 navbus::GnssFix, navbus::StarTrackerAttitude>;
+
+/// One recorded sample in the merged order: by data time, then by topic (IMU first, as the
+/// filter's merge ranks them), then file order.
+struct Event {
+  std::int64_t time_ns;
+  int rank;
+  std::size_t index;
+  Sample sample;
+};
+
+std::int64_t dataTimeNs(const navbus::ImuIncrementBlock& b) {
+  return b.increments().empty() ? 0
+                                : static_cast<std::int64_t>(b.increments().back().time_gps_ns());
+}
+template <class T>
+std::int64_t dataTimeNs(const T& m) {
+  return static_cast<std::int64_t>(m.time_gps_ns());
+}
+
+std::string fileOf(const char* topic) {
+  std::string file = topic;
+  std::replace(file.begin(), file.end(), '/', '_');
+  return file + ".csv";
+}
+
+template <class T>
+void load(const std::filesystem::path& dir, const char* topic, int rank, std::vector<Event>& out,
+          std::string& inputs) {
+  const std::filesystem::path file = dir / fileOf(topic);
+  if (!std::filesystem::exists(file)) return;
+  const records::CsvTable table = records::readCsv(file);
+  const auto messages = records::parseMessages<T>(table, records::messageRowRanges(table));
+  for (const T& m : messages) out.push_back({dataTimeNs(m), rank, out.size(), m});
+  inputs += fmt::format("{}: {} samples\n", file.string(), messages.size());
+}
+
+}  // namespace
+
+RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolutionHook& hook) {
+  RecordingResult result;
+  std::vector<Event> events;
+  load<navbus::ImuIncrement>(setup.dir, bus::topic::kImuIncrement, 0, events, result.inputs);
+  load<navbus::ImuIncrementBlock>(setup.dir, bus::topic::kImuIncrementBlock, 0, events,
+                                  result.inputs);
+  load<navbus::GnssObservationEpoch>(setup.dir, bus::topic::kGnssObservations, 1, events,
+                                     result.inputs);
+  load<navbus::GnssFix>(setup.dir, bus::topic::kGnssFix, 2, events, result.inputs);
+  load<navbus::StarTrackerAttitude>(setup.dir, bus::topic::kStarTracker, 3, events, result.inputs);
+  if (events.empty())
+    throw bus::ConfigError(
+        "no recording of a sensor topic in '" + setup.dir.string() +
+        "' (navbus import or navbus record write navbus_imu_increment_block.csv, "
+        "navbus_gnss_fix.csv, ...)");
+  if (setup.withhold) {
+    const auto before = events.size();
+    events.erase(std::remove_if(events.begin(), events.end(),
+                                [&](const Event& e) {
+                                  const auto* fix = std::get_if<navbus::GnssFix>(&e.sample);
+                                  return fix != nullptr && setup.withhold(*fix);
+                                }),
+                 events.end());
+    result.fixes_withheld = before - events.size();
+  }
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
+    return std::tie(a.time_ns, a.rank, a.index) < std::tie(b.time_ns, b.rank, b.index);
+  });
+
+  bus::HealthCounters health("navbus-offline");
+  std::optional<fault_manager::FaultPipeline> faults;
+  nav_filter::FilterPipeline* filter_ptr = nullptr;
+  if (setup.fault_manager) {
+    faults.emplace(*setup.fault_manager, health,
+                   fault_manager::FaultPipeline::Sinks{
+                       [&](const navbus::FaultDecision& d) { result.decisions.push_back(d); },
+                       [&](const navbus::FilterCommand& c) {
+                         result.commands.push_back(c);
+                         filter_ptr->onCommand(c);
+                       }});
+  }
+  std::function<void(const navbus::FilterDiagnostics&)> on_diagnostics;
+  std::function<void(const navbus::FilterCommandOutcome&)> on_outcome;
+  if (faults) {
+    on_diagnostics = [&](const navbus::FilterDiagnostics& d) { faults->onDiagnostics(d); };
+    on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };
+  }
+  nav_filter::FilterPipeline pipeline(setup.filter, health,
+                                      {[&](const navbus::NavigationSolution& s) {
+                                         ++result.solutions;
+                                         if (hook) hook(s);
+                                       },
+                                       on_diagnostics, nullptr, on_outcome});
+  filter_ptr = &pipeline;
+  for (const Event& e : events) {
+    std::visit(
+        [&](const auto& m) {
+          using T = std::decay_t<decltype(m)>;
+          if constexpr (std::is_same_v<T, navbus::ImuIncrement>) pipeline.onImu(m);
+          if constexpr (std::is_same_v<T, navbus::ImuIncrementBlock>) pipeline.onImuBlock(m);
+          if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
+            pipeline.onGnssObservations(m);
+          if constexpr (std::is_same_v<T, navbus::GnssFix>) pipeline.onGnssFix(m);
+          if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) pipeline.onStarTracker(m);
+        },
+        e.sample);
+    pipeline.pump(e.time_ns);  // data time bounds the wait for a silent stream
+  }
+  pipeline.flush(events.back().time_ns);
+  result.summary = pipeline.summary();
+  if (faults) result.fault_summary = faults->summary();
+  return result;
+}
+
+int runRecordingCommand(const RecordingOptions& o) {
+  RecordingSetup setup;
+  setup.dir = o.recording;
+  setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
+  if (!o.fault_manager.empty())
+    setup.fault_manager = bus::parseFile(o.fault_manager, fault_manager::parseFaultManagerConfig);
+  std::filesystem::create_directories(o.out_dir);
+  const std::string path = o.out_dir + "/solution.csv";
+  std::ofstream sol(path);
+  if (!sol) throw bus::ConfigError("cannot write " + path);
+  sol << records::csvHeader<navbus::NavigationSolution>() << "\n";
+  fmt::memory_buffer buffer;
+  const RecordingResult r = runRecording(setup, [&](const navbus::NavigationSolution& s) {
+    records::appendCsvLine(s, buffer);
+    if (buffer.size() > (1u << 20)) {
+      sol.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      buffer.clear();
+    }
+  });
+  sol.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  if (setup.fault_manager) {
+    records::writeCsvFile(o.out_dir + "/decisions.csv", r.decisions);
+    records::writeCsvFile(o.out_dir + "/commands.csv", r.commands);
+  }
+  std::printf("%s%s\n%s%s%zu solutions written to %s\n", r.inputs.c_str(), r.summary.c_str(),
+              r.fault_summary.c_str(), r.fault_summary.empty() ? "" : "\n",
+              static_cast<std::size_t>(r.solutions), path.c_str());
+  return sol ? 0 : bus::kExitConfigError;
+}
+
+}  // namespace navbus::evaluation

@@ -1,0 +1,78 @@
+// Real logs, offline (no DDS participant): `navbus import` turns a user's logs, described by a
+// data set YAML, into a navbus recording (components/importers); `navbus benchmark real-car`
+// scores the filter on one with GNSS outages (evaluation/real_car_benchmark.hpp).
+#include <cstdio>
+
+#include "navbus/evaluation/real_car_benchmark.hpp"
+#include "navbus/importers/importer.hpp"
+#include "subcommand.hpp"
+
+namespace navbus::tool::cli {
+namespace {
+
+class ImportCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = app.add_subcommand(
+        "import",
+        "real logs into a navbus recording (for replay and offline): an IMU CSV file with its "
+        "clock (RTKLIB time tag), RTKLIB solutions (.pos), as a data set YAML describes them "
+        "(config/datasets/)");
+    cli_->add_option("dataset", dataset_, "data set YAML")->required()->check(CLI::ExistingFile);
+    cli_->add_option("-o,--out", out_dir_, "recording directory (created)")->required();
+  }
+  bool usesBus() const override { return false; }
+  int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    const auto description = importers::readDatasetDescription(dataset_);
+    const auto report = importers::importDataset(description, out_dir_);
+    std::fputs(report.text.c_str(), stdout);
+    return 0;
+  }
+
+ private:
+  std::string dataset_;
+  std::string out_dir_;
+};
+
+class RealCarBenchmarkCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    CLI::App* benchmark = app.add_subcommand("benchmark", "benchmarks on real logs");
+    benchmark->require_subcommand(1);
+    cli_ = benchmark->add_subcommand(
+        "real-car",
+        "a car's log with GNSS outages: the filter runs causally without the GNSS solutions "
+        "inside each outage; its antenna positions are scored against the withheld fixed epochs");
+    cli_->add_option("dataset", o_.dataset, "data set YAML (config/datasets/drive_0708.yaml)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cli_->add_option("--filter", o_.filter, "navbus-filter YAML (config/filter_drive_0708.yaml)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cli_->add_option("--outages", o_.outages,
+                     "outage list: `START END` per line, GPS seconds of week, # comments "
+                     "(config/datasets/drive_0708_outages.txt)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cli_->add_option("-o,--out", o_.out_dir,
+                     "output directory: solution.csv (antenna, IMU rate), outages.csv, the "
+                     "imported recording")
+        ->required();
+  }
+  bool usesBus() const override { return false; }
+  int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    return evaluation::runRealCarBenchmark(o_);
+  }
+
+ private:
+  evaluation::RealCarOptions o_;
+};
+
+}  // namespace
+
+void addRealDataSubcommands(Subcommands& out) {
+  out.push_back(std::make_unique<ImportCommand>());
+  out.push_back(std::make_unique<RealCarBenchmarkCommand>());
+}
+
+}  // namespace navbus::tool::cli
