@@ -1,8 +1,10 @@
-// Real logs, offline (no DDS participant): `navbus import` turns a user's logs, described by a
+// Real logs, offline (no DDS participant): `navbus allan` reads a recorded IMU's noise densities
+// from its standing start; `navbus import` turns a user's logs, described by a
 // data set YAML, into a navbus recording (components/importers); `navbus benchmark real-car`
 // scores the filter on one with GNSS outages (evaluation/real_car_benchmark.hpp).
 #include <cstdio>
 
+#include "navbus/evaluation/imu_noise_survey.hpp"
 #include "navbus/evaluation/real_car_benchmark.hpp"
 #include "navbus/importers/importer.hpp"
 #include "subcommand.hpp"
@@ -68,9 +70,40 @@ class RealCarBenchmarkCommand final : public Subcommand {
   evaluation::RealCarOptions o_;
 };
 
+class AllanCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = app.add_subcommand(
+        "allan",
+        "noise densities of a recorded IMU from the Allan deviation of a stretch at rest, as the "
+        "filter configuration's ekf keys");
+    cli_->add_option("recording", dir_, "recording directory (navbus import, navbus record)")
+        ->required()
+        ->check(CLI::ExistingDirectory);
+    cli_->add_option("--from", from_s_,
+                     "start of the stretch at rest [s after the first increment]")
+        ->check(CLI::Range(0.0, 1e7));
+    cli_->add_option("--to", to_s_, "its end [s after the first increment]")
+        ->required()
+        ->check(CLI::Range(0.0, 1e7));
+  }
+  bool usesBus() const override { return false; }
+  int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    std::fputs(evaluation::formatSurvey(evaluation::surveyImuNoise(dir_, from_s_, to_s_)).c_str(),
+               stdout);
+    return 0;
+  }
+
+ private:
+  std::string dir_;
+  double from_s_{0.0};
+  double to_s_{0.0};
+};
+
 }  // namespace
 
 void addRealDataSubcommands(Subcommands& out) {
+  out.push_back(std::make_unique<AllanCommand>());
   out.push_back(std::make_unique<ImportCommand>());
   out.push_back(std::make_unique<RealCarBenchmarkCommand>());
 }

@@ -40,7 +40,7 @@ void addInspectionSubcommands(Subcommands& out);
 void addBusSubcommands(Subcommands& out);
 /// offline, montecarlo, rinex (evaluation_commands.cpp).
 void addEvaluationSubcommands(Subcommands& out);
-/// import, benchmark real-car (real_data_commands.cpp).
+/// import, allan, benchmark real-car (real_data_commands.cpp).
 void addRealDataSubcommands(Subcommands& out);
 
 }  // namespace navbus::tool::cli

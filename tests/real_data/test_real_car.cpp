@@ -1,0 +1,96 @@
+// The real car (tests/data/real/drive_0708) through navbus import, navbus offline --recording
+// and navbus benchmark real-car: the import's counts, and the benchmark's scores held to what
+// the shipped configuration measured (docs/real_data.md), so that a change that loses accuracy
+// on real data fails here. The targets are not met yet; the bounds say where we are.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/evaluation/real_car_benchmark.hpp"
+#include "navbus/evaluation/recording_runner.hpp"
+#include "navbus/records/csv_table.hpp"
+
+namespace fs = std::filesystem;
+using namespace navbus;
+
+namespace {
+const fs::path kConfig(NAVBUS_CONFIG_DIR);
+
+fs::path workDir(const std::string& name) {
+  const fs::path dir = fs::path(NAVBUS_WORK_DIR) / (name + "-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+}  // namespace
+
+TEST(RealCar, TheDriveWithFifteenSecondOutagesScoresAsMeasured) {
+  const fs::path out = workDir("real-car");
+  evaluation::RealCarOptions o;
+  o.dataset = (kConfig / "datasets/drive_0708.yaml").string();
+  o.filter = (kConfig / "filter_drive_0708.yaml").string();
+  o.outages = (kConfig / "datasets/drive_0708_outages.txt").string();
+  o.out_dir = out.string();
+  ASSERT_EQ(evaluation::runRealCarBenchmark(o), 0);
+
+  const records::CsvTable table = records::readCsv(out / "outages.csv");
+  // The first outage starts 2.3 s after the car moves, before the filter has its heading from
+  // the GNSS course: nothing to score. The other ten are scored.
+  ASSERT_EQ(table.rows.size(), 10u);
+  double end_sum = 0.0, worst = 0.0, squares = 0.0, inside = 0.0;
+  std::size_t epochs = 0;
+  for (const auto& row : table.rows) {
+    const double n = std::stod(row[table.column("epochs")]);
+    EXPECT_EQ(n, 60.0) << "15 s of 4 Hz fixed epochs";
+    const double end = std::stod(row[table.column("end_error_m")]);
+    end_sum += end;
+    worst = std::max(worst, end);
+    squares += std::pow(std::stod(row[table.column("rms_m")]), 2) * n;
+    inside += std::stod(row[table.column("inside_3sigma")]) * n;
+    epochs += static_cast<std::size_t>(n);
+  }
+  const double mean_end = end_sum / 10.0;
+  const double rms = std::sqrt(squares / static_cast<double>(epochs));
+  std::printf(
+      "drive_0708: outage end mean %.2f m, worst %.2f m, RMS %.2f m, inside 3 sigma %.1f %%\n",
+      mean_end, worst, rms, 100.0 * inside / static_cast<double>(epochs));
+  // Measured 3.48 / 8.80 / 1.95 m and 63.7 % (targets 2.0 / 4.0 / 1.5 m and 95 %).
+  EXPECT_LT(mean_end, 4.0);
+  EXPECT_LT(worst, 10.0);
+  EXPECT_LT(rms, 2.3);
+  EXPECT_GT(inside / static_cast<double>(epochs), 0.55);
+
+  // The solution file: antenna positions at the IMU's rate with their sigmas.
+  const records::CsvTable sol = records::readCsv(out / "solution.csv");
+  EXPECT_GT(sol.rows.size(), 45'000u);
+  for (const char* column : {"gpst_s", "lat_deg", "lon_deg", "height_m", "sigma_h_m", "sigma_v_m"})
+    EXPECT_TRUE(sol.has(column)) << column;
+  fs::remove_all(out);
+}
+
+TEST(RealCar, TheImportedRecordingRunsOfflineWithEveryIncrement) {
+  const fs::path out = workDir("real-car-offline");
+  evaluation::RealCarOptions o;  // the benchmark imports into out/recording
+  o.dataset = (kConfig / "datasets/drive_0708.yaml").string();
+  o.filter = (kConfig / "filter_drive_0708.yaml").string();
+  o.outages = (kConfig / "datasets/drive_0708_outages.txt").string();
+  o.out_dir = out.string();
+  ASSERT_EQ(evaluation::runRealCarBenchmark(o), 0);
+  evaluation::RecordingSetup setup;
+  setup.dir = out / "recording";
+  setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
+  std::size_t solutions = 0;
+  const auto r = evaluation::runRecording(setup, [&](const NavigationSolution&) { ++solutions; });
+  EXPECT_EQ(r.fixes_withheld, 0u);
+  // Every one of the 54,859 increments reached the engine: integrated, or taken by the
+  // alignment before the filter started.
+  EXPECT_NE(r.summary.find("refused by the engine 0"), std::string::npos) << r.summary;
+  EXPECT_NE(r.summary.find("inertial gaps 0"), std::string::npos) << r.summary;
+  EXPECT_GT(solutions, 45'000u);
+  fs::remove_all(out);
+}
