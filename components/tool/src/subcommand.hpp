@@ -19,7 +19,8 @@ class Subcommand {
   virtual void add(CLI::App& app) = 0;
   /// True when the command line chose this subcommand.
   bool chosen() const { return cli_ != nullptr && cli_->parsed(); }
-  /// False for offline work (offline, montecarlo, rinex, import, benchmark): no DDS participant at all.
+  /// False for offline work (offline, montecarlo, rinex, import, benchmark): no DDS participant at
+  /// all.
   virtual bool usesBus() const { return true; }
   /// Inspection tools (topics, echo, record) see every endpoint under a discovery server, not
   /// only their matches.
