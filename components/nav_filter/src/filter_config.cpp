@@ -36,11 +36,14 @@ std::optional<InputConfig> input(const YAML::Node& inputs, const std::string& ke
     return std::nullopt;
   }
   const std::string where = "inputs." + key;
-  bus::checkKeys(n, where, {"id", "period_s"});
+  bus::checkKeys(n, where, {"id", "period_s", "time_offset_s"});
   InputConfig c;
   c.id = bus::require<std::uint32_t>(n, where, "id");
   c.period_ns = seconds(
       bus::checkRange(bus::require<double>(n, where, "period_s"), 1e-4, 60.0, where + ".period_s"));
+  if (n["time_offset_s"])
+    c.time_offset_ns = seconds(bus::checkRange(bus::require<double>(n, where, "time_offset_s"),
+                                               -10.0, 10.0, where + ".time_offset_s"));
   return c;
 }
 }  // namespace
@@ -243,6 +246,10 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
               kDegPerSqrtHour)
       .number("clock_bias_noise_m_per_sqrts", t.clock_bias_noise_m_per_sqrts, kAnyNonNegative)
       .number("clock_drift_noise_mps_per_sqrts", t.clock_drift_noise_mps_per_sqrts, kAnyNonNegative)
+      .number("accel_bias_rw_ug_per_sqrts", t.accel_bias_rw_mps2_per_sqrts, kAnyNonNegative,
+              kMicroG)
+      .number("gyro_bias_rw_dps_per_sqrts", t.gyro_bias_rw_radps_per_sqrts, kAnyNonNegative,
+              kDegree)
       .number("initial_position_sigma_m", t.pos_sigma_m, kAnyNonNegative)
       .number("initial_velocity_sigma_mps", t.vel_sigma_mps, kAnyNonNegative)
       .number("initial_level_sigma_mrad", t.level_sigma_rad, kAnyNonNegative, kMilliRad)

@@ -112,7 +112,8 @@ bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, StreamId id
 void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
   if (!admit(imu_gate_, msg, {kRankImu, msg.sensor_id()}, config_.imu)) return;
   if (imu_gate_.sourceRestarted()) startNewRun();
-  const core::ImuIncrement inc = config_.imu_mounting.toBody(bus::toCore(msg));
+  core::ImuIncrement inc = config_.imu_mounting.toBody(bus::toCore(msg));
+  inc.time_ns += config_.imu.time_offset_ns;
   queue(imu_gate_, {kRankImu, msg.sensor_id()}, inc.time_ns, inc);
   if (config_.low_latency_output && sinks_.low_latency) publishLowLatency(inc);
 }
@@ -140,20 +141,24 @@ void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
       bus::screenSatellites(m, gnss_obs_gate_.limits());
   for (const bus::SatelliteRejection& d : dropped)
     gnss_obs_gate_.rejectElement(d.rejection, m.receiver_id());
-  queue(gnss_obs_gate_, {kRankGnssObs, m.receiver_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
-        GnssEpochInput{static_cast<std::int64_t>(m.time_gps_ns()), bus::toCore(m, dropped)});
+  const std::int64_t time_ns =
+      static_cast<std::int64_t>(m.time_gps_ns()) + config_.gnss_observations->time_offset_ns;
+  queue(gnss_obs_gate_, {kRankGnssObs, m.receiver_id()}, time_ns,
+        GnssEpochInput{time_ns, bus::toCore(m, dropped)});
 }
 
 void FilterPipeline::onGnssFix(const navbus::GnssFix& m) {
   if (!admit(gnss_fix_gate_, m, {kRankGnssFix, m.receiver_id()}, config_.gnss_fix)) return;
-  queue(gnss_fix_gate_, {kRankGnssFix, m.receiver_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
-        bus::toCore(m));
+  core::GnssFixMeasurement fix = bus::toCore(m);
+  fix.time_ns += config_.gnss_fix->time_offset_ns;
+  queue(gnss_fix_gate_, {kRankGnssFix, m.receiver_id()}, fix.time_ns, fix);
 }
 
 void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
   if (!admit(star_gate_, m, {kRankStarTracker, m.tracker_id()}, config_.star_tracker)) return;
-  queue(star_gate_, {kRankStarTracker, m.tracker_id()}, static_cast<std::int64_t>(m.time_gps_ns()),
-        bus::toCore(m));
+  core::StarAttitudeMeasurement st = bus::toCore(m);
+  st.time_ns += config_.star_tracker->time_offset_ns;
+  queue(star_gate_, {kRankStarTracker, m.tracker_id()}, st.time_ns, st);
 }
 
 void FilterPipeline::startNewRun() {

@@ -175,6 +175,44 @@ TEST(FilterPipelineCommands, AStreamThatEndedAsAnnouncedIsNotLost) {
   EXPECT_NE(solutions.back().active_fault_flags() & FAULT_IMU_STREAM_LOST, 0u);
 }
 
+// A per-stream time offset (inputs.<stream>.time_offset_s) moves the stream's samples in the
+// merge: an IMU stamped 30 ms late gives the same states 30 ms earlier (a solution per
+// increment, so that both runs publish every state).
+TEST(FilterPipelineGeometry, AnInputsTimeOffsetMovesItsSamples) {
+  auto run = [](const std::string& imu) {
+    const auto cfg = nav_filter::parseFilterConfig(
+        YAML::Load("initial_state: {latitude_deg: 36.5, longitude_deg: 127.5, height_m: 100.0}\n"
+                   "solution_rate_hz: 100\ninputs: {imu: " +
+                   imu + "}\n"));
+    bus::HealthCounters health("test");
+    std::map<std::uint64_t, double> latitude_by_time;
+    nav_filter::FilterPipeline pipeline(
+        cfg, health,
+        {[&](const NavigationSolution& s) { latitude_by_time[s.time_gps_ns()] = s.latitude_rad(); },
+         nullptr});
+    sim::ScenarioSource src(sourceConfig());
+    std::int64_t now = 0;
+    for (std::uint64_t seq = 1; seq <= 200; ++seq) {
+      pipeline.onImu(bus::toIdl(src.next().increment, 1, seq));
+      pipeline.pump(now += 10'000'000);
+    }
+    pipeline.flush(now);
+    return latitude_by_time;
+  };
+  const auto plain = run("{id: 1, period_s: 0.01}");
+  const auto shifted = run("{id: 1, period_s: 0.01, time_offset_s: -0.03}");
+  ASSERT_GT(shifted.size(), 150u);
+  std::size_t compared = 0;
+  for (const auto& [time_ns, latitude] : shifted) {
+    const auto it = plain.find(time_ns + 30'000'000);
+    if (it == plain.end()) continue;
+    EXPECT_EQ(it->second, latitude) << time_ns;
+    ++compared;
+  }
+  EXPECT_GT(compared, 150u);
+  EXPECT_EQ(plain.count(shifted.begin()->first), 0u) << "the shifted run starts 30 ms earlier";
+}
+
 // A simulator restarted with its scenario starting at a fixed time sends the same times
 // again, with its sequence restarting. The filter recognises the restart once the samples
 // after the first continue from it, and starts over: its solutions go on, and from then on

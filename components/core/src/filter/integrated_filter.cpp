@@ -97,7 +97,8 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   clock_bias_m_ += clock_drift_mps_ * dt;
   if (suspend_filter) return;
   // Discrete process noise: white specific force / rate noise into velocity / attitude
-  // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3).
+  // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3),
+  // bias random walks (a failed axis's own walk replaces its bias's).
   StateVector q = StateVector::Zero();
   q.segment<3>(kVel.index).setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt);
   q.segment<3>(kAtt.index).setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt);
@@ -116,10 +117,16 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
     }
   }
   for (int a = 0; a < 3; ++a) {
-    if (axis_failed_[static_cast<std::size_t>(a)])
-      q[kAccelBias.index + a] = std::pow(tuning_.failed_accel_bias_rw_mps2_per_sqrts, 2) * dt;
-    if (axis_failed_[static_cast<std::size_t>(3 + a)])
-      q[kGyroBias.index + a] = std::pow(tuning_.failed_gyro_bias_rw_radps_per_sqrts, 2) * dt;
+    q[kAccelBias.index + a] = std::pow(axis_failed_[static_cast<std::size_t>(a)]
+                                           ? tuning_.failed_accel_bias_rw_mps2_per_sqrts
+                                           : tuning_.accel_bias_rw_mps2_per_sqrts,
+                                       2) *
+                              dt;
+    q[kGyroBias.index + a] = std::pow(axis_failed_[static_cast<std::size_t>(3 + a)]
+                                          ? tuning_.failed_gyro_bias_rw_radps_per_sqrts
+                                          : tuning_.gyro_bias_rw_radps_per_sqrts,
+                                      2) *
+                             dt;
   }
   if (structure_ == FusionStructure::kFederated) {
     for (ErrorState& l : local_) l.predict(Phi, q * tuning_.federated_share);

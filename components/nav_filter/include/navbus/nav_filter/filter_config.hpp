@@ -20,6 +20,9 @@ namespace navbus::nav_filter {
 struct InputConfig {
   std::uint32_t id{1};
   std::int64_t period_ns{0};
+  /// Added to every sample's time as it enters the merge [ns]: a sensor whose stamps are late
+  /// or early by a known delay (a logger's buffering, a receiver's output latency).
+  std::int64_t time_offset_ns{0};
 };
 
 /// The fault manager whose health reports (navbus/health) show that faults are monitored.

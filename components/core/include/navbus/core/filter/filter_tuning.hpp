@@ -17,6 +17,10 @@ struct FilterTuning {
   double gyro_noise_radps_per_sqrthz{0.001 * units::kDeg / 60.0};  ///< 0.001 deg/sqrt(h)
   double clock_bias_noise_m_per_sqrts{0.1};
   double clock_drift_noise_mps_per_sqrts{0.01};
+  /// Random walk of the sensor biases (a MEMS bias wanders; 0: the biases are constants, as the
+  /// simulator's are).
+  double accel_bias_rw_mps2_per_sqrts{0.0};
+  double gyro_bias_rw_radps_per_sqrts{0.0};
   // Initial 1-sigma (also the values the covariance reset rules re-initialize to).
   double pos_sigma_m{40.0};
   double vel_sigma_mps{1.0};
