@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include "navbus/bus/config.hpp"
 #include "navbus/evaluation/real_car_benchmark.hpp"
 #include "navbus/evaluation/recording_runner.hpp"
+#include "navbus/importers/importer.hpp"
 #include "navbus/records/csv_table.hpp"
 
 namespace fs = std::filesystem;
@@ -75,20 +77,22 @@ TEST(RealCar, TheDriveWithFifteenSecondOutagesScoresAsMeasured) {
 
 TEST(RealCar, TheImportedRecordingRunsOfflineWithEveryIncrement) {
   const fs::path out = workDir("real-car-offline");
-  evaluation::RealCarOptions o;  // the benchmark imports into out/recording
-  o.dataset = (kConfig / "datasets/drive_0708.yaml").string();
-  o.filter = (kConfig / "filter_drive_0708.yaml").string();
-  o.outages = (kConfig / "datasets/drive_0708_outages.txt").string();
-  o.out_dir = out.string();
-  ASSERT_EQ(evaluation::runRealCarBenchmark(o), 0);
+  const std::string filter = (kConfig / "filter_drive_0708.yaml").string();
+  importers::importDataset(importers::readDatasetDescription(kConfig / "datasets/drive_0708.yaml"),
+                           out / "recording");
   evaluation::RecordingSetup setup;
   setup.dir = out / "recording";
-  setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
+  setup.filter = bus::parseFile(filter, nav_filter::parseFilterConfig);
   std::size_t solutions = 0;
   const auto r = evaluation::runRecording(setup, [&](const NavigationSolution&) { ++solutions; });
   EXPECT_EQ(r.fixes_withheld, 0u);
   // Every one of the 54,859 increments reached the engine: integrated, or taken by the
   // alignment before the filter started.
+  std::smatch integrated, aligning;
+  ASSERT_TRUE(std::regex_search(r.summary, integrated, std::regex("increments integrated (\\d+)")));
+  ASSERT_TRUE(
+      std::regex_search(r.summary, aligning, std::regex("aligned after (\\d+) increments")));
+  EXPECT_EQ(std::stoul(integrated[1]) + std::stoul(aligning[1]), 54'859u) << r.summary;
   EXPECT_NE(r.summary.find("refused by the engine 0"), std::string::npos) << r.summary;
   EXPECT_NE(r.summary.find("inertial gaps 0"), std::string::npos) << r.summary;
   EXPECT_GT(solutions, 45'000u);

@@ -7,9 +7,11 @@
 #include <navbus_idl/Imu.h>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/bus/topics.hpp"
 #include "navbus/core/math/allan.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/records/csv_messages.hpp"
+#include "navbus/tool/topic_registry.hpp"
 
 namespace navbus::evaluation {
 
@@ -17,8 +19,8 @@ namespace {
 
 std::vector<navbus::ImuIncrement> recordedIncrements(const std::filesystem::path& dir) {
   std::vector<navbus::ImuIncrement> out;
-  const auto blocks = dir / "navbus_imu_increment_block.csv";
-  const auto singles = dir / "navbus_imu_increment.csv";
+  const auto blocks = dir / tool::recordFileName(bus::topic::kImuIncrementBlock);
+  const auto singles = dir / tool::recordFileName(bus::topic::kImuIncrement);
   if (std::filesystem::exists(blocks)) {
     const records::CsvTable t = records::readCsv(blocks);
     for (const auto& b :

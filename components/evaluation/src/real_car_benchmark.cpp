@@ -10,6 +10,7 @@
 
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
+#include "navbus/core/gnss/gps_broadcast_ephemeris.hpp"
 #include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/evaluation/recording_runner.hpp"
@@ -21,7 +22,7 @@ namespace navbus::evaluation {
 namespace {
 
 namespace earth = core::earth;
-constexpr std::int64_t kWeekNs = 604'800'000'000'000;
+constexpr auto kWeekNs = static_cast<std::int64_t>(core::gps::kSecondsPerWeek) * 1'000'000'000;
 constexpr std::uint8_t kQualityFix = 1;
 
 std::int64_t secondsOfWeekNs(std::int64_t time_ns) {
@@ -108,7 +109,7 @@ std::vector<Outage> readOutages(const std::filesystem::path& file) {
     if (!(fields >> o.end_sow) || (fields >> rest))
       throw bus::ConfigError(
           fmt::format("{} line {}: '{}' is not `START END`", file.string(), line, text));
-    if (!(o.start_sow >= 0.0 && o.end_sow > o.start_sow && o.end_sow <= 604800.0))
+    if (!(o.start_sow >= 0.0 && o.end_sow > o.start_sow && o.end_sow <= core::gps::kSecondsPerWeek))
       throw bus::ConfigError(
           fmt::format("{} line {}: outage {} .. {} is not within a week and "
                       "of positive length",

@@ -14,6 +14,7 @@
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/records/csv_messages.hpp"
 #include "navbus/records/formatters.hpp"
+#include "navbus/tool/topic_registry.hpp"
 
 namespace navbus::evaluation {
 
@@ -41,16 +42,10 @@ std::int64_t dataTimeNs(const T& m) {
   return static_cast<std::int64_t>(m.time_gps_ns());
 }
 
-std::string fileOf(const char* topic) {
-  std::string file = topic;
-  std::replace(file.begin(), file.end(), '/', '_');
-  return file + ".csv";
-}
-
 template <class T>
 void load(const std::filesystem::path& dir, const char* topic, int rank, std::vector<Event>& out,
           std::string& inputs) {
-  const std::filesystem::path file = dir / fileOf(topic);
+  const std::filesystem::path file = dir / tool::recordFileName(topic);
   if (!std::filesystem::exists(file)) return;
   const records::CsvTable table = records::readCsv(file);
   const auto messages = records::parseMessages<T>(table, records::messageRowRanges(table));

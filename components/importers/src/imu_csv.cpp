@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/core/gnss/gps_broadcast_ephemeris.hpp"
 #include "navbus/importers/rtklib_time_tag.hpp"
 #include "navbus/records/csv_table.hpp"
 
@@ -14,7 +15,7 @@ namespace navbus::importers {
 
 namespace {
 
-constexpr double kSecondsPerWeek = 604800.0;
+using core::gps::kSecondsPerWeek;
 /// A device clock that disagrees with the time tag's span by more than this is another log's.
 constexpr double kMaxClockRateError = 0.01;
 

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/core/gnss/gps_broadcast_ephemeris.hpp"
 #include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/gnss_data/rinex2.hpp"
@@ -17,7 +18,7 @@ namespace navbus::importers {
 
 namespace {
 
-constexpr double kSecondsPerWeek = 604800.0;
+using core::gps::kSecondsPerWeek;
 
 /// Where each value is in a data line's whitespace-separated tokens (the time takes two).
 struct Columns {
