@@ -262,6 +262,8 @@ class NavigationEngine {
   std::uint8_t failed_axes_{0};  ///< bit i: accelerometer i (0-2), gyro i - 3 (3-5)
   std::int64_t next_output_ns_{0};
   std::int64_t last_fix_ns_{-1};
+  /// That fix's horizontal ground speed less 3 of its sigmas: the speed it proves [m/s].
+  double last_fix_moving_speed_mps_{0.0};
   /// The latest increment integrated (compensated): held across a gap (ins/gap_bridge.hpp).
   std::optional<ImuIncrement> last_increment_;
   /// The latest increment's bias-corrected angular rate [rad/s, body] (the antenna's velocity).

@@ -37,7 +37,9 @@ struct StationarityConfig {
   double window_s{1.0};                      ///< detection window
   double accel_std_mps2{0.03};               ///< specific-force scatter below this ...
   double gyro_std_radps{0.3 * units::kDeg};  ///< ... and angular-rate scatter below this ...
-  double speed_mps{0.3};  ///< ... and estimated ground speed below this: stationary
+  /// ... and the filter's ground speed below this, unless a recent fix proves more (speed less
+  /// 3 sigma above it)
+  double speed_mps{0.3};
 };
 
 struct MdfConfig {
