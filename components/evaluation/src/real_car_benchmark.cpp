@@ -103,6 +103,124 @@ struct OutageScore {
   std::size_t inside_3_sigma{0};
 };
 
+/// The scores of one run over every outage, and with GNSS available.
+struct Scored {
+  std::vector<OutageScore> outages;
+  std::size_t scored{0};  ///< outages with an epoch judged
+  double end_mean_m{0.0}, end_worst_m{0.0}, max_worst_m{0.0}, rms_m{0.0}, inside{0.0};
+  std::size_t epochs{0};
+  std::size_t available{0};
+  double available_rms_m{0.0};
+};
+
+AntennaPoint antennaOf(const core::SmoothedEpoch& e, const Eigen::Vector3d& lever_b) {
+  const auto sd = e.sigma.segment<3>(core::layout::kPos.index);
+  return {e.time_ns, earth::offsetNed(e.state.position, e.state.q_b_to_n * lever_b),
+          e.state.vel_ned_mps, std::hypot(sd[0], sd[1]), sd[2]};
+}
+
+void appendPoint(const AntennaPoint& p, const std::string& tail, fmt::memory_buffer& out) {
+  fmt::format_to(fmt::appender(out), "{:.6f},{:.10f},{:.10f},{:.4f},{:.4f},{:.4f},{}\n",
+                 1e-9 * static_cast<double>(secondsOfWeekNs(p.time_ns)),
+                 p.position.latitude_rad / units::kDeg, p.position.longitude_rad / units::kDeg,
+                 p.position.height_m, p.sigma_h_m, p.sigma_v_m, tail);
+}
+
+/// How a GNSS-available epoch is judged: a causal filter once it fused the epoch's fix, a
+/// smoothed run between its epochs.
+enum class Judging { kAfterFusion, kInterpolated };
+
+Scored score(const std::vector<AntennaPoint>& points, const importers::PosLog& reference,
+             const std::vector<Outage>& outages, Judging judging) {
+  Scored r;
+  r.outages.resize(outages.size());
+  double available_sum = 0.0;
+  for (std::size_t i = 0; i < reference.fixes.size(); ++i) {
+    if (reference.quality[i] != kQualityFix) continue;
+    const navbus::GnssFix& f = reference.fixes[i];
+    const auto t = static_cast<std::int64_t>(f.time_gps_ns());
+    const earth::Geodetic truth{f.latitude_rad(), f.longitude_rad(), f.height_m()};
+    const int k = outageOf(t, outages);
+    if (k < 0) {
+      std::optional<double> e;
+      if (judging == Judging::kAfterFusion) {
+        e = judgeAfterFusion(points, t, truth);
+      } else if (const auto j = judge(points, t, truth)) {
+        e = j->horizontal_m;
+      }
+      if (e) {
+        available_sum += *e * *e;
+        ++r.available;
+      }
+      continue;
+    }
+    const auto judged = judge(points, t, truth);
+    if (!judged) continue;
+    OutageScore& s = r.outages[static_cast<std::size_t>(k)];
+    ++s.epochs;
+    s.end_error_m = judged->horizontal_m;  // the last one judged is the end
+    s.max_error_m = std::max(s.max_error_m, judged->horizontal_m);
+    s.sum_squares += judged->horizontal_m * judged->horizontal_m;
+    s.inside_3_sigma += judged->horizontal_m <= 3.0 * judged->sigma_h_m ? 1 : 0;
+  }
+  double end_sum = 0.0, squares = 0.0;
+  std::size_t inside = 0;
+  for (const OutageScore& s : r.outages) {
+    if (s.epochs == 0) continue;
+    ++r.scored;
+    end_sum += s.end_error_m;
+    r.end_worst_m = std::max(r.end_worst_m, s.end_error_m);
+    r.max_worst_m = std::max(r.max_worst_m, s.max_error_m);
+    squares += s.sum_squares;
+    r.epochs += s.epochs;
+    inside += s.inside_3_sigma;
+  }
+  if (r.scored > 0) {
+    r.end_mean_m = end_sum / static_cast<double>(r.scored);
+    r.rms_m = std::sqrt(squares / static_cast<double>(r.epochs));
+    r.inside = static_cast<double>(inside) / static_cast<double>(r.epochs);
+  }
+  if (r.available > 0)
+    r.available_rms_m = std::sqrt(available_sum / static_cast<double>(r.available));
+  return r;
+}
+
+/// The run's table (printed, and written to `table_file`) and its summary lines.
+std::string report(const std::string& title, const Scored& r, Judging judging,
+                   const std::vector<Outage>& outages, const std::filesystem::path& table_file,
+                   const std::string& outage_file) {
+  if (r.scored == 0) throw bus::ConfigError(outage_file + ": no fixed epoch falls in an outage");
+  std::ofstream table(table_file);
+  table << "outage,start_sow,end_sow,epochs,end_error_m,max_error_m,rms_m,inside_3sigma\n";
+  std::string text = title + ":\n";
+  text += "outage  start [s of week]  epochs  end error [m]  max error [m]  inside 3 sigma\n";
+  for (std::size_t k = 0; k < outages.size(); ++k) {
+    const OutageScore& s = r.outages[k];
+    if (s.epochs == 0) continue;
+    text += fmt::format("{:6}  {:17.3f}  {:6}  {:13.2f}  {:13.2f}  {:8}/{}\n", k + 1,
+                        outages[k].start_sow, s.epochs, s.end_error_m, s.max_error_m,
+                        s.inside_3_sigma, s.epochs);
+    table << fmt::format("{},{:.3f},{:.3f},{},{:.4f},{:.4f},{:.4f},{:.4f}\n", k + 1,
+                         outages[k].start_sow, outages[k].end_sow, s.epochs, s.end_error_m,
+                         s.max_error_m, std::sqrt(s.sum_squares / static_cast<double>(s.epochs)),
+                         static_cast<double>(s.inside_3_sigma) / static_cast<double>(s.epochs));
+  }
+  if (!table) throw bus::ConfigError("cannot write " + table_file.string());
+  text += fmt::format(
+      "outage end: mean {:.2f} m, worst {:.2f} m; largest inside an outage {:.2f} m; RMS over {} "
+      "outage epochs {:.2f} m; inside its own 3 sigma {:.1f} %\n"
+      "GNSS available: horizontal RMS against {} fixed epochs{} {:.3f} m\n",
+      r.end_mean_m, r.end_worst_m, r.max_worst_m, r.epochs, r.rms_m, 100.0 * r.inside, r.available,
+      judging == Judging::kAfterFusion ? ", each once fused," : "", r.available_rms_m);
+  return text;
+}
+
+std::string scoreLine(const std::string& run, const Scored& r) {
+  return fmt::format("{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.4f}\n", run, r.scored,
+                     r.end_mean_m, r.end_worst_m, r.max_worst_m, r.rms_m, r.inside, r.available,
+                     r.available_rms_m);
+}
+
 }  // namespace
 
 std::vector<Outage> readOutages(const std::filesystem::path& file) {
@@ -150,6 +268,7 @@ int runRealCarBenchmark(const RealCarOptions& o) {
   setup.withhold = [&](const navbus::GnssFix& f) {
     return outageOf(static_cast<std::int64_t>(f.time_gps_ns()), outages) >= 0;
   };
+  setup.smooth = o.smooth;
   const Eigen::Vector3d lever_b = setup.filter.engine.antenna_lever_arm_b_m;
   std::vector<AntennaPoint> points;
   std::ofstream sol(out_dir / "solution.csv");
@@ -160,77 +279,43 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     if (s.mode() == navbus::MODE_INITIALIZING || s.mode() == navbus::MODE_INERTIAL_LOST) return;
     const AntennaPoint p = antennaOf(s, lever_b);
     points.push_back(p);
-    fmt::format_to(fmt::appender(buffer), "{:.6f},{:.10f},{:.10f},{:.4f},{:.4f},{:.4f},{},{}\n",
-                   1e-9 * static_cast<double>(secondsOfWeekNs(p.time_ns)),
-                   p.position.latitude_rad / units::kDeg, p.position.longitude_rad / units::kDeg,
-                   p.position.height_m, p.sigma_h_m, p.sigma_v_m, static_cast<int>(s.mode()),
-                   s.covariance_valid() ? 1 : 0);
+    appendPoint(p, fmt::format("{},{}", static_cast<int>(s.mode()), s.covariance_valid() ? 1 : 0),
+                buffer);
   });
   sol.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
 
   // The reference: the fixed epochs of the same file, read as the import read them.
   const importers::PosLog reference = importers::readPosFile(*dataset.gnss_solutions);
-  std::vector<OutageScore> scores(outages.size());
-  double available_sum = 0.0;
-  std::size_t available = 0;
-  for (std::size_t i = 0; i < reference.fixes.size(); ++i) {
-    if (reference.quality[i] != kQualityFix) continue;
-    const navbus::GnssFix& f = reference.fixes[i];
-    const auto t = static_cast<std::int64_t>(f.time_gps_ns());
-    const earth::Geodetic truth{f.latitude_rad(), f.longitude_rad(), f.height_m()};
-    const int k = outageOf(t, outages);
-    if (k < 0) {
-      if (const auto e = judgeAfterFusion(points, t, truth)) {
-        available_sum += *e * *e;
-        ++available;
-      }
-      continue;
-    }
-    const auto judged = judge(points, t, truth);
-    if (!judged) continue;
-    OutageScore& s = scores[static_cast<std::size_t>(k)];
-    ++s.epochs;
-    s.end_error_m = judged->horizontal_m;  // the last one judged is the end
-    s.max_error_m = std::max(s.max_error_m, judged->horizontal_m);
-    s.sum_squares += judged->horizontal_m * judged->horizontal_m;
-    s.inside_3_sigma += judged->horizontal_m <= 3.0 * judged->sigma_h_m ? 1 : 0;
-  }
-
-  std::ofstream table(out_dir / "outages.csv");
-  table << "outage,start_sow,end_sow,epochs,end_error_m,max_error_m,rms_m,inside_3sigma\n";
   std::string text = fmt::format("{}{}{} fixes withheld in {} outages\n", imported.text,
                                  run.summary + "\n", run.fixes_withheld, outages.size());
-  text += "outage  start [s of week]  epochs  end error [m]  max error [m]  inside 3 sigma\n";
-  double end_sum = 0.0, end_worst = 0.0, all_squares = 0.0;
-  std::size_t scored = 0, all_epochs = 0, all_inside = 0;
-  for (std::size_t k = 0; k < outages.size(); ++k) {
-    const OutageScore& s = scores[k];
-    if (s.epochs == 0) continue;
-    ++scored;
-    end_sum += s.end_error_m;
-    end_worst = std::max(end_worst, s.end_error_m);
-    all_squares += s.sum_squares;
-    all_epochs += s.epochs;
-    all_inside += s.inside_3_sigma;
-    text += fmt::format("{:6}  {:17.3f}  {:6}  {:13.2f}  {:13.2f}  {:8}/{}\n", k + 1,
-                        outages[k].start_sow, s.epochs, s.end_error_m, s.max_error_m,
-                        s.inside_3_sigma, s.epochs);
-    table << fmt::format("{},{:.3f},{:.3f},{},{:.4f},{:.4f},{:.4f},{:.4f}\n", k + 1,
-                         outages[k].start_sow, outages[k].end_sow, s.epochs, s.end_error_m,
-                         s.max_error_m, std::sqrt(s.sum_squares / static_cast<double>(s.epochs)),
-                         static_cast<double>(s.inside_3_sigma) / static_cast<double>(s.epochs));
+  std::ofstream scores(out_dir / "scores.csv");
+  scores << "run,outages_scored,end_mean_m,end_worst_m,max_worst_m,rms_m,inside_3sigma,"
+            "available_epochs,available_rms_m\n";
+  const Scored causal = score(points, reference, outages, Judging::kAfterFusion);
+  text += report("the filter (causal)", causal, Judging::kAfterFusion, outages,
+                 out_dir / "outages.csv", o.outages);
+  scores << scoreLine("filter", causal);
+  std::string written = "solution.csv, outages.csv, scores.csv";
+  if (o.smooth) {
+    std::vector<AntennaPoint> smoothed;
+    smoothed.reserve(run.smoothed.size());
+    fmt::memory_buffer lines;
+    for (const core::SmoothedEpoch& e : run.smoothed) {
+      smoothed.push_back(antennaOf(e, lever_b));
+      appendPoint(smoothed.back(), e.smoothed ? "1" : "0", lines);
+    }
+    std::ofstream file(out_dir / "smoothed.csv");
+    file << "gpst_s,lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m,smoothed\n";
+    file.write(lines.data(), static_cast<std::streamsize>(lines.size()));
+    const Scored backward = score(smoothed, reference, outages, Judging::kInterpolated);
+    text += run.smoother_summary + "\n";
+    text += report("smoothed (--smooth)", backward, Judging::kInterpolated, outages,
+                   out_dir / "smoothed_outages.csv", o.outages);
+    scores << scoreLine("smoothed", backward);
+    written += ", smoothed.csv, smoothed_outages.csv";
   }
-  if (scored == 0) throw bus::ConfigError(o.outages + ": no fixed epoch falls in an outage");
-  text += fmt::format(
-      "outage end: mean {:.2f} m, worst {:.2f} m; RMS over {} outage epochs {:.2f} m; inside "
-      "the filter's 3 sigma {:.1f} %\nGNSS available: horizontal RMS against {} fixed epochs, each "
-      "once fused, "
-      "{:.3f} m\nwritten: {}/solution.csv, {}/outages.csv\n",
-      end_sum / static_cast<double>(scored), end_worst, all_epochs,
-      std::sqrt(all_squares / static_cast<double>(all_epochs)),
-      100.0 * static_cast<double>(all_inside) / static_cast<double>(all_epochs), available,
-      available > 0 ? std::sqrt(available_sum / static_cast<double>(available)) : 0.0, o.out_dir,
-      o.out_dir);
+  if (!sol || !scores) throw bus::ConfigError("cannot write into " + o.out_dir);
+  text += fmt::format("written into {}: {}\n", o.out_dir, written);
   std::fputs(text.c_str(), stdout);
   return 0;
 }

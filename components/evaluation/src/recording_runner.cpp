@@ -10,6 +10,9 @@
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/topics.hpp"
+#include "navbus/core/gnss/gps_broadcast_ephemeris.hpp"
+#include "navbus/core/math/rotation.hpp"
+#include "navbus/core/math/units.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/records/csv_messages.hpp"
@@ -102,7 +105,10 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
     on_diagnostics = [&](const navbus::FilterDiagnostics& d) { faults->onDiagnostics(d); };
     on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };
   }
-  nav_filter::FilterPipeline pipeline(setup.filter, health,
+  core::SmoothingLog smoothing_log;
+  nav_filter::FilterConfig filter_config = setup.filter;
+  if (setup.smooth) filter_config.engine.smoothing_log = &smoothing_log;
+  nav_filter::FilterPipeline pipeline(filter_config, health,
                                       {[&](const navbus::NavigationSolution& s) {
                                          ++result.solutions;
                                          if (hook) hook(s);
@@ -125,12 +131,51 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
   }
   pipeline.flush(events.back().time_ns);
   result.summary = pipeline.summary();
+  if (setup.smooth) {
+    std::uint64_t singular = 0;
+    result.smoothed = core::smoothFixedInterval(smoothing_log.records(), &singular);
+    const auto smoothed = std::count_if(result.smoothed.begin(), result.smoothed.end(),
+                                        [](const core::SmoothedEpoch& e) { return e.smoothed; });
+    result.smoother_summary = fmt::format(
+        "smoother: {} forward records ({} of passes abandoned by a rewind dropped), {} smoothed, "
+        "{} where the forward filter restarted or its predicted covariance was singular ({})",
+        result.smoothed.size(), smoothing_log.dropped(), smoothed,
+        result.smoothed.size() - static_cast<std::size_t>(smoothed), singular);
+  }
   if (faults) result.fault_summary = faults->summary();
   return result;
 }
 
+void writeSmoothedCsv(const std::filesystem::path& file,
+                      const std::vector<core::SmoothedEpoch>& epochs) {
+  std::ofstream out(file);
+  if (!out) throw bus::ConfigError("cannot write " + file.string());
+  out << "gpst_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,roll_deg,pitch_deg,"
+         "yaw_deg,sigma_n_m,sigma_e_m,sigma_d_m,smoothed\n";
+  fmt::memory_buffer buffer;
+  constexpr std::int64_t kWeekNs =
+      static_cast<std::int64_t>(core::gps::kSecondsPerWeek) * 1'000'000'000;
+  for (const core::SmoothedEpoch& e : epochs) {
+    const Eigen::Vector3d rpy_deg =
+        core::eulerFromDcm(e.state.q_b_to_n.toRotationMatrix()) / units::kDeg;
+    const Eigen::Vector3d& v = e.state.vel_ned_mps;
+    const auto sd = e.sigma.segment<3>(core::layout::kPos.index);
+    fmt::format_to(fmt::appender(buffer),
+                   "{:.6f},{:.10f},{:.10f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},"
+                   "{:.4f},{:.4f},{}\n",
+                   1e-9 * static_cast<double>(e.time_ns % kWeekNs),
+                   e.state.position.latitude_rad / units::kDeg,
+                   e.state.position.longitude_rad / units::kDeg, e.state.position.height_m, v[0],
+                   v[1], v[2], rpy_deg[0], rpy_deg[1], rpy_deg[2], sd[0], sd[1], sd[2],
+                   e.smoothed ? 1 : 0);
+  }
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  if (!out) throw bus::ConfigError("cannot write " + file.string());
+}
+
 int runRecordingCommand(const RecordingOptions& o) {
   RecordingSetup setup;
+  setup.smooth = o.smooth;
   setup.dir = o.recording;
   setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
   if (!o.fault_manager.empty())
@@ -156,6 +201,11 @@ int runRecordingCommand(const RecordingOptions& o) {
   std::printf("%s%s\n%s%s%zu solutions written to %s\n", r.inputs.c_str(), r.summary.c_str(),
               r.fault_summary.c_str(), r.fault_summary.empty() ? "" : "\n",
               static_cast<std::size_t>(r.solutions), path.c_str());
+  if (o.smooth) {
+    writeSmoothedCsv(o.out_dir + "/smoothed.csv", r.smoothed);
+    std::printf("%s\nsmoothed epochs written to %s/smoothed.csv\n", r.smoother_summary.c_str(),
+                o.out_dir.c_str());
+  }
   return sol ? 0 : bus::kExitConfigError;
 }
 

@@ -219,6 +219,7 @@ void FilterPipeline::flush(std::int64_t now_ns) {
     now_ns += config_.sequencer_max_wait_ns;
     pump(now_ns);
   }
+  engine_.closeSmoothingLog();  // post-processing: the last epoch's updates
 }
 
 void FilterPipeline::process(StreamId stream, std::int64_t time_ns, const FilterInput& input) {

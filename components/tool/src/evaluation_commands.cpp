@@ -32,6 +32,11 @@ class OfflineCommand final : public Subcommand {
                          "them; --start, --seed and --duration do not apply")
             ->check(CLI::ExistingDirectory);
     scenario->excludes(recording);
+    cli_->add_flag("--smooth", recording_.smooth,
+                   "with --recording: a fixed-interval (Rauch-Tung-Striebel) smoother runs "
+                   "backward over the forward filter's states and covariances; writes "
+                   "smoothed.csv (the IMU's position, velocity, attitude and smoothed sigmas)")
+        ->needs(recording);
     cli_->add_option("--filter", offline.filter, "navbus-filter YAML (config/)")
         ->required()
         ->check(CLI::ExistingFile);

@@ -57,9 +57,12 @@ class RealCarBenchmarkCommand final : public Subcommand {
         ->required()
         ->check(CLI::ExistingFile);
     cli_->add_option("-o,--out", o_.out_dir,
-                     "output directory: solution.csv (antenna, IMU rate), outages.csv, the "
-                     "imported recording")
+                     "output directory: solution.csv (antenna, IMU rate), outages.csv, "
+                     "scores.csv, the imported recording")
         ->required();
+    cli_->add_flag("--smooth", o_.smooth,
+                   "also score the fixed-interval (Rauch-Tung-Striebel) smoother over the same "
+                   "forward run: smoothed.csv, smoothed_outages.csv");
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {

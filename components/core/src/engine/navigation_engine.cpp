@@ -100,6 +100,10 @@ bool NavigationEngine::aligning() const {
   return config_.start == StartSource::kAligned && !filter_->initialized();
 }
 
+void NavigationEngine::closeSmoothingLog() {
+  filter_->closeSmoothingRecord();
+}
+
 void NavigationEngine::reset() {
   *filter_ = IntegratedFilter();
   *aligner_ = InitialAligner(config_.alignment);
@@ -226,6 +230,7 @@ void NavigationEngine::crossGap(std::int64_t start_ns) {
 
 void NavigationEngine::start(const NavState& state, double clock_bias_m, double clock_drift_mps,
                              const StateMatrix& initial_covariance) {
+  filter_->setSmoothingLog(config_.smoothing_log);
   filter_->initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
                       config_.fusion, initial_covariance);
   filter_->keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled);

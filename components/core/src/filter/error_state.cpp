@@ -2,9 +2,20 @@
 
 #include <cassert>
 
+#include "navbus/core/math/earth.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/sparse_rows.hpp"
 
 namespace navbus::core {
+
+NavState correctedState(const NavState& s, const StateVector& error) {
+  NavState out = s;
+  out.position = earth::offsetNed(s.position, -error.segment<3>(layout::kPos.index));
+  out.vel_ned_mps -= error.segment<3>(layout::kVel.index);
+  out.q_b_to_n = (quaternionFromRotationVector(error.segment<3>(layout::kAtt.index)) * s.q_b_to_n)
+                     .normalized();
+  return out;
+}
 
 StateMask maskOf(std::initializer_list<StateBlock> blocks) {
   StateMask m;

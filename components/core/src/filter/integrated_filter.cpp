@@ -65,6 +65,9 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   windows_[2].configure(tuning.adaptive_window,
                         Eigen::Vector3d::Constant(tuning.adaptive_floor_attitude_rad));
   phi_since_update_.setIdentity();
+  const std::int64_t last_record_ns = smoothing_.last_record_ns;
+  smoothing_ = SmoothingPending{};  // a new run: nothing smoothed across its start
+  smoothing_.last_record_ns = last_record_ns;
   structure_ = FusionStructure::kCentralized;
   setStructure(structure);
 }
@@ -85,6 +88,7 @@ void IntegratedFilter::setStructure(FusionStructure s) {
 }
 
 void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
+  if (smoothing_log_ != nullptr) recordForSmoothing();
   ImuIncrement inc = raw;
   inc.delta_vel_b_mps -= accel_bias_ * inc.interval_s;
   inc.delta_angle_b_rad -= gyro_bias_ * inc.interval_s;
@@ -95,7 +99,10 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
       transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, at_state), dt);
   ins_.propagate(inc, at_state);
   clock_bias_m_ += clock_drift_mps_ * dt;
-  if (suspend_filter) return;
+  if (suspend_filter) {
+    smoothing_.continues = false;  // the covariance stood still: nothing to smooth across
+    return;
+  }
   // Discrete process noise: white specific force / rate noise into velocity / attitude
   // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3),
   // bias random walks (a failed axis's own walk replaces its bias's).
@@ -133,9 +140,50 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   }
   // The master (federated) covariance is propagated too, so that it is valid between updates.
   central_.predict(Phi, q);
-  if (keep_transition_)
-    phi_since_update_ =
-        SparseRows<layout::kSize>(Phi, transitionPattern()).times(phi_since_update_);
+  if (keep_transition_ || smoothing_log_ != nullptr) {
+    const SparseRows<layout::kSize> sparse(Phi, transitionPattern());
+    if (keep_transition_) phi_since_update_ = sparse.times(phi_since_update_);
+    if (smoothing_log_ != nullptr) smoothing_.transition = sparse.times(smoothing_.transition);
+  }
+  if (smoothing_log_ != nullptr) {
+    // P(k|k-1) as the propagation made it: the stage logic's resets and inflations that may
+    // follow before the updates are the forward filter's own device; the smoother's gain
+    // needs the covariance that Phi and Q give.
+    smoothing_.predicted = central_.P();
+    smoothing_.predicted_taken = true;
+  }
+}
+
+void IntegratedFilter::recordForSmoothing() {
+  const std::int64_t now_ns = ins_.state().time_ns;
+  if (smoothing_.updated || smoothing_.starts_run ||
+      now_ns - smoothing_.last_record_ns >= smoothing_log_->interval())
+    emitSmoothingRecord();
+}
+
+void IntegratedFilter::closeSmoothingRecord() {
+  if (smoothing_log_ != nullptr && initialized() &&
+      (smoothing_.updated || ins_.state().time_ns > smoothing_.last_record_ns))
+    emitSmoothingRecord();
+}
+
+void IntegratedFilter::emitSmoothingRecord() {
+  SmoothingRecord r;
+  r.time_ns = ins_.state().time_ns;
+  r.state = ins_.state();
+  r.accel_bias_mps2 = accel_bias_;
+  r.gyro_bias_radps = gyro_bias_;
+  r.covariance = central_.P();
+  r.predicted = smoothing_.predicted_taken ? smoothing_.predicted : central_.P();
+  r.transition = smoothing_.transition;
+  r.correction = smoothing_.correction;
+  r.active = central_.active();
+  r.continues = smoothing_.continues;
+  smoothing_log_->add(r, smoothing_.last_record_ns);
+  smoothing_ = SmoothingPending{};
+  smoothing_.continues = true;
+  smoothing_.starts_run = false;
+  smoothing_.last_record_ns = r.time_ns;
 }
 
 ErrorState& IntegratedFilter::target(AidingKind kind) {
@@ -265,13 +313,12 @@ void IntegratedFilter::turnAttitudeCovariance(double dpsi_rad) {
 }
 
 void IntegratedFilter::feedback(const StateVector& dx) {
+  if (smoothing_log_ != nullptr) {
+    smoothing_.correction += dx;
+    smoothing_.updated = true;
+  }
   // Errors are estimate minus truth: subtract them from the estimate, then the error state is 0.
-  NavState s = ins_.state();
-  s.position = earth::offsetNed(s.position, -dx.segment<3>(kPos.index));
-  s.vel_ned_mps -= dx.segment<3>(kVel.index);
-  // C_est = (I - [phi x]) C_true  =>  C_true = (I + [phi x]) C_est.
-  s.q_b_to_n = (quaternionFromRotationVector(dx.segment<3>(kAtt.index)) * s.q_b_to_n).normalized();
-  ins_.correct(s);
+  ins_.correct(correctedState(ins_.state(), dx));
   accel_bias_ -= dx.segment<3>(kAccelBias.index);
   gyro_bias_ -= dx.segment<3>(kGyroBias.index);
   star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);
@@ -382,6 +429,7 @@ void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
 }
 
 void IntegratedFilter::resetNavigation(const GnssFixMeasurement& fix) {
+  smoothing_.continues = false;  // what the filter knew of position and velocity is dropped
   NavState s = ins_.state();
   s.position = fix.position;
   s.vel_ned_mps = fix.vel_ned_mps;

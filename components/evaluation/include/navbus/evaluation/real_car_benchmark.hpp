@@ -3,7 +3,8 @@
 // positions it gives are scored against the withheld fixed (RTK) epochs: the horizontal error
 // at the end of each outage, the largest inside it, the RMS over all outage epochs and the share
 // of outage epochs inside the filter's own 3-sigma; and, with GNSS available, the horizontal RMS
-// against the fixed epochs it fused.
+// against the fixed epochs it fused. With smoothing, the fixed-interval smoother's positions are
+// scored on the same outages.
 #pragma once
 
 #include <filesystem>
@@ -27,7 +28,8 @@ struct RealCarOptions {
   std::string dataset;  ///< data set YAML (config/datasets/)
   std::string filter;   ///< navbus-filter YAML
   std::string outages;  ///< outage list
-  std::string out_dir;  ///< solution.csv, outages.csv, the recording
+  std::string out_dir;  ///< solution.csv, outages.csv, scores.csv, the recording
+  bool smooth{false};   ///< also the smoothed run: smoothed.csv, smoothed_outages.csv
 };
 
 int runRealCarBenchmark(const RealCarOptions& o);

@@ -14,6 +14,7 @@
 #include <navbus_idl/Fault.h>
 #include <navbus_idl/Navigation.h>
 
+#include "navbus/core/filter/rts_smoother.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 
@@ -25,6 +26,9 @@ struct RecordingSetup {
   std::optional<fault_manager::FaultManagerConfig> fault_manager;
   /// GNSS fixes for which this is true are left out (GNSS outages of a benchmark); counted.
   std::function<bool(const navbus::GnssFix&)> withhold{};
+  /// Post-processing: a fixed-interval (RTS) smoother runs backward over the forward
+  /// filter's records (core/filter/rts_smoother.hpp).
+  bool smooth{false};
 };
 
 struct RecordingResult {
@@ -35,6 +39,9 @@ struct RecordingResult {
   std::string fault_summary;
   std::vector<navbus::FaultDecision> decisions;
   std::vector<navbus::FilterCommand> commands;
+  /// With RecordingSetup::smooth: one epoch per forward record, and what the smoother says.
+  std::vector<core::SmoothedEpoch> smoothed;
+  std::string smoother_summary;
 };
 
 using RecordedSolutionHook = std::function<void(const navbus::NavigationSolution&)>;
@@ -48,7 +55,13 @@ struct RecordingOptions {
   std::string filter;
   std::string fault_manager;
   std::string out_dir;
+  bool smooth{false};  ///< also write smoothed.csv
 };
+
+/// The smoothed epochs as CSV (smoothed.csv): GPS time [s of week], the IMU's position, velocity
+/// and attitude, their smoothed 1-sigma, and whether the epoch is smoothed.
+void writeSmoothedCsv(const std::filesystem::path& file,
+                      const std::vector<core::SmoothedEpoch>& epochs);
 
 /// `navbus offline --recording`: writes solution.csv (and decisions.csv, commands.csv with a
 /// fault manager) into out_dir; returns an exit code.

@@ -127,7 +127,8 @@ class FilterPipeline {
   /// filter goes on without it. Without this information (offline) a declaration acts at once.
   void setWritersAlive(bus::StreamKind kind, bool alive, std::int64_t now_ns);
   /// End of input (offline): releases everything still held, as the bounded wait would on
-  /// the bus once every stream has fallen silent.
+  /// the bus once every stream has fallen silent, and closes the engine's smoothing log (when
+  /// its configuration has one).
   void flush(std::int64_t now_ns);
   /// While inertial data is lost, the last solution is republished (held, not propagated).
   void publishHeldSolution();

@@ -29,6 +29,7 @@ namespace navbus::core {
 
 // The engine's parts: their headers are not part of its interface.
 class IntegratedFilter;
+class SmoothingLog;
 class InitialAligner;
 class GlrProtectionLevel;
 class StationarityDetector;
@@ -101,6 +102,10 @@ struct EngineConfig {
   ConsistencyConfig consistency;
   /// The GNSS antenna's offset from the IMU [m, body axes]: fixes are of the antenna.
   Eigen::Vector3d antenna_lever_arm_b_m{Eigen::Vector3d::Zero()};
+  /// Post-processing: where the filter records what the fixed-interval smoother needs
+  /// (rts_smoother.hpp); nullptr (the default, and always on the bus): nothing recorded.
+  /// Not owned; must outlive every engine made from this configuration.
+  SmoothingLog* smoothing_log{nullptr};
 };
 
 struct EngineCounters {
@@ -164,6 +169,8 @@ class NavigationEngine {
   bool selectFusion(FusionStructure s);
   void markInertialLost();
   void reset();
+  /// The end of a post-processing run: records the epoch still pending in the smoothing log.
+  void closeSmoothingLog();
 
   bool initialized() const;
   const NavState& state() const;

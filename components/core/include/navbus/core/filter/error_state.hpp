@@ -11,11 +11,16 @@
 
 #include "navbus/core/filter/aiding_measurements.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
+#include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/math/kalman_update.hpp"
 
 namespace navbus::core {
 
 using StateVector = Eigen::Matrix<double, layout::kSize, 1>;
+
+/// The navigation state an error estimate describes, corrected: errors are estimate minus
+/// truth, so position, velocity and attitude (C_true = (I + [phi x]) C_est) lose them.
+NavState correctedState(const NavState& s, const StateVector& error);
 
 /// The mask with the given blocks active.
 StateMask maskOf(std::initializer_list<StateBlock> blocks);

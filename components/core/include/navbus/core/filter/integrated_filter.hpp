@@ -23,6 +23,7 @@
 #include "navbus/core/filter/error_state.hpp"
 #include "navbus/core/filter/filter_tuning.hpp"
 #include "navbus/core/filter/innovation_window.hpp"
+#include "navbus/core/filter/rts_smoother.hpp"
 #include "navbus/core/gnss/gnss_measurement.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/math/kalman_update.hpp"
@@ -136,6 +137,11 @@ class IntegratedFilter {
   void keepTransitionSinceUpdate(bool on) { keep_transition_ = on; }
   const EpochDiagnostics& lastEpoch() const { return last_epoch_; }
   void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
+  /// Records what a fixed-interval smoother needs into `log` (nullptr: nothing recorded, the
+  /// default), from the next increment on (rts_smoother.hpp). Not owned.
+  void setSmoothingLog(SmoothingLog* log) { smoothing_log_ = log; }
+  /// Records the epoch still pending (the updates since the last increment): the end of a run.
+  void closeSmoothingRecord();
   bool initialized() const { return ins_.initialized(); }
   const FilterTuning& tuning() const { return tuning_; }
 
@@ -150,6 +156,10 @@ class IntegratedFilter {
   /// feedback): turned by R_D(dpsi) with the frame the INS computes.
   void turnAttitudeCovariance(double dpsi_rad);
   InnovationWindow<3>* window(AidingKind kind);
+  /// Smoothing log: the record of the epoch reached (at an increment's start, when the epoch
+  /// had updates or the log's interval has passed).
+  void recordForSmoothing();
+  void emitSmoothingRecord();
 
   FilterTuning tuning_;
   std::array<bool, 6> axis_failed_{};  ///< accelerometers x y z, gyros x y z
@@ -169,6 +179,19 @@ class IntegratedFilter {
   Eigen::Vector3d star_tracker_bias_{Eigen::Vector3d::Zero()};
   double clock_bias_m_{0.0};
   double clock_drift_mps_{0.0};
+  /// What the next smoothing record gathers since the last one.
+  struct SmoothingPending {
+    StateMatrix transition{StateMatrix::Identity()};
+    StateMatrix predicted{StateMatrix::Zero()};
+    StateVector correction{StateVector::Zero()};
+    bool predicted_taken{false};
+    bool updated{false};
+    bool continues{false};  ///< false: no smoothing across the previous record
+    bool starts_run{true};  ///< the first record of a run is due
+    std::int64_t last_record_ns{-1};
+  };
+  SmoothingLog* smoothing_log_{nullptr};
+  SmoothingPending smoothing_;
 };
 
 template <int M>
