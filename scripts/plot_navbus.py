@@ -24,6 +24,10 @@
       solution) -> latency.png
   With --scenario, times are seconds from the scenario's start (timing.start); without, from
   the first row of the file.
+  plot_navbus.py realcar BENCH_DIR -o OUT_DIR [--name NAME]
+      from `navbus benchmark real-car ... -o BENCH_DIR [--smooth]`: the antenna's trajectory
+      with the GNSS outages marked, and per outage the horizontal error against the filter's
+      3-sigma (and the smoother's, with --smooth) -> NAME.png (default real_car)
   plot_navbus.py demo SCENARIO DEMO_DIR -o OUT_DIR
       the main demo's figures (errors, with/without the fault manager, GLR statistic) from
       scripts/demo.sh's output directory
@@ -286,6 +290,80 @@ def latency(raw_csv, e2e_csv, out_dir):
     return _save(fig, out_dir, "latency.png")
 
 
+def _local_en(lat_deg, lon_deg, lat0_deg, lon0_deg):
+    """East and north [m] from a reference point (a local plane, metres-scale accuracy)."""
+    radius = 6378137.0
+    east = np.radians(lon_deg - lon0_deg) * radius * math.cos(math.radians(lat0_deg))
+    north = np.radians(lat_deg - lat0_deg) * radius
+    return east, north
+
+
+def realcar(bench_dir, out_dir, name="real_car"):
+    sol = read_csv(os.path.join(bench_dir, "solution.csv"))
+    outages = read_csv(os.path.join(bench_dir, "outages.csv"))
+    epochs = read_csv(os.path.join(bench_dir, "errors.csv"))
+    t = np.array([float(r["gpst_s"]) for r in sol])
+    lat = np.array([float(r["lat_deg"]) for r in sol])
+    lon = np.array([float(r["lon_deg"]) for r in sol])
+    east, north = _local_en(lat, lon, lat[0], lon[0])
+    runs = sorted({r["run"] for r in epochs}, key=lambda x: x != "filter")
+    n = len(outages)
+    cols = 5
+    rows = (n + cols - 1) // cols
+    fig = plt.figure(figsize=(16, 4.2 + 2.4 * rows))
+    grid = fig.add_gridspec(1 + rows, cols, height_ratios=[2.2] + [1] * rows)
+    ax = fig.add_subplot(grid[0, :3])
+    ax.plot(east, north, color="0.6", lw=0.8, label="filter (causal), antenna")
+    for o in outages:
+        inside = (t >= float(o["start_sow"])) & (t < float(o["end_sow"]))
+        ax.plot(east[inside], north[inside], color="tab:red", lw=2.0)
+        if inside.any():
+            ax.annotate(o["outage"], (east[inside][0], north[inside][0]), fontsize=8)
+    ax.plot([], [], color="tab:red", lw=2.0, label="GNSS withheld (outages, numbered)")
+    ax.set_xlabel("east [m]")
+    ax.set_ylabel("north [m]")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(f"{name}: trajectory and GNSS outages")
+    colours = {"filter": "tab:blue", "smoothed": "tab:green"}
+    bars = fig.add_subplot(grid[0, 3:])
+    labels = [o["outage"] for o in outages]
+    x = np.arange(len(labels))
+    width = 0.8 / len(runs)
+    for j, run in enumerate(runs):
+        table = outages if run == "filter" else read_csv(
+            os.path.join(bench_dir, f"{run}_outages.csv"))
+        bars.bar(x + j * width, [float(o["end_error_m"]) for o in table], width,
+                 color=colours.get(run, "k"), label=f"{run}: at the end")
+        bars.scatter(x + j * width, [float(o["max_error_m"]) for o in table], marker="_", s=80,
+                     color="k")
+    bars.scatter([], [], marker="_", color="k", label="largest inside")
+    bars.set_xticks(x + 0.4 - width / 2, labels)
+    bars.set_xlabel("outage")
+    bars.set_ylabel("horizontal error [m]")
+    bars.legend(fontsize=8)
+    bars.set_title("error per outage")
+    for i, o in enumerate(outages):
+        a = fig.add_subplot(grid[1 + i // cols, i % cols])
+        start = float(o["start_sow"])
+        for run in runs:
+            sel = [r for r in epochs if r["run"] == run and r["outage"] == o["outage"]]
+            ts = np.array([float(r["gpst_s"]) - start for r in sel])
+            err = np.array([float(r["error_h_m"]) for r in sel])
+            sig = np.array([float(r["sigma_h_m"]) for r in sel])
+            c = colours.get(run, "k")
+            a.plot(ts, err, color=c, lw=1.2, label=f"{run}: error")
+            a.plot(ts, 3 * sig, color=c, lw=0.9, ls="--", label=f"{run}: 3 sigma")
+        a.set_title(f"outage {o['outage']}", fontsize=9)
+        a.set_xlabel("s into the outage", fontsize=8)
+        if i % cols == 0:
+            a.set_ylabel("horizontal [m]", fontsize=8)
+        a.tick_params(labelsize=7)
+        if i == 0:
+            a.legend(fontsize=6)
+    return _save(fig, out_dir, f"{name}.png")
+
+
 def demo(scenario_path, demo_dir, out_dir):
     start_ns = int(load_scenario(scenario_path)["timing"]["start"])
     paths = [errors(os.path.join(demo_dir, "offline"), out_dir, start_ns,
@@ -324,6 +402,10 @@ def main():
     a.add_argument("--raw", help="navbus latency ping --csv file")
     a.add_argument("--e2e", help="navbus latency imu --csv file")
     a.add_argument("-o", "--out", required=True)
+    a = sub.add_parser("realcar")
+    a.add_argument("bench_dir")
+    a.add_argument("--name", default="real_car")
+    a.add_argument("-o", "--out", required=True)
     a = sub.add_parser("demo")
     a.add_argument("scenario")
     a.add_argument("demo_dir")
@@ -345,6 +427,8 @@ def main():
         paths = montecarlo(args.csv_dir, args.out)
     elif args.cmd == "latency":
         paths = [latency(args.raw, args.e2e, args.out)]
+    elif args.cmd == "realcar":
+        paths = [realcar(args.bench_dir, args.out, args.name)]
     else:
         paths = demo(args.scenario, args.demo_dir, args.out)
     for path in paths:

@@ -23,14 +23,19 @@ grep -q ',1$' "$work/with/glr.csv" || { echo "glr.csv: no detected epoch"; exit 
 detected=$(awk -F, 'NR > 1 && $4 == 1' "$work/mc/faults.csv" | wc -l)
 echo "montecarlo faults.csv: $detected of 4 runs detected"
 [ "$detected" -eq 4 ] || { cat "$work/mc.log"; exit 1; }
+"$navbus" benchmark real-car "$src/config/datasets/drive_0708.yaml" \
+  --filter "$src/config/filter_drive_0708.yaml" \
+  --outages "$src/config/datasets/drive_0708_outages.txt" --smooth -o "$work/real" \
+  > "$work/real.log" 2>&1 || { cat "$work/real.log"; exit 1; }
 py=/usr/bin/python3
+$py "$src/scripts/plot_navbus.py" realcar "$work/real" --name drive_0708 -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" errors "$work/with" -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" compare "$work/with" "$work/without" -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" spectrum "$work/raw/imu_raw.csv" --before 40 --after 40.2 \
   --axis x -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" glr "$work/with" -o "$work/fig" --scenario "$scenario"
 $py "$src/scripts/plot_navbus.py" montecarlo "$work/mc" -o "$work/fig"
-for f in errors with_without_fault_manager spectrum_x glr nees detection_delay; do
+for f in errors with_without_fault_manager spectrum_x glr nees detection_delay drive_0708; do
   size=$(stat -c %s "$work/fig/$f.png" 2>/dev/null || echo 0)
   echo "figure $f.png: $size bytes"
   [ "$size" -gt 20000 ] || { echo "figure $f.png missing or trivial"; exit 1; }

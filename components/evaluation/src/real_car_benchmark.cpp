@@ -111,6 +111,9 @@ struct Scored {
   std::size_t epochs{0};
   std::size_t available{0};
   double available_rms_m{0.0};
+  /// Every judged epoch (errors.csv): run, GPS s of week, outage (0: GNSS available), error
+  /// and 1-sigma [m].
+  fmt::memory_buffer epoch_lines;
 };
 
 AntennaPoint antennaOf(const core::SmoothedEpoch& e, const Eigen::Vector3d& lever_b) {
@@ -130,8 +133,9 @@ void appendPoint(const AntennaPoint& p, const std::string& tail, fmt::memory_buf
 /// smoothed run between its epochs.
 enum class Judging { kAfterFusion, kInterpolated };
 
-Scored score(const std::vector<AntennaPoint>& points, const importers::PosLog& reference,
-             const std::vector<Outage>& outages, Judging judging) {
+Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
+             const importers::PosLog& reference, const std::vector<Outage>& outages,
+             Judging judging) {
   Scored r;
   r.outages.resize(outages.size());
   double available_sum = 0.0;
@@ -151,11 +155,16 @@ Scored score(const std::vector<AntennaPoint>& points, const importers::PosLog& r
       if (e) {
         available_sum += *e * *e;
         ++r.available;
+        fmt::format_to(fmt::appender(r.epoch_lines), "{},{:.3f},0,{:.4f},\n", run,
+                       1e-9 * static_cast<double>(secondsOfWeekNs(t)), *e);
       }
       continue;
     }
     const auto judged = judge(points, t, truth);
     if (!judged) continue;
+    fmt::format_to(fmt::appender(r.epoch_lines), "{},{:.3f},{},{:.4f},{:.4f}\n", run,
+                   1e-9 * static_cast<double>(secondsOfWeekNs(t)), k + 1, judged->horizontal_m,
+                   judged->sigma_h_m);
     OutageScore& s = r.outages[static_cast<std::size_t>(k)];
     ++s.epochs;
     s.end_error_m = judged->horizontal_m;  // the last one judged is the end
@@ -291,11 +300,14 @@ int runRealCarBenchmark(const RealCarOptions& o) {
   std::ofstream scores(out_dir / "scores.csv");
   scores << "run,outages_scored,end_mean_m,end_worst_m,max_worst_m,rms_m,inside_3sigma,"
             "available_epochs,available_rms_m\n";
-  const Scored causal = score(points, reference, outages, Judging::kAfterFusion);
+  const Scored causal = score("filter", points, reference, outages, Judging::kAfterFusion);
   text += report("the filter (causal)", causal, Judging::kAfterFusion, outages,
                  out_dir / "outages.csv", o.outages);
   scores << scoreLine("filter", causal);
-  std::string written = "solution.csv, outages.csv, scores.csv";
+  std::ofstream epochs(out_dir / "errors.csv");
+  epochs << "run,gpst_s,outage,error_h_m,sigma_h_m\n";
+  epochs.write(causal.epoch_lines.data(), static_cast<std::streamsize>(causal.epoch_lines.size()));
+  std::string written = "solution.csv, outages.csv, scores.csv, errors.csv";
   if (o.smooth) {
     std::vector<AntennaPoint> smoothed;
     smoothed.reserve(run.smoothed.size());
@@ -307,14 +319,16 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     std::ofstream file(out_dir / "smoothed.csv");
     file << "gpst_s,lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m,smoothed\n";
     file.write(lines.data(), static_cast<std::streamsize>(lines.size()));
-    const Scored backward = score(smoothed, reference, outages, Judging::kInterpolated);
+    const Scored backward = score("smoothed", smoothed, reference, outages, Judging::kInterpolated);
     text += run.smoother_summary + "\n";
     text += report("smoothed (--smooth)", backward, Judging::kInterpolated, outages,
                    out_dir / "smoothed_outages.csv", o.outages);
     scores << scoreLine("smoothed", backward);
+    epochs.write(backward.epoch_lines.data(),
+                 static_cast<std::streamsize>(backward.epoch_lines.size()));
     written += ", smoothed.csv, smoothed_outages.csv";
   }
-  if (!sol || !scores) throw bus::ConfigError("cannot write into " + o.out_dir);
+  if (!sol || !scores || !epochs) throw bus::ConfigError("cannot write into " + o.out_dir);
   text += fmt::format("written into {}: {}\n", o.out_dir, written);
   std::fputs(text.c_str(), stdout);
   return 0;
