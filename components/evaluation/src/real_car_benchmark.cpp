@@ -83,7 +83,7 @@ std::optional<Judged> judge(const std::vector<AntennaPoint>& points, std::int64_
 /// solution at or after t (the fix is fused at the increment that reaches its time), brought
 /// back to t along its own velocity. Interpolating with the solution before t would score the
 /// prediction the fix corrects (after an outage: the outage's end error, once more).
-std::optional<double> judgeAfterFusion(const std::vector<AntennaPoint>& points, std::int64_t t,
+std::optional<Judged> judgeAfterFusion(const std::vector<AntennaPoint>& points, std::int64_t t,
                                        const earth::Geodetic& reference) {
   const auto at =
       std::lower_bound(points.begin(), points.end(), t,
@@ -92,7 +92,22 @@ std::optional<double> judgeAfterFusion(const std::vector<AntennaPoint>& points, 
   const double back_s = 1e-9 * static_cast<double>(at->time_ns - t);
   const Eigen::Vector3d e =
       earth::differenceNed(at->position, reference) - at->vel_ned_mps * back_s;
-  return e.head<2>().norm();
+  return Judged{e.head<2>().norm(), at->sigma_h_m};
+}
+
+/// A solution of its own epochs (single point positioning): the one nearest t, within 20 ms.
+std::optional<Judged> judgeNearest(const std::vector<AntennaPoint>& points, std::int64_t t,
+                                   const earth::Geodetic& reference) {
+  constexpr std::int64_t kToleranceNs = 20'000'000;
+  const auto after =
+      std::lower_bound(points.begin(), points.end(), t,
+                       [](const AntennaPoint& p, std::int64_t v) { return p.time_ns < v; });
+  const AntennaPoint* best = nullptr;
+  if (after != points.end()) best = &*after;
+  if (after != points.begin() && (best == nullptr || t - (after - 1)->time_ns < best->time_ns - t))
+    best = &*(after - 1);
+  if (best == nullptr || std::llabs(best->time_ns - t) > kToleranceNs) return std::nullopt;
+  return Judged{earth::differenceNed(best->position, reference).head<2>().norm(), best->sigma_h_m};
 }
 
 struct OutageScore {
@@ -111,6 +126,7 @@ struct Scored {
   std::size_t epochs{0};
   std::size_t available{0};
   double available_rms_m{0.0};
+  double available_inside{0.0};  ///< share of GNSS-available epochs inside 3 sigma_h
   /// Every judged epoch (errors.csv): run, GPS s of week, outage (0: GNSS available), error
   /// and 1-sigma [m].
   fmt::memory_buffer epoch_lines;
@@ -130,8 +146,8 @@ void appendPoint(const AntennaPoint& p, const std::string& tail, fmt::memory_buf
 }
 
 /// How a GNSS-available epoch is judged: a causal filter once it fused the epoch's fix, a
-/// smoothed run between its epochs.
-enum class Judging { kAfterFusion, kInterpolated };
+/// smoothed run between its epochs, single point positioning at its own epoch.
+enum class Judging { kAfterFusion, kInterpolated, kNearest };
 
 Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
              const importers::PosLog& reference, const std::vector<Outage>& outages,
@@ -139,6 +155,7 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
   Scored r;
   r.outages.resize(outages.size());
   double available_sum = 0.0;
+  std::size_t available_inside = 0;
   for (std::size_t i = 0; i < reference.fixes.size(); ++i) {
     if (reference.quality[i] != kQualityFix) continue;
     const navbus::GnssFix& f = reference.fixes[i];
@@ -146,17 +163,21 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
     const earth::Geodetic truth{f.latitude_rad(), f.longitude_rad(), f.height_m()};
     const int k = outageOf(t, outages);
     if (k < 0) {
-      std::optional<double> e;
+      std::optional<Judged> e;
       if (judging == Judging::kAfterFusion) {
         e = judgeAfterFusion(points, t, truth);
-      } else if (const auto j = judge(points, t, truth)) {
-        e = j->horizontal_m;
+      } else if (judging == Judging::kNearest) {
+        e = judgeNearest(points, t, truth);
+      } else {
+        e = judge(points, t, truth);
       }
       if (e) {
-        available_sum += *e * *e;
+        available_sum += e->horizontal_m * e->horizontal_m;
         ++r.available;
-        fmt::format_to(fmt::appender(r.epoch_lines), "{},{:.3f},0,{:.4f},\n", run,
-                       1e-9 * static_cast<double>(secondsOfWeekNs(t)), *e);
+        available_inside += e->horizontal_m <= 3.0 * e->sigma_h_m ? 1 : 0;
+        fmt::format_to(fmt::appender(r.epoch_lines), "{},{:.3f},0,{:.4f},{:.4f}\n", run,
+                       1e-9 * static_cast<double>(secondsOfWeekNs(t)), e->horizontal_m,
+                       e->sigma_h_m);
       }
       continue;
     }
@@ -189,8 +210,10 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
     r.rms_m = std::sqrt(squares / static_cast<double>(r.epochs));
     r.inside = static_cast<double>(inside) / static_cast<double>(r.epochs);
   }
-  if (r.available > 0)
+  if (r.available > 0) {
     r.available_rms_m = std::sqrt(available_sum / static_cast<double>(r.available));
+    r.available_inside = static_cast<double>(available_inside) / static_cast<double>(r.available);
+  }
   return r;
 }
 
@@ -198,6 +221,12 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
 std::string report(const std::string& title, const Scored& r, Judging judging,
                    const std::vector<Outage>& outages, const std::filesystem::path& table_file,
                    const std::string& outage_file) {
+  const std::string available = fmt::format(
+      "GNSS available: horizontal RMS against {} fixed epochs{} {:.3f} m, inside its own 3 sigma "
+      "{:.1f} %\n",
+      r.available, judging == Judging::kAfterFusion ? ", each once fused," : "", r.available_rms_m,
+      100.0 * r.available_inside);
+  if (outages.empty()) return title + ":\n" + available;
   if (r.scored == 0) throw bus::ConfigError(outage_file + ": no fixed epoch falls in an outage");
   std::ofstream table(table_file);
   table << "outage,start_sow,end_sow,epochs,end_error_m,max_error_m,rms_m,inside_3sigma\n";
@@ -217,11 +246,9 @@ std::string report(const std::string& title, const Scored& r, Judging judging,
   if (!table) throw bus::ConfigError("cannot write " + table_file.string());
   text += fmt::format(
       "outage end: mean {:.2f} m, worst {:.2f} m; largest inside an outage {:.2f} m; RMS over {} "
-      "outage epochs {:.2f} m; inside its own 3 sigma {:.1f} %\n"
-      "GNSS available: horizontal RMS against {} fixed epochs{} {:.3f} m\n",
-      r.end_mean_m, r.end_worst_m, r.max_worst_m, r.epochs, r.rms_m, 100.0 * r.inside, r.available,
-      judging == Judging::kAfterFusion ? ", each once fused," : "", r.available_rms_m);
-  return text;
+      "outage epochs {:.2f} m; inside its own 3 sigma {:.1f} %\n",
+      r.end_mean_m, r.end_worst_m, r.max_worst_m, r.epochs, r.rms_m, 100.0 * r.inside);
+  return text + available;
 }
 
 std::string scoreLine(const std::string& run, const Scored& r) {
@@ -269,7 +296,8 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     throw bus::ConfigError(o.dataset + ": the benchmark needs imu and gnss_solutions");
   const std::filesystem::path out_dir(o.out_dir);
   const importers::ImportReport imported = importers::importDataset(dataset, out_dir / "recording");
-  const std::vector<Outage> outages = readOutages(o.outages);
+  const std::vector<Outage> outages =
+      o.outages.empty() ? std::vector<Outage>{} : readOutages(o.outages);
 
   RecordingSetup setup;
   setup.dir = out_dir / "recording";
@@ -295,8 +323,8 @@ int runRealCarBenchmark(const RealCarOptions& o) {
 
   // The reference: the fixed epochs of the same file, read as the import read them.
   const importers::PosLog reference = importers::readPosFile(*dataset.gnss_solutions);
-  std::string text = fmt::format("{}{}{} fixes withheld in {} outages\n", imported.text,
-                                 run.summary + "\n", run.fixes_withheld, outages.size());
+  std::string text = fmt::format("{}{}\n{} fixes withheld in {} outages\n", imported.text,
+                                 run.summary, run.fixes_withheld, outages.size());
   std::ofstream scores(out_dir / "scores.csv");
   scores << "run,outages_scored,end_mean_m,end_worst_m,max_worst_m,rms_m,inside_3sigma,"
             "available_epochs,available_rms_m\n";
@@ -327,6 +355,22 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     epochs.write(backward.epoch_lines.data(),
                  static_cast<std::streamsize>(backward.epoch_lines.size()));
     written += ", smoothed.csv, smoothed_outages.csv";
+  }
+  if (dataset.gnss_observations) {
+    // The receiver's own pseudoranges alone, epoch by epoch: what the filter adds to them.
+    const importers::ObservationLog log =
+        importers::readRinexObservations(*dataset.gnss_observations);
+    std::vector<AntennaPoint> spp;
+    for (const importers::SinglePointEpoch& e : log.single_point)
+      spp.push_back({e.time_ns, core::earth::ecefToGeodetic(e.pos_ecef_m), Eigen::Vector3d::Zero(),
+                     e.sigma_h_m, e.sigma_v_m});
+    const Scored single = score("spp", spp, reference, {}, Judging::kNearest);
+    text += report("single point positioning of the same pseudoranges (" +
+                       std::to_string(spp.size()) + " epochs solved)",
+                   single, Judging::kNearest, {}, {}, o.outages);
+    scores << scoreLine("spp", single);
+    epochs.write(single.epoch_lines.data(),
+                 static_cast<std::streamsize>(single.epoch_lines.size()));
   }
   if (!sol || !scores || !epochs) throw bus::ConfigError("cannot write into " + o.out_dir);
   text += fmt::format("written into {}: {}\n", o.out_dir, written);

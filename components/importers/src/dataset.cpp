@@ -121,6 +121,27 @@ PosDescription pos(const YAML::Node& node, const std::filesystem::path& yaml) {
   return d;
 }
 
+RinexDescription rinex(const YAML::Node& node, const std::filesystem::path& yaml) {
+  RinexDescription d;
+  bus::KeyReader r(node, "gnss_observations");
+  d.obs = requiredFile(r, "obs", yaml);
+  d.nav = requiredFile(r, "nav", yaml);
+  r.nested({"obs", "nav"});
+  double mask_deg = 0.0;
+  r.integer("receiver_id", d.receiver_id, {0, 4294967295.0})
+      .value("range_type", d.range_type)
+      .value("doppler_type", d.doppler_type)
+      .value("cn0_type", d.cn0_type)
+      .number("rate_sigma_mps", d.rate_sigma_mps, {1e-4, 1e3})
+      .number("range_sigma_scale", d.range_sigma_scale, {1e-3, 1e3})
+      .number("min_range_sigma_m", d.min_range_sigma_m, {0.0, 1e4})
+      .number("elevation_mask_deg", mask_deg, {0.0, 90.0})
+      .number("time_offset_s", d.time_offset_s, kAnySeconds);
+  d.elevation_mask_rad = mask_deg * units::kDeg;
+  r.finish();
+  return d;
+}
+
 }  // namespace
 
 DatasetDescription readDatasetDescription(const std::filesystem::path& yaml_file) {
@@ -131,10 +152,11 @@ DatasetDescription readDatasetDescription(const std::filesystem::path& yaml_file
   r.value("name", d.name);
   if (root["imu"]) d.imu = imu(root["imu"], yaml_file);
   if (root["gnss_solutions"]) d.gnss_solutions = pos(root["gnss_solutions"], yaml_file);
-  if (!d.imu && !d.gnss_solutions)
+  if (root["gnss_observations"]) d.gnss_observations = rinex(root["gnss_observations"], yaml_file);
+  if (!d.imu && !d.gnss_solutions && !d.gnss_observations)
     throw bus::ConfigError("data set " + yaml_file.string() +
-                           ": nothing to import (no imu, no gnss_solutions)");
-  r.finish({"imu", "gnss_solutions"});
+                           ": nothing to import (no imu, gnss_solutions or gnss_observations)");
+  r.finish({"imu", "gnss_solutions", "gnss_observations"});
   return d;
 }
 

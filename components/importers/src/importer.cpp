@@ -61,6 +61,32 @@ void importSolutions(const PosDescription& d, const std::filesystem::path& out_d
   write(out_dir, bus::topic::kGnssFix, log.fixes, report.text);
 }
 
+void importObservations(const RinexDescription& d, const std::filesystem::path& out_dir,
+                        ImportReport& report) {
+  const ObservationLog log = readRinexObservations(d);
+  std::size_t measurements = 0;
+  for (const auto& e : log.epochs) measurements += e.satellites().size();
+  report.gnss_epochs = log.epochs.size();
+  report.text += fmt::format(
+      "{}: {} epochs read, {} written with {} satellite measurements; left out: {} epochs before "
+      "a first position to place the satellites from, {} of other systems, {} without {}, {} "
+      "without ephemeris, {} below the mask, {} out of range; {} without {} (no rate)\n",
+      d.obs.string(), log.epochs_read, log.epochs.size(), measurements, log.epochs_unplaced,
+      log.other_systems, log.missing_range, d.range_type, log.no_ephemeris, log.below_mask,
+      log.bad_range, log.no_doppler, d.doppler_type);
+  if (!log.has_iono)
+    report.text += fmt::format(
+        "{}: no ionosphere parameters (ION ALPHA/BETA): only the model's constant night-time "
+        "delay is removed\n",
+        d.nav.string());
+  if (d.ramp)
+    report.text += fmt::format(
+        "injected: {:g} m/s into G{:02d}'s pseudoranges from {:g} s after the first epoch "
+        "({} pseudoranges changed)\n",
+        d.ramp->rate_mps, d.ramp->sv_id, d.ramp->onset_after_start_s, log.injected);
+  write(out_dir, bus::topic::kGnssObservations, log.epochs, report.text);
+}
+
 }  // namespace
 
 ImportReport importDataset(const DatasetDescription& dataset,
@@ -69,6 +95,7 @@ ImportReport importDataset(const DatasetDescription& dataset,
   ImportReport report;
   if (dataset.imu) importImu(*dataset.imu, out_dir, report);
   if (dataset.gnss_solutions) importSolutions(*dataset.gnss_solutions, out_dir, report);
+  if (dataset.gnss_observations) importObservations(*dataset.gnss_observations, out_dir, report);
   return report;
 }
 

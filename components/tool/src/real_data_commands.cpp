@@ -2,7 +2,12 @@
 // from its standing start; `navbus import` turns a user's logs, described by a
 // data set YAML, into a navbus recording (components/importers); `navbus benchmark real-car`
 // scores the filter on one with GNSS outages (evaluation/real_car_benchmark.hpp).
+#include <cmath>
 #include <cstdio>
+
+#include <fmt/format.h>
+
+#include "navbus/bus/config.hpp"
 
 #include "navbus/evaluation/imu_noise_survey.hpp"
 #include "navbus/evaluation/real_car_benchmark.hpp"
@@ -22,10 +27,28 @@ class ImportCommand final : public Subcommand {
         "(config/datasets/)");
     cli_->add_option("dataset", dataset_, "data set YAML")->required()->check(CLI::ExistingFile);
     cli_->add_option("-o,--out", out_dir_, "recording directory (created)")->required();
+    cli_->add_option("--ramp", ramp_,
+                     "SV,RATE,ONSET: add RATE [m/s] * (t - ONSET) to GPS satellite SV's raw "
+                     "pseudoranges from ONSET [s after the first observation epoch] (a fault "
+                     "for the GLR to find; needs gnss_observations in the data set)")
+        ->expected(3)
+        ->delimiter(',');
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
-    const auto description = importers::readDatasetDescription(dataset_);
+    auto description = importers::readDatasetDescription(dataset_);
+    if (!ramp_.empty()) {
+      if (!description.gnss_observations)
+        throw bus::ConfigError("--ramp: " + dataset_ + " has no gnss_observations to inject into");
+      const double sv = ramp_[0];
+      if (!(sv >= 1 && sv <= 32 && sv == std::floor(sv)) || !std::isfinite(ramp_[1]) ||
+          !(ramp_[2] >= 0.0))
+        throw bus::ConfigError(
+            fmt::format("--ramp {},{},{}: SV must be a GPS PRN 1..32, RATE finite, ONSET >= 0 s",
+                        ramp_[0], ramp_[1], ramp_[2]));
+      description.gnss_observations->ramp =
+          importers::PseudorangeRamp{static_cast<int>(sv), ramp_[1], ramp_[2]};
+    }
     const auto report = importers::importDataset(description, out_dir_);
     std::fputs(report.text.c_str(), stdout);
     return 0;
@@ -34,14 +57,23 @@ class ImportCommand final : public Subcommand {
  private:
   std::string dataset_;
   std::string out_dir_;
+  std::vector<double> ramp_;
 };
+
+/// `navbus benchmark`, the parent of the real-log benchmarks (made by the first one added).
+CLI::App* benchmarkApp(CLI::App& app) {
+  for (CLI::App* existing : app.get_subcommands({})) {
+    if (existing->get_name() == "benchmark") return existing;
+  }
+  CLI::App* benchmark = app.add_subcommand("benchmark", "benchmarks on real logs");
+  benchmark->require_subcommand(1);
+  return benchmark;
+}
 
 class RealCarBenchmarkCommand final : public Subcommand {
  public:
   void add(CLI::App& app) override {
-    CLI::App* benchmark = app.add_subcommand("benchmark", "benchmarks on real logs");
-    benchmark->require_subcommand(1);
-    cli_ = benchmark->add_subcommand(
+    cli_ = benchmarkApp(app)->add_subcommand(
         "real-car",
         "a car's log with GNSS outages: the filter runs causally without the GNSS solutions "
         "inside each outage; its antenna positions are scored against the withheld fixed epochs");
@@ -63,6 +95,33 @@ class RealCarBenchmarkCommand final : public Subcommand {
     cli_->add_flag("--smooth", o_.smooth,
                    "also score the fixed-interval (Rauch-Tung-Striebel) smoother over the same "
                    "forward run: smoothed.csv, smoothed_outages.csv");
+  }
+  bool usesBus() const override { return false; }
+  int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    return evaluation::runRealCarBenchmark(o_);
+  }
+
+ private:
+  evaluation::RealCarOptions o_;
+};
+
+class RealDataBenchmarkCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = benchmarkApp(app)->add_subcommand(
+        "real-data",
+        "any real log with RTK fixes: the filter's antenna positions against the fixed epochs "
+        "(with --outages, as real-car), beside single point positioning of the log's own "
+        "pseudoranges when the data set has gnss_observations (config/datasets/walk_0827.yaml)");
+    cli_->add_option("dataset", o_.dataset, "data set YAML")->required()->check(CLI::ExistingFile);
+    cli_->add_option("--filter", o_.filter, "navbus-filter YAML (config/filter_walk_0827_tc.yaml)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cli_->add_option("--outages", o_.outages, "outage list (optional)")->check(CLI::ExistingFile);
+    cli_->add_option("-o,--out", o_.out_dir,
+                     "output directory: solution.csv, scores.csv, errors.csv, the recording")
+        ->required();
+    cli_->add_flag("--smooth", o_.smooth, "also score the fixed-interval smoother");
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
@@ -109,6 +168,7 @@ void addRealDataSubcommands(Subcommands& out) {
   out.push_back(std::make_unique<AllanCommand>());
   out.push_back(std::make_unique<ImportCommand>());
   out.push_back(std::make_unique<RealCarBenchmarkCommand>());
+  out.push_back(std::make_unique<RealDataBenchmarkCommand>());
 }
 
 }  // namespace navbus::tool::cli

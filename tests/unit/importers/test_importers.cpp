@@ -3,6 +3,7 @@
 // file, the line and the column.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include "navbus/importers/importer.hpp"
 #include "navbus/importers/imu_csv.hpp"
 #include "navbus/importers/imu_increments.hpp"
+#include "navbus/importers/rinex_observations.hpp"
 #include "navbus/importers/rtklib_pos.hpp"
 #include "navbus/importers/rtklib_time_tag.hpp"
 #include "navbus/records/csv_messages.hpp"
@@ -340,4 +342,98 @@ TEST(Import, TheDriveBecomesARecordingThatReadsBack) {
   ASSERT_EQ(fixes.size(), 2197u);
   const PosLog direct = readPosFile(*d.gnss_solutions);
   EXPECT_EQ(fixes.back().pos_ecef_m(), direct.fixes.back().pos_ecef_m()) << "bit for bit";
+}
+
+TEST(RinexObservations, TheWalksPseudorangesAndDopplerBecomeObservationEpochs) {
+  const auto d = readDatasetDescription(kDatasets / "walk_0827.yaml");
+  ASSERT_TRUE(d.gnss_observations);
+  const ObservationLog log = readRinexObservations(*d.gnss_observations);
+  // 536 epochs of 7 GPS satellites; 4 of them have broadcast ephemeris in the log.
+  EXPECT_EQ(log.epochs_read, 536u);
+  ASSERT_EQ(log.epochs.size(), 536u);
+  EXPECT_GT(log.no_ephemeris, 1000u);
+  EXPECT_FALSE(log.has_iono);
+  std::size_t measurements = 0;
+  for (const auto& e : log.epochs) measurements += e.satellites().size();
+  std::ifstream in(d.gnss_observations->obs);
+  const auto rinex = gnss_data::readObservationFile(in, "walk.obs");
+  std::size_t in_file = 0;
+  for (const auto& e : rinex.epochs) in_file += e.satellites.size();
+  EXPECT_EQ(measurements + log.no_ephemeris + log.missing_range + log.below_mask +
+                log.other_systems + log.bad_range,
+            in_file)
+      << "every satellite of every epoch is written or counted";
+  // First epoch, G10: C1 20576396.770 m, D1 1064.326 Hz in the RINEX file.
+  const auto& first = log.epochs.front();
+  EXPECT_EQ(first.time_gps_ns(), static_cast<std::uint64_t>(gpsNs(2025, 8, 28, 17, 30, 39.748)));
+  const auto g10 = std::find_if(first.satellites().begin(), first.satellites().end(),
+                                [](const auto& s) { return s.sv_id() == 10; });
+  ASSERT_NE(g10, first.satellites().end());
+  EXPECT_NEAR(g10->pseudorange_rate_mps(), -1064.326 * 299792458.0 / 1575.42e6, 1e-6);
+  // The pseudorange as received less the modelled atmosphere (a few metres at most).
+  EXPECT_LT(g10->pseudorange_m(), 20576396.770);
+  EXPECT_GT(g10->pseudorange_m(), 20576396.770 - 30.0);
+  EXPECT_NEAR(
+      Eigen::Vector3d(g10->sat_pos_ecef_m()[0], g10->sat_pos_ecef_m()[1], g10->sat_pos_ecef_m()[2])
+          .norm(),
+      26.56e6, 0.5e6)
+      << "a GPS orbit";
+  EXPECT_EQ(g10->pseudorange_rate_sigma_mps(), d.gnss_observations->rate_sigma_mps);
+  EXPECT_GT(log.single_point.size(), 500u);
+}
+
+TEST(RinexObservations, ARampChangesOnlyItsSatelliteAfterItsOnset) {
+  auto d = readDatasetDescription(kDatasets / "walk_0827.yaml");
+  const ObservationLog clean = readRinexObservations(*d.gnss_observations);
+  d.gnss_observations->ramp = PseudorangeRamp{10, 2.0, 40.0};
+  const ObservationLog ramped = readRinexObservations(*d.gnss_observations);
+  ASSERT_EQ(clean.epochs.size(), ramped.epochs.size());
+  const double first_s = 1e-9 * static_cast<double>(clean.epochs.front().time_gps_ns());
+  std::uint64_t changed = 0;
+  for (std::size_t i = 0; i < clean.epochs.size(); ++i) {
+    const double after_onset_s =
+        1e-9 * static_cast<double>(clean.epochs[i].time_gps_ns()) - first_s - 40.0;
+    for (std::size_t k = 0; k < clean.epochs[i].satellites().size(); ++k) {
+      const auto& a = clean.epochs[i].satellites()[k];
+      const auto& b = ramped.epochs[i].satellites()[k];
+      ASSERT_EQ(a.sv_id(), b.sv_id());
+      const double expected = a.sv_id() == 10 && after_onset_s > 0.0 ? 2.0 * after_onset_s : 0.0;
+      EXPECT_NEAR(b.pseudorange_m() - a.pseudorange_m(), expected, 1e-6)
+          << "G" << a.sv_id() << " epoch " << i;
+      changed += expected > 0.0 ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(changed, ramped.injected);
+  EXPECT_GT(changed, 300u);
+}
+
+TEST(RinexObservations, ErrorsNameTheKeyAndTheFile) {
+  const std::string obs = (kReal / "walk_0827/rinex/walk.obs").string();
+  const std::string nav = (kReal / "walk_0827/rinex/walk.nav").string();
+  auto error = [&](const std::string& name, const std::string& yaml) {
+    const fs::path p = writeText(name, yaml);
+    return errorOf([&] { readRinexObservations(*readDatasetDescription(p).gnss_observations); });
+  };
+  EXPECT_NE(error("nonav.yaml", "gnss_observations: {obs: " + obs + "}\n")
+                .find("gnss_observations.nav is missing"),
+            std::string::npos);
+  EXPECT_NE(error("type.yaml",
+                  "gnss_observations: {obs: " + obs + ", nav: " + nav + ", range_type: P1}\n")
+                .find("no 'P1' observable"),
+            std::string::npos);
+  EXPECT_NE(error("sigma.yaml",
+                  "gnss_observations: {obs: " + obs + ", nav: " + nav + ", rate_sigma_mps: -1}\n")
+                .find("rate_sigma_mps"),
+            std::string::npos);
+  // A malformed observation record names the file and the line.
+  std::ifstream in(obs);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = text.find(" 25 08 28 17 30 40.2480000");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 26, " 25 08 28 17 30 4x.2480000");
+  const fs::path bad = writeText("bad.obs", text);
+  const std::string message =
+      error("bad.yaml", "gnss_observations: {obs: " + bad.string() + ", nav: " + nav + "}\n");
+  EXPECT_NE(message.find("bad.obs"), std::string::npos) << message;
+  EXPECT_NE(message.find("bad.obs:47: field 'second'"), std::string::npos) << message;
 }

@@ -183,7 +183,10 @@ CoarseAlignment InitialAligner::alignWindow(double max_heading_sigma_rad) const 
 
 void InitialAligner::relevel() {
   // Still at rest while waiting for the course: roll and pitch again from the whole rest
-  // window, the heading carried by the gyros kept.
+  // window, the heading carried by the gyros kept. The first block of a new rest has no window
+  // yet (onMotion dropped the two blocks the detector may have seen motion in): its levelling
+  // would have an infinite sigma, so the last one stands until the window is long enough.
+  if (window_.duration_s() < config_.min_static_window_s) return;
   const CoarseAlignment coarse = alignWindow(0.0);
   const double yaw_rad = eulerFromDcm(q_levelled_b_to_n_.toRotationMatrix()).z();
   q_levelled_b_to_n_ =

@@ -120,6 +120,7 @@ SinglePointSolution solveSinglePoint(double t_rx_s,
         var = variance(config, s.direction.elevation_rad, s.iono_m, accuracy[i]);
       }
       s.sat_clock_m = earth::kSpeedOfLight_mps * states[i].clock_offset_s;
+      s.sat_clock_drift_mps = earth::kSpeedOfLight_mps * states[i].clock_drift_sps;
       const double corrected = observations[i].pseudorange_m + s.sat_clock_m - s.iono_m - s.tropo_m;
       const Eigen::Vector3d d = sat - x.head<3>();
       const double range = d.norm();

@@ -4,7 +4,9 @@
 // at the end of each outage, the largest inside it, the RMS over all outage epochs and the share
 // of outage epochs inside the filter's own 3-sigma; and, with GNSS available, the horizontal RMS
 // against the fixed epochs it fused. With smoothing, the fixed-interval smoother's positions are
-// scored on the same outages.
+// scored on the same outages. Without outages (`navbus benchmark real-data`) every fixed epoch
+// is scored with GNSS; a data set with raw observations is scored beside its own single point
+// positioning.
 #pragma once
 
 #include <filesystem>
@@ -27,7 +29,7 @@ std::vector<Outage> readOutages(const std::filesystem::path& file);
 struct RealCarOptions {
   std::string dataset;  ///< data set YAML (config/datasets/)
   std::string filter;   ///< navbus-filter YAML
-  std::string outages;  ///< outage list
+  std::string outages;  ///< outage list; empty: every fixed epoch is scored with GNSS
   std::string out_dir;  ///< solution.csv, outages.csv, scores.csv, the recording
   bool smooth{false};   ///< also the smoothed run: smoothed.csv, smoothed_outages.csv
 };

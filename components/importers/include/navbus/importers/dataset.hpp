@@ -11,6 +11,8 @@
 #include <optional>
 #include <string>
 
+#include "navbus/importers/rinex_observations.hpp"
+
 namespace navbus::importers {
 
 /// Where an IMU sample's GPS time comes from.
@@ -70,6 +72,7 @@ struct DatasetDescription {
   std::string name;
   std::optional<ImuCsvDescription> imu;
   std::optional<PosDescription> gnss_solutions;
+  std::optional<RinexDescription> gnss_observations;
 };
 
 /// Reads a data set description; throws bus::ConfigError naming the key and the value.

@@ -14,7 +14,8 @@ struct ImportReport {
   std::uint64_t imu_increments{0};
   std::uint64_t imu_blocks{0};
   std::uint64_t gnss_fixes{0};
-  std::string text;  ///< what was read, skipped and written, for the user
+  std::uint64_t gnss_epochs{0};  ///< observation epochs written
+  std::string text;              ///< what was read, skipped and written, for the user
 };
 
 /// Writes the recording into `out_dir` (created). Throws bus::ConfigError for bad input.

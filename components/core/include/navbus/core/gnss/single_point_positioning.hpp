@@ -51,8 +51,9 @@ struct SinglePointSatellite {
   int sv_id{0};
   SatelliteUse use{SatelliteUse::kUsed};
   AzimuthElevation direction;
-  double sat_clock_m{0.0};  ///< c * satellite clock offset (added to the pseudorange)
-  double iono_m{0.0};       ///< modelled delays (subtracted)
+  double sat_clock_m{0.0};          ///< c * satellite clock offset (added to the pseudorange)
+  double sat_clock_drift_mps{0.0};  ///< c * satellite clock drift (added to the range rate)
+  double iono_m{0.0};               ///< modelled delays (subtracted)
   double tropo_m{0.0};
   double residual_m{0.0};  ///< corrected pseudorange minus modelled range and clock, at the fix
   /// The corrected measurement: satellite at transmission expressed in the ECEF frame of
