@@ -252,9 +252,9 @@ std::string report(const std::string& title, const Scored& r, Judging judging,
 }
 
 std::string scoreLine(const std::string& run, const Scored& r) {
-  return fmt::format("{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.4f}\n", run, r.scored,
+  return fmt::format("{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.4f},{:.4f}\n", run, r.scored,
                      r.end_mean_m, r.end_worst_m, r.max_worst_m, r.rms_m, r.inside, r.available,
-                     r.available_rms_m);
+                     r.available_rms_m, r.available_inside);
 }
 
 }  // namespace
@@ -327,7 +327,7 @@ int runRealCarBenchmark(const RealCarOptions& o) {
                                  run.summary, run.fixes_withheld, outages.size());
   std::ofstream scores(out_dir / "scores.csv");
   scores << "run,outages_scored,end_mean_m,end_worst_m,max_worst_m,rms_m,inside_3sigma,"
-            "available_epochs,available_rms_m\n";
+            "available_epochs,available_rms_m,available_inside_3sigma\n";
   const Scored causal = score("filter", points, reference, outages, Judging::kAfterFusion);
   text += report("the filter (causal)", causal, Judging::kAfterFusion, outages,
                  out_dir / "outages.csv", o.outages);
