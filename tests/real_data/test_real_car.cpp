@@ -160,9 +160,13 @@ TEST(RealWalk, TightlyCoupledOnItsOwnPseudorangesBesideSinglePointPositioning) {
   std::printf(
       "walk_0827: tightly coupled %.2f m, single point %.2f m horizontal RMS; inside 3 "
       "sigma %.1f %% / %.1f %%\n",
-      filter_rms, spp_rms, 100.0 * value(0, "inside_3sigma"), 100.0 * value(1, "inside_3sigma"));
+      filter_rms, spp_rms, 100.0 * value(0, "available_inside_3sigma"),
+      100.0 * value(1, "available_inside_3sigma"));
   // Measured 7.70 m against 8.29 m (349 fixed epochs; the filter aligns after 12.6 s, 296).
   EXPECT_LT(filter_rms, spp_rms);
+  // Single point positioning's own sigma holds its error; the filter's does not (docs:
+  // the 4 satellites' errors are slow biases, which white measurement noise does not model).
+  EXPECT_GT(value(1, "available_inside_3sigma"), 0.95);
   EXPECT_LT(filter_rms, 8.0);
   EXPECT_GT(value(0, "available_epochs"), 290.0);
   EXPECT_EQ(value(1, "available_epochs"), 349.0);
