@@ -77,6 +77,9 @@ void parseAlignment(const YAML::Node& node, core::EngineConfig& e) {
       .number("max_heading_sigma_deg", a.max_heading_sigma_rad, {0.0, 180.0}, kDegree)
       .number("course_min_speed_mps", a.course_min_speed_mps, {0.1, 1e4})
       .number("course_sigma_deg", a.course_sigma_rad, {1e-3, 90.0}, kDegree)
+      .number("max_course_heading_sigma_deg", a.max_course_heading_sigma_rad, {0.01, 180.0},
+              kDegree)
+      .number("course_window_s", a.course_window_s, {0.0, 600.0})
       .number("course_check_heading_sigma_deg", a.course_check_heading_sigma_rad, {0.0, 180.0},
               kDegree)
       .finish();

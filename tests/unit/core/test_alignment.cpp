@@ -374,12 +374,14 @@ TEST(InitialAligner, MemsLevelsAtRestThenTakesTheHeadingFromTheGnssCourse) {
       EXPECT_NEAR(t_s, 33.0 + 2.5, 0.11);  // the first fix at 5 m/s
       EXPECT_EQ(s.attitude_source, core::AttitudeSource::kGnssCourse);
       EXPECT_EQ(s.position_source, core::PositionSource::kGnssFix);
-      // The heading is the course; the tilt is off by the horizontal Earth rate left out over the
-      // 2.5 s of motion (about 1.5e-4 rad), which the tilt sigma covers.
+      // The heading is the course; the tilt is off by the horizontal Earth rate left out since
+      // the last levelling at rest (the turn on the spot has no scatter, but windows shorter
+      // than min_static_window_s do not level again): about 5.5 s, 3.3e-4 rad, which the tilt
+      // sigma covers.
       EXPECT_NEAR(core::eulerFromDcm(s.state.q_b_to_n.toRotationMatrix()).z(),
                   yaw_deg * units::kDeg, 1e-9);
       const double error_rad = attitudeError(s.state.q_b_to_n, C_b_n);
-      EXPECT_LT(error_rad, 3e-4);
+      EXPECT_LT(error_rad, 4e-4);
       EXPECT_GT(s.att_sigma_ned_rad.x(), error_rad);
       EXPECT_GT(s.gyrocompass_heading_sigma_rad, 0.5);  // the MEMS gyro cannot gyrocompass
       EXPECT_NEAR(s.att_sigma_ned_rad.z(), std::hypot(config.course_sigma_rad, 0.1 / 5.0), 1e-3);

@@ -148,7 +148,14 @@ void InitialAligner::addStarAttitude(const StarAttitudeMeasurement& st) {
 void InitialAligner::takeFix(const Fix& fix) {
   fix_ = fix;
   if (phase_ == AlignmentPhase::kWaitingForPosition) phase_ = AlignmentPhase::kWaitingForRest;
-  if (phase_ == AlignmentPhase::kWaitingForCourse) tryCourse();
+  if (phase_ != AlignmentPhase::kWaitingForCourse) return;
+  const GnssFixMeasurement& m = fix.measurement;
+  track_[track_next_] = {fix.time_ns, m.position, m.pos_sigma_ned_m.head<2>().maxCoeff(),
+                         eulerFromDcm(q_levelled_b_to_n_.toRotationMatrix()).z(),
+                         levelled_dv_ne_mps_};
+  track_next_ = (track_next_ + 1) % kTrackPoints;
+  track_count_ = std::min(track_count_ + 1, kTrackPoints);
+  tryCourse();
 }
 
 void InitialAligner::onRestWindowEnd() {
@@ -183,11 +190,15 @@ CoarseAlignment InitialAligner::alignWindow(double max_heading_sigma_rad) const 
 
 void InitialAligner::relevel() {
   // Still at rest while waiting for the course: roll and pitch again from the whole rest
-  // window, the heading carried by the gyros kept. The first block of a new rest has no window
-  // yet (onMotion dropped the two blocks the detector may have seen motion in): its levelling
-  // would have an infinite sigma, so the last one stands until the window is long enough.
+  // window, the heading carried by the gyros kept, when that window is at least
+  // min_static_window_s long and levels better than the last levelling carried since. A short
+  // "rest" while waiting for the course is often none: steady acceleration or turning has no
+  // scatter either, and a position-only receiver's speed cannot tell (seed 004 with positions
+  // only: 1-s windows of a car accelerating at 2 m/s^2 tilted the start by 0.2 rad). And the
+  // first block of a new rest has no window at all (an infinite sigma).
   if (window_.duration_s() < config_.min_static_window_s) return;
   const CoarseAlignment coarse = alignWindow(0.0);
+  if (!(coarse.level_sigma_rad < currentLevelSigma())) return;
   const double yaw_rad = eulerFromDcm(q_levelled_b_to_n_.toRotationMatrix()).z();
   q_levelled_b_to_n_ =
       Eigen::Quaterniond(dcmFromEuler(Eigen::Vector3d(coarse.roll_pitch_yaw_rad.x(),
@@ -196,6 +207,16 @@ void InitialAligner::relevel() {
   q_at_levelling_b_to_n_ = q_levelled_b_to_n_;
   level_sigma_rad_ = coarse.level_sigma_rad;
   levelled_for_s_ = 0.0;
+}
+
+double InitialAligner::currentLevelSigma() const {
+  // The last levelling, then the gyro bias and the unmodelled horizontal Earth rate integrated
+  // since (propagateAttitude).
+  const double horizontal_earth_rate_radps =
+      earth::kRotationRate_radps * std::cos(fix_.measurement.position.latitude_rad);
+  const double tilt_rate_radps =
+      std::hypot(config_.budget.gyro_bias_sigma_radps, horizontal_earth_rate_radps);
+  return std::hypot(level_sigma_rad_, tilt_rate_radps * levelled_for_s_);
 }
 
 void InitialAligner::propagateAttitude(const ImuIncrement& inc) {
@@ -210,30 +231,82 @@ void InitialAligner::propagateAttitude(const ImuIncrement& inc) {
   q_levelled_b_to_n_ = quaternionFromRotationVector(-earth_rotation_n) * q_levelled_b_to_n_ *
                        quaternionFromRotationVector(inc.delta_angle_b_rad);
   q_levelled_b_to_n_.normalize();
+  // Gravity has no horizontal component: the horizontal specific force is the acceleration.
+  levelled_dv_ne_mps_ += (q_levelled_b_to_n_ * inc.delta_vel_b_mps).head<2>();
   levelled_for_s_ += inc.interval_s;
 }
 
-void InitialAligner::tryCourse() {
+std::optional<InitialAligner::Course> InitialAligner::courseFromVelocity() const {
   const Eigen::Vector3d& v = fix_.measurement.vel_ned_mps;
   const double speed_mps = v.head<2>().norm();
-  if (speed_mps < config_.course_min_speed_mps) return;
-  const double course_rad = std::atan2(v.y(), v.x());
-  const double yaw_rad = eulerFromDcm(q_levelled_b_to_n_.toRotationMatrix()).z();
+  if (speed_mps < config_.course_min_speed_mps) return std::nullopt;
+  // The body-to-velocity misalignment and the velocity's own noise across the track.
+  const double cross_track_sigma_mps = fix_.measurement.vel_sigma_ned_mps.head<2>().maxCoeff();
+  return Course{std::atan2(v.y(), v.x()), eulerFromDcm(q_levelled_b_to_n_.toRotationMatrix()).z(),
+                std::hypot(config_.course_sigma_rad, cross_track_sigma_mps / speed_mps),
+                std::nullopt};
+}
+
+std::pair<Eigen::Vector3d, Eigen::Vector3d> InitialAligner::chordVelocity(
+    const TrackPoint& now, const TrackPoint& then, double heading_correction_rad) const {
+  // The chord gives the mean velocity, the one at mid-interval for a steady acceleration; the
+  // velocity at the newer fix adds half the change the accelerometers integrated since (in the
+  // levelled frame, turned by the heading found). Its sigma: the fixes' over the interval, and
+  // the levelling's tilt leaking gravity into the integral.
+  const double dt_s = 1e-9 * static_cast<double>(now.time_ns - then.time_ns);
+  const Eigen::Vector3d chord_ned = earth::differenceNed(now.position, then.position);
+  const Eigen::Rotation2Dd turn(heading_correction_rad);
+  Eigen::Vector3d v = chord_ned / dt_s;
+  v.head<2>() += turn * (0.5 * (now.levelled_dv_ne_mps - then.levelled_dv_ne_mps));
+  const double horizontal_sigma = std::hypot(std::hypot(now.sigma_h_m, then.sigma_h_m) / dt_s,
+                                             0.5 * level_sigma_rad_ * gravity() * dt_s);
+  const double vertical_sigma =
+      std::hypot(fix_.measurement.pos_sigma_ned_m.z() * std::sqrt(2.0) / dt_s,
+                 0.5 * level_sigma_rad_ * gravity() * dt_s);
+  return {v, Eigen::Vector3d(horizontal_sigma, horizontal_sigma, vertical_sigma)};
+}
+
+std::optional<InitialAligner::Course> InitialAligner::courseFromPositions() const {
+  if (track_count_ < 2) return std::nullopt;
+  const TrackPoint& now = track_[(track_next_ + kTrackPoints - 1) % kTrackPoints];
+  std::optional<Course> best;
+  for (std::size_t k = 1; k < track_count_; ++k) {
+    const TrackPoint& then = track_[(track_next_ + kTrackPoints - 1 - k) % kTrackPoints];
+    const double dt_s = 1e-9 * static_cast<double>(now.time_ns - then.time_ns);
+    if (!(dt_s > 0.0) || dt_s > config_.course_window_s) break;
+    // The chord is the course only where the track is straight: the gyros' turn between.
+    const double turn_rad = std::remainder(now.yaw_rad - then.yaw_rad, 2.0 * M_PI);
+    if (std::abs(turn_rad) > 2.0 * config_.course_sigma_rad) continue;
+    const Eigen::Vector3d chord_ned = earth::differenceNed(now.position, then.position);
+    const double length_m = chord_ned.head<2>().norm();
+    if (length_m < config_.course_min_speed_mps * dt_s) continue;
+    const double sigma_rad =
+        std::hypot(config_.course_sigma_rad, std::hypot(now.sigma_h_m, then.sigma_h_m) / length_m);
+    if (best && sigma_rad >= best->heading_sigma_rad) continue;
+    const double course_rad = std::atan2(chord_ned.y(), chord_ned.x());
+    const double yaw_rad = then.yaw_rad + 0.5 * turn_rad;
+    best = Course{course_rad, yaw_rad, sigma_rad, chordVelocity(now, then, course_rad - yaw_rad)};
+  }
+  return best;
+}
+
+void InitialAligner::tryCourse() {
+  // The better of the fix's velocity and the chord between two fixes; none while the heading
+  // would not be known well enough for the filter's error model.
+  std::optional<Course> c = courseFromVelocity();
+  if (const std::optional<Course> p = courseFromPositions();
+      p && (!c || p->heading_sigma_rad < c->heading_sigma_rad))
+    c = p;
+  if (!c || c->heading_sigma_rad > config_.max_course_heading_sigma_rad) return;
+  const double course_rad = c->course_rad;
+  const double yaw_rad = c->yaw_rad;
   const Eigen::Quaterniond q =
       Eigen::Quaterniond(Eigen::AngleAxisd(course_rad - yaw_rad, Eigen::Vector3d::UnitZ())) *
       q_levelled_b_to_n_;
-  // Heading: the body-to-velocity misalignment and the velocity's own noise across the track;
-  // tilt: the levelling plus the gyro bias integrated since.
-  const double cross_track_sigma_mps = fix_.measurement.vel_sigma_ned_mps.head<2>().maxCoeff();
-  const double heading_sigma_rad =
-      std::hypot(config_.course_sigma_rad, cross_track_sigma_mps / speed_mps);
+  const double heading_sigma_rad = c->heading_sigma_rad;
   // Tilt: the last levelling, then the gyro bias and the unmodelled horizontal Earth rate
   // integrated since (propagateAttitude).
-  const double horizontal_earth_rate_radps =
-      earth::kRotationRate_radps * std::cos(fix_.measurement.position.latitude_rad);
-  const double tilt_rate_radps =
-      std::hypot(config_.budget.gyro_bias_sigma_radps, horizontal_earth_rate_radps);
-  const double level_sigma_rad = std::hypot(level_sigma_rad_, tilt_rate_radps * levelled_for_s_);
+  const double level_sigma_rad = currentLevelSigma();
   // The tilt errors are those of the latest levelling, whose attitude is now known with the
   // course's heading correction (step 8, levelling rows only).
   const Eigen::Matrix3d C_at_levelling =
@@ -246,6 +319,12 @@ void InitialAligner::tryCourse() {
       C_at_levelling, fix_.measurement.position.latitude_rad, gravity(), false);
   sensitivity.d_att_d_gyro_bias_b.topRows<2>() =
       -q.toRotationMatrix().topRows<2>() * levelled_for_s_;
+  if (c->velocity_ned_mps && c->velocity_ned_mps->second.head<2>().maxCoeff() <
+                                 fix_.measurement.vel_sigma_ned_mps.head<2>().maxCoeff()) {
+    // The fix's own velocity is worse (a position-only receiver): the chord's.
+    fix_.measurement.vel_ned_mps = c->velocity_ned_mps->first;
+    fix_.measurement.vel_sigma_ned_mps = c->velocity_ned_mps->second;
+  }
   finish(q.normalized(), Eigen::Vector3d(level_sigma_rad, level_sigma_rad, heading_sigma_rad),
          AttitudeSource::kGnssCourse, sensitivity);
 }

@@ -31,6 +31,14 @@ struct InitialAlignmentConfig {
   double max_heading_sigma_rad{0.1745};  ///< gyrocompassing accepted below (10 deg)
   double course_min_speed_mps{5.0};      ///< GNSS course used above this horizontal speed
   double course_sigma_rad{0.0349};       ///< body x to velocity misalignment, 1 sigma (2 deg)
+  /// The alignment ends on a course only once its heading 1-sigma is below this: beyond it the
+  /// filter's small-angle error model does not hold (a position-only receiver's "velocity"
+  /// gave 2.8 rad).
+  double max_course_heading_sigma_rad{0.1745};
+  /// The course is also taken from two fixes up to this far apart in time (receivers that give
+  /// positions only, or poor velocities), when the track between them is straight: the gyros
+  /// turned it by less than twice course_sigma_rad.
+  double course_window_s{10.0};
   /// After gyrocompassing with a heading sigma above this, the heading is measured once more
   /// from the GNSS course when the vehicle first moves faster than course_min_speed_mps
   /// (NavigationEngine; 0: never).

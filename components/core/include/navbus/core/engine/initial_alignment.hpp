@@ -13,6 +13,9 @@
 // order, no clock, no I/O.
 #pragma once
 
+#include <array>
+#include <optional>
+
 #include <cstdint>
 #include <vector>
 
@@ -74,9 +77,40 @@ class InitialAligner {
   CoarseAlignment alignWindow(double max_heading_sigma_rad) const;
   void relevel();
   void propagateAttitude(const ImuIncrement& inc);
+  /// The tilt 1-sigma of the levelled attitude now.
+  double currentLevelSigma() const;
+  /// A heading from the GNSS course: the course, the levelled attitude's yaw at the course's
+  /// time, and the heading's 1-sigma.
+  struct Course {
+    double course_rad{0.0};
+    double yaw_rad{0.0};
+    double heading_sigma_rad{0.0};
+    /// From two fixes: the velocity at the newer one and its 1-sigma [m/s, NED], which the
+    /// filter starts from when the fix's own velocity is worse.
+    std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> velocity_ned_mps;
+  };
   void tryCourse();
+  std::optional<Course> courseFromVelocity() const;
+  std::optional<Course> courseFromPositions() const;
+  struct TrackPoint;
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> chordVelocity(const TrackPoint& now,
+                                                            const TrackPoint& then,
+                                                            double heading_correction_rad) const;
+  /// The fixes taken while waiting for the course, with the levelled yaw at each (a ring).
+  struct TrackPoint {
+    std::int64_t time_ns{0};
+    earth::Geodetic position;
+    double sigma_h_m{0.0};  ///< the larger horizontal 1-sigma
+    double yaw_rad{0.0};
+    /// The horizontal velocity change the levelled attitude integrated up to this point
+    /// [m/s, north and east of the levelled frame, whose yaw is off by the unknown heading].
+    Eigen::Vector2d levelled_dv_ne_mps{Eigen::Vector2d::Zero()};
+  };
+  static constexpr std::size_t kTrackPoints = 128;  ///< 32 s of 4 Hz fixes
   void finish(const Eigen::Quaterniond& q_b_to_n, const Eigen::Vector3d& att_sigma_ned_rad,
               AttitudeSource source, const AlignmentSensitivity& sensitivity = {});
+  /// The velocity change integrated while waiting for the course (TrackPoint).
+  Eigen::Vector2d levelled_dv_ne_mps_{Eigen::Vector2d::Zero()};
   double gravity() const;
   bool hasFix() const { return fix_.time_ns >= 0; }
 
@@ -98,6 +132,9 @@ class InitialAligner {
   double levelled_for_s_{0.0};
   double gyrocompass_sigma_rad_{0.0};
   std::uint64_t failed_solutions_{0};
+  std::array<TrackPoint, kTrackPoints> track_{};
+  std::size_t track_count_{0};  ///< points held (the newest at (track_next_ - 1) mod size)
+  std::size_t track_next_{0};
   AlignedStart start_;
 };
 
