@@ -81,7 +81,16 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
       });
   p.subscribe<navbus::FaultMonitorProgressPubSubType>(
       topic::kFaultProgress, profile::kProgressReader,
-      [this](const auto& report, const auto&) { pipeline_.onFaultMonitorProgress(report); });
+      [this](const auto& report, const auto& info) {
+        pipeline_.onFaultMonitorProgress(report);
+        // Judging is proof of life too: a monitor busy with a burst of diagnostics (a replay
+        // as fast as the readers take it) may send its 1-Hz health late, and a filter that
+        // then believed it dead stopped waiting for its judgements (bus != offline).
+        if (monitor_ && monitor_identity_) {
+          const std::optional<std::string> writer = participant_.dds().writerIdentity(info);
+          if (!writer || *writer == *monitor_identity_) monitor_->onReport(steadyNowNs());
+        }
+      });
   // Bounded-wait release of inputs held for a silent stream, and the held solution while
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });
@@ -110,6 +119,7 @@ bus::SensorReaders::Events FilterNode::sensorEvents() {
 
 void FilterNode::watchFaultMonitor(const FaultMonitorWatch& watch) {
   monitor_.emplace(watch.timeout_ns, steadyNowNs());
+  monitor_identity_ = watch.identity;
   bus::StreamCounters& counters = participant_.health().stream(bus::topic::kHealth);
   participant_.subscribe<navbus::HealthPubSubType>(
       bus::topic::kHealth, bus::profile::kHealthReader,

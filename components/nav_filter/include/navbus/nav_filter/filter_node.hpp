@@ -53,7 +53,8 @@ class FilterNode {
   bus::StallDetector stalls_;          ///< pauses of this process between two pumps
   std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)
   bus::SensorReaders sensors_;         ///< the sensor streams' readers (owning writers only)
-  std::optional<MonitorLiveness> monitor_;  ///< the fault monitor's liveness, when configured
+  std::optional<MonitorLiveness> monitor_;       ///< the fault monitor's liveness, when configured
+  std::optional<std::string> monitor_identity_;  ///< its writers' identity under DDS Security
 };
 
 }  // namespace navbus::nav_filter
