@@ -203,3 +203,73 @@ TEST(RealData, SlowRampIsDetectedLater) {
   EXPECT_GT(delay, 30.0);
   EXPECT_LT(delay, 600.0);
 }
+
+// RINEX 3: the walk's raw u-blox log converted by convbin with its default output (RINEX 3.04,
+// mixed GPS, Galileo and SBAS) reads as the shipped RINEX 2.11 conversion does: the same GPS
+// epochs, pseudoranges and Doppler (C1C/D1C against C1/D1), the same GPS ephemerides; the
+// other systems' satellites and records counted.
+TEST(Rinex3, TheWalksConvbinDefaultOutputReadsAsItsRinex2) {
+  const std::string convbin = NAVBUS_CONVBIN;
+  ASSERT_FALSE(convbin.empty() || convbin.find("NOTFOUND") != std::string::npos)
+      << "convbin not found: install Debian's rtklib (scripts/install-deps.sh)";
+  const std::string work = std::string(NAVBUS_WORK_DIR) + "/rinex3";
+  std::filesystem::create_directories(work);
+  const std::string real = std::string(NAVBUS_REAL_DIR) + "/walk_0827";
+  const std::string command = convbin + " -r ubx -od -os -o " + work + "/walk.obs -n " + work +
+                              "/walk.nav " + real + "/gnss_1730.ubx > " + work +
+                              "/convbin.log 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  auto read = [](const std::string& file, auto reader) {
+    std::ifstream in(file);
+    return reader(in, file);
+  };
+  const auto obs3 = read(work + "/walk.obs", &nb::gnss_data::readObservationFile);
+  const auto obs2 = read(real + "/rinex/walk.obs", &nb::gnss_data::readObservationFile);
+  const auto nav3 = read(work + "/walk.nav", &nb::gnss_data::readNavigationFile);
+  const auto nav2 = read(real + "/rinex/walk.nav", &nb::gnss_data::readNavigationFile);
+  EXPECT_EQ(obs3.major_version, 3);
+  EXPECT_EQ(obs3.system_types.size(), 3u) << "G, E and S";
+  ASSERT_EQ(obs3.epochs.size(), obs2.epochs.size());
+  const int c3 = obs3.typeIndex("C1C"), d3 = obs3.typeIndex("D1C");
+  const int c2 = obs2.typeIndex("C1"), d2 = obs2.typeIndex("D1");
+  ASSERT_GE(c3, 0);
+  ASSERT_GE(d3, 0);
+  std::size_t compared = 0, other_systems = 0;
+  for (std::size_t i = 0; i < obs3.epochs.size(); ++i) {
+    ASSERT_DOUBLE_EQ(obs3.epochs[i].time_s, obs2.epochs[i].time_s) << i;
+    for (const auto& s3 : obs3.epochs[i].satellites) {
+      if (s3.system != 'G') {
+        ++other_systems;
+        continue;
+      }
+      for (const auto& s2 : obs2.epochs[i].satellites) {
+        if (s2.prn != s3.prn) continue;
+        const auto& a = s3.values[static_cast<std::size_t>(c3)];
+        const auto& b = s2.values[static_cast<std::size_t>(c2)];
+        ASSERT_EQ(a.has_value(), b.has_value()) << "epoch " << i << " G" << s3.prn;
+        if (a) EXPECT_DOUBLE_EQ(*a, *b);
+        const auto& da = s3.values[static_cast<std::size_t>(d3)];
+        const auto& db = s2.values[static_cast<std::size_t>(d2)];
+        if (da && db) EXPECT_DOUBLE_EQ(*da, *db);
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 3000u);
+  EXPECT_GT(other_systems, 0u);
+  ASSERT_EQ(nav3.ephemerides.size(), nav2.ephemerides.size());
+  for (std::size_t i = 0; i < nav3.ephemerides.size(); ++i) {
+    EXPECT_EQ(nav3.ephemerides[i].sv_id, nav2.ephemerides[i].sv_id);
+    EXPECT_EQ(nav3.ephemerides[i].toe_s, nav2.ephemerides[i].toe_s);
+    EXPECT_EQ(nav3.ephemerides[i].toc_s, nav2.ephemerides[i].toc_s);
+    EXPECT_EQ(nav3.ephemerides[i].sqrt_a_sqrtm, nav2.ephemerides[i].sqrt_a_sqrtm);
+    EXPECT_EQ(nav3.ephemerides[i].af0_s, nav2.ephemerides[i].af0_s);
+  }
+  EXPECT_GT(nav3.other_systems, 0u) << "Galileo records";
+  std::printf(
+      "RINEX 3: %zu epochs, %zu GPS measurements equal to RINEX 2's, %zu of other "
+      "systems; %zu GPS ephemerides equal, %llu other records\n",
+      obs3.epochs.size(), compared, other_systems, nav3.ephemerides.size(),
+      static_cast<unsigned long long>(nav3.other_systems));
+  std::filesystem::remove_all(work);
+}

@@ -76,20 +76,41 @@ std::string trimmed(const std::string& s) {
   return s.substr(b, s.find_last_not_of(' ') - b + 1);
 }
 
+/// The major version of a "RINEX VERSION / TYPE" line: 2 or 3, else an error.
+int majorVersion(const LineReader& r, const std::string& version) {
+  if (!version.empty() && (version[0] == '2' || version[0] == '3')) return version[0] - '0';
+  r.fail("RINEX version '" + version + "' is not 2.xx or 3.xx");
+}
+
+/// RINEX 3 "SYS / # / OBS TYPES": the system's count, then 13 types a line (continuation lines
+/// have a blank system).
+void readSystemTypes(LineReader& r, const std::string& line, RinexObservationFile& f, char& system,
+                     std::size_t& count) {
+  if (r.column(line, 0, 1) != " ") {
+    system = r.column(line, 0, 1)[0];
+    count = static_cast<std::size_t>(r.integer(line, 3, 3, "SYS / # / OBS TYPES"));
+  }
+  std::vector<std::string>& types = f.system_types[system];
+  for (std::size_t i = 0; i < 13 && types.size() < count; ++i)
+    types.push_back(trimmed(r.column(line, 7 + 4 * i, 3)));
+}
+
 void readObservationHeader(LineReader& r, RinexObservationFile& f) {
   std::string line;
   bool version_seen = false;
   std::size_t type_count = 0;
+  char system = ' ';
+  std::size_t system_count = 0;
   while (r.next(line)) {
     const std::string l = label(line);
     if (l == "RINEX VERSION / TYPE") {
       f.version = trimmed(r.column(line, 0, 9));
-      if (f.version.empty() || f.version[0] != '2') {
-        r.fail("RINEX version '" + f.version + "' is not 2.xx (only RINEX 2 is supported)");
-      }
+      f.major_version = majorVersion(r, f.version);
       const std::string type = r.column(line, 20, 1);
       if (type != "O") r.fail("file type '" + type + "' is not O (observation)");
       version_seen = true;
+    } else if (l == "SYS / # / OBS TYPES") {
+      readSystemTypes(r, line, f, system, system_count);
     } else if (l == "MARKER NAME") {
       f.marker = trimmed(r.column(line, 0, 60));
     } else if (l == "APPROX POSITION XYZ") {
@@ -108,6 +129,14 @@ void readObservationHeader(LineReader& r, RinexObservationFile& f) {
       f.interval_s = r.number(line, 0, 10, "INTERVAL");
     } else if (l == "END OF HEADER") {
       if (!version_seen) r.fail("no 'RINEX VERSION / TYPE' line before END OF HEADER");
+      if (f.major_version == 3) {
+        // The GPS observables are the file's types; other systems' satellites are counted.
+        const auto gps = f.system_types.find('G');
+        if (gps == f.system_types.end() || gps->second.empty())
+          r.fail("'SYS / # / OBS TYPES' lists no GPS (G) observation type");
+        f.types = gps->second;
+        return;
+      }
       if (f.types.empty() || f.types.size() != type_count) {
         r.fail("'# / TYPES OF OBSERV' lists " + std::to_string(f.types.size()) + " of " +
                std::to_string(type_count) + " types");
@@ -154,10 +183,59 @@ int RinexObservationFile::typeIndex(const std::string& type) const {
   return -1;
 }
 
+namespace {
+
+/// RINEX 3 epochs: "> yyyy mm dd hh mm ss.sssssss  f nnn", then one line per satellite
+/// ("G10" and 16 columns per observable of its system).
+void readObservationsV3(LineReader& r, RinexObservationFile& f) {
+  std::string line;
+  while (r.next(line)) {
+    if (LineReader::blank(line)) continue;
+    if (line[0] != '>') r.fail("'" + line.substr(0, 20) + "' is not an epoch record ('>')");
+    const int flag = r.integer(line, 31, 1, "epoch flag");
+    const int count = r.integer(line, 32, 3, "number of satellites");
+    if (flag >= 2) {
+      for (int i = 0; i < count; ++i) r.require("an event record");
+      ++f.event_records;
+      continue;
+    }
+    RinexObservationEpoch e;
+    e.flag = flag;
+    e.time_s =
+        gpsSecondsFromCalendar(r.integer(line, 2, 4, "year"), r.integer(line, 7, 2, "month"),
+                               r.integer(line, 10, 2, "day"), r.integer(line, 13, 2, "hour"),
+                               r.integer(line, 16, 2, "minute"), r.number(line, 18, 11, "second"));
+    for (int i = 0; i < count; ++i) {
+      const std::string sat = r.require("an epoch's observations");
+      RinexSatelliteObservations s;
+      s.system = sat[0] == ' ' ? 'G' : sat[0];
+      s.prn = r.integer(sat, 1, 2, "satellite number");
+      if (s.system == 'G') {
+        for (std::size_t k = 0; k < f.types.size(); ++k) {
+          const std::string field = r.column(sat, 3 + 16 * k, 14);
+          if (LineReader::blank(field)) {
+            s.values.emplace_back();
+          } else {
+            s.values.emplace_back(r.number(sat, 3 + 16 * k, 14, "observation"));
+          }
+        }
+      }
+      e.satellites.push_back(std::move(s));
+    }
+    f.epochs.push_back(std::move(e));
+  }
+}
+
+}  // namespace
+
 RinexObservationFile readObservationFile(std::istream& in, const std::string& name) {
   LineReader r(in, name);
   RinexObservationFile f;
   readObservationHeader(r, f);
+  if (f.major_version == 3) {
+    readObservationsV3(r, f);
+    return f;
+  }
   const std::size_t lines_per_sat = (f.types.size() + 4) / 5;
   std::string line;
   while (r.next(line)) {
@@ -203,18 +281,24 @@ RinexNavigationFile readNavigationFile(std::istream& in, const std::string& name
   RinexNavigationFile f;
   std::string line;
   bool header_done = false;
+  int major = 2;
   while (!header_done && r.next(line)) {
     const std::string l = label(line);
     if (l == "RINEX VERSION / TYPE") {
       f.version = trimmed(r.column(line, 0, 9));
-      if (f.version.empty() || f.version[0] != '2') {
-        r.fail("RINEX version '" + f.version + "' is not 2.xx (only RINEX 2 is supported)");
-      }
+      major = majorVersion(r, f.version);
       const std::string type = r.column(line, 20, 1);
-      if (type != "N") r.fail("file type '" + type + "' is not N (GPS navigation)");
+      if (type != "N") r.fail("file type '" + type + "' is not N (navigation)");
     } else if (l == "ION ALPHA" || l == "ION BETA") {
       auto& target = l == "ION ALPHA" ? f.iono.alpha : f.iono.beta;
       for (std::size_t i = 0; i < 4; ++i) target[i] = r.number(line, 2 + 12 * i, 12, l.c_str());
+      f.has_iono = true;
+    } else if (l == "IONOSPHERIC CORR" &&
+               (r.column(line, 0, 4) == "GPSA" || r.column(line, 0, 4) == "GPSB")) {
+      // RINEX 3: GPSA alpha0..3, GPSB beta0..3.
+      auto& target = r.column(line, 0, 4) == "GPSA" ? f.iono.alpha : f.iono.beta;
+      for (std::size_t i = 0; i < 4; ++i)
+        target[i] = r.number(line, 5 + 12 * i, 12, "IONOSPHERIC CORR");
       f.has_iono = true;
     } else if (l == "LEAP SECONDS") {
       f.leap_seconds = r.integer(line, 0, 6, "LEAP SECONDS");
@@ -224,18 +308,34 @@ RinexNavigationFile readNavigationFile(std::istream& in, const std::string& name
   }
   if (!header_done) r.fail("no END OF HEADER");
   if (f.version.empty()) r.fail("no 'RINEX VERSION / TYPE' line");
+  // RINEX 3 records are one column further right and name their system; GLONASS and SBAS
+  // records have 3 orbit lines, the others 7.
+  const std::size_t shift = major == 3 ? 1 : 0;
   while (r.next(line)) {
     if (LineReader::blank(line)) continue;
     core::gps::BroadcastEphemeris e;
-    e.sv_id = r.integer(line, 0, 2, "PRN");
+    if (major == 3 && line[0] != 'G') {
+      const int orbit_lines = (line[0] == 'R' || line[0] == 'S') ? 3 : 7;
+      for (int k = 0; k < orbit_lines; ++k) r.require("a broadcast orbit record");
+      ++f.other_systems;
+      continue;
+    }
+    e.sv_id = r.integer(line, shift, 2, "PRN");
     if (e.sv_id < 1 || e.sv_id > 32) r.fail("PRN " + std::to_string(e.sv_id) + " is not 1..32");
-    e.toc_s = gpsSecondsFromCalendar(
-        fullYear(r.integer(line, 3, 2, "toc year")), r.integer(line, 6, 2, "toc month"),
-        r.integer(line, 9, 2, "toc day"), r.integer(line, 12, 2, "toc hour"),
-        r.integer(line, 15, 2, "toc minute"), r.number(line, 17, 5, "toc second"));
-    e.af0_s = r.number(line, 22, 19, "af0");
-    e.af1_sps = r.number(line, 41, 19, "af1");
-    e.af2_sps2 = r.number(line, 60, 19, "af2");
+    if (major == 3) {
+      e.toc_s = gpsSecondsFromCalendar(
+          r.integer(line, 4, 4, "toc year"), r.integer(line, 9, 2, "toc month"),
+          r.integer(line, 12, 2, "toc day"), r.integer(line, 15, 2, "toc hour"),
+          r.integer(line, 18, 2, "toc minute"), r.number(line, 21, 2, "toc second"));
+    } else {
+      e.toc_s = gpsSecondsFromCalendar(
+          fullYear(r.integer(line, 3, 2, "toc year")), r.integer(line, 6, 2, "toc month"),
+          r.integer(line, 9, 2, "toc day"), r.integer(line, 12, 2, "toc hour"),
+          r.integer(line, 15, 2, "toc minute"), r.number(line, 17, 5, "toc second"));
+    }
+    e.af0_s = r.number(line, 22 + shift, 19, "af0");
+    e.af1_sps = r.number(line, 41 + shift, 19, "af1");
+    e.af2_sps2 = r.number(line, 60 + shift, 19, "af2");
     // Broadcast orbit lines 1-7: four 19-column fields from column 4.
     static constexpr const char* kNames[7][4] = {
         {"IODE", "Crs", "Delta n", "M0"},
@@ -249,9 +349,10 @@ RinexNavigationFile readNavigationFile(std::istream& in, const std::string& name
     for (std::size_t k = 0; k < 7; ++k) {
       const std::string orbit = r.require("a broadcast orbit record");
       for (std::size_t j = 0; j < 4; ++j) {
-        const std::string field = r.column(orbit, 3 + 19 * j, 19);
+        const std::size_t col = 3 + shift + 19 * j;
+        const std::string field = r.column(orbit, col, 19);
         // Spare fields and the optional fit interval of the last line may be blank.
-        o[k][j] = LineReader::blank(field) ? 0.0 : r.number(orbit, 3 + 19 * j, 19, kNames[k][j]);
+        o[k][j] = LineReader::blank(field) ? 0.0 : r.number(orbit, col, 19, kNames[k][j]);
       }
     }
     e.iode = o[0][0];

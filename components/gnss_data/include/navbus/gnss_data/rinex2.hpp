@@ -1,13 +1,16 @@
-// Readers for RINEX 2.10/2.11 GPS observation and navigation files (Gurtner, "RINEX: The
-// Receiver Independent Exchange Format Version 2.10"). Fixed-column text, read line by line;
-// any malformed field stops the read with an error naming the file, the line, the field and
-// the text found. What the readers skip on purpose (event records, satellites of other
+// Readers for RINEX 2.10/2.11 and 3.0x GPS observation and navigation files (Gurtner, "RINEX:
+// The Receiver Independent Exchange Format Version 2.10"; IGS/RTCM, "RINEX Version 3.04"): the
+// GPS observables of a mixed RINEX 3 file (its "SYS / # / OBS TYPES" for G, e.g. C1C D1C) and
+// its GPS ephemerides; other systems' satellites and records are counted. Fixed-column text, read
+// line by line; any malformed field stops the read with an error naming the file, the line, the
+// field and the text found. What the readers skip on purpose (event records, satellites of other
 // systems, satellites without the requested observable) is counted, never dropped silently.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <istream>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -43,8 +46,12 @@ struct RinexObservationEpoch {
 
 struct RinexObservationFile {
   std::string version;
+  int major_version{2};
   std::string marker;
-  std::vector<std::string> types;  ///< "C1", "L1", "P2", ... in file order
+  /// The GPS observables in file order: "C1", "L1", "P2", ... (RINEX 2), "C1C", "D1C", ...
+  /// (RINEX 3, the G line of "SYS / # / OBS TYPES").
+  std::vector<std::string> types;
+  std::map<char, std::vector<std::string>> system_types;  ///< RINEX 3: every system's
   Eigen::Vector3d approx_position_ecef_m{Eigen::Vector3d::Zero()};
   double interval_s{0.0};
   std::vector<RinexObservationEpoch> epochs;
@@ -63,6 +70,7 @@ struct RinexNavigationFile {
   bool has_iono{false};
   int leap_seconds{0};
   std::vector<core::gps::BroadcastEphemeris> ephemerides;
+  std::uint64_t other_systems{0};  ///< RINEX 3: records of other systems, skipped
 };
 
 /// Reads a whole GPS navigation file (RINEX 2 "N").
