@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <sstream>
 
 namespace navbus::gnss_data {
@@ -185,6 +186,21 @@ int RinexObservationFile::typeIndex(const std::string& type) const {
 
 namespace {
 
+/// An epoch with flag 2..6 carries `count` special records (header lines, cycle slips): they
+/// are skipped and counted. True when the epoch was one.
+bool skippedEvent(LineReader& r, int flag, int count, RinexObservationFile& f) {
+  if (flag < 2) return false;
+  for (int i = 0; i < count; ++i) r.require("an event record");
+  ++f.event_records;
+  return true;
+}
+
+/// One observation field (F14.3 in 16 columns), or nothing when blank.
+std::optional<double> observation(const LineReader& r, const std::string& line, std::size_t col) {
+  if (LineReader::blank(r.column(line, col, 14))) return std::nullopt;
+  return r.number(line, col, 14, "observation");
+}
+
 /// RINEX 3 epochs: "> yyyy mm dd hh mm ss.sssssss  f nnn", then one line per satellite
 /// ("G10" and 16 columns per observable of its system).
 void readObservationsV3(LineReader& r, RinexObservationFile& f) {
@@ -194,11 +210,7 @@ void readObservationsV3(LineReader& r, RinexObservationFile& f) {
     if (line[0] != '>') r.fail("'" + line.substr(0, 20) + "' is not an epoch record ('>')");
     const int flag = r.integer(line, 31, 1, "epoch flag");
     const int count = r.integer(line, 32, 3, "number of satellites");
-    if (flag >= 2) {
-      for (int i = 0; i < count; ++i) r.require("an event record");
-      ++f.event_records;
-      continue;
-    }
+    if (skippedEvent(r, flag, count, f)) continue;
     RinexObservationEpoch e;
     e.flag = flag;
     e.time_s =
@@ -211,14 +223,8 @@ void readObservationsV3(LineReader& r, RinexObservationFile& f) {
       s.system = sat[0] == ' ' ? 'G' : sat[0];
       s.prn = r.integer(sat, 1, 2, "satellite number");
       if (s.system == 'G') {
-        for (std::size_t k = 0; k < f.types.size(); ++k) {
-          const std::string field = r.column(sat, 3 + 16 * k, 14);
-          if (LineReader::blank(field)) {
-            s.values.emplace_back();
-          } else {
-            s.values.emplace_back(r.number(sat, 3 + 16 * k, 14, "observation"));
-          }
-        }
+        for (std::size_t k = 0; k < f.types.size(); ++k)
+          s.values.push_back(observation(r, sat, 3 + 16 * k));
       }
       e.satellites.push_back(std::move(s));
     }
@@ -242,12 +248,7 @@ RinexObservationFile readObservationFile(std::istream& in, const std::string& na
     if (LineReader::blank(line)) continue;
     const int flag = r.integer(line, 28, 1, "epoch flag");
     const int count = r.integer(line, 29, 3, "number of satellites");
-    if (flag >= 2) {
-      // Special records: `count` lines follow (header lines or cycle-slip records).
-      for (int i = 0; i < count; ++i) r.require("an event record");
-      ++f.event_records;
-      continue;
-    }
+    if (skippedEvent(r, flag, count, f)) continue;
     RinexObservationEpoch e;
     e.flag = flag;
     e.time_s = gpsSecondsFromCalendar(
@@ -260,14 +261,8 @@ RinexObservationFile readObservationFile(std::istream& in, const std::string& na
       s.prn = prn;
       for (std::size_t l = 0; l < lines_per_sat; ++l) {
         const std::string obs_line = r.require("an epoch's observations");
-        for (std::size_t k = 0; k < 5 && s.values.size() < f.types.size(); ++k) {
-          const std::string field = r.column(obs_line, 16 * k, 14);
-          if (LineReader::blank(field)) {
-            s.values.emplace_back();
-          } else {
-            s.values.emplace_back(r.number(obs_line, 16 * k, 14, "observation"));
-          }
-        }
+        for (std::size_t k = 0; k < 5 && s.values.size() < f.types.size(); ++k)
+          s.values.push_back(observation(r, obs_line, 16 * k));
       }
       e.satellites.push_back(std::move(s));
     }
