@@ -247,10 +247,14 @@ TEST(Rinex3, TheWalksConvbinDefaultOutputReadsAsItsRinex2) {
         const auto& a = s3.values[static_cast<std::size_t>(c3)];
         const auto& b = s2.values[static_cast<std::size_t>(c2)];
         ASSERT_EQ(a.has_value(), b.has_value()) << "epoch " << i << " G" << s3.prn;
-        if (a) EXPECT_DOUBLE_EQ(*a, *b);
+        if (a) {
+          EXPECT_DOUBLE_EQ(*a, *b);
+        }
         const auto& da = s3.values[static_cast<std::size_t>(d3)];
         const auto& db = s2.values[static_cast<std::size_t>(d2)];
-        if (da && db) EXPECT_DOUBLE_EQ(*da, *db);
+        if (da && db) {
+          EXPECT_DOUBLE_EQ(*da, *db);
+        }
         ++compared;
       }
     }
