@@ -176,13 +176,11 @@ TEST(Replay, TheImportedRealDriveReplaysBitIdentical) {
 }
 
 // The real walk (config/datasets/walk_0827.yaml) imported with a 2 m/s ramp in G10's
-// pseudoranges from 40 s, then replayed as fast as the readers take it into navbus-filter
-// (tightly coupled on the walk's own pseudoranges and Doppler) and the fault manager (the GLR):
-// the same decisions, commands and solutions as `navbus offline --recording ... --fault-manager`,
-// bit for bit. Domain 69.
-#ifndef NAVBUS_WALK_REPLAY_SPEED
-#define NAVBUS_WALK_REPLAY_SPEED "10"
-#endif
+// pseudoranges from 40 s, then replayed at 10x real time into navbus-filter (tightly coupled on
+// the walk's own pseudoranges and Doppler) and the fault manager (the GLR): the same commands
+// and solutions as `navbus offline --recording ... --fault-manager`, bit for bit, apart from the
+// wall-clock FAULT_NO_FAULT_MONITOR flag (as fast as the readers take it, the rewinds for late
+// commands differ: tests/integration/CMakeLists.txt). Domain 69.
 TEST(Replay, TheImportedRealWalkWithARampReplaysBitIdentical) {
   constexpr int kDomain = 69;
   test::cleanSharedMemory();
@@ -233,7 +231,7 @@ TEST(Replay, TheImportedRealWalkWithARampReplaysBitIdentical) {
   test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
   test::ChildProcess replay(
       NAVBUS_TOOL_EXE,
-      {"-d", std::to_string(kDomain), "replay", rec, "--speed", NAVBUS_WALK_REPLAY_SPEED, "--min-readers",
+      {"-d", std::to_string(kDomain), "replay", rec, "--speed", "10", "--min-readers",
        "navbus/imu/increment_block=2", "--min-readers", "navbus/gnss/observations=2"},
       (dir / "replay.log").string());
   while (replay.running()) me.spinOnce(50ms);

@@ -335,7 +335,8 @@ int runRealCarBenchmark(const RealCarOptions& o) {
   std::ofstream epochs(out_dir / "errors.csv");
   epochs << "run,gpst_s,outage,error_h_m,sigma_h_m\n";
   epochs.write(causal.epoch_lines.data(), static_cast<std::streamsize>(causal.epoch_lines.size()));
-  std::string written = "solution.csv, outages.csv, scores.csv, errors.csv";
+  std::string written = outages.empty() ? "solution.csv, scores.csv, errors.csv"
+                                        : "solution.csv, outages.csv, scores.csv, errors.csv";
   if (o.smooth) {
     std::vector<AntennaPoint> smoothed;
     smoothed.reserve(run.smoothed.size());
@@ -354,7 +355,7 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     scores << scoreLine("smoothed", backward);
     epochs.write(backward.epoch_lines.data(),
                  static_cast<std::streamsize>(backward.epoch_lines.size()));
-    written += ", smoothed.csv, smoothed_outages.csv";
+    written += outages.empty() ? ", smoothed.csv" : ", smoothed.csv, smoothed_outages.csv";
   }
   if (dataset.gnss_observations) {
     // The receiver's own pseudoranges alone, epoch by epoch: what the filter adds to them.
