@@ -25,9 +25,11 @@
   With --scenario, times are seconds from the scenario's start (timing.start); without, from
   the first row of the file.
   plot_navbus.py realcar BENCH_DIR -o OUT_DIR [--name NAME]
-      from `navbus benchmark real-car ... -o BENCH_DIR [--smooth]`: the antenna's trajectory
-      with the GNSS outages marked, and per outage the horizontal error against the filter's
-      3-sigma (and the smoother's, with --smooth) -> NAME.png (default real_car)
+      from `navbus benchmark real-car ... -o BENCH_DIR [--smooth]` (or `real-data`): the
+      antenna's trajectory with the GNSS outages marked, and per outage the horizontal error
+      against the filter's 3-sigma (and the smoother's, with --smooth) -> NAME.png (default
+      real_car). A benchmark run without outages (no outages.csv) gives the trajectory and the
+      horizontal error of every judged epoch against 3-sigma, per run (filter, spp, smoothed).
   plot_navbus.py demo SCENARIO DEMO_DIR -o OUT_DIR
       the main demo's figures (errors, with/without the fault manager, GLR statistic) from
       scripts/demo.sh's output directory
@@ -298,15 +300,78 @@ def _local_en(lat_deg, lon_deg, lat0_deg, lon0_deg):
     return east, north
 
 
-def realcar(bench_dir, out_dir, name="real_car"):
+RUN_COLOURS = {"filter": "tab:blue", "smoothed": "tab:green", "spp": "tab:orange"}
+
+
+def _trajectory(bench_dir):
+    """Times [GPS s of week] and east, north [m] of the filter's antenna from solution.csv."""
     sol = read_csv(os.path.join(bench_dir, "solution.csv"))
-    outages = read_csv(os.path.join(bench_dir, "outages.csv"))
-    epochs = read_csv(os.path.join(bench_dir, "errors.csv"))
     t = np.array([float(r["gpst_s"]) for r in sol])
     lat = np.array([float(r["lat_deg"]) for r in sol])
     lon = np.array([float(r["lon_deg"]) for r in sol])
     east, north = _local_en(lat, lon, lat[0], lon[0])
-    runs = sorted({r["run"] for r in epochs}, key=lambda x: x != "filter")
+    return t, east, north
+
+
+def _runs(epochs):
+    return sorted({r["run"] for r in epochs}, key=lambda x: x != "filter")
+
+
+def realdata(bench_dir, out_dir, name):
+    """A benchmark run without outages: trajectory, and every judged epoch's horizontal error
+    against 3 sigma, one panel per run (the filter, single point positioning, the smoother)."""
+    t, east, north = _trajectory(bench_dir)
+    epochs = read_csv(os.path.join(bench_dir, "errors.csv"))
+    runs = _runs(epochs)
+    fig = plt.figure(figsize=(15, 5.5))
+    grid = fig.add_gridspec(len(runs), 2, width_ratios=[1, 1.6])
+    ax = fig.add_subplot(grid[:, 0])
+    ref = [r for r in epochs if r["run"] == runs[0]]
+    sol = read_csv(os.path.join(bench_dir, "solution.csv"))
+    lat0, lon0 = float(sol[0]["lat_deg"]), float(sol[0]["lon_deg"])
+    ref_e, ref_n = _local_en(np.array([float(r["ref_lat_deg"]) for r in ref]),
+                             np.array([float(r["ref_lon_deg"]) for r in ref]), lat0, lon0)
+    ax.plot(ref_e, ref_n, ".", color="k", ms=2.5, label="reference (receiver's fixed RTK)")
+    ax.plot(east, north, color=RUN_COLOURS["filter"], lw=0.8, label="filter (causal), antenna")
+    ax.plot(east[0], north[0], "o", color=RUN_COLOURS["filter"], label="filter's first solution")
+    ax.set_xlabel("east [m]")
+    ax.set_ylabel("north [m]")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(f"{name}: trajectory")
+    t0 = min(float(r["gpst_s"]) for r in epochs)
+    first = None
+    for i, run in enumerate(runs):
+        sel = [r for r in epochs if r["run"] == run]
+        ts = np.array([float(r["gpst_s"]) - t0 for r in sel])
+        err = np.array([float(r["error_h_m"]) for r in sel])
+        sig = np.array([float(r["sigma_h_m"]) for r in sel])
+        a = fig.add_subplot(grid[i, 1], sharex=first)
+        first = first or a
+        c = RUN_COLOURS.get(run, "k")
+        rms = math.sqrt(float(np.mean(err**2))) if len(err) else float("nan")
+        inside = 100.0 * float(np.mean(err <= 3 * sig)) if len(err) else float("nan")
+        a.plot(ts, err, color=c, lw=1.0,
+               label=f"{run}: horizontal error (RMS {rms:.2f} m, {len(err)} epochs)")
+        a.plot(ts, 3 * sig, color=c, lw=0.9, ls="--",
+               label=f"{run}: own 3 sigma ({inside:.1f} % inside)")
+        a.set_ylabel("horizontal [m]")
+        a.grid(True, lw=0.3)
+        a.legend(fontsize=7, loc="upper right")
+        a.set_ylim(bottom=0.0)
+        if i == len(runs) - 1:
+            a.set_xlabel("s from the first judged epoch")
+    fig.suptitle(f"{name}: horizontal error against the receiver's fixed RTK epochs")
+    return _save(fig, out_dir, f"{name}.png")
+
+
+def realcar(bench_dir, out_dir, name="real_car"):
+    if not os.path.exists(os.path.join(bench_dir, "outages.csv")):
+        return realdata(bench_dir, out_dir, name)
+    outages = read_csv(os.path.join(bench_dir, "outages.csv"))
+    epochs = read_csv(os.path.join(bench_dir, "errors.csv"))
+    t, east, north = _trajectory(bench_dir)
+    runs = _runs(epochs)
     n = len(outages)
     cols = 5
     rows = (n + cols - 1) // cols
@@ -325,7 +390,7 @@ def realcar(bench_dir, out_dir, name="real_car"):
     ax.set_aspect("equal", adjustable="datalim")
     ax.legend(loc="best", fontsize=8)
     ax.set_title(f"{name}: trajectory and GNSS outages")
-    colours = {"filter": "tab:blue", "smoothed": "tab:green"}
+    colours = RUN_COLOURS
     bars = fig.add_subplot(grid[0, 3:])
     labels = [o["outage"] for o in outages]
     x = np.arange(len(labels))

@@ -27,15 +27,19 @@ echo "montecarlo faults.csv: $detected of 4 runs detected"
   --filter "$src/config/filter_drive_0708.yaml" \
   --outages "$src/config/datasets/drive_0708_outages.txt" --smooth -o "$work/real" \
   > "$work/real.log" 2>&1 || { cat "$work/real.log"; exit 1; }
+"$navbus" benchmark real-data "$src/config/datasets/walk_0827.yaml" \
+  --filter "$src/config/filter_walk_0827_tc.yaml" -o "$work/walk" \
+  > "$work/walk.log" 2>&1 || { cat "$work/walk.log"; exit 1; }
 py=/usr/bin/python3
 $py "$src/scripts/plot_navbus.py" realcar "$work/real" --name drive_0708 -o "$work/fig"
+$py "$src/scripts/plot_navbus.py" realcar "$work/walk" --name walk_0827 -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" errors "$work/with" -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" compare "$work/with" "$work/without" -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" spectrum "$work/raw/imu_raw.csv" --before 40 --after 40.2 \
   --axis x -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" glr "$work/with" -o "$work/fig" --scenario "$scenario"
 $py "$src/scripts/plot_navbus.py" montecarlo "$work/mc" -o "$work/fig"
-for f in errors with_without_fault_manager spectrum_x glr nees detection_delay drive_0708; do
+for f in errors with_without_fault_manager spectrum_x glr nees detection_delay drive_0708 walk_0827; do
   size=$(stat -c %s "$work/fig/$f.png" 2>/dev/null || echo 0)
   echo "figure $f.png: $size bytes"
   [ "$size" -gt 20000 ] || { echo "figure $f.png missing or trivial"; exit 1; }

@@ -128,7 +128,7 @@ struct Scored {
   double available_rms_m{0.0};
   double available_inside{0.0};  ///< share of GNSS-available epochs inside 3 sigma_h
   /// Every judged epoch (errors.csv): run, GPS s of week, outage (0: GNSS available), error
-  /// and 1-sigma [m].
+  /// and 1-sigma [m], the reference position [deg].
   fmt::memory_buffer epoch_lines;
 };
 
@@ -148,6 +148,16 @@ void appendPoint(const AntennaPoint& p, const std::string& tail, fmt::memory_buf
 /// How a GNSS-available epoch is judged: a causal filter once it fused the epoch's fix, a
 /// smoothed run between its epochs, single point positioning at its own epoch.
 enum class Judging { kAfterFusion, kInterpolated, kNearest };
+
+/// One line of errors.csv: the run, the reference epoch's time and position, which outage it
+/// falls in (0: GNSS available) and the judged horizontal error and 1-sigma [m].
+void appendEpoch(const std::string& run, std::int64_t time_ns, int outage,
+                 const earth::Geodetic& reference, const Judged& judged, fmt::memory_buffer& out) {
+  fmt::format_to(fmt::appender(out), "{},{:.3f},{},{:.4f},{:.4f},{:.10f},{:.10f}\n", run,
+                 1e-9 * static_cast<double>(secondsOfWeekNs(time_ns)), outage, judged.horizontal_m,
+                 judged.sigma_h_m, reference.latitude_rad / units::kDeg,
+                 reference.longitude_rad / units::kDeg);
+}
 
 Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
              const importers::PosLog& reference, const std::vector<Outage>& outages,
@@ -175,17 +185,13 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
         available_sum += e->horizontal_m * e->horizontal_m;
         ++r.available;
         available_inside += e->horizontal_m <= 3.0 * e->sigma_h_m ? 1 : 0;
-        fmt::format_to(fmt::appender(r.epoch_lines), "{},{:.3f},0,{:.4f},{:.4f}\n", run,
-                       1e-9 * static_cast<double>(secondsOfWeekNs(t)), e->horizontal_m,
-                       e->sigma_h_m);
+        appendEpoch(run, t, 0, truth, *e, r.epoch_lines);
       }
       continue;
     }
     const auto judged = judge(points, t, truth);
     if (!judged) continue;
-    fmt::format_to(fmt::appender(r.epoch_lines), "{},{:.3f},{},{:.4f},{:.4f}\n", run,
-                   1e-9 * static_cast<double>(secondsOfWeekNs(t)), k + 1, judged->horizontal_m,
-                   judged->sigma_h_m);
+    appendEpoch(run, t, k + 1, truth, *judged, r.epoch_lines);
     OutageScore& s = r.outages[static_cast<std::size_t>(k)];
     ++s.epochs;
     s.end_error_m = judged->horizontal_m;  // the last one judged is the end
@@ -333,7 +339,7 @@ int runRealCarBenchmark(const RealCarOptions& o) {
                  out_dir / "outages.csv", o.outages);
   scores << scoreLine("filter", causal);
   std::ofstream epochs(out_dir / "errors.csv");
-  epochs << "run,gpst_s,outage,error_h_m,sigma_h_m\n";
+  epochs << "run,gpst_s,outage,error_h_m,sigma_h_m,ref_lat_deg,ref_lon_deg\n";
   epochs.write(causal.epoch_lines.data(), static_cast<std::streamsize>(causal.epoch_lines.size()));
   std::string written = outages.empty() ? "solution.csv, scores.csv, errors.csv"
                                         : "solution.csv, outages.csv, scores.csv, errors.csv";

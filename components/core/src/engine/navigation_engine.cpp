@@ -291,7 +291,11 @@ StateMatrix NavigationEngine::alignedCovariance(const AlignedStart& a) const {
 
 void NavigationEngine::startFromAlignment() {
   // The clock from the pseudorange solution when there was one.
-  const AlignedStart& a = aligner_->start();
+  AlignedStart a = aligner_->start();
+  // The aligner placed the IMU where the antenna is: move it back along the lever arm.
+  const Eigen::Vector3d& lever_b = config_.antenna_lever_arm_b_m;
+  a.state.position = earth::offsetNed(a.state.position, -(a.state.q_b_to_n * lever_b));
+  a.state.vel_ned_mps -= a.state.q_b_to_n * bodyRate().cross(lever_b);
   double clock_bias_m = config_.initial_clock_bias_m;
   double clock_drift_mps = config_.initial_clock_drift_mps;
   if (a.has_clock) {
@@ -448,7 +452,8 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
         pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_->state().position));
     if (pf.valid) checkHeadingFromCourse(pf.fix.vel_ned_mps, pf.fix.vel_sigma_ned_mps.x());
   }
-  const std::vector<MeasurementReport>& reports = filter_->update(used_);
+  const std::vector<MeasurementReport>& reports =
+      filter_->update(used_, AntennaArm{config_.antenna_lever_arm_b_m, bodyRate()});
   for (const auto& rep : reports) {
     counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
   }

@@ -206,7 +206,7 @@ InnovationWindow<3>* IntegratedFilter::window(AidingKind kind) {
 }
 
 const std::vector<MeasurementReport>& IntegratedFilter::update(
-    const std::vector<SatelliteObservation>& sats) {
+    const std::vector<SatelliteObservation>& sats, const AntennaArm& antenna) {
   ErrorState& es = structure_ == FusionStructure::kFederated ? local_[kGnssLocal] : central_;
   const auto m = static_cast<Eigen::Index>(2 * sats.size());
   EpochDiagnostics& d = last_epoch_;
@@ -219,7 +219,8 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   Eigen::VectorXd r(m);
   for (std::size_t i = 0; i < sats.size(); ++i) {
     const auto& sat = sats[i];
-    const RangePrediction p = predictRange(ins_.state(), clock_bias_m_, clock_drift_mps_, sat);
+    const RangePrediction p =
+        predictRange(ins_.state(), clock_bias_m_, clock_drift_mps_, sat, antenna);
     const auto row = static_cast<Eigen::Index>(2 * i);
     // Innovations in the error-state form z = H dx + v: predicted minus measured (seed 000 eq. 5).
     d.innovation[row] = p.pseudorange_m - sat.pseudorange_m;

@@ -325,10 +325,8 @@ double GlrMonitor::vInv(int i, int j) const {
 bool GlrMonitor::biasAndClockRowsSparse() const {
   // Random-constant biases and a clock that only the clock drives (the layout's error model)
   // make the bias and clock rows of Phi [0 I 0] and [0 0 Phi_clock] exactly, and G H only
-  // adds support columns.
-  constexpr int kNav = layout::kAtt.end();
-  return b_.block<kStates - kNav, layout::kAtt.dof>(kNav, layout::kAtt.index).isZero(0.0) &&
-         b_.block<kBiasStates, kBiasStates>(kBiasIndex, kBiasIndex).isIdentity(0.0) &&
+  // adds support columns (attitude among them: the lever arm's).
+  return b_.block<kBiasStates, kBiasStates>(kBiasIndex, kBiasIndex).isIdentity(0.0) &&
          b_.block<kSupportTail.dof, kBiasStates>(kSupportTail.index, kBiasIndex).isZero(0.0);
 }
 
@@ -339,7 +337,7 @@ void GlrMonitor::propagate() {
   const auto in = mu_.leftCols(columns);
   auto out = mu_next_.leftCols(columns);
   if (biasAndClockRowsSparse()) {
-    // Bias and clock rows: B = [0 I 0] + B(:, support): 11 x 8 per column instead of 11 x n.
+    // Bias and clock rows: B = [0 I 0] + B(:, support): 11 x 11 per column instead of 11 x n.
     constexpr int kNav = layout::kAtt.end();  // position, velocity, attitude rows
     constexpr int kLower = kStates - kNav;    // bias and clock rows
     // (Eigen's kernels work on blocks of 4 rows: 8 rows as a product, the 9th alone.)

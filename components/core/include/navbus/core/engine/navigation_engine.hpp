@@ -100,7 +100,8 @@ struct EngineConfig {
   IntegrityConfig integrity;
   /// The filter's test of its own innovations, and when it re-initialises.
   ConsistencyConfig consistency;
-  /// The GNSS antenna's offset from the IMU [m, body axes]: fixes are of the antenna.
+  /// The GNSS antenna's offset from the IMU [m, body axes]: fixes and pseudoranges are of the
+  /// antenna.
   Eigen::Vector3d antenna_lever_arm_b_m{Eigen::Vector3d::Zero()};
   /// Post-processing: where the filter records what the fixed-interval smoother needs
   /// (rts_smoother.hpp); nullptr (the default, and always on the bus): nothing recorded.

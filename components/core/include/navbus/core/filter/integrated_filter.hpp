@@ -67,7 +67,9 @@ class IntegratedFilter {
   /// reused from epoch to epoch, valid until the next call). Rows a satellite's use_range /
   /// use_rate exclude are monitored only: their innovations are in the diagnostics (for the
   /// fault monitor's readmission test) but they do not update the filter.
-  const std::vector<MeasurementReport>& update(const std::vector<SatelliteObservation>& sats);
+  /// The ranges are predicted at the antenna, `antenna` away from the IMU.
+  const std::vector<MeasurementReport>& update(const std::vector<SatelliteObservation>& sats,
+                                               const AntennaArm& antenna = {});
   /// Processes an aiding measurement, one decorrelated row at a time.
   template <int M>
   std::array<ScalarUpdateResult, M> update(const AidingMeasurement<M>& m, AidingKind kind);

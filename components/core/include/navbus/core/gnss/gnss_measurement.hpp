@@ -36,11 +36,24 @@ struct RangePrediction {
   Eigen::Matrix<double, 1, layout::kSize> h_rate;
 };
 
-/// Predicts the measurements of `sat` from the INS state and the clock estimates. With
-/// error = estimate - truth, a predicted-minus-measured innovation z = H dx + noise, where
-/// H_range = [-l^T 0 0 0 0 1 0] and H_rate = [0 -l^T 0 0 0 0 1] (l = line of sight in NED;
-/// the rate's dependence on position through l is neglected, as in seed 000 eq. 5).
+/// Where the antenna is from the IMU: the lever arm in body axes and the body's angular rate
+/// relative to NED (which moves the antenna around the IMU). Zero: the antenna is at the IMU.
+struct AntennaArm {
+  Eigen::Vector3d lever_arm_b_m{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d rate_nb_b_radps{Eigen::Vector3d::Zero()};
+};
+
+/// Predicts the measurements of `sat` at the antenna from the INS state and the clock
+/// estimates. With error = estimate - truth, a predicted-minus-measured innovation
+/// z = H dx + noise, where (seed 000 eq. 5, l = line of sight in NED, a = C_b_n lever the
+/// antenna's offset in NED, b = C_b_n (w_nb x lever) its velocity about the IMU)
+///   H_range: -l^T on the position error, -l^T [a x] on the attitude error, 1 on the clock bias;
+///   H_rate:  -l^T on the velocity error, -l^T [b x] on the attitude error, 1 on the drift.
+/// The attitude columns follow
+/// from C_b_n,est = (I - [phi x]) C_b_n, as in the loosely coupled rows
+/// (aiding_measurements.hpp). The rate's dependence on position through l is neglected, as in
+/// seed 000 eq. 5, and so is the gyro-bias error's share of the antenna velocity.
 RangePrediction predictRange(const NavState& ins, double clock_bias_m, double clock_drift_mps,
-                             const SatelliteObservation& sat);
+                             const SatelliteObservation& sat, const AntennaArm& antenna = {});
 
 }  // namespace navbus::core

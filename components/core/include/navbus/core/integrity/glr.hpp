@@ -48,17 +48,20 @@ inline constexpr int kMaxDirections = kImuDirections + kSatDirections * kMaxSate
 /// (ramps are sums of steps, see glr.cpp).
 inline constexpr int kMaxPropagated = kImuDirections + 2 * kMaxSatellites;
 inline constexpr int kMaxWindow = 100;  ///< largest configurable window M [epochs]
-/// The states pseudorange and rate rows measure: position and velocity (the first six) and the
-/// clock bias and drift (the last two). f and R see a signature only through H, so they are
-/// accumulated on these eight states; an epoch whose H reaches others is refused.
-inline constexpr StateBlock kSupportHead{layout::kPos.index, layout::kPos.dof + layout::kVel.dof};
+/// The states pseudorange and rate rows measure: position, velocity and attitude (the first
+/// nine; attitude through the antenna's lever arm, gnss_measurement.hpp) and the clock bias and
+/// drift (the last two). f and R see a signature only through H, so they are accumulated on
+/// these eleven states; an epoch whose H reaches others is refused.
+inline constexpr StateBlock kSupportHead{layout::kPos.index,
+                                         layout::kPos.dof + layout::kVel.dof + layout::kAtt.dof};
 inline constexpr StateBlock kSupportTail{layout::kClockBias.index,
                                          layout::kClockBias.dof + layout::kClockDrift.dof};
 inline constexpr int kSupport = kSupportHead.dof + kSupportTail.dof;
 static_assert(kSupportHead.index == 0 && layout::kVel.index == layout::kPos.end() &&
+                  layout::kAtt.index == layout::kVel.end() &&
                   layout::kClockDrift.index == layout::kClockBias.end() &&
                   kSupportTail.end() == kStates,
-              "the GLR's support is position, velocity (leading) and clock (trailing)");
+              "the GLR's support is position, velocity, attitude (leading) and clock (trailing)");
 
 using RowVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRows, 1>;
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, kMaxRows>;
