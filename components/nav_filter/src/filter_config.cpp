@@ -171,6 +171,7 @@ void parseAuthorities(const YAML::Node& root, FilterConfig& c) {
         .value("identity", w.identity)
         .seconds("timeout_s", w.timeout_ns, {0.1, 3600.0})
         .seconds("judgement_wait_s", w.judgement_wait_ns, {0.001, 3600.0})
+        .value("judged_from_start", w.judged_from_start)
         .finish();
     c.fault_monitor = w;
   }

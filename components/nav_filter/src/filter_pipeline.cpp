@@ -38,8 +38,9 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
     s.push_back({{kRankStarTracker, c.star_tracker->id}, c.star_tracker->period_ns});
   // The fault manager's commands: sporadic, and held for where a judgement is owed.
   const bool monitored = c.fault_monitor.has_value();
-  s.push_back(
-      {kCommandStream, 0, true, monitored, monitored ? c.fault_monitor->judgement_wait_ns : 0});
+  s.push_back({kCommandStream, 0, true, monitored,
+               monitored ? c.fault_monitor->judgement_wait_ns : 0,
+               monitored && c.fault_monitor->judged_from_start});
   return s;
 }
 
@@ -177,6 +178,7 @@ void FilterPipeline::startNewRun() {
   diagnostics_seq_ = 0;
   published_up_to_ns_ = -1;
   diagnosed_up_to_ns_ = -1;
+  owed_judgement_ns_ = -1;
   judged_up_to_ns_ = -1;
   time_reference_.latest_ns = 0;
   for (bus::StreamGate* g : {&gnss_obs_gate_, &gnss_fix_gate_, &star_gate_})
@@ -268,14 +270,15 @@ bool FilterPipeline::mergeLate(StreamId id, std::int64_t time_ns, FilterInput& i
 
 void FilterPipeline::publishDiagnostics() {
   if (!sinks_.diagnostics) return;
-  sequencer_.owe(kCommandStream, engine_.state().time_ns);  // a command may answer it
+  owed_judgement_ns_ = engine_.state().time_ns;
+  sequencer_.owe(kCommandStream, owed_judgement_ns_);  // a command may answer it
   sinks_.diagnostics(bus::toIdl(engine_.lastEpoch(), config_.vehicle_id, ++diagnostics_seq_,
                                 engine_.state().time_ns));
 }
 
 bool FilterPipeline::monitored() const {
-  if (judgements_.reports() == 0 || diagnosed_up_to_ns_ < 0) return flags_.faultMonitorAlive();
-  return judged_up_to_ns_ >= diagnosed_up_to_ns_;
+  if (judgements_.reports() == 0 || owed_judgement_ns_ < 0) return flags_.faultMonitorAlive();
+  return judged_up_to_ns_ >= owed_judgement_ns_;
 }
 
 void FilterPipeline::publishSolution() {

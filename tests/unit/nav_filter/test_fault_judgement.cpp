@@ -61,9 +61,10 @@ FaultMonitorProgress progress(const FilterDiagnostics& d, std::uint64_t last_com
 
 /// The reference: the command applied within the callback of the epoch it answers, as
 /// `navbus offline` runs the fault manager.
-void answerInTime(FilterRun& run, FilterCommand (*make)(std::uint64_t)) {
-  run.on_diagnostics = [&run, make](const FilterDiagnostics& d) {
-    if (run.diagnostics.size() == kJudgedEpoch + 1) run.pipeline->onCommand(make(d.time_gps_ns()));
+void answerInTime(FilterRun& run, FilterCommand (*make)(std::uint64_t),
+                  std::size_t epoch = kJudgedEpoch) {
+  run.on_diagnostics = [&run, make, epoch](const FilterDiagnostics& d) {
+    if (run.diagnostics.size() == epoch + 1) run.pipeline->onCommand(make(d.time_gps_ns()));
   };
 }
 
@@ -74,13 +75,14 @@ struct DelayedMonitor {
   FilterCommand (*make)(std::uint64_t);
   long command_first_by{0};
   std::size_t delay_frames{kDelayFrames};
+  std::size_t answered_epoch{kJudgedEpoch};  ///< the diagnostics epoch the command answers
   std::deque<std::pair<std::size_t, std::function<void()>>> due;  ///< frame, delivery
 
   void attach() {
     run.on_diagnostics = [this](const FilterDiagnostics& d) {
       const std::size_t at = frameNow + delay_frames;
-      const bool answers = run.diagnostics.size() == kJudgedEpoch + 1;
-      const std::uint64_t last_id = run.diagnostics.size() > kJudgedEpoch ? 1 : 0;
+      const bool answers = run.diagnostics.size() == answered_epoch + 1;
+      const std::uint64_t last_id = run.diagnostics.size() > answered_epoch ? 1 : 0;
       if (answers) {
         const FilterCommand c = make(d.time_gps_ns());
         schedule(static_cast<std::size_t>(static_cast<long>(at) - command_first_by),
@@ -125,7 +127,8 @@ TEST(FaultJudgement, TheOutputWaitsForEachEpochsJudgementAndEqualsOffline) {
   for (const long command_first_by : {20L, 0L, -20L}) {  // the report may overtake the command
     FilterRun offline(config), bus(config);
     answerInTime(offline, compensateGyroX);
-    DelayedMonitor monitor{bus, compensateGyroX, command_first_by, kDelayFrames, {}};
+    DelayedMonitor monitor{bus, compensateGyroX, command_first_by, kDelayFrames, kJudgedEpoch,
+                          {}};
     monitor.attach();
     offline.play(all);
     bus.play(all);
@@ -147,7 +150,7 @@ TEST(FaultJudgement, WithoutWaitingTheOutputDiffersOnlyUntilTheCommandCame) {
   const auto config = tightlyCoupled(40.0);
   FilterRun offline(config), bus(config);
   answerInTime(offline, compensateGyroX);
-  DelayedMonitor monitor{bus, compensateGyroX, 0, kDelayFrames, {}};
+  DelayedMonitor monitor{bus, compensateGyroX, 0, kDelayFrames, kJudgedEpoch, {}};
   monitor.attach();
   offline.play(all);
   bus.play(all);
@@ -170,7 +173,7 @@ TEST(FaultJudgement, AJudgedEpochIsMonitoredWhateverTheParticipantsClockSaid) {
   answerInTime(offline, compensateGyroX);
   // Within an epoch (kDelayFrames would hold each epoch's successors for longer than an epoch,
   // and the last ones would only be flushed, unjudged, at the end of the data).
-  DelayedMonitor monitor{bus, compensateGyroX, 0, 50, {}};
+  DelayedMonitor monitor{bus, compensateGyroX, 0, 50, kJudgedEpoch, {}};
   monitor.attach();
   const auto deliver = bus.before_frame;
   bus.before_frame = [&bus, deliver](std::size_t k) {
@@ -191,6 +194,37 @@ TEST(FaultJudgement, AJudgedEpochIsMonitoredWhateverTheParticipantsClockSaid) {
   EXPECT_EQ(bus.solutions.back().active_fault_flags() & FAULT_NO_FAULT_MONITOR, 0u);
 }
 
+TEST(FaultJudgement, AMonitorExpectedFromTheStartIsWaitedForBeforeItsFirstReport) {
+  // The fault manager answers the very first diagnostics epoch, 1.5 s later, before it has
+  // reported anything (a replay as fast as the readers take it outruns its start).
+  const std::vector<Frame> all = frames(kFrames);
+  std::size_t differing_without = 0;
+  for (const bool from_start : {true, false}) {
+    const auto config = tightlyCoupled(
+        40.0, std::string("fault_monitor: {participant: navbus-fault-manager, ") +
+                  "judgement_wait_s: 1000, judged_from_start: " + (from_start ? "true" : "false") +
+                  "}\n");
+    FilterRun offline(config), bus(config);
+    answerInTime(offline, compensateGyroX, 0);
+    DelayedMonitor monitor{bus, compensateGyroX, 0, kDelayFrames, 0, {}};
+    monitor.attach();
+    offline.play(all);
+    bus.play(all);
+    ASSERT_EQ(offline.solutions.size(), bus.solutions.size());
+    std::size_t differing = 0;
+    for (std::size_t k = 0; k < offline.solutions.size(); ++k)
+      differing += sameBits(offline.solutions[k], bus.solutions[k]) ? 0 : 1;
+    const std::string summary = bus.pipeline->summary();
+    if (from_start) {
+      EXPECT_EQ(differing, 0u) << summary;
+      EXPECT_NE(summary.find(") late 0"), std::string::npos) << summary;
+    } else {
+      differing_without = differing;
+    }
+  }
+  EXPECT_GT(differing_without, 0u) << "without it, the first judgement is not waited for";
+}
+
 class LateCommand : public ::testing::TestWithParam<FilterCommand (*)(std::uint64_t)> {};
 
 TEST_P(LateCommand, GivesTheFullInTimeStateBitForBit) {
@@ -198,7 +232,7 @@ TEST_P(LateCommand, GivesTheFullInTimeStateBitForBit) {
   const auto config = tightlyCoupled(40.0);
   FilterRun in_time(config), late(config);
   answerInTime(in_time, GetParam());
-  DelayedMonitor monitor{late, GetParam(), 0, kDelayFrames, {}};
+  DelayedMonitor monitor{late, GetParam(), 0, kDelayFrames, kJudgedEpoch, {}};
   monitor.attach();
   in_time.play(all);
   late.play(all);

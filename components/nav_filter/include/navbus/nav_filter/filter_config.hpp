@@ -36,6 +36,9 @@ struct FaultMonitorWatch {
   /// (FaultMonitorProgress) before it goes on without [ns]: longer than the monitor's stalls
   /// the output should ride through (a command that comes later is merged by rewinding).
   std::int64_t judgement_wait_ns{5'000'000'000};
+  /// The monitor runs from the start: the output waits for its first judgement too (at most
+  /// judgement_wait_ns if it never reports), not only once it has reported.
+  bool judged_from_start{false};
 };
 
 struct FilterConfig {

@@ -224,6 +224,9 @@ class FilterPipeline {
   /// after a rewind is not published twice.
   std::int64_t published_up_to_ns_{-1};
   std::int64_t diagnosed_up_to_ns_{-1};
+  /// The data time of the latest diagnostics published, the state's (a GNSS epoch between two
+  /// IMU increments is diagnosed at the increment before it): what the monitor must judge.
+  std::int64_t owed_judgement_ns_{-1};
   std::int64_t judged_up_to_ns_{-1};  ///< the fault manager's judgement counted up to here
 };
 

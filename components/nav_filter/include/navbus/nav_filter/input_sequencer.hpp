@@ -51,6 +51,9 @@ class InputSequencer {
     bool judging{false};
     /// How long this stream may hold the head back [wall ns] (0: the sequencer's max_wait).
     std::int64_t max_wait_ns{0};
+    /// Judging: its judge is expected from the start, so the first owed judgement holds the
+    /// others back as later ones do (otherwise only once the judge has reported at all).
+    bool judged_from_start{false};
   };
   enum class PushResult { kQueued, kLate, kUnexpected };
 
@@ -58,6 +61,8 @@ class InputSequencer {
     for (const auto& e : expected) {
       State state{e.period_ns, e.sporadic, e.judging};
       state.max_wait_ns = e.max_wait_ns > 0 ? e.max_wait_ns : max_wait_ns;
+      state.judged_from_start = e.judging && e.judged_from_start;
+      state.seen = state.judged_from_start;
       streams_.emplace(e.id, state);
     }
   }
@@ -155,8 +160,8 @@ class InputSequencer {
     last_released_ = Key{0, {}};
     head_blocked_since_ns_ = -1;
     for (auto& [id, s] : streams_) {
-      s.seen = id == first;
-      s.active = id == first;
+      s.seen = id == first || s.judged_from_start;
+      s.active = s.seen;
       s.last_time_ns = 0;
       s.owed_up_to_ns = -1;
       s.judged_up_to_ns = -1;
@@ -205,6 +210,7 @@ class InputSequencer {
     std::int64_t period_ns;
     bool sporadic{false};
     bool judging{false};
+    bool judged_from_start{false};
     bool seen{false};
     bool active{true};
     std::int64_t last_time_ns{0};
