@@ -127,8 +127,7 @@ TEST(FaultJudgement, TheOutputWaitsForEachEpochsJudgementAndEqualsOffline) {
   for (const long command_first_by : {20L, 0L, -20L}) {  // the report may overtake the command
     FilterRun offline(config), bus(config);
     answerInTime(offline, compensateGyroX);
-    DelayedMonitor monitor{bus, compensateGyroX, command_first_by, kDelayFrames, kJudgedEpoch,
-                          {}};
+    DelayedMonitor monitor{bus, compensateGyroX, command_first_by, kDelayFrames, kJudgedEpoch, {}};
     monitor.attach();
     offline.play(all);
     bus.play(all);
