@@ -7,6 +7,8 @@ launcher=()
 if command -v ccache > /dev/null; then
   # Cached by content, paths relative to the checkout: another clone rebuilds from the cache.
   export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
+  # The normal and the sanitizer builds together need about 7 GB (ccache's default is 5 GB).
+  export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-12G}
   launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
 cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" > build/configure.log 2>&1 ||

@@ -9,13 +9,22 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh --sanitizers
 mkdir -p build-san
 t0=$SECONDS
+launcher=()
+if command -v ccache > /dev/null; then
+  # As scripts/build.sh: cached by content, paths relative to the checkout.
+  export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
+  # The normal and the sanitizer builds together need about 7 GB (ccache's default is 5 GB).
+  export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-12G}
+  launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
 # Line tables only: the sanitizers' stack traces keep file and line, and the build of the
 # Eigen-heavy sources does not carry full debug information (their largest cost here).
 CC=clang CXX=clang++ cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
   -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
   -DNAVBUS_SANITIZE=address,undefined -DNAVBUS_BUILD_FUZZERS=ON \
-  -DNAVBUS_BUILD_BENCHMARKS=OFF -DNAVBUS_BUILD_INTEROP=OFF > build-san/configure.log 2>&1 ||
+  -DNAVBUS_BUILD_BENCHMARKS=OFF -DNAVBUS_BUILD_INTEROP=OFF "${launcher[@]}" \
+  > build-san/configure.log 2>&1 ||
   { cat build-san/configure.log; exit 1; }
 cmake --build build-san -j"$(nproc)"
 echo "sanitizers: build $((SECONDS - t0)) s"

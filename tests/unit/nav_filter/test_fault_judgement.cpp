@@ -224,6 +224,30 @@ TEST(FaultJudgement, AMonitorExpectedFromTheStartIsWaitedForBeforeItsFirstReport
   EXPECT_GT(differing_without, 0u) << "without it, the first judgement is not waited for";
 }
 
+TEST(FaultJudgement, AnEpochBetweenIncrementsIsMonitoredOnceItsDiagnosticsAreJudged) {
+  // A real receiver's epochs fall between IMU increments: 4 ms after one here. The filter
+  // diagnoses an epoch at its state's time, the increment before it, and the fault manager
+  // reports that time judged; the solutions after it are under its watch.
+  std::vector<Frame> all = frames(kFrames);
+  for (Frame& frame : all)
+    for (Sample& sample : frame)
+      if (auto* epoch = std::get_if<GnssObservationEpoch>(&sample))
+        epoch->time_gps_ns(epoch->time_gps_ns() + 4'000'000);
+  FilterRun bus(tightlyCoupled(40.0, kMonitored));
+  bus.on_diagnostics = [&bus](const FilterDiagnostics& d) {
+    bus.pipeline->onFaultMonitorProgress(progress(d, 0));  // judged at once
+  };
+  bus.play(all);
+  ASSERT_GT(bus.diagnostics.size(), 10u);
+  EXPECT_EQ(bus.diagnostics.front().time_gps_ns() % 10'000'000, 0u) << "at an increment";
+  std::size_t flagged = 0;
+  for (const NavigationSolution& s : bus.solutions) {
+    if (s.time_gps_ns() <= bus.diagnostics.front().time_gps_ns()) continue;
+    flagged += (s.active_fault_flags() & FAULT_NO_FAULT_MONITOR) != 0 ? 1 : 0;
+  }
+  EXPECT_EQ(flagged, 0u) << "of " << bus.solutions.size();
+}
+
 class LateCommand : public ::testing::TestWithParam<FilterCommand (*)(std::uint64_t)> {};
 
 TEST_P(LateCommand, GivesTheFullInTimeStateBitForBit) {
