@@ -18,8 +18,12 @@ if command -v ccache > /dev/null; then
   launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
 # Line tables only: the sanitizers' stack traces keep file and line, and the build of the
-# Eigen-heavy sources does not carry full debug information (their largest cost here).
+# Eigen-heavy sources does not carry full debug information (their largest cost here). A unity
+# build (8 sources a unit; the test programs whose files share helper names are left out in
+# tests/) parses the Eigen and Fast DDS headers once per unit: about 9 instead of 15 minutes
+# on 2 cores without a cache.
 CC=clang CXX=clang++ cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=8 \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
   -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
   -DNAVBUS_SANITIZE=address,undefined -DNAVBUS_BUILD_FUZZERS=ON \

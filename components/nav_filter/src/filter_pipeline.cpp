@@ -17,17 +17,6 @@ namespace navbus::nav_filter {
 
 namespace {
 
-constexpr int rankOf(bus::StreamKind kind) {
-  return bus::streamInfo(kind).merge_rank;
-}
-constexpr int kRankImu = rankOf(bus::StreamKind::kImu);
-constexpr int kRankGnssObs = rankOf(bus::StreamKind::kGnssObservations);
-constexpr int kRankGnssFix = rankOf(bus::StreamKind::kGnssFix);
-constexpr int kRankStarTracker = rankOf(bus::StreamKind::kStarTracker);
-static_assert(kRankCommand > kRankImu && kRankCommand > kRankGnssObs &&
-                  kRankCommand > kRankGnssFix && kRankCommand > kRankStarTracker,
-              "a command follows every measurement of its data time");
-
 std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const FilterConfig& c) {
   std::vector<InputSequencer<FilterInput>::ExpectedStream> s;
   s.push_back({{kRankImu, c.imu.id}, c.imu.period_ns});

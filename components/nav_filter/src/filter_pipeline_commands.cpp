@@ -8,10 +8,6 @@
 
 namespace navbus::nav_filter {
 
-namespace {
-constexpr int kRankImu = bus::streamInfo(bus::StreamKind::kImu).merge_rank;
-}  // namespace
-
 bool FilterPipeline::countRecovery(bool restored) {
   ++(restored ? counters_.onset_recoveries : counters_.onset_beyond_history);
   return restored;

@@ -12,9 +12,9 @@ using navbus::core::ConsistencyMonitor;
 namespace {
 
 constexpr std::int64_t kEpochNs = 1'000'000'000;
-constexpr int kRows = 16;
+constexpr int kEpochRows = 16;
 
-/// `epochs` epochs of kRows normalized innovations scaled by `scale` (1: consistent).
+/// `epochs` epochs of kEpochRows normalized innovations scaled by `scale` (1: consistent).
 ConsistencyMonitor feed(const ConsistencyConfig& config, int epochs, double scale, unsigned seed) {
   ConsistencyMonitor m;
   m.configure(config);
@@ -22,11 +22,11 @@ ConsistencyMonitor feed(const ConsistencyConfig& config, int epochs, double scal
   std::normal_distribution<double> n(0.0, scale);
   for (int k = 0; k < epochs; ++k) {
     double nis = 0.0;
-    for (int i = 0; i < kRows; ++i) {
+    for (int i = 0; i < kEpochRows; ++i) {
       const double v = n(rng);
       nis += v * v;
     }
-    m.onEpoch(k * kEpochNs, nis, kRows);
+    m.onEpoch(k * kEpochNs, nis, kEpochRows);
   }
   return m;
 }
@@ -67,8 +67,8 @@ TEST(ConsistencyMonitor, ABriefExcessAlarmsWithoutAskingForReinitialisation) {
   ConsistencyMonitor m;
   m.configure(c);
   for (int k = 0; k < 40; ++k) {
-    const double nis = (k >= 20 && k < 22) ? 400.0 : kRows;  // two bad epochs
-    m.onEpoch(k * kEpochNs, nis, kRows);
+    const double nis = (k >= 20 && k < 22) ? 400.0 : kEpochRows;  // two bad epochs
+    m.onEpoch(k * kEpochNs, nis, kEpochRows);
   }
   EXPECT_EQ(m.counters().alarms, 1u);
   EXPECT_EQ(m.counters().reinitialisations, 0u);

@@ -35,9 +35,17 @@
 
 namespace navbus::nav_filter {
 
+/// The sensor streams' places in the ordered merge at equal data times (bus/streams.hpp).
+inline constexpr int kRankImu = bus::streamInfo(bus::StreamKind::kImu).merge_rank;
+inline constexpr int kRankGnssObs = bus::streamInfo(bus::StreamKind::kGnssObservations).merge_rank;
+inline constexpr int kRankGnssFix = bus::streamInfo(bus::StreamKind::kGnssFix).merge_rank;
+inline constexpr int kRankStarTracker = bus::streamInfo(bus::StreamKind::kStarTracker).merge_rank;
 /// A command follows the measurements of its data time (the epoch its decision was taken at)
-/// in the ordered merge; the sensor streams' ranks are in bus/streams.hpp.
+/// in the ordered merge.
 inline constexpr int kRankCommand = 4;
+static_assert(kRankCommand > kRankImu && kRankCommand > kRankGnssObs &&
+                  kRankCommand > kRankGnssFix && kRankCommand > kRankStarTracker,
+              "a command follows every measurement of its data time");
 /// The commands' place in the merge (one stream, whoever issues them).
 inline constexpr StreamId kCommandStream{kRankCommand, 0};
 
