@@ -108,12 +108,17 @@ struct DelayedMonitor {
   std::size_t frameNow{0};
 };
 
-void expectSameSolutions(const FilterRun& a, const FilterRun& b) {
-  ASSERT_EQ(a.solutions.size(), b.solutions.size());
+/// Solutions of two runs of the same length that differ in their bits.
+std::size_t differingSolutions(const FilterRun& a, const FilterRun& b) {
   std::size_t differing = 0;
   for (std::size_t k = 0; k < a.solutions.size(); ++k)
     differing += sameBits(a.solutions[k], b.solutions[k]) ? 0 : 1;
-  EXPECT_EQ(differing, 0u) << "of " << a.solutions.size();
+  return differing;
+}
+
+void expectSameSolutions(const FilterRun& a, const FilterRun& b) {
+  ASSERT_EQ(a.solutions.size(), b.solutions.size());
+  EXPECT_EQ(differingSolutions(a, b), 0u) << "of " << a.solutions.size();
 }
 
 const std::string kMonitored =
@@ -154,9 +159,7 @@ TEST(FaultJudgement, WithoutWaitingTheOutputDiffersOnlyUntilTheCommandCame) {
   offline.play(all);
   bus.play(all);
   ASSERT_EQ(offline.solutions.size(), bus.solutions.size());
-  std::size_t differing = 0;
-  for (std::size_t k = 0; k < offline.solutions.size(); ++k)
-    differing += sameBits(offline.solutions[k], bus.solutions[k]) ? 0 : 1;
+  const std::size_t differing = differingSolutions(offline, bus);
   EXPECT_GT(differing, 0u) << "the test would not see a missing wait";
   EXPECT_LE(differing, kDelayFrames + 1) << "only those published before the command came";
   EXPECT_NE(bus.pipeline->summary().find(") late 1"), std::string::npos) << bus.pipeline->summary();
@@ -210,9 +213,7 @@ TEST(FaultJudgement, AMonitorExpectedFromTheStartIsWaitedForBeforeItsFirstReport
     offline.play(all);
     bus.play(all);
     ASSERT_EQ(offline.solutions.size(), bus.solutions.size());
-    std::size_t differing = 0;
-    for (std::size_t k = 0; k < offline.solutions.size(); ++k)
-      differing += sameBits(offline.solutions[k], bus.solutions[k]) ? 0 : 1;
+    const std::size_t differing = differingSolutions(offline, bus);
     const std::string summary = bus.pipeline->summary();
     if (from_start) {
       EXPECT_EQ(differing, 0u) << summary;
