@@ -1,20 +1,28 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages navbus needs, only those missing. Run as root.
+# --package: only what building the package needs (the Docker image's build stage).
 # --sanitizers adds clang and its sanitizer and libFuzzer runtimes (scripts/sanitize.sh).
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config git ccache              # ccache: a rebuild of the same sources is quick
-  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools   # Fast DDS 2.9, Fast-CDR, code generator, CLI
+  libfastrtps-dev libfastcdr-dev fastddsgen                # Fast DDS 2.9, Fast-CDR, code generator
+  python3                                                  # IDL schemas for MCAP recordings (idl/idl_schemas.py)
   libeigen3-dev libfftw3-dev libboost-dev                  # math (Boost.Math: noncentral chi-square)
   libyaml-cpp-dev libcli11-dev libspdlog-dev               # configuration, command line, logging
   libcsv-dev libtinyxml2-dev                               # CSV recordings (navbus replay), QoS files
-  libgtest-dev libbenchmark-dev                            # tests and benchmarks
-  cyclonedds-dev cyclonedds-tools                          # second DDS vendor for the interop test
-  iproute2                                                 # network namespaces for the topology test
-  time                                                     # GNU time: peak RSS in scripts/bench.sh
-  rtklib                                                   # rnx2rtkp: independent GPS fixes for the real-data test
-  python3-matplotlib python3-yaml                          # demo summary and figures (scripts/*.py)
+  zlib1g-dev libzstd-dev                                   # MCAP recordings: CRC-32, zstd chunks
 )
+if [ "${1:-}" != --package ]; then
+  packages+=(
+    fastdds-tools                                          # Fast DDS CLI (discovery server)
+    libgtest-dev libbenchmark-dev                          # tests and benchmarks
+    cyclonedds-dev cyclonedds-tools                        # second DDS vendor for the interop test
+    iproute2                                               # network namespaces for the topology test
+    time                                                   # GNU time: peak RSS in scripts/bench.sh
+    rtklib                                                 # rnx2rtkp: independent GPS fixes for the real-data test
+    python3-matplotlib python3-yaml                        # demo summary and figures (scripts/*.py)
+  )
+fi
 if [ "${1:-}" = --sanitizers ]; then
   packages+=(clang libclang-rt-14-dev llvm)          # ASan, UBSan, libFuzzer; llvm-symbolizer
 fi

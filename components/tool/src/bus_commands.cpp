@@ -18,9 +18,10 @@ class ReplayCommand final : public Subcommand {
         "publish a `navbus record` recording's sensor topics back onto the bus, content unchanged, "
         "paced by their data times (or the recorded source time stamps) scaled by --speed; the "
         "streams are disposed at the end");
-    cli_->add_option("dir", replay.dir, "the recording's directory")
+    cli_->add_option("recording", replay.recording,
+                     "the recording: its directory of CSV files, or its MCAP file")
         ->required()
-        ->check(CLI::ExistingDirectory);
+        ->check(CLI::ExistingPath);
     cli_->add_option("--speed", replay.speed, "1: as recorded, 10: ten times faster, 0: no pacing")
         ->check(CLI::Range(0.0, 1e6));
     cli_->add_option("--pace", replay.pace,

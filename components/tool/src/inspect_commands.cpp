@@ -1,5 +1,5 @@
 // `navbus topics`, `echo` and `record`: what is on the bus, one topic's samples, every
-// chosen topic into CSV files.
+// chosen topic into CSV files or one MCAP file.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +16,7 @@
 
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
+#include "navbus/tool/record_sinks.hpp"
 #include "navbus/tool/topic_registry.hpp"
 #include "subcommand.hpp"
 
@@ -76,15 +77,13 @@ class EchoSink : public SampleSink {
   EchoSink(bool csv, const std::string& header, std::uint64_t limit) : csv_(csv), limit_(limit) {
     if (csv_) std::cout << header << "\n";
   }
-  void onSample(const std::string& topic, const SampleTimes&,
-                const std::function<std::string()>& text,
-                const std::function<std::vector<std::string>()>& rows) override {
+  void onSample(const std::string& topic, const SampleTimes&, const SampleViews& sample) override {
     if (limit_ > 0 && count_ >= limit_) return;  // one dispatch round may hold more samples
     ++count_;
     if (csv_) {
-      for (const auto& r : rows()) std::cout << r << "\n";
+      for (const auto& r : sample.csv_rows()) std::cout << r << "\n";
     } else {
-      std::cout << "--- " << topic << " #" << count_ << "\n" << text();
+      std::cout << "--- " << topic << " #" << count_ << "\n" << sample.text();
     }
     std::cout.flush();
   }
@@ -94,46 +93,6 @@ class EchoSink : public SampleSink {
   bool csv_;
   std::uint64_t limit_;
   std::uint64_t count_{0};
-};
-
-/// Writes one CSV file per topic: the message's columns, then when it was written (DDS source
-/// time stamp) and received [ns, system clocks], so that `navbus replay` can pace it.
-class RecordSink : public SampleSink {
- public:
-  void open(const TopicEntry& e, const std::filesystem::path& dir) {
-    const std::filesystem::path path = dir / recordFileName(e.name);
-    auto& f = files_[e.name];
-    f.stream = std::make_unique<std::ofstream>(path);
-    if (!*f.stream) throw std::runtime_error("cannot write " + path.string());
-    *f.stream << e.csv_header << ",source_timestamp_ns,reception_timestamp_ns\n";
-  }
-  void onSample(const std::string& topic, const SampleTimes& times,
-                const std::function<std::string()>&,
-                const std::function<std::vector<std::string>()>& rows) override {
-    auto& f = files_.at(topic);
-    ++f.samples;
-    last_sample_ = std::chrono::steady_clock::now();
-    for (const auto& r : rows()) {
-      *f.stream << r << ',' << times.source_ns << ',' << times.reception_ns << '\n';
-    }
-  }
-  void flush() {
-    for (auto& [name, f] : files_) f.stream->flush();
-  }
-  std::uint64_t samples(const std::string& topic) const { return files_.at(topic).samples; }
-  /// Seconds since the last sample of any topic; negative before the first.
-  double idleSeconds() const {
-    if (!last_sample_) return -1.0;
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - *last_sample_).count();
-  }
-
- private:
-  struct File {
-    std::unique_ptr<std::ofstream> stream;
-    std::uint64_t samples{0};
-  };
-  std::map<std::string, File> files_;
-  std::optional<std::chrono::steady_clock::time_point> last_sample_;
 };
 
 const TopicEntry& requireTopic(const std::string& name) {
@@ -211,10 +170,17 @@ class EchoCommand final : public Subcommand {
 class RecordCommand final : public Subcommand {
  public:
   void add(CLI::App& app) override {
-    cli_ = app.add_subcommand("record", "record topics into CSV files, one per topic");
+    cli_ = app.add_subcommand("record",
+                              "record topics into CSV files, one per topic, or into one MCAP file");
     cli_->add_option("topics", record_topics, "topic names");
     cli_->add_flag("--all", record_all, "every navbus topic");
-    cli_->add_option("-o,--out", out_dir, "output directory (created)")->required();
+    cli_->add_option("-o,--out", out, "csv: the output directory (created); mcap: the output file")
+        ->required();
+    cli_->add_option("--format", format,
+                     "csv: a file per topic (navbus replay, offline); mcap: one MCAP file, a "
+                     "channel per topic with its schema and the samples' CDR bytes (Foxglove, "
+                     "the mcap CLI, navbus replay)")
+        ->check(CLI::IsMember({"csv", "mcap"}));
     cli_->add_option("-n,--count", count,
                      "stop when every topic has this many samples (exit 1 if not reached)");
     cli_->add_option("--idle", idle_s,
@@ -225,9 +191,16 @@ class RecordCommand final : public Subcommand {
   }
   bool inspectsBus() const override { return true; }
   int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
-    std::filesystem::create_directories(out_dir);
+    std::unique_ptr<RecordSink> sink_owner;
+    if (format == "mcap") {
+      const auto parent = std::filesystem::path(out).parent_path();
+      if (!parent.empty()) std::filesystem::create_directories(parent);
+      sink_owner = std::make_unique<McapRecordSink>(out, options.dds.ros2_names);
+    } else {
+      sink_owner = std::make_unique<CsvRecordSink>(out);
+    }
+    RecordSink& sink = *sink_owner;
     nb::bus::Participant p(options, shutdown);
-    RecordSink sink;
     std::vector<const TopicEntry*> entries;
     if (record_all) {
       for (const auto& t : topicRegistry()) record_topics.push_back(t.name);
@@ -237,7 +210,7 @@ class RecordCommand final : public Subcommand {
     }
     for (const auto& t : record_topics) {
       entries.push_back(&requireTopic(t));
-      sink.open(*entries.back(), out_dir);
+      sink.open(*entries.back());
       entries.back()->subscribe(p, sink);
     }
     auto all_counted = [&] {
@@ -248,7 +221,7 @@ class RecordCommand final : public Subcommand {
       return true;
     };
     runFor(p, duration_s, all_counted);
-    sink.flush();
+    sink.finish();
     bool reached = true;
     for (const auto* e : entries) {
       spdlog::info("recorded {} samples of {}", sink.samples(e->name), e->name);
@@ -259,7 +232,8 @@ class RecordCommand final : public Subcommand {
 
  private:
   std::vector<std::string> record_topics;
-  std::string out_dir;
+  std::string out;
+  std::string format{"csv"};
   bool record_all{false};
   double idle_s{0.0};
   std::uint64_t count{0};

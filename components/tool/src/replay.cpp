@@ -11,6 +11,7 @@
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/streams.hpp"
 #include "navbus/records/csv_messages.hpp"
+#include "navbus/records/mcap.hpp"
 #include "navbus/tool/spin.hpp"
 #include "navbus/tool/topic_registry.hpp"
 
@@ -58,24 +59,13 @@ template <class PubSubType>
 class TypedStream : public Stream {
  public:
   using T = typename PubSubType::type;
-  TypedStream(std::string topic, std::string profile, const records::CsvTable& table)
-      : topic_(std::move(topic)), profile_(std::move(profile)) {
-    const auto ranges = records::messageRowRanges(table);
-    messages_ = records::parseMessages<T>(table, ranges);
-    if (table.has(kSourceTimeColumn)) {
-      const std::size_t column = table.column(kSourceTimeColumn);
-      for (const auto& [first, count] : ranges) {
-        const std::string& cell = table.rows[first][column];
-        std::int64_t ns = 0;
-        const auto [ptr, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), ns);
-        if (ec != std::errc() || ptr != cell.data() + cell.size()) {
-          throw bus::ConfigError(table.file + " line " + std::to_string(first + 2) + " column '" +
-                                 kSourceTimeColumn + "': '" + cell + "' is not a valid number");
-        }
-        source_ns_.push_back(ns);
-      }
-    }
-  }
+  /// `source_ns`: one per message, or empty when the recording has no source time stamps.
+  TypedStream(std::string topic, std::string profile, std::vector<T> messages,
+              std::vector<std::int64_t> source_ns)
+      : topic_(std::move(topic)),
+        profile_(std::move(profile)),
+        messages_(std::move(messages)),
+        source_ns_(std::move(source_ns)) {}
   const std::string& topic() const override { return topic_; }
   std::size_t size() const override { return messages_.size(); }
   std::int64_t paceNs(std::size_t i, bool source_times) const override {
@@ -100,19 +90,90 @@ class TypedStream : public Stream {
   bus::Writer<T> writer_;
 };
 
-std::unique_ptr<Stream> loadStream(const std::string& topic, const std::filesystem::path& file) {
-  const records::CsvTable table = records::readCsv(file);
-  std::unique_ptr<Stream> stream;
+/// The recorded source time stamps of a CSV table's messages (empty without the column).
+std::vector<std::int64_t> csvSourceTimes(
+    const records::CsvTable& table,
+    const std::vector<std::pair<std::size_t, std::size_t>>& ranges) {
+  std::vector<std::int64_t> source_ns;
+  if (!table.has(kSourceTimeColumn)) return source_ns;
+  const std::size_t column = table.column(kSourceTimeColumn);
+  for (const auto& [first, count] : ranges) {
+    const std::string& cell = table.rows[first][column];
+    std::int64_t ns = 0;
+    const auto [ptr, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), ns);
+    if (ec != std::errc() || ptr != cell.data() + cell.size()) {
+      throw bus::ConfigError(table.file + " line " + std::to_string(first + 2) + " column '" +
+                             kSourceTimeColumn + "': '" + cell + "' is not a valid number");
+    }
+    source_ns.push_back(ns);
+  }
+  return source_ns;
+}
+
+/// Calls `f(traits_tag)` for the sensor message type published on `topic`.
+template <class F>
+void forSensorTopic(const std::string& topic, F&& f) {
   bus::forEachSensorMessage([&](auto tag) {
     using Traits = bus::SensorMessage<typename decltype(tag)::type>;
-    if (topic != Traits::kTopic.topic) return;
+    if (topic == Traits::kTopic.topic) f(Traits{});
+  });
+}
+
+std::unique_ptr<Stream> loadCsvStream(const std::string& topic, const std::filesystem::path& file) {
+  const records::CsvTable table = records::readCsv(file);
+  std::unique_ptr<Stream> stream;
+  forSensorTopic(topic, [&](auto traits) {
+    using Traits = decltype(traits);
+    using T = typename Traits::PubSubType::type;
+    const auto ranges = records::messageRowRanges(table);
     stream = std::make_unique<TypedStream<typename Traits::PubSubType>>(
-        topic, Traits::kTopic.writer_profile, table);
+        topic, Traits::kTopic.writer_profile, records::parseMessages<T>(table, ranges),
+        csvSourceTimes(table, ranges));
   });
   return stream;
 }
 
-std::vector<std::unique_ptr<Stream>> loadStreams(const ReplayOptions& o) {
+/// A recorded channel's messages decoded with the topic's type.
+std::unique_ptr<Stream> loadMcapStream(const std::string& file, const std::string& topic,
+                                       const records::McapChannel& channel,
+                                       const std::vector<const records::McapMessage*>& messages) {
+  if (channel.message_encoding != "cdr") {
+    throw bus::ConfigError(file + ": channel '" + channel.topic + "' has message encoding '" +
+                           channel.message_encoding + "', not cdr");
+  }
+  std::unique_ptr<Stream> stream;
+  forSensorTopic(topic, [&](auto traits) {
+    using Traits = decltype(traits);
+    using PubSubType = typename Traits::PubSubType;
+    using T = typename PubSubType::type;
+    PubSubType type;
+    std::vector<T> decoded(messages.size());
+    std::vector<std::int64_t> source_ns;
+    for (std::size_t i = 0; i < messages.size(); ++i) {
+      const auto& m = *messages[i];
+      eprosima::fastrtps::rtps::SerializedPayload_t payload(
+          static_cast<std::uint32_t>(m.data.size()));
+      std::copy(m.data.begin(), m.data.end(), payload.data);
+      payload.length = static_cast<std::uint32_t>(m.data.size());
+      if (!type.deserialize(&payload, &decoded[i])) {
+        throw bus::ConfigError(file + ": channel '" + channel.topic + "' message " +
+                               std::to_string(i + 1) + " (sequence " + std::to_string(m.sequence) +
+                               ") is not a valid " + type.getName());
+      }
+      source_ns.push_back(static_cast<std::int64_t>(m.publish_time_ns));
+    }
+    stream = std::make_unique<TypedStream<PubSubType>>(topic, Traits::kTopic.writer_profile,
+                                                       std::move(decoded), std::move(source_ns));
+  });
+  return stream;
+}
+
+/// The navbus topic a recorded channel carries: its name, or under ROS 2 naming "/" + name.
+std::string navbusTopic(const std::string& channel_topic) {
+  return channel_topic.rfind('/', 0) == 0 ? channel_topic.substr(1) : channel_topic;
+}
+
+void checkReplayable(const ReplayOptions& o) {
   const auto& replayable = replayableTopics();
   for (const auto& t : o.topics) {
     if (std::find(replayable.begin(), replayable.end(), t) == replayable.end()) {
@@ -121,20 +182,62 @@ std::vector<std::unique_ptr<Stream>> loadStreams(const ReplayOptions& o) {
       throw bus::ConfigError("topic '" + t + "' cannot be replayed; replayable topics:" + known);
     }
   }
+}
+
+std::vector<std::unique_ptr<Stream>> loadCsvStreams(const ReplayOptions& o) {
   std::vector<std::unique_ptr<Stream>> streams;
-  for (const auto& topic : o.topics.empty() ? replayable : o.topics) {
-    const std::filesystem::path file = std::filesystem::path(o.dir) / recordFileName(topic);
+  for (const auto& topic : o.topics.empty() ? replayableTopics() : o.topics) {
+    const std::filesystem::path file = std::filesystem::path(o.recording) / recordFileName(topic);
     if (!std::filesystem::exists(file)) {
       if (!o.topics.empty()) throw bus::ConfigError(file.string() + ": no such file");
       continue;
     }
-    auto stream = loadStream(topic, file);
-    spdlog::info("{}: {} samples of {}", file.string(), stream->size(), topic);
-    if (stream->size() > 0) streams.push_back(std::move(stream));  // nothing to wait a reader for
+    streams.push_back(loadCsvStream(topic, file));
+    spdlog::info("{}: {} samples of {}", file.string(), streams.back()->size(), topic);
   }
+  return streams;
+}
+
+std::vector<std::unique_ptr<Stream>> loadMcapStreams(const ReplayOptions& o) {
+  const records::McapContents contents = records::readMcap(o.recording);
+  std::map<std::string, std::uint16_t> channel_of_topic;
+  for (const auto& [id, channel] : contents.channels) {
+    channel_of_topic[navbusTopic(channel.topic)] = id;
+  }
+  std::map<std::uint16_t, std::vector<const records::McapMessage*>> by_channel;
+  for (const auto& m : contents.messages) by_channel[m.channel_id].push_back(&m);
+  std::vector<std::unique_ptr<Stream>> streams;
+  for (const auto& topic : o.topics.empty() ? replayableTopics() : o.topics) {
+    const auto channel = channel_of_topic.find(topic);
+    if (channel == channel_of_topic.end()) {
+      if (!o.topics.empty()) {
+        throw bus::ConfigError(o.recording + ": no channel of topic '" + topic + "'");
+      }
+      continue;
+    }
+    streams.push_back(loadMcapStream(o.recording, topic, contents.channels.at(channel->second),
+                                     by_channel[channel->second]));
+    spdlog::info("{}: {} samples of {}", o.recording, streams.back()->size(), topic);
+  }
+  return streams;
+}
+
+std::vector<std::unique_ptr<Stream>> loadStreams(const ReplayOptions& o) {
+  checkReplayable(o);
+  const bool mcap = std::filesystem::is_regular_file(o.recording);
+  if (mcap && !records::isMcapFile(o.recording)) {
+    throw bus::ConfigError(o.recording +
+                           ": neither a directory of CSV files nor an MCAP file (no MCAP magic)");
+  }
+  std::vector<std::unique_ptr<Stream>> streams = mcap ? loadMcapStreams(o) : loadCsvStreams(o);
+  // A topic without samples has no reader to wait for.
+  streams.erase(
+      std::remove_if(streams.begin(), streams.end(), [](const auto& s) { return s->size() == 0; }),
+      streams.end());
   if (streams.empty()) {
-    throw bus::ConfigError("no recording of a sensor topic in '" + o.dir +
-                           "' (navbus record writes navbus_imu_increment.csv, ...)");
+    throw bus::ConfigError("no recording of a sensor topic in '" + o.recording +
+                           "' (navbus record writes navbus_imu_increment.csv, ..., or one MCAP "
+                           "file with --format mcap)");
   }
   return streams;
 }

@@ -10,6 +10,18 @@
 namespace navbus::tool {
 
 namespace {
+
+template <class PubSubType>
+std::vector<std::uint8_t> serialized(const typename PubSubType::type& m) {
+  PubSubType type;
+  auto* data = const_cast<typename PubSubType::type*>(&m);  // the serializer only reads it
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(data)());
+  if (!type.serialize(data, &payload)) {
+    throw std::runtime_error(std::string("cannot serialize a sample of ") + type.getName());
+  }
+  return {payload.data, payload.data + payload.length};
+}
+
 template <class PubSubType>
 TopicEntry entry(const char* topic, const char* profile) {
   using T = typename PubSubType::type;
@@ -20,8 +32,9 @@ TopicEntry entry(const char* topic, const char* profile) {
         p.subscribe<PubSubType>(topic, profile, [topic, &sink](const T& m, const auto& info) {
           const SampleTimes times{info.source_timestamp.to_ns(), info.reception_timestamp.to_ns()};
           sink.onSample(
-              topic, times, [&m] { return records::textOf(m); },
-              [&m] { return records::csvRows(m); });
+              topic, times,
+              SampleViews{[&m] { return records::textOf(m); }, [&m] { return records::csvRows(m); },
+                          [&m] { return serialized<PubSubType>(m); }});
         });
       }};
 }

@@ -1,8 +1,10 @@
-// `navbus replay DIR`: a recording made by `navbus record` back onto the bus, so that a
-// recorded run can be re-run through a new filter. Every sensor topic with a file in DIR is
-// published with its recorded content (sequence numbers and data time stamps unchanged, bit for
-// bit: record writes shortest round-trip numbers), paced by the samples' data times (or, with
-// --pace source, by the DDS source time stamps record wrote beside them) scaled by --speed
+// `navbus replay RECORDING`: a recording made by `navbus record` back onto the bus, so that a
+// recorded run can be re-run through a new filter. RECORDING is a directory of CSV files or an
+// MCAP file. Every sensor topic recorded in it is published with its recorded content (sequence
+// numbers and data time stamps unchanged, bit for bit: record writes shortest round-trip numbers
+// to CSV, and the samples' CDR bytes to MCAP), paced by the samples' data times (or, with --pace
+// source, by the DDS source time stamps record wrote beside them: an MCAP message's publish
+// time) scaled by --speed
 // (0: as fast as the reliable writers take them). At the end each stream is disposed, as the
 // simulator does, so a filter knows the data ended rather than was lost.
 #pragma once
@@ -15,7 +17,8 @@
 namespace navbus::tool {
 
 struct ReplayOptions {
-  std::string dir;    ///< the recording: <topic with / as _>.csv per topic
+  /// The recording: a directory with <topic with / as _>.csv per topic, or an MCAP file.
+  std::string recording;
   double speed{1.0};  ///< 1: real time; 2: twice as fast; 0: no pacing
   /// "data": paced by the samples' data times (a fast-paced recording plays at the speed of its
   /// data); "source": by the recorded DDS source time stamps (the bus timing as recorded,

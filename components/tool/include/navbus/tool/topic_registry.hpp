@@ -17,12 +17,21 @@ struct SampleTimes {
   std::int64_t reception_ns{0};
 };
 
-/// Receives samples as text and CSV rows, computed only when asked for.
+/// One sample's renderings, each computed only when asked for.
+struct SampleViews {
+  std::function<std::string()> text;
+  std::function<std::vector<std::string>()> csv_rows;
+  /// The sample serialized by its type's own serializer: XCDR1 little endian with its 4-byte
+  /// encapsulation header, the bytes a navbus writer puts on the wire (DDS hands readers the
+  /// deserialized sample, so this is its re-serialization).
+  std::function<std::vector<std::uint8_t>()> cdr;
+};
+
+/// Receives samples.
 struct SampleSink {
   virtual ~SampleSink() = default;
   virtual void onSample(const std::string& topic, const SampleTimes& times,
-                        const std::function<std::string()>& text,
-                        const std::function<std::vector<std::string>()>& csv_rows) = 0;
+                        const SampleViews& sample) = 0;
 };
 
 struct TopicEntry {

@@ -1,0 +1,69 @@
+// What `navbus record` writes: one CSV file per topic (the message's columns, then its DDS source
+// and reception time stamps), or one MCAP file with a channel per topic (the sample's CDR bytes,
+// its reception time as the log time and its source time as the publish time, each topic's
+// type as a self-contained OMG IDL schema, or as a ROS 2 message definition under ROS 2 naming).
+// Both count the samples of each topic and when the last one came.
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "navbus/records/mcap.hpp"
+#include "navbus/tool/topic_registry.hpp"
+
+namespace navbus::tool {
+
+class RecordSink : public SampleSink {
+ public:
+  /// Prepares the topic's file or channel (before it is subscribed to).
+  virtual void open(const TopicEntry& topic) = 0;
+  /// Writes what is buffered and closes the recording.
+  virtual void finish() = 0;
+  std::uint64_t samples(const std::string& topic) const;
+  /// Seconds since the last sample of any topic; negative before the first.
+  double idleSeconds() const;
+
+ protected:
+  void counted(const std::string& topic);
+
+ private:
+  std::map<std::string, std::uint64_t> samples_;
+  std::optional<std::chrono::steady_clock::time_point> last_sample_;
+};
+
+/// One CSV file per topic in a directory (recordFileName()).
+class CsvRecordSink final : public RecordSink {
+ public:
+  explicit CsvRecordSink(std::filesystem::path dir);
+  void open(const TopicEntry& topic) override;
+  void onSample(const std::string& topic, const SampleTimes& times,
+                const SampleViews& sample) override;
+  void finish() override;
+
+ private:
+  std::filesystem::path dir_;
+  std::map<std::string, std::unique_ptr<std::ofstream>> files_;
+};
+
+/// One MCAP file; `ros2`: the bus runs under ROS 2 naming, so the channels carry the ROS 2
+/// topic names ("/navbus/imu/increment") and ros2msg schemas ("navbus/msg/ImuIncrement").
+class McapRecordSink final : public RecordSink {
+ public:
+  McapRecordSink(const std::filesystem::path& file, bool ros2);
+  void open(const TopicEntry& topic) override;
+  void onSample(const std::string& topic, const SampleTimes& times,
+                const SampleViews& sample) override;
+  void finish() override;
+
+ private:
+  bool ros2_;
+  records::McapWriter writer_;
+  std::map<std::string, std::uint16_t> schema_of_type_, channel_of_topic_;
+};
+
+}  // namespace navbus::tool

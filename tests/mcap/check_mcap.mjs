@@ -1,0 +1,239 @@
+// navbus's MCAP file read by Foxglove's own libraries, independent of navbus's reader:
+//   1. @mcap/core's stream reader reads every record front to back, checking the chunks' CRCs;
+//   2. its indexed reader opens the file from the footer (summary, statistics, chunk and
+//      message indexes) and reads every message through the index: the same messages, and the
+//      statistics' counts;
+//   3. every channel's schema is parsed by Foxglove's parser (OMG IDL: @foxglove/omgidl-parser;
+//      ROS 2 msg: @foxglove/rosmsg) and every message decoded from its CDR bytes
+//      (@foxglove/omgidl-serialization, @foxglove/rosmsg2-serialization);
+//   4. the decoded fields equal the CSV recording of the same run (navbus record --format csv),
+//      message by message, matched by their DDS source time stamps.
+// Usage: node check_mcap.mjs FILE.mcap CSV_DIR [--ros2]. Exits 1 naming the first difference.
+import { readFileSync, existsSync } from "node:fs";
+import { McapIndexedReader, McapStreamReader } from "@mcap/core";
+import { parseIDL } from "@foxglove/omgidl-parser";
+import { MessageReader as IdlReader } from "@foxglove/omgidl-serialization";
+import { parse as parseRosMsg } from "@foxglove/rosmsg";
+import { MessageReader as Ros2Reader } from "@foxglove/rosmsg2-serialization";
+import { decompress as zstdDecompress } from "fzstd";
+import { parse as parseCsv } from "csv-parse/sync";
+
+const [file, csvDir, ...flags] = process.argv.slice(2);
+const ros2 = flags.includes("--ros2");
+const bytes = new Uint8Array(readFileSync(file));
+const decompressHandlers = {
+  zstd: (data, size) => {
+    const out = zstdDecompress(data);
+    if (BigInt(out.length) !== size) throw new Error(`zstd chunk: ${out.length} != ${size} bytes`);
+    return out;
+  },
+};
+let failures = 0;
+const fail = (what) => {
+  failures += 1;
+  if (failures <= 20) console.log(`FAIL: ${what}`);
+};
+
+// 1. Every record, front to back.
+const stream = new McapStreamReader({ decompressHandlers, validateCrcs: true });
+stream.append(bytes);
+const streamed = [];
+const opcodes = new Map();
+for (let record; (record = stream.nextRecord()); ) {
+  opcodes.set(record.type, (opcodes.get(record.type) ?? 0) + 1);
+  if (record.type === "Message") streamed.push(record);
+}
+if (!stream.done()) fail("the stream reader did not reach the end of the file");
+console.log(`stream reader: ${[...opcodes].map(([k, v]) => `${v} ${k}`).join(", ")}`);
+
+// 2. Through the index.
+const readable = {
+  size: async () => BigInt(bytes.length),
+  read: async (offset, length) => bytes.subarray(Number(offset), Number(offset + length)),
+};
+const indexed = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+const stats = indexed.statistics;
+const viaIndex = [];
+for await (const m of indexed.readMessages({ validateCrcs: true })) viaIndex.push(m);
+console.log(
+  `indexed reader: ${indexed.chunkIndexes.length} chunk indexes, ${indexed.channelsById.size} ` +
+    `channels, ${indexed.schemasById.size} schemas, ${viaIndex.length} messages; statistics ` +
+    `${stats?.messageCount} messages, ${stats?.chunkCount} chunks`,
+);
+if (stats === undefined) fail("no Statistics record in the summary");
+if (BigInt(viaIndex.length) !== stats?.messageCount) fail("the index and the statistics disagree");
+if (viaIndex.length !== streamed.length) fail("the index and the stream disagree on the count");
+for (const [id, n] of stats?.channelMessageCounts ?? []) {
+  const counted = viaIndex.filter((m) => m.channelId === id).length;
+  if (BigInt(counted) !== n) fail(`channel ${id}: statistics ${n}, index ${counted}`);
+}
+const key = (m) => `${m.channelId}/${m.sequence}/${m.logTime}`;
+const byKey = new Map(streamed.map((m) => [key(m), m]));
+for (const m of viaIndex) {
+  const s = byKey.get(key(m));
+  if (!s || Buffer.compare(Buffer.from(s.data), Buffer.from(m.data)) !== 0) {
+    fail(`message ${key(m)} differs between the index and the stream`);
+  }
+}
+if (indexed.header.profile !== (ros2 ? "ros2" : "")) fail(`profile '${indexed.header.profile}'`);
+
+// 3 and 4. Decode every channel and compare with the CSV recording.
+let topicsCompared = 0;
+const recordFileName = (topic) => `${topic.replace(/^\//, "").replaceAll("/", "_")}.csv`;
+for (const channel of indexed.channelsById.values()) {
+  const schema = indexed.schemasById.get(channel.schemaId);
+  const messages = viaIndex.filter((m) => m.channelId === channel.id);
+  const expectedEncoding = ros2 ? "ros2msg" : "omgidl";
+  if (schema.encoding !== expectedEncoding || channel.messageEncoding !== "cdr") {
+    fail(`${channel.topic}: schema ${schema.encoding}, messages ${channel.messageEncoding}`);
+    continue;
+  }
+  const text = new TextDecoder().decode(schema.data);
+  let reader, enums;
+  if (ros2) {
+    const definitions = parseRosMsg(text, { ros2: true });
+    reader = new Ros2Reader(definitions);
+    enums = constants(definitions);
+  } else {
+    const definitions = parseIDL(text);
+    reader = new IdlReader(schema.name, definitions);
+    enums = constants(definitions);
+  }
+  const decoded = messages.map((m) => ({ m, value: reader.readMessage(m.data) }));
+  const csvFile = `${csvDir}/${recordFileName(channel.topic)}`;
+  if (!existsSync(csvFile)) {
+    fail(`${channel.topic}: no CSV recording ${csvFile}`);
+    continue;
+  }
+  const rows = parseCsv(readFileSync(csvFile), { columns: true, skip_empty_lines: true });
+  // A message's rows (one per element of its sequence of structs) by source time stamp.
+  const csvBySource = new Map();
+  for (const row of rows) {
+    const k = row.source_timestamp_ns;
+    if (!csvBySource.has(k)) csvBySource.set(k, []);
+    csvBySource.get(k).push(row);
+  }
+  let compared = 0;
+  let cells = 0;
+  for (const { m, value } of decoded) {
+    const group = csvBySource.get(m.publishTime.toString());
+    if (!group) continue;
+    compared += 1;
+    cells += compareRows(channel.topic, value, group, enums);
+  }
+  console.log(
+    `${channel.topic}: ${schema.name} (${schema.encoding}), ${messages.length} messages decoded, ` +
+      `${compared} compared with ${rows.length ? csvFile.split("/").pop() : "no rows"} ` +
+      `(${cells} fields equal)`,
+  );
+  if (messages.length === 0 && rows.length === 0) continue; // nothing published on it
+  if (compared === 0) fail(`${channel.topic}: no message matched the CSV recording`);
+  // Reliable streams: every message is in both recordings. Health and progress reports are
+  // latest-value streams, which a slower reader samples.
+  const latestValue = /health|progress/.test(channel.metadata.get("reader_profile") ?? "");
+  if (!latestValue && compared !== messages.length) {
+    fail(`${channel.topic}: ${messages.length - compared} messages not in the CSV recording`);
+  }
+  if (compared > 0) topicsCompared += 1;
+}
+if (topicsCompared === 0) fail("no topic was compared");
+console.log(`${topicsCompared} topics decoded and equal to the CSV recording`);
+if (failures > 0) {
+  console.log(`${failures} failures`);
+  process.exit(1);
+}
+console.log("mcap check: ok");
+
+// Every constant of a schema (OMG IDL enumerators and consts; ROS 2 msg constants, which carry
+// the IDL enumerators): [name, value] pairs.
+function constants(definitions) {
+  const all = [];
+  for (const d of definitions) {
+    for (const c of d.definitions ?? []) if (c.isConstant) all.push([c.name, c.value]);
+  }
+  return all;
+}
+
+// Compares one decoded message with its CSV rows; returns the number of cells compared.
+// CSV columns (records/formatters.hpp): "name", "name[i]" for arrays, "seq.field" (a row per
+// element) for the sequence of structs, "a;b;c" for a sequence of numbers, enums by name,
+// booleans as 0/1, a nested struct's fields as "<struct>_<field>". Fields the CSV summarizes as text (diagnostics, decision candidates) are
+// not compared.
+function compareRows(topic, value, rows, enums) {
+  let cells = 0;
+  const columns = Object.keys(rows[0]).filter(
+    (c) => c !== "source_timestamp_ns" && c !== "reception_timestamp_ns",
+  );
+  rows.forEach((row, r) => {
+    for (const column of columns) {
+      const m = /^([a-z_0-9]+)(?:\[(\d+)\])?(?:\.([a-z_0-9]+)(?:\[(\d+)\])?)?$/.exec(column);
+      if (!m) {
+        fail(`${topic}: column '${column}' is not a field path`);
+        continue;
+      }
+      let v = field(value, m[1]);
+      if (m[3] !== undefined) {
+        if (row[column] === "" && (v?.length ?? 0) === 0) continue; // no element: empty cells
+        v = v?.[r]?.[m[3]];
+        if (m[4] !== undefined) v = v?.[Number(m[4])];
+      } else if (m[2] !== undefined) {
+        v = v?.[Number(m[2])];
+      } else if (r > 0) {
+        continue; // a message's own fields are repeated on each of its rows
+      }
+      if (v === undefined) {
+        fail(`${topic}: column '${column}' has no decoded field`);
+        continue;
+      }
+      if (typeof v === "object" && !ArrayBuffer.isView(v) && !Array.isArray(v)) continue; // text summary
+      if (!equalCell(row[column], v, enums)) {
+        fail(`${topic}: '${column}' CSV '${row[column]}' decoded '${format(v)}'`);
+        continue;
+      }
+      cells += 1;
+    }
+  });
+  return cells;
+}
+
+// A message's field by its CSV name; a nested struct's fields are named "<struct>_<field>"
+// (FaultDecision.dither.peak_frequency_hz as dither_peak_frequency_hz).
+function field(value, name) {
+  if (name in value) return value[name];
+  for (let i = name.indexOf("_"); i > 0; i = name.indexOf("_", i + 1)) {
+    const outer = value[name.slice(0, i)];
+    if (outer && typeof outer === "object" && !ArrayBuffer.isView(outer) && !Array.isArray(outer)) {
+      const inner = field(outer, name.slice(i + 1));
+      if (inner !== undefined) return inner;
+    }
+  }
+  return undefined;
+}
+
+function format(v) {
+  return ArrayBuffer.isView(v) || Array.isArray(v) ? Array.from(v).join(";") : String(v);
+}
+
+function equalCell(cell, v, enums) {
+  if (typeof v === "bigint") return /^-?\d+$/.test(cell) && BigInt(cell) === v;
+  if (typeof v === "boolean") return cell === (v ? "1" : "0");
+  if (typeof v === "string") return cell === v;
+  if (ArrayBuffer.isView(v) || Array.isArray(v)) {
+    // A sequence of numbers as one cell, or a struct sequence summarized as text.
+    if (v.length > 0 && typeof v[0] === "object") return true;
+    const parts = cell === "" ? [] : cell.split(";");
+    return parts.length === v.length && parts.every((p, i) => Number(p) === Number(v[i]));
+  }
+  if (typeof v === "number") {
+    // An enumerator by name: the CSV writes it without the enum's prefix (MODE_INERTIAL_ONLY
+    // as INERTIAL_ONLY, records/message_fields.hpp's enumName).
+    if (/^[A-Za-z][A-Za-z0-9_]*$/.test(cell)) {
+      const upper = cell.toUpperCase();
+      return enums.some(
+        ([name, value]) => (name === upper || name.endsWith(`_${upper}`)) && value === v,
+      );
+    }
+    return Number(cell) === v;
+  }
+  return false;
+}

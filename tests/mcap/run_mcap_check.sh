@@ -1,0 +1,138 @@
+#!/usr/bin/env bash
+# MCAP recordings checked by the format's own readers, and replayed:
+#   1. the main demo's loop (simulator, filter, fault manager) on domain 106, recorded twice at
+#      once with `navbus record --all`: as CSV and as one MCAP file;
+#   2. Foxglove's libraries (check_mcap.mjs: @mcap/core, @foxglove/omgidl-parser and
+#      -serialization) validate the file, its index and summary, decode every message of every
+#      topic and compare it with the CSV recording;
+#   3. `navbus replay` of the MCAP file and of the CSV directory, each into a CSV recorder on
+#      domain 107: both replays must equal the original recording, bit for bit;
+#   4. a ROS 2 named run (--ros2, domain 108) recorded as MCAP with ros2msg schemas, decoded by
+#      @foxglove/rosmsg and @foxglove/rosmsg2-serialization.
+# The npm packages (tests/mcap/package.json, exact versions) go into BUILD_DIR/mcap-node.
+# Usage: run_mcap_check.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+build=$(cd "$1" && pwd) src=$(cd "$2" && pwd)
+bin=$build/bin
+work=$(mktemp -d /tmp/navbus-mcap.XXXXXX)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -KILL "$p" 2> /dev/null || true; done
+  rm -rf "$work"
+  rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2> /dev/null || true
+}
+trap cleanup EXIT
+fail() {
+  echo "FAIL: $*"
+  for f in "$work"/*.log; do echo "--- $f"; tail -15 "$f"; done
+  exit 1
+}
+
+# --- Foxglove's readers, in the test's own folder --------------------------------------------
+node_dir=$build/mcap-node
+command -v node > /dev/null && command -v npm > /dev/null || {
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends nodejs npm > /dev/null
+}
+mkdir -p "$node_dir"
+if ! cmp -s "$src/tests/mcap/package-lock.json" "$node_dir/package-lock.json" ||
+  [ ! -d "$node_dir/node_modules" ]; then
+  cp "$src/tests/mcap/package.json" "$src/tests/mcap/package-lock.json" "$node_dir/"
+  (cd "$node_dir" && npm ci --no-audit --no-fund --loglevel=error) || fail "npm ci"
+fi
+cp "$src/tests/mcap/check_mcap.mjs" "$node_dir/"
+
+# Stops the given pids with SIGTERM and checks each exited 0.
+stop() {
+  local p rc
+  for p in "$@"; do kill -TERM "$p" 2> /dev/null || true; done
+  for p in "$@"; do
+    rc=0
+    wait "$p" || rc=$?
+    [ $rc -eq 0 ] || fail "process $p exited $rc"
+  done
+}
+
+# --- 1. the demo's loop, recorded as CSV and MCAP --------------------------------------------
+domain=106
+cat > "$work/sim.yaml" << YAML
+extends: $src/sim/scenarios/demo_fault_loop.yaml
+domain_id: $domain
+# The filter, the fault manager and the two recorders read the IMU and the GNSS; the fault
+# manager and the recorders the raw IMU.
+timing: {min_readers: {imu: 4, raw_imu: 3, gnss: 4, star_tracker: 0}}
+YAML
+echo "domain_id: $domain" > "$work/fm.yaml"
+printf 'extends: %s\ndomain_id: %s\n' "$src/config/filter_demo.yaml" $domain > "$work/filter.yaml"
+"$bin/navbus-filter" -c "$work/filter.yaml" > "$work/filter.log" 2>&1 &
+filter=$!
+"$bin/navbus-fault-manager" -c "$src/config/fault_manager.yaml" -d $domain > "$work/fm.log" 2>&1 &
+fm=$!
+"$bin/navbus" -d $domain record --all -o "$work/csv" > "$work/record_csv.log" 2>&1 &
+rec_csv=$!
+"$bin/navbus" -d $domain record --all --format mcap -o "$work/run.mcap" > "$work/record_mcap.log" 2>&1 &
+rec_mcap=$!
+pids=($filter $fm $rec_csv $rec_mcap)
+timeout 120 "$bin/navbus-sensor-sim" -c "$work/sim.yaml" > "$work/sim.log" 2>&1 || fail "simulator"
+sleep 1
+stop $filter $fm
+sleep 1
+stop $rec_csv $rec_mcap
+pids=()
+grep "recorded" "$work/record_mcap.log" | sed 's/^.*\] //'
+diff <(grep -o "recorded .*" "$work/record_csv.log") <(grep -o "recorded .*" "$work/record_mcap.log") ||
+  echo "(the two recorders took different numbers of some samples: compared by time stamp)"
+ls -l "$work/run.mcap" | awk '{print "MCAP file: " $5 " bytes"}'
+du -sb "$work/csv" | awk '{print "CSV recording: " $1 " bytes"}'
+
+# --- 2. Foxglove's readers -------------------------------------------------------------------
+(cd "$node_dir" && node check_mcap.mjs "$work/run.mcap" "$work/csv") || fail "Foxglove's readers"
+
+# --- 3. replay from MCAP = replay from CSV = the recording -----------------------------------
+replay_into() {  # RECORDING OUT_DIR
+  local rec_pid
+  "$bin/navbus" -d 107 record navbus/imu/increment_block navbus/imu/raw navbus/gnss/observations \
+    navbus/gnss/fix -o "$2" --idle 3 > "$work/replay_record.log" 2>&1 &
+  rec_pid=$!
+  pids=($rec_pid)
+  "$bin/navbus" -d 107 replay "$1" --speed 0 > "$work/replay.log" 2>&1 ||
+    fail "navbus replay $1: $(tail -3 "$work/replay.log")"
+  wait $rec_pid || fail "the replay's recorder"
+  pids=()
+}
+# The recorded message columns of a CSV file, without the time stamps of reception.
+content() { python3 -c '
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+drop = {i for i, c in enumerate(rows[0]) if c in ("source_timestamp_ns", "reception_timestamp_ns")}
+for r in rows:
+    print(",".join(c for i, c in enumerate(r) if i not in drop))' "$1"; }
+replay_into "$work/run.mcap" "$work/from_mcap"
+replay_into "$work/csv" "$work/from_csv"
+for topic in navbus_imu_increment_block navbus_imu_raw navbus_gnss_observations navbus_gnss_fix; do
+  original=$(content "$work/csv/$topic.csv" | md5sum)
+  [ "$(content "$work/from_mcap/$topic.csv" | md5sum)" = "$original" ] ||
+    fail "$topic replayed from MCAP differs from the recording"
+  [ "$(content "$work/from_csv/$topic.csv" | md5sum)" = "$original" ] ||
+    fail "$topic replayed from CSV differs from the recording"
+  echo "$topic: replayed from MCAP = replayed from CSV = recorded ($(($(wc -l < "$work/csv/$topic.csv") - 1)) rows)"
+done
+
+# --- 4. ROS 2 naming: ros2msg schemas ----------------------------------------------------------
+domain=108
+cat > "$work/sim_ros2.yaml" << YAML
+extends: $src/sim/scenarios/seed004_land_vehicle.yaml
+domain_id: $domain
+ros2_names: true
+timing: {duration_s: 10, min_readers: {imu: 2, raw_imu: 2, gnss: 2, star_tracker: 2}}
+YAML
+"$bin/navbus" --ros2 -d $domain record --all -o "$work/csv_ros2" > "$work/record_csv2.log" 2>&1 &
+rec_csv=$!
+"$bin/navbus" --ros2 -d $domain record --all --format mcap -o "$work/ros2.mcap" > "$work/record_mcap2.log" 2>&1 &
+rec_mcap=$!
+pids=($rec_csv $rec_mcap)
+timeout 120 "$bin/navbus-sensor-sim" -c "$work/sim_ros2.yaml" > "$work/sim2.log" 2>&1 || fail "simulator (ROS 2)"
+sleep 1
+stop $rec_csv $rec_mcap
+pids=()
+(cd "$node_dir" && node check_mcap.mjs "$work/ros2.mcap" "$work/csv_ros2" --ros2) || fail "ROS 2 MCAP"
+echo "mcap: ok"
