@@ -180,6 +180,14 @@ void Participant::runDueTimers() {
   }
 }
 
+void Participant::spinFor(std::chrono::nanoseconds duration) {
+  const auto end = std::chrono::steady_clock::now() + duration;
+  for (auto now = std::chrono::steady_clock::now(); now < end && !stopping();
+       now = std::chrono::steady_clock::now()) {
+    spinOnce(end - now);
+  }
+}
+
 void Participant::spinOnce(std::chrono::nanoseconds max_wait) {
   promoteIfProcessing();
   auto next = std::chrono::steady_clock::now() + max_wait;

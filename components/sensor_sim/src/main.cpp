@@ -6,6 +6,7 @@
 
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
+#include "navbus/bus/stream_end.hpp"
 #include "navbus/sensor_sim/file_writer.hpp"
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
@@ -134,8 +135,10 @@ int main(int argc, char** argv) {
     }
     // The end of the data is announced (not a loss). Not on SIGTERM: a reader that stopped
     // taking (a full KEEP_ALL history) would hold the dispose's acknowledgment up.
-    if (!participant.stopping()) publisher.endStreams();
+    const bool announce_end = !participant.stopping();
+    if (announce_end) publisher.endStreams();
     publisher.flush();
+    if (announce_end) participant.spinFor(navbus::bus::kEndOfStreamLinger);
     // From the first write to the last acknowledgment: the bus throughput in fast pacing.
     const double wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
     participant.finish();

@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "navbus/bus/app.hpp"
+#include "navbus/bus/stream_end.hpp"
 #include "navbus/bus/streams.hpp"
 #include "navbus/records/csv_messages.hpp"
 #include "navbus/records/mcap.hpp"
@@ -348,6 +349,7 @@ int runReplayCommand(const bus::Participant::Options& participant, const ReplayO
   }
   for (auto& s : streams) s->end();
   const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+  if (!p.stopping()) p.spinFor(bus::kEndOfStreamLinger);  // the ends reach best-effort readers
   bool complete = true;
   for (std::size_t s = 0; s < streams.size(); ++s) {
     spdlog::info("replayed {} of {} samples of {}", published[s], streams[s]->size(),

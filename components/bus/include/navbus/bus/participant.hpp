@@ -155,6 +155,8 @@ class Participant {
   /// One loop iteration: waits at most `max_wait` (less if a timer is due), then handles
   /// readers and due timers. For participants that drive their own loop (the simulator).
   void spinOnce(std::chrono::nanoseconds max_wait);
+  /// Spins for `duration`, or until stopped.
+  void spinFor(std::chrono::nanoseconds duration);
   /// Publishes the final (STOPPING) health report; run() does it by itself.
   void finish();
   /// Asks the loop to end (from a handler).

@@ -5,12 +5,20 @@
 // alike, so the changes between the last one taken and the dispose are the ones missed.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 
 #include "navbus/bus/writer_gate.hpp"
 
 namespace navbus::bus {
+
+/// How long a writer that announced the end of its streams (disposed them and waited for the
+/// reliable readers' acknowledgments) stays on the bus before it leaves. Best-effort readers
+/// (the fault manager's watchdogs) acknowledge nothing: a writer that left at once could be
+/// gone before its dispose was taken there, and the stream was judged lost, not ended (3 of 4
+/// streams in one compose run under DDS Security; one replay in four under AddressSanitizer).
+inline constexpr std::chrono::milliseconds kEndOfStreamLinger{300};
 
 class StreamEndCounter {
  public:
