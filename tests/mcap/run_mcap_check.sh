@@ -52,6 +52,20 @@ stop() {
   done
 }
 
+# Waits up to 120 s for the given pids to exit by themselves, each with 0.
+finished() {
+  local p rc deadline=$((SECONDS + 120))
+  for p in "$@"; do
+    while kill -0 "$p" 2> /dev/null; do
+      [ $SECONDS -lt $deadline ] || fail "process $p did not stop by itself"
+      sleep 0.2
+    done
+    rc=0
+    wait "$p" || rc=$?
+    [ $rc -eq 0 ] || fail "process $p exited $rc"
+  done
+}
+
 # --- 1. the demo's loop, recorded as CSV and MCAP --------------------------------------------
 domain=106
 cat > "$work/sim.yaml" << YAML
@@ -62,21 +76,26 @@ domain_id: $domain
 timing: {min_readers: {imu: 4, raw_imu: 3, gnss: 4, star_tracker: 0}}
 YAML
 echo "domain_id: $domain" > "$work/fm.yaml"
-printf 'extends: %s\ndomain_id: %s\n' "$src/config/filter_demo.yaml" $domain > "$work/filter.yaml"
+# Every solution to both recorders, as slow as either is: the default solution writer keeps
+# the last 50 (a latest-value stream), which a recorder behind on a loaded machine misses.
+printf 'extends: %s\ndomain_id: %s\nsolution_writer_profile: navbus_solution_writer_lossless\n' \
+  "$src/config/filter_demo.yaml" $domain > "$work/filter.yaml"
 "$bin/navbus-filter" -c "$work/filter.yaml" > "$work/filter.log" 2>&1 &
 filter=$!
 "$bin/navbus-fault-manager" -c "$src/config/fault_manager.yaml" -d $domain > "$work/fm.log" 2>&1 &
 fm=$!
-"$bin/navbus" -d $domain record --all -o "$work/csv" > "$work/record_csv.log" 2>&1 &
+# The recorders stop by themselves once nothing came for 3 s: each takes everything it was sent,
+# however far behind (a SIGTERM would cut a slow one short).
+"$bin/navbus" -d $domain record --all -o "$work/csv" --idle 3 > "$work/record_csv.log" 2>&1 &
 rec_csv=$!
-"$bin/navbus" -d $domain record --all --format mcap -o "$work/run.mcap" > "$work/record_mcap.log" 2>&1 &
+"$bin/navbus" -d $domain record --all --format mcap -o "$work/run.mcap" --idle 3 \
+  > "$work/record_mcap.log" 2>&1 &
 rec_mcap=$!
 pids=($filter $fm $rec_csv $rec_mcap)
 timeout 120 "$bin/navbus-sensor-sim" -c "$work/sim.yaml" > "$work/sim.log" 2>&1 || fail "simulator"
 sleep 1
 stop $filter $fm
-sleep 1
-stop $rec_csv $rec_mcap
+finished $rec_csv $rec_mcap
 pids=()
 grep "recorded" "$work/record_mcap.log" | sed 's/^.*\] //'
 diff <(grep -o "recorded .*" "$work/record_csv.log") <(grep -o "recorded .*" "$work/record_mcap.log") ||
@@ -125,14 +144,15 @@ domain_id: $domain
 ros2_names: true
 timing: {duration_s: 10, min_readers: {imu: 2, raw_imu: 2, gnss: 2, star_tracker: 2}}
 YAML
-"$bin/navbus" --ros2 -d $domain record --all -o "$work/csv_ros2" > "$work/record_csv2.log" 2>&1 &
+"$bin/navbus" --ros2 -d $domain record --all -o "$work/csv_ros2" --idle 3 \
+  > "$work/record_csv2.log" 2>&1 &
 rec_csv=$!
-"$bin/navbus" --ros2 -d $domain record --all --format mcap -o "$work/ros2.mcap" > "$work/record_mcap2.log" 2>&1 &
+"$bin/navbus" --ros2 -d $domain record --all --format mcap -o "$work/ros2.mcap" --idle 3 \
+  > "$work/record_mcap2.log" 2>&1 &
 rec_mcap=$!
 pids=($rec_csv $rec_mcap)
 timeout 120 "$bin/navbus-sensor-sim" -c "$work/sim_ros2.yaml" > "$work/sim2.log" 2>&1 || fail "simulator (ROS 2)"
-sleep 1
-stop $rec_csv $rec_mcap
+finished $rec_csv $rec_mcap
 pids=()
 (cd "$node_dir" && node check_mcap.mjs "$work/ros2.mcap" "$work/csv_ros2" --ros2) || fail "ROS 2 MCAP"
 echo "mcap: ok"
