@@ -20,11 +20,10 @@ using records::McapCompression;
 
 namespace {
 
+/// A file of this process in the temporary directory; each test removes its own.
 std::filesystem::path scratch(const std::string& name) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("navbus-mcap-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir / name;
+  return std::filesystem::temp_directory_path() /
+         ("navbus-mcap-" + std::to_string(::getpid()) + "-" + name);
 }
 
 std::vector<std::uint8_t> bytesOf(const std::filesystem::path& file) {
