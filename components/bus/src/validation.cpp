@@ -275,12 +275,13 @@ SequenceTracker::Outcome SequenceTracker::check(std::uint32_t sensor_id, std::ui
     restart_candidate_.erase(sensor_id);  // the stream goes on: a stale sample, no restart
   }
   const std::uint64_t stream_latest = it != last_.end() ? it->second.time_ns : 0;
-  if (auto r = checkJump(sensor_id, seq, time_ns, stream_latest, out)) {
+  std::uint64_t first_seq = seq;  // of a confirmed chain: its first sample's
+  if (auto r = checkJump(sensor_id, seq, time_ns, stream_latest, out, first_seq)) {
     out.rejection = r;
     return out;
   }
-  if (started_.insert(sensor_id).second && seq > 1) {
-    out.missing = out.missing_before_first = seq - 1;
+  if (started_.insert(sensor_id).second && first_seq > 1) {
+    out.missing = out.missing_before_first = first_seq - 1;
   } else if (it != last_.end() && !out.jump_adopted) {
     if (seq > it->second.seq + 1) {
       out.missing = seq - it->second.seq - 1;
@@ -308,13 +309,14 @@ bool SequenceTracker::confirmsRestart(std::uint32_t sensor_id, std::uint64_t seq
     restart_candidate_.erase(sensor_id);
     return true;
   }
-  restart_candidate_[sensor_id] = Candidate{seq, time_ns, count};
+  restart_candidate_[sensor_id] = Candidate{seq, time_ns, count, seq};
   return false;
 }
 
 std::optional<Rejection> SequenceTracker::checkJump(std::uint32_t sensor_id, std::uint64_t seq,
                                                     std::uint64_t time_ns,
-                                                    std::uint64_t stream_latest_ns, Outcome& out) {
+                                                    std::uint64_t stream_latest_ns, Outcome& out,
+                                                    std::uint64_t& first_seq) {
   if (rule_.tolerance_ns == 0) return std::nullopt;
   const std::uint64_t latest =
       std::max(stream_latest_ns, reference_ != nullptr ? reference_->latest_ns : 0);
@@ -327,12 +329,16 @@ std::optional<Rejection> SequenceTracker::checkJump(std::uint32_t sensor_id, std
   // when the samples after it continue from it.
   const bool more = cand != candidate_.end() && continues(cand->second, seq, time_ns);
   const int count = more ? cand->second.count + 1 : 1;
+  const std::uint64_t chain_first_seq = more ? cand->second.first_seq : seq;
   if (count >= rule_.confirmations) {
     candidate_.erase(sensor_id);
     out.jump_adopted = true;
+    out.jump_held = count - 1;
+    first_seq = chain_first_seq;
     return std::nullopt;
   }
-  candidate_[sensor_id] = Candidate{seq, time_ns, count};
+  candidate_[sensor_id] = Candidate{seq, time_ns, count, chain_first_seq};
+  out.jump_candidate = count;
   return Rejection{navbus::REJECT_TIME_JUMP, "time_gps_ns", static_cast<double>(time_ns)};
 }
 
@@ -356,6 +362,18 @@ void StreamGate::rejectElement(const Rejection& r, std::uint32_t sensor_id) {
     spdlog::warn("{}: dropped an element of sensor {}'s sample, the rest kept ({}; {} so far)",
                  topic_, sensor_id, r.describe(), n);
   }
+}
+
+void StreamGate::admitHeld(std::uint32_t sensor_id, std::size_t n) {
+  if (n == 0) return;
+  auto it = counters_.rejected.find(navbus::REJECT_TIME_JUMP);
+  const std::uint64_t undone =
+      it == counters_.rejected.end() ? 0 : std::min<std::uint64_t>(n, it->second);
+  if (undone > 0 && (it->second -= undone) == 0) counters_.rejected.erase(it);
+  counters_.accepted += n;
+  spdlog::info(
+      "{}: the {} samples of sensor {} refused before the confirmed jump continue to it: used",
+      topic_, n, sensor_id);
 }
 
 void StreamGate::unaccept() {

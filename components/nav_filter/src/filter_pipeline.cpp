@@ -99,9 +99,27 @@ bool FilterPipeline::admit(bus::StreamGate& gate, const Sample& msg, StreamId id
   return gate.admit(msg, id.sensor_id, msg.seq(), msg.time_gps_ns());
 }
 
+template <class Sample, class Use>
+bool FilterPipeline::admitOrHold(bus::StreamGate& gate, HeldSamples<Sample>& held,
+                                 const Sample& msg, StreamId id,
+                                 const std::optional<InputConfig>& expected, Use use) {
+  if (!admit(gate, msg, id, expected)) {
+    held.afterRefusal(gate, id.sensor_id, msg);
+    return false;
+  }
+  for (const Sample& confirmed : held.afterAdmission(gate, id.sensor_id)) use(confirmed);
+  return true;
+}
+
 void FilterPipeline::onImu(const navbus::ImuIncrement& msg) {
-  if (!admit(imu_gate_, msg, {kRankImu, msg.sensor_id()}, config_.imu)) return;
+  const auto use = [this](const navbus::ImuIncrement& m) { useImu(m); };
+  if (!admitOrHold(imu_gate_, imu_held_, msg, {kRankImu, msg.sensor_id()}, config_.imu, use))
+    return;
   if (imu_gate_.sourceRestarted()) startNewRun();
+  useImu(msg);
+}
+
+void FilterPipeline::useImu(const navbus::ImuIncrement& msg) {
   core::ImuIncrement inc = config_.imu_mounting.toBody(bus::toCore(msg));
   inc.time_ns += config_.imu.time_offset_ns;
   queue(imu_gate_, {kRankImu, msg.sensor_id()}, inc.time_ns, inc);
@@ -125,7 +143,13 @@ void FilterPipeline::publishLowLatency(const core::ImuIncrement& inc) {
 }
 
 void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
-  if (!admit(gnss_obs_gate_, m, {kRankGnssObs, m.receiver_id()}, config_.gnss_observations)) return;
+  const auto use = [this](const navbus::GnssObservationEpoch& e) { useGnssObservations(e); };
+  if (admitOrHold(gnss_obs_gate_, gnss_obs_held_, m, {kRankGnssObs, m.receiver_id()},
+                  config_.gnss_observations, use))
+    useGnssObservations(m);
+}
+
+void FilterPipeline::useGnssObservations(const navbus::GnssObservationEpoch& m) {
   // A bad satellite costs that satellite only (counted per reason); the others are used.
   const std::vector<bus::SatelliteRejection> dropped =
       bus::screenSatellites(m, gnss_obs_gate_.limits());
@@ -138,14 +162,26 @@ void FilterPipeline::onGnssObservations(const navbus::GnssObservationEpoch& m) {
 }
 
 void FilterPipeline::onGnssFix(const navbus::GnssFix& m) {
-  if (!admit(gnss_fix_gate_, m, {kRankGnssFix, m.receiver_id()}, config_.gnss_fix)) return;
+  const auto use = [this](const navbus::GnssFix& f) { useGnssFix(f); };
+  if (admitOrHold(gnss_fix_gate_, gnss_fix_held_, m, {kRankGnssFix, m.receiver_id()},
+                  config_.gnss_fix, use))
+    useGnssFix(m);
+}
+
+void FilterPipeline::useGnssFix(const navbus::GnssFix& m) {
   core::GnssFixMeasurement fix = bus::toCore(m);
   fix.time_ns += config_.gnss_fix->time_offset_ns;
   queue(gnss_fix_gate_, {kRankGnssFix, m.receiver_id()}, fix.time_ns, fix);
 }
 
 void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
-  if (!admit(star_gate_, m, {kRankStarTracker, m.tracker_id()}, config_.star_tracker)) return;
+  const auto use = [this](const navbus::StarTrackerAttitude& a) { useStarTracker(a); };
+  if (admitOrHold(star_gate_, star_held_, m, {kRankStarTracker, m.tracker_id()},
+                  config_.star_tracker, use))
+    useStarTracker(m);
+}
+
+void FilterPipeline::useStarTracker(const navbus::StarTrackerAttitude& m) {
   core::StarAttitudeMeasurement st = bus::toCore(m);
   st.time_ns += config_.star_tracker->time_offset_ns;
   queue(star_gate_, {kRankStarTracker, m.tracker_id()}, st.time_ns, st);
@@ -172,6 +208,9 @@ void FilterPipeline::startNewRun() {
   time_reference_.latest_ns = 0;
   for (bus::StreamGate* g : {&gnss_obs_gate_, &gnss_fix_gate_, &star_gate_})
     g->tracker().resetAll();
+  gnss_obs_held_.clear();
+  gnss_fix_held_.clear();
+  star_held_.clear();
   ++counters_.new_runs;
   spdlog::warn(
       "the IMU source restarted at an earlier time: new run {} (the filter starts over; "

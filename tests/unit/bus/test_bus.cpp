@@ -141,15 +141,34 @@ TEST(SequenceTracker, ForwardJumpRejectedUnlessTheSamplesAfterItConfirmIt) {
   // Another stream is judged against the participant's reference too.
   EXPECT_EQ(gnss.check(1, 1, t + hour).rejection->reason, navbus::REJECT_TIME_JUMP);
   EXPECT_FALSE(gnss.check(1, 2, t).rejection);
-  // A real resumption after 60 s of silence: the first two samples are rejected, the third,
-  // continuing from them, is accepted and adopted.
+  // A real resumption after 60 s of silence: the first two samples are refused as candidates
+  // of a chain, the third, continuing from them, is accepted and adopted, and says that the
+  // two before it belong to the chain (a caller that held them uses them).
   t += 60'000'000'000;
-  EXPECT_EQ(next().rejection->reason, navbus::REJECT_TIME_JUMP);
-  EXPECT_EQ(next().rejection->reason, navbus::REJECT_TIME_JUMP);
+  o = next();
+  EXPECT_EQ(o.rejection->reason, navbus::REJECT_TIME_JUMP);
+  EXPECT_EQ(o.jump_candidate, 1);
+  o = next();
+  EXPECT_EQ(o.rejection->reason, navbus::REJECT_TIME_JUMP);
+  EXPECT_EQ(o.jump_candidate, 2);
   o = next();
   EXPECT_FALSE(o.rejection);
   EXPECT_TRUE(o.jump_adopted);
-  EXPECT_FALSE(next().rejection);
+  EXPECT_EQ(o.jump_held, 2);
+  EXPECT_EQ(o.missing, 0u);
+  o = next();
+  EXPECT_FALSE(o.rejection);
+  EXPECT_EQ(o.jump_held, 0);
+  // A stream that starts more than the tolerance ahead of the others: its first sample number
+  // is the chain's, so nothing counts as missed before it.
+  SequenceTracker star({2'000'000'000, 3}, &reference);
+  const std::uint64_t ahead = reference.latest_ns + 5'000'000'000;
+  EXPECT_EQ(star.check(1, 1, ahead).jump_candidate, 1);
+  EXPECT_EQ(star.check(1, 2, ahead + dt).jump_candidate, 2);
+  o = star.check(1, 3, ahead + 2 * dt);
+  EXPECT_TRUE(o.jump_adopted);
+  EXPECT_EQ(o.jump_held, 2);
+  EXPECT_EQ(o.missing_before_first, 0u);
   // Without a rule nothing is judged (the fault manager's counters).
   SequenceTracker plain;
   EXPECT_FALSE(plain.check(1, 1, t0).rejection);

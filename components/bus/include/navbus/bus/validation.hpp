@@ -82,8 +82,11 @@ struct TimeJumpRule {
   /// (REJECT_TIME_JUMP) and not adopted as the stream's time; 0: no check.
   std::uint64_t tolerance_ns{0};
   /// ... unless this many samples in a row continue from it (sequence and time increasing,
-  /// each within the tolerance of the previous): a real resumption after a long silence. The
-  /// last of them is accepted, the ones before stay rejected.
+  /// each within the tolerance of the previous): a real resumption after a long silence, or a
+  /// stream whose start arrived before the other streams' data that leads up to it. The last
+  /// of them is accepted; the ones before were refused as candidates, and a caller that held
+  /// them may use them then (Outcome::jump_held), so the outcome does not depend on the order
+  /// in which the streams' samples arrived.
   /// The same count confirms a source restart: a sample whose time and sequence number are
   /// both behind the stream's latest is rejected as not monotonic, unless this many samples
   /// in a row continue from it (a restarted writer replaying its scenario from the start).
@@ -101,6 +104,12 @@ class SequenceTracker {
     std::uint64_t missing_before_first{0};
     bool restarted{false};     ///< sequence went back while time went forward (writer restart)
     bool jump_adopted{false};  ///< a forward jump confirmed by the samples after it
+    /// With jump_adopted: how many samples before this one, refused as REJECT_TIME_JUMP when
+    /// they came, belong to the confirmed chain (they continue to this one).
+    int jump_held{0};
+    /// With a REJECT_TIME_JUMP rejection: this sample's place in a chain that may still be
+    /// confirmed (1: it starts a new chain, and earlier candidates of the sensor are void).
+    int jump_candidate{0};
     /// Time and sequence went back, confirmed by the samples after it: the source started a
     /// new run, and the stream continues from this sample.
     bool source_restarted{false};
@@ -136,11 +145,13 @@ class SequenceTracker {
     std::uint64_t seq;
     std::uint64_t time_ns;
     int count;
+    std::uint64_t first_seq;  ///< the sequence number of the chain's first sample
   };
-  /// The forward-jump rule: nullopt to accept, or the rejection.
+  /// The forward-jump rule: nullopt to accept, or the rejection. On adoption, `first_seq` is
+  /// the sequence number of the confirmed chain's first sample.
   std::optional<Rejection> checkJump(std::uint32_t sensor_id, std::uint64_t seq,
                                      std::uint64_t time_ns, std::uint64_t stream_latest_ns,
-                                     Outcome& out);
+                                     Outcome& out, std::uint64_t& first_seq);
   /// The restart rule for a sample behind the stream: true when it confirms a restart.
   bool confirmsRestart(std::uint32_t sensor_id, std::uint64_t seq, std::uint64_t time_ns);
   /// A candidate continues from the previous one: sequence and time increasing (time within
@@ -174,22 +185,34 @@ class StreamGate {
   template <class Sample>
   bool admit(const Sample& sample, std::uint32_t sensor_id, std::uint64_t seq,
              std::uint64_t time_ns) {
+    jump_candidate_ = 0;
     if (auto r = validate(sample, limits_)) {
       reject(*r, sensor_id);
       return false;
     }
     const SequenceTracker::Outcome o = tracker_.check(sensor_id, seq, time_ns);
     if (o.rejection) {
+      jump_candidate_ = o.jump_candidate;
       reject(*o.rejection, sensor_id);
       return false;
     }
     noteSequence(o);
     source_restarted_ = o.source_restarted;
+    jump_held_ = o.jump_held;
     return true;
   }
 
   /// The sample admitted last started a new run of its source (SequenceTracker::Outcome).
   bool sourceRestarted() const { return source_restarted_; }
+  /// The sample refused last is a forward-jump candidate: its place in the chain
+  /// (SequenceTracker::Outcome::jump_candidate), 0 for any other refusal.
+  int jumpCandidate() const { return jump_candidate_; }
+  /// The sample admitted last confirmed a forward jump: how many refused candidates before it
+  /// belong to the chain (SequenceTracker::Outcome::jump_held).
+  int jumpHeld() const { return jump_held_; }
+  /// Counts `n` samples of the confirmed chain, refused as REJECT_TIME_JUMP when they came and
+  /// held by the caller, as accepted after all.
+  void admitHeld(std::uint32_t sensor_id, std::size_t n);
 
   /// Counts a rejection decided after admission (e.g. late for the sequencer).
   void reject(const Rejection& r, std::uint32_t sensor_id);
@@ -209,6 +232,8 @@ class StreamGate {
   ValidationLimits limits_;
   SequenceTracker tracker_;
   bool source_restarted_{false};
+  int jump_candidate_{0};
+  int jump_held_{0};
 };
 
 }  // namespace navbus::bus

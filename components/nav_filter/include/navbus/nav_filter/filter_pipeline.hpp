@@ -27,6 +27,7 @@
 #include "navbus/core/ins/output_predictor.hpp"
 #include "navbus/nav_filter/command_gate.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
+#include "navbus/nav_filter/held_samples.hpp"
 #include "navbus/nav_filter/input_history.hpp"
 #include "navbus/nav_filter/input_sequencer.hpp"
 #include "navbus/nav_filter/judgement_tracker.hpp"
@@ -163,6 +164,16 @@ class FilterPipeline {
   template <class Sample>
   bool admit(bus::StreamGate& gate, const Sample& msg, StreamId id,
              const std::optional<InputConfig>& expected);
+  /// admit(), keeping a refused forward-jump candidate in `held`; on admission, `use` takes
+  /// the held samples the admitted one confirmed, oldest first (HeldSamples).
+  template <class Sample, class Use>
+  bool admitOrHold(bus::StreamGate& gate, HeldSamples<Sample>& held, const Sample& msg, StreamId id,
+                   const std::optional<InputConfig>& expected, Use use);
+  /// After admission: convert to the core types, correct the configured time offset, queue.
+  void useImu(const navbus::ImuIncrement& msg);
+  void useGnssObservations(const navbus::GnssObservationEpoch& m);
+  void useGnssFix(const navbus::GnssFix& m);
+  void useStarTracker(const navbus::StarTrackerAttitude& m);
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
   void process(StreamId stream, std::int64_t time_ns, const FilterInput& input);
   /// A sample whose place in the order was already passed: the engine is restored to before
@@ -215,6 +226,10 @@ class FilterPipeline {
   bus::StreamGate gnss_obs_gate_;
   bus::StreamGate gnss_fix_gate_;
   bus::StreamGate star_gate_;
+  HeldSamples<navbus::ImuIncrement> imu_held_;
+  HeldSamples<navbus::GnssObservationEpoch> gnss_obs_held_;
+  HeldSamples<navbus::GnssFix> gnss_fix_held_;
+  HeldSamples<navbus::StarTrackerAttitude> star_held_;
   SolutionFlags flags_;  ///< stream-lost and fault-monitor flags of the solutions
   /// Merged streams whose writer announced their end (disposed), no sample since: not lost.
   std::set<StreamId> ended_streams_;
