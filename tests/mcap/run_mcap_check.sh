@@ -11,20 +11,23 @@
 #      @foxglove/rosmsg and @foxglove/rosmsg2-serialization.
 # The npm packages (tests/mcap/package.json, exact versions) go into BUILD_DIR/mcap-node.
 # Usage: run_mcap_check.sh BUILD_DIR SOURCE_DIR
+# With KEEP_WORK=1 the scratch directory (printed) is kept, to look at after a failure.
 set -euo pipefail
 build=$(cd "$1" && pwd) src=$(cd "$2" && pwd)
 bin=$build/bin
 work=$(mktemp -d /tmp/navbus-mcap.XXXXXX)
+[ -z "${KEEP_WORK:-}" ] || echo "scratch directory (kept): $work"
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill -KILL "$p" 2> /dev/null || true; done
-  rm -rf "$work"
+  [ -n "${KEEP_WORK:-}" ] || rm -rf "$work"
   rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2> /dev/null || true
 }
 trap cleanup EXIT
 fail() {
   echo "FAIL: $*"
   for f in "$work"/*.log; do echo "--- $f"; tail -15 "$f"; done
+  echo "FAIL: $*"  # again, last: what a truncated log shows
   exit 1
 }
 

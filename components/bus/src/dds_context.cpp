@@ -1,5 +1,7 @@
 #include "navbus/bus/dds_context.hpp"
 
+#include <algorithm>
+
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
@@ -99,6 +101,13 @@ dds::Topic* DdsContext::topicForType(const std::string& name, dds::TypeSupport t
 
 MalformedCounter* DdsContext::malformedCounter(const std::string& type_name) {
   return dynamic_cast<MalformedCounter*>(participant_->find_type(type_name).get());
+}
+
+bool DdsContext::waitForAcknowledgments(std::chrono::nanoseconds max_wait) {
+  const auto ns = std::max<std::int64_t>(0, max_wait.count());
+  const eprosima::fastrtps::Duration_t wait(static_cast<std::int32_t>(ns / 1'000'000'000),
+                                            static_cast<std::uint32_t>(ns % 1'000'000'000));
+  return publisher_->wait_for_acknowledgments(wait) == ReturnCode_t::RETCODE_OK;
 }
 
 dds::DataWriter* DdsContext::createWriter(dds::Topic* topic, const std::string& profile) {

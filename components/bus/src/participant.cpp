@@ -223,6 +223,12 @@ void Participant::run() {
 void Participant::finish() {
   state_ = navbus::STATE_STOPPING;
   publishHealth();
+  if (!dds_.waitForAcknowledgments(kFinishAcknowledgmentWait)) {
+    spdlog::warn(
+        "leaving the bus: not every reliable reader acknowledged what this participant wrote "
+        "within {} s; the samples they had not taken are lost to them",
+        kFinishAcknowledgmentWait.count());
+  }
 }
 
 void Participant::publishHealth() {

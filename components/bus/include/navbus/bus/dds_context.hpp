@@ -1,6 +1,7 @@
 // A domain participant created from a named XML profile, with its topics, writers and readers.
 #pragma once
 
+#include <chrono>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -76,6 +77,10 @@ class DdsContext {
                                                    const std::string& profile);
   eprosima::fastdds::dds::DataReader* createReader(eprosima::fastdds::dds::Topic* topic,
                                                    const std::string& profile);
+
+  /// Waits until the reliable readers matched with this participant's writers acknowledged
+  /// every sample written, at most `max_wait`. False if some had not by then.
+  bool waitForAcknowledgments(std::chrono::nanoseconds max_wait);
 
   eprosima::fastdds::dds::DomainParticipant* participant() { return participant_; }
   const std::string& name() const { return name_; }

@@ -157,8 +157,12 @@ class Participant {
   void spinOnce(std::chrono::nanoseconds max_wait);
   /// Spins for `duration`, or until stopped.
   void spinFor(std::chrono::nanoseconds duration);
-  /// Publishes the final (STOPPING) health report; run() does it by itself.
+  /// Publishes the final (STOPPING) health report, then waits up to kFinishAcknowledgmentWait
+  /// for the reliable readers to acknowledge everything this participant wrote, so that a
+  /// reader that is behind (a recorder on a loaded machine) still gets it; logs a warning if
+  /// they had not. run() does it by itself.
   void finish();
+  static constexpr std::chrono::seconds kFinishAcknowledgmentWait{5};
   /// Asks the loop to end (from a handler).
   void stop() { shutdown_.request(); }
   bool stopping() const { return shutdown_.requested(); }
