@@ -103,11 +103,14 @@ MalformedCounter* DdsContext::malformedCounter(const std::string& type_name) {
   return dynamic_cast<MalformedCounter*>(participant_->find_type(type_name).get());
 }
 
+eprosima::fastrtps::Duration_t toDdsDuration(std::chrono::nanoseconds d) {
+  const auto ns = std::max<std::int64_t>(0, d.count());
+  return eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(ns / 1'000'000'000),
+                                        static_cast<std::uint32_t>(ns % 1'000'000'000));
+}
+
 bool DdsContext::waitForAcknowledgments(std::chrono::nanoseconds max_wait) {
-  const auto ns = std::max<std::int64_t>(0, max_wait.count());
-  const eprosima::fastrtps::Duration_t wait(static_cast<std::int32_t>(ns / 1'000'000'000),
-                                            static_cast<std::uint32_t>(ns % 1'000'000'000));
-  return publisher_->wait_for_acknowledgments(wait) == ReturnCode_t::RETCODE_OK;
+  return publisher_->wait_for_acknowledgments(toDdsDuration(max_wait)) == ReturnCode_t::RETCODE_OK;
 }
 
 dds::DataWriter* DdsContext::createWriter(dds::Topic* topic, const std::string& profile) {

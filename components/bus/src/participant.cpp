@@ -194,14 +194,8 @@ void Participant::spinOnce(std::chrono::nanoseconds max_wait) {
   for (const auto& t : timers_) {
     next = std::min(next, t.next);
   }
-  const auto wait =
-      std::max(std::chrono::nanoseconds(0), std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                                next - std::chrono::steady_clock::now()));
-  const auto wait_ns = wait.count();
   active_.clear();
-  waitset_.wait(
-      active_, eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(wait_ns / 1'000'000'000),
-                                              static_cast<std::uint32_t>(wait_ns % 1'000'000'000)));
+  waitset_.wait(active_, toDdsDuration(next - std::chrono::steady_clock::now()));
   for (auto& entry : readers_) {
     // Poll every reader: a condition can be triggered again while we handle another one.
     dispatch(*entry);

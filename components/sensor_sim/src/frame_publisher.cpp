@@ -201,12 +201,13 @@ bool FramePublisher::readersMatched() const {
 }
 
 void FramePublisher::flush() {
-  const eprosima::fastrtps::Duration_t timeout(5, 0);
+  constexpr auto kWait = bus::Participant::kFinishAcknowledgmentWait;
   for (auto* w :
        {imu_.raw(), imu_blocks_.raw(), raw_.raw(), gnss_.raw(), fix_.raw(), star_.raw()}) {
-    if (w != nullptr && w->wait_for_acknowledgments(timeout) != ReturnCode_t::RETCODE_OK) {
+    if (w != nullptr &&
+        w->wait_for_acknowledgments(bus::toDdsDuration(kWait)) != ReturnCode_t::RETCODE_OK) {
       spdlog::warn("{}: not every reliable reader acknowledged the data within {} s",
-                   w->get_topic()->get_name(), timeout.seconds);
+                   w->get_topic()->get_name(), kWait.count());
     }
   }
 }

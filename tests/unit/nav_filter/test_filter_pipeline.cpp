@@ -76,6 +76,20 @@ nav_filter::FilterConfig imuOnlyConfig() {
                  "inputs: {imu: {id: 1, period_s: 0.01}}\n"));
 }
 
+/// Seed 001's loosely coupled filter, without a fault monitor to wait for.
+nav_filter::FilterConfig seed001Filter() {
+  const std::string dir = NAVBUS_SCENARIO_DIR;
+  auto cfg = nav_filter::parseFilterConfig(
+      bus::loadYamlFile(dir + "/../../config/filter_seed001_lc.yaml"));
+  cfg.fault_monitor.reset();
+  return cfg;
+}
+
+sensor_sim::SimConfig seed001Sim() {
+  const std::string dir = NAVBUS_SCENARIO_DIR;
+  return sensor_sim::parseSimConfig(bus::loadYamlFile(dir + "/seed001_leo.yaml"));
+}
+
 sim::ScenarioConfig sourceConfig() {
   sim::ScenarioConfig c;
   c.vehicle.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
@@ -277,12 +291,8 @@ TEST(FilterPipelineRestart, SourceRestartingAtAnEarlierTimeStartsANewRun) {
 // compensation beyond the limit is still refused.
 TEST(FilterPipelineCommands, RelearnBeyondTheCompensationLimitRelearnsUpToTheLimit) {
   // Given seed 001's loosely coupled filter fed by its scenario for 2 s,
-  const std::string dir = NAVBUS_SCENARIO_DIR;
-  auto cfg = nav_filter::parseFilterConfig(
-      bus::loadYamlFile(dir + "/../../config/filter_seed001_lc.yaml"));
-  cfg.fault_monitor.reset();
-  const sensor_sim::SimConfig sim =
-      sensor_sim::parseSimConfig(bus::loadYamlFile(dir + "/seed001_leo.yaml"));
+  const auto cfg = seed001Filter();
+  const sensor_sim::SimConfig sim = seed001Sim();
   bus::HealthCounters health("test");
   std::vector<NavigationSolution> solutions;
   nav_filter::FilterPipeline pipeline(
@@ -495,12 +505,8 @@ TEST(LowLatencyOutput, ReproducibleFromItsAnchorSolutionAndCloseToTheFilter) {
 // first block, then the fixes between them. The candidates the confirmation proves real are
 // used, so the filter's input, and its solutions, do not depend on that order.
 TEST(FilterPipelineOrder, AStreamStartingAfterAnotherGivesTheSameSolutionsInAnyArrivalOrder) {
-  const std::string dir = NAVBUS_SCENARIO_DIR;
-  auto cfg = nav_filter::parseFilterConfig(
-      bus::loadYamlFile(dir + "/../../config/filter_seed001_lc.yaml"));
-  cfg.fault_monitor.reset();
-  const sensor_sim::SimConfig sim =
-      sensor_sim::parseSimConfig(bus::loadYamlFile(dir + "/seed001_leo.yaml"));
+  const auto cfg = seed001Filter();
+  const sensor_sim::SimConfig sim = seed001Sim();
   // Given 10 s of the scenario's fixes and, from 3.5 s on, its IMU increments (numbered from 1),
   using Sample = std::variant<ImuIncrement, GnssFix>;
   std::vector<Sample> in_time_order;

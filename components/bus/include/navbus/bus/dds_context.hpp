@@ -106,4 +106,7 @@ class DdsContext {
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
 };
 
+/// A duration as Fast DDS takes it (negative: zero).
+eprosima::fastrtps::Duration_t toDdsDuration(std::chrono::nanoseconds d);
+
 }  // namespace navbus::bus
