@@ -283,3 +283,51 @@ TEST(Replay, TheImportedRealWalkWithARampReplaysBitIdentical) {
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }
+
+// A reader that stops taking (a stalled process) must slow the replay down, not lose samples:
+// the real drive's 2,197 GNSS fixes replayed as fast as possible to a reader that takes nothing
+// for 3 s. Its history (1,000 fixes) and the writer's (500) fill, so writes stay blocked for
+// longer than the profile's max_blocking_time (1 s); the replay tries them again until the
+// reader takes. Every fix must arrive, in order, and the replay must say it waited. Domain 109.
+TEST(Replay, AReaderThatFallsBehindSlowsTheReplayDownWithoutLosingSamples) {
+  constexpr int kDomain = 109;
+  constexpr std::size_t kFixes = 2197;
+  test::cleanSharedMemory();
+  const auto dir = test::scratchDir("replay-slow-reader");
+  const std::string rec = (dir / "rec").string();
+  test::ChildProcess import(
+      NAVBUS_TOOL_EXE,
+      {"import", std::string(NAVBUS_SOURCE_DIR) + "/config/datasets/drive_0708.yaml", "-o", rec},
+      (dir / "import.log").string());
+  ASSERT_EQ(import.wait(60s), 0) << test::readFile(dir / "import.log");
+
+  bus::ShutdownSignal shutdown;
+  bus::Participant me(test::testParticipant(kDomain, "replay-slow-reader-test"), shutdown);
+  std::vector<std::uint64_t> times_ns;
+  me.subscribe<GnssFixPubSubType>(
+      bus::topic::kGnssFix, bus::profile::kMeasurementReader,
+      [&](const GnssFix& f, const auto&) { times_ns.push_back(f.time_gps_ns()); });
+  test::ChildProcess replay(
+      NAVBUS_TOOL_EXE,
+      {"-d", std::to_string(kDomain), "replay", rec, "--topics", "navbus/gnss/fix", "--speed", "0"},
+      (dir / "replay.log").string());
+  std::this_thread::sleep_for(3s);  // nothing taken: the reader has fallen behind
+  while (replay.running()) me.spinOnce(50ms);
+  test::spinUntil(me, 10s, [&] { return times_ns.size() >= kFixes; });
+  const std::string replay_log = test::readFile(dir / "replay.log");
+  EXPECT_EQ(replay.wait(1s), 0) << replay_log;
+  std::smatch waits;
+  ASSERT_TRUE(std::regex_search(
+      replay_log, waits,
+      std::regex("replayed 2197 of 2197 samples of navbus/gnss/fix \\(writes that waited for a "
+                 "reader behind: ([0-9]+)\\)")))
+      << replay_log;
+  EXPECT_GT(std::stoul(waits[1]), 0u) << "the reader never held the writer up: nothing tested";
+  EXPECT_EQ(times_ns.size(), kFixes);
+  EXPECT_TRUE(std::is_sorted(times_ns.begin(), times_ns.end()));
+  EXPECT_EQ(std::adjacent_find(times_ns.begin(), times_ns.end()), times_ns.end());
+  std::printf("replay to a reader 3 s behind: %zu of %zu fixes taken, %lu writes waited\n",
+              times_ns.size(), kFixes, std::stoul(waits[1]));
+  test::cleanSharedMemory();
+  std::filesystem::remove_all(dir);
+}

@@ -112,14 +112,8 @@ bus::Writer<Message> FramePublisher::createWriter() {
 
 template <class Sample>
 bool FramePublisher::writeReliably(bus::Writer<Sample>& writer, const Sample& sample) {
-  while (!writer.write(sample)) {
-    // max_blocking_time elapsed with the history full: a reliable reader is behind.
-    ++write_retries_;
-    if (participant_.stopping()) {
-      return false;
-    }
-  }
-  return true;
+  return writer.writeWaitingForReaders(
+      sample, [this] { return participant_.stopping(); }, write_retries_);
 }
 
 bool FramePublisher::writeIncrement(const navbus::ImuIncrement& increment) {

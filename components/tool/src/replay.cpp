@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 
@@ -51,7 +52,11 @@ class Stream {
   virtual bool hasSourceTimes() const = 0;
   virtual void open(bus::Participant& p) = 0;
   virtual std::size_t matchedReaders() const = 0;
-  virtual bool publish(std::size_t i) = 0;
+  /// Writes message i, waiting for a reader that fell behind (bus::Writer); false if it was
+  /// not written (the replay stops, or no reader is left).
+  virtual bool publish(std::size_t i, const std::function<bool()>& stopping) = 0;
+  /// Writes retried because a reliable reader had not acknowledged within max_blocking_time.
+  virtual std::uint64_t writeWaits() const = 0;
   /// Disposes the instance (end of stream) and waits for the readers' acknowledgments.
   virtual void end() = 0;
 };
@@ -77,7 +82,10 @@ class TypedStream : public Stream {
     writer_ = p.createWriter<PubSubType>(topic_, profile_);
   }
   std::size_t matchedReaders() const override { return writer_.matchedReaders(); }
-  bool publish(std::size_t i) override { return writer_.write(messages_[i]); }
+  bool publish(std::size_t i, const std::function<bool()>& stopping) override {
+    return writer_.writeWaitingForReaders(messages_[i], stopping, write_waits_);
+  }
+  std::uint64_t writeWaits() const override { return write_waits_; }
   void end() override {
     if (messages_.empty()) return;
     writer_.dispose(messages_.back());
@@ -89,6 +97,7 @@ class TypedStream : public Stream {
   std::vector<T> messages_;
   std::vector<std::int64_t> source_ns_;
   bus::Writer<T> writer_;
+  std::uint64_t write_waits_{0};
 };
 
 /// The recorded source time stamps of a CSV table's messages (empty without the column).
@@ -345,15 +354,15 @@ int runReplayCommand(const bus::Participant::Options& participant, const ReplayO
                       1e-9 * static_cast<double>(e.pace_ns - events.front().pace_ns) / o.speed));
       while (Clock::now() < due && !p.stopping()) p.spinOnce(due - Clock::now());
     }
-    if (streams[e.stream]->publish(e.index)) ++published[e.stream];
+    if (streams[e.stream]->publish(e.index, [&p] { return p.stopping(); })) ++published[e.stream];
   }
   for (auto& s : streams) s->end();
   const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
   if (!p.stopping()) p.spinFor(bus::kEndOfStreamLinger);  // the ends reach best-effort readers
   bool complete = true;
   for (std::size_t s = 0; s < streams.size(); ++s) {
-    spdlog::info("replayed {} of {} samples of {}", published[s], streams[s]->size(),
-                 streams[s]->topic());
+    spdlog::info("replayed {} of {} samples of {} (writes that waited for a reader behind: {})",
+                 published[s], streams[s]->size(), streams[s]->topic(), streams[s]->writeWaits());
     complete = complete && published[s] == streams[s]->size();
   }
   const double span_s =

@@ -35,15 +35,26 @@ class Writer {
       : writer_(writer), health_(health) {}
   /// Returns false (and logs) if the sample could not be written.
   bool write(const Sample& sample) {
-    if (writer_ == nullptr) {
-      spdlog::error("write on a writer that was never created");
-      return false;
+    if (tryWrite(sample)) return true;
+    logWriteFailure();
+    return false;
+  }
+  /// Writes without losing the sample to a reader that fell behind. A reliable KEEP_ALL
+  /// writer's write() fails once its history stayed full for the profile's max_blocking_time:
+  /// a matched reader has not acknowledged. The write is then tried again, for as long as a
+  /// reader is matched and `stopping()` is false; `waits` counts the retries. A failure with
+  /// no reader matched is not flow control: after one more try, it returns false (and logs).
+  template <class Stopping>
+  bool writeWaitingForReaders(const Sample& sample, Stopping&& stopping, std::uint64_t& waits) {
+    bool readers_left = false;
+    while (!tryWrite(sample)) {
+      if (stopping() || readers_left) {
+        logWriteFailure();
+        return false;
+      }
+      readers_left = matchedReaders() == 0;
+      ++waits;
     }
-    if (!writer_->write(const_cast<Sample*>(&sample))) {
-      spdlog::error("write on '{}' failed", writer_->get_topic()->get_name());
-      return false;
-    }
-    health_->countPublished();
     return true;
   }
   /// Disposes the instance whose key `key_holder` carries: readers learn that the stream
@@ -62,6 +73,19 @@ class Writer {
   std::size_t matchedReaders() const;
 
  private:
+  bool tryWrite(const Sample& sample) {
+    if (writer_ == nullptr || !writer_->write(const_cast<Sample*>(&sample))) return false;
+    health_->countPublished();
+    return true;
+  }
+  void logWriteFailure() const {
+    if (writer_ == nullptr) {
+      spdlog::error("write on a writer that was never created");
+    } else {
+      spdlog::error("write on '{}' failed", writer_->get_topic()->get_name());
+    }
+  }
+
   eprosima::fastdds::dds::DataWriter* writer_{nullptr};
   HealthCounters* health_{nullptr};
 };
