@@ -28,6 +28,7 @@
 #include "navbus/bus/shared_memory.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/sim/scenario_source.hpp"
+#include "test_paths.hpp"
 
 namespace navbus::test {
 
@@ -196,7 +197,7 @@ struct Seed000Loop {
 inline Seed000Loop writeSeed000Loop(const std::filesystem::path& dir, int domain,
                                     const std::string& sim_extra,
                                     const std::string& scenario = "seed000_aircraft") {
-  const std::string src = NAVBUS_SOURCE_DIR;
+  const std::string src = navbus::test_paths::sourceDir();
   const std::string dom = "domain_id: " + std::to_string(domain) + "\n";
   return {writeFile(dir / "sim.yaml",
                     "extends: " + src + "/sim/scenarios/" + scenario + ".yaml\n" + dom + sim_extra),
@@ -222,7 +223,7 @@ inline std::optional<int> runOffline(const Seed000Loop& loop, const std::filesys
                                 "-o",
                                 (dir / "offline").string()};
   if (!seed.empty()) args.insert(args.end(), {"--seed", seed});
-  ChildProcess offline(NAVBUS_TOOL_EXE, args, (dir / "offline.log").string());
+  ChildProcess offline(navbus::test_paths::toolExe(), args, (dir / "offline.log").string());
   return offline.wait(std::chrono::seconds(180));
 }
 

@@ -23,6 +23,7 @@
 #include "navbus/bus/health.hpp"
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sim/scenario_source.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -67,7 +68,8 @@ TEST(BadInput, RejectedByReasonCountedAndSolutionStaysFinite) {
   const auto dir = test::scratchDir("bad-input");
   const std::string cfg =
       test::writeFile(dir / "filter.yaml", test::filterConfig(kDomain) + "mode: tightly_coupled\n");
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", cfg},
+                            (dir / "filter.log").string());
 
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(kDomain, "bad-input-test"), shutdown);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "harness.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -15,7 +16,7 @@ constexpr int kDomain = 67;
 int runTool(const std::filesystem::path& dir, const std::string& log,
             std::vector<std::string> args) {
   args.insert(args.begin(), {"-d", std::to_string(kDomain), "command"});
-  test::ChildProcess tool(NAVBUS_TOOL_EXE, args, (dir / log).string());
+  test::ChildProcess tool(navbus::test_paths::toolExe(), args, (dir / log).string());
   return tool.wait(30s).value_or(-1);
 }
 
@@ -24,16 +25,18 @@ int runTool(const std::filesystem::path& dir, const std::string& log,
 TEST(CommandTool, AppliedRefusedAndBadOptions) {
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("command");
-  const std::string filter_cfg = test::writeFile(
-      dir / "filter.yaml", "extends: " + std::string(NAVBUS_SOURCE_DIR) + "/config/filter.yaml\n" +
-                               "domain_id: " + std::to_string(kDomain) + "\n");
+  const std::string filter_cfg =
+      test::writeFile(dir / "filter.yaml",
+                      "extends: " + std::string(navbus::test_paths::sourceDir()) +
+                          "/config/filter.yaml\n" + "domain_id: " + std::to_string(kDomain) + "\n");
 
   // No filter yet: nobody reads the commands.
   EXPECT_EQ(runTool(dir, "none.log", {"RESET", "--match-timeout", "0.5"}), 1);
   EXPECT_NE(test::readFile(dir / "none.log").find("no reader of navbus/filter/command"),
             std::string::npos);
 
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
   EXPECT_EQ(
       runTool(dir, "ok.log", {"EXCLUDE_STREAM", "--sensor", "GNSS_FIX_STREAM", "--sensor-id", "1"}),
       0)

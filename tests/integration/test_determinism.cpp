@@ -8,6 +8,7 @@
 #include "navbus/records/formatters.hpp"
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sim/scenario_source.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -49,7 +50,8 @@ Run runFilter(int domain, Delivery delivery, const std::vector<sim::SensorFrame>
         " initial_position_sigma_m: 10, accel_bias_sigma_ug: 1000}\n";
   }
   const std::string cfg = test::writeFile(dir / "filter.yaml", yaml);
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", cfg},
+                            (dir / "filter.log").string());
 
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(domain, "determinism-test"), shutdown);

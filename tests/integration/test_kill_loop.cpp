@@ -30,6 +30,7 @@
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "harness.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -86,9 +87,9 @@ struct Spawner {
                                         : which == 1 ? filter_cfg
                                                      : fm_cfg,
                                         "--profile", profileUnderTest()};
-    const char* exe = which == 0   ? NAVBUS_SENSOR_SIM_EXE
-                      : which == 1 ? NAVBUS_FILTER_EXE
-                                   : NAVBUS_FAULT_MANAGER_EXE;
+    const char* exe = which == 0   ? navbus::test_paths::sensorSimExe()
+                      : which == 1 ? navbus::test_paths::filterExe()
+                                   : navbus::test_paths::faultManagerExe();
     return std::make_unique<test::ChildProcess>(exe, args, log);
   }
 };
@@ -281,7 +282,7 @@ TEST(SharedMemory, WhatAKilledParticipantLeftIsReclaimedByALiveOne) {
                                      ++health_seen;
                                  });
   {
-    test::ChildProcess filter(NAVBUS_FILTER_EXE,
+    test::ChildProcess filter(navbus::test_paths::filterExe(),
                               {"-c", filter_cfg, "--profile", "navbus_participant_shm"},
                               (dir / "filter.log").string());
     ASSERT_TRUE(test::spinUntil(me, 20s, [&] { return health_seen > 0; }))
@@ -298,7 +299,7 @@ TEST(SharedMemory, WhatAKilledParticipantLeftIsReclaimedByALiveOne) {
               std::chrono::duration<double>(Clock::now() - t0).count());
   // The live participant still works: it hears a new participant's health.
   health_seen = 0;
-  test::ChildProcess filter(NAVBUS_FILTER_EXE,
+  test::ChildProcess filter(navbus::test_paths::filterExe(),
                             {"-c", filter_cfg, "--profile", "navbus_participant_shm"},
                             (dir / "filter2.log").string());
   EXPECT_TRUE(test::spinUntil(me, 20s, [&] { return health_seen > 0; }));
@@ -326,7 +327,7 @@ TEST(SharedMemory, TheLastParticipantOutLeavesNothing) {
                                    [&](const Health& h, const auto&) {
                                      health_seen |= h.participant().to_string() == "navbus-filter";
                                    });
-    test::ChildProcess filter(NAVBUS_FILTER_EXE,
+    test::ChildProcess filter(navbus::test_paths::filterExe(),
                               {"-c", filter_cfg, "--profile", "navbus_participant_shm"},
                               (dir / "filter.log").string());
     ASSERT_TRUE(test::spinUntil(me, 20s, [&] { return health_seen; }))

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "harness.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 
@@ -18,21 +19,22 @@ TEST(LowLatencyBus, EveryIncrementGetsItsOutputOverTheBus) {
   const auto dir = test::scratchDir("low-latency");
   const std::string cfg = test::writeFile(
       dir / "filter.yaml",
-      test::readFile(std::string(NAVBUS_SOURCE_DIR) + "/config/filter_latency.yaml") +
+      test::readFile(std::string(navbus::test_paths::sourceDir()) + "/config/filter_latency.yaml") +
           "domain_id: " + std::to_string(kDomain) + "\n");
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", cfg},
+                            (dir / "filter.log").string());
   const std::string csv = (dir / "latency.csv").string();
   // A passive observer on the same bus: IMU source time stamps -> outputs received. It stops
   // after kObserved outputs past its warm-up (fewer than the tool sends: the first increments
   // come before the filter's first solution, the anchor of the outputs).
   constexpr int kObserved = kSamples / 2;
   test::ChildProcess observer(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"-d", std::to_string(kDomain), "latency", "observe", "--samples", std::to_string(kObserved),
        "--warmup", std::to_string(kWarmup), "--duration", "60"},
       (dir / "observe.log").string());
   test::ChildProcess tool(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"-d", std::to_string(kDomain), "latency", "imu", "--samples", std::to_string(kSamples),
        "--warmup", std::to_string(kWarmup), "--csv", csv},
       (dir / "tool.log").string());
@@ -101,10 +103,10 @@ TEST(LatencyFlood, ReliableFloodReachesTheSinkWithoutLoss) {
   constexpr int kSamples = 20000, kWarmup = 1000;
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("latency-flood");
-  test::ChildProcess sink(NAVBUS_TOOL_EXE,
+  test::ChildProcess sink(navbus::test_paths::toolExe(),
                           {"-d", std::to_string(kDomain), "latency", "sink", "--duration", "60"},
                           (dir / "sink.log").string());
-  test::ChildProcess flood(NAVBUS_TOOL_EXE,
+  test::ChildProcess flood(navbus::test_paths::toolExe(),
                            {"-d", std::to_string(kDomain), "latency", "flood", "--samples",
                             std::to_string(kSamples), "--warmup", std::to_string(kWarmup)},
                            (dir / "flood.log").string());

@@ -14,6 +14,7 @@
 
 #include "harness.hpp"
 #include "navbus/records/formatters.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -32,8 +33,10 @@ struct Case {
 void runCase(const Case& c) {
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("offline-" + std::to_string(c.domain));
-  const std::string scenario = std::string(NAVBUS_SOURCE_DIR) + "/sim/scenarios/" + c.scenario;
-  const std::string filter_base = std::string(NAVBUS_SOURCE_DIR) + "/config/" + c.filter;
+  const std::string scenario =
+      std::string(navbus::test_paths::sourceDir()) + "/sim/scenarios/" + c.scenario;
+  const std::string filter_base =
+      std::string(navbus::test_paths::sourceDir()) + "/config/" + c.filter;
   const std::string domain = "domain_id: " + std::to_string(c.domain) + "\n";
   const std::string sim_cfg = test::writeFile(
       dir / "sim.yaml", "extends: " + scenario + "\n" + domain +
@@ -57,7 +60,7 @@ void runCase(const Case& c) {
 
   // Offline first: no DDS at all.
   test::ChildProcess offline(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"offline", "--scenario", sim_cfg, "--filter", filter_cfg, "--start", "config", "--seed",
        std::to_string(c.seed), "-o", (dir / "offline").string()},
       (dir / "offline.log").string());
@@ -75,9 +78,12 @@ void runCase(const Case& c) {
                                                if (s.mode() != MODE_INERTIAL_LOST)
                                                  rows.push_back(records::csvRows(s).at(0));
                                              });
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
-  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg, "--seed", std::to_string(c.seed)},
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
+                        (dir / "fm.log").string());
+  test::ChildProcess sim(navbus::test_paths::sensorSimExe(),
+                         {"-c", sim_cfg, "--seed", std::to_string(c.seed)},
                          (dir / "sim.log").string());
   // The simulator waits for the filter and the fault manager, publishes as fast as they take
   // it (reliable, nothing lost) and exits.
@@ -123,13 +129,13 @@ TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
   const auto dir = test::scratchDir("fusion-switch");
   const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
   const std::string sim_cfg = test::writeFile(
-      dir / "sim.yaml", "extends: " + std::string(NAVBUS_SOURCE_DIR) +
+      dir / "sim.yaml", "extends: " + std::string(navbus::test_paths::sourceDir()) +
                             "/sim/scenarios/seed001_leo.yaml\n" + domain +
                             "timing: {duration_s: 0, pacing: realtime,\n"
                             "  min_readers: {imu: 1, raw_imu: 0, gnss: 1, star_tracker: 1}}\n");
-  const std::string filter_cfg =
-      test::writeFile(dir / "filter.yaml", "extends: " + std::string(NAVBUS_SOURCE_DIR) +
-                                               "/config/filter_seed001_lc.yaml\n" + domain);
+  const std::string filter_cfg = test::writeFile(
+      dir / "filter.yaml", "extends: " + std::string(navbus::test_paths::sourceDir()) +
+                               "/config/filter_seed001_lc.yaml\n" + domain);
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(kDomain, "fusion-switch-test"), shutdown);
   std::vector<FusionStructure> seen;
@@ -138,8 +144,10 @@ TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
       [&](const NavigationSolution& s, const auto&) { seen.push_back(s.fusion()); });
   auto commands = me.createWriter<FilterCommandPubSubType>(bus::topic::kFilterCommand,
                                                            bus::profile::kDecisionWriter);
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg}, (dir / "sim.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg},
+                         (dir / "sim.log").string());
   ASSERT_TRUE(test::spinUntil(me, 30s, [&] { return seen.size() >= 5; }))
       << test::readFile(dir / "filter.log");
   EXPECT_EQ(seen.back(), FUSION_CENTRALIZED);
@@ -219,9 +227,12 @@ TEST(FaultLoop, RampDetectedExcludedAndRecoveredOverTheBusAsOffline) {
   me.subscribe<FilterCommandPubSubType>(
       bus::topic::kFilterCommand, bus::profile::kDecisionReader,
       [&](const FilterCommand& c, const auto&) { commands.push_back(c); });
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
-  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg}, (dir / "sim.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
+                        (dir / "fm.log").string());
+  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg},
+                         (dir / "sim.log").string());
   while (sim.running()) me.spinOnce(50ms);
   EXPECT_EQ(sim.wait(1s), 0) << test::readFile(dir / "sim.log");
   test::spinUntil(me, 20s, [&] { return rows.size() >= expected.size(); });
@@ -295,7 +306,7 @@ TEST(FaultLoop, StuckAccelerometerFlaggedByTheDitherMonitorOverTheBus) {
   constexpr int kDomain = 90;
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("dither-loop");
-  const std::string src = NAVBUS_SOURCE_DIR;
+  const std::string src = navbus::test_paths::sourceDir();
   const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
   // Seed 003: the static laser INS with accelerometer x stuck at 8 s, in real time: the
   // target (flagged within 0.5 s of the fault) is a data-time latency, which a fast-paced
@@ -327,9 +338,12 @@ TEST(FaultLoop, StuckAccelerometerFlaggedByTheDitherMonitorOverTheBus) {
   me.subscribe<FilterCommandPubSubType>(
       bus::topic::kFilterCommand, bus::profile::kDecisionReader,
       [&](const FilterCommand& c, const auto&) { commands.push_back(c); });
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
-  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg}, (dir / "sim.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
+                        (dir / "fm.log").string());
+  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg},
+                         (dir / "sim.log").string());
   while (sim.running()) me.spinOnce(50ms);
   EXPECT_EQ(sim.wait(1s), 0) << test::readFile(dir / "sim.log");
   test::spinUntil(me, 20s, [&] {

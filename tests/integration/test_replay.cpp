@@ -14,6 +14,7 @@
 
 #include "harness.hpp"
 #include "navbus/records/formatters.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -30,7 +31,7 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
   constexpr int kDomain = 66;
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("replay");
-  const std::string src = NAVBUS_SOURCE_DIR;
+  const std::string src = navbus::test_paths::sourceDir();
   const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
   const std::string sim_cfg = test::writeFile(
       dir / "sim.yaml", "extends: " + src + "/sim/scenarios/seed004_land_vehicle.yaml\n" + domain +
@@ -42,7 +43,7 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
                                "sequencer_max_wait_s: 30\n");
   const std::string fm_cfg = test::writeFile(dir / "fm.yaml", domain);
 
-  test::ChildProcess offline(NAVBUS_TOOL_EXE,
+  test::ChildProcess offline(navbus::test_paths::toolExe(),
                              {"offline", "--scenario", sim_cfg, "--filter", filter_cfg, "--start",
                               "config", "--seed", "5", "-o", (dir / "offline").string()},
                              (dir / "offline.log").string());
@@ -53,11 +54,11 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
   // 1. The simulator's run, recorded from the bus (the recorder is its only reader).
   const std::string rec = (dir / "rec").string();
   test::ChildProcess recorder(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"-d", std::to_string(kDomain), "record", "navbus/imu/increment_block", "navbus/imu/raw",
        "navbus/gnss/observations", "navbus/gnss/fix", "-o", rec},
       (dir / "record.log").string());
-  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg, "--seed", "5"},
+  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg, "--seed", "5"},
                          (dir / "sim.log").string());
   ASSERT_EQ(sim.wait(120s), 0) << test::readFile(dir / "sim.log");
   std::this_thread::sleep_for(1s);  // the recorder writes what it took last
@@ -85,9 +86,11 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
                                                if (s.mode() != MODE_INERTIAL_LOST)
                                                  rows.push_back(records::csvRows(s).at(0));
                                              });
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
-  test::ChildProcess replay(NAVBUS_TOOL_EXE,
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
+                        (dir / "fm.log").string());
+  test::ChildProcess replay(navbus::test_paths::toolExe(),
                             {"-d", std::to_string(kDomain), "replay", rec, "--speed", "0",
                              "--min-readers", "navbus/imu/increment_block=2", "--min-readers",
                              "navbus/gnss/observations=2", "--min-readers", "navbus/gnss/fix=2"},
@@ -122,7 +125,7 @@ TEST(Replay, TheImportedRealDriveReplaysBitIdentical) {
   constexpr int kDomain = 68;
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("replay-real");
-  const std::string src = NAVBUS_SOURCE_DIR;
+  const std::string src = navbus::test_paths::sourceDir();
   const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
   const std::string filter_cfg = test::writeFile(
       dir / "filter.yaml", "extends: " + src + "/config/filter_drive_0708.yaml\n" + domain +
@@ -130,12 +133,12 @@ TEST(Replay, TheImportedRealDriveReplaysBitIdentical) {
                                "sequencer_max_wait_s: 30\n");
   const std::string fm_cfg = test::writeFile(dir / "fm.yaml", domain);
   const std::string rec = (dir / "rec").string();
-  test::ChildProcess import(NAVBUS_TOOL_EXE,
+  test::ChildProcess import(navbus::test_paths::toolExe(),
                             {"import", src + "/config/datasets/drive_0708.yaml", "-o", rec},
                             (dir / "import.log").string());
   ASSERT_EQ(import.wait(60s), 0) << test::readFile(dir / "import.log");
   test::ChildProcess offline(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"offline", "--recording", rec, "--filter", filter_cfg, "-o", (dir / "offline").string()},
       (dir / "offline.log").string());
   ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
@@ -148,10 +151,12 @@ TEST(Replay, TheImportedRealDriveReplaysBitIdentical) {
   me.subscribe<NavigationSolutionPubSubType>(
       bus::topic::kNavSolution, bus::profile::kSolutionReader,
       [&](const NavigationSolution& s, const auto&) { rows.push_back(records::csvRows(s).at(0)); });
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
+                        (dir / "fm.log").string());
   test::ChildProcess replay(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"-d", std::to_string(kDomain), "replay", rec, "--speed", "0", "--min-readers",
        "navbus/imu/increment_block=2", "--min-readers", "navbus/gnss/fix=2"},
       (dir / "replay.log").string());
@@ -188,7 +193,7 @@ TEST(Replay, TheImportedRealWalkWithARampReplaysBitIdentical) {
   constexpr int kDomain = 69;
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("replay-walk");
-  const std::string src = NAVBUS_SOURCE_DIR;
+  const std::string src = navbus::test_paths::sourceDir();
   const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
   const std::string filter_cfg = test::writeFile(
       dir / "filter.yaml", "extends: " + src + "/config/filter_walk_0827_tc.yaml\n" + domain +
@@ -198,11 +203,11 @@ TEST(Replay, TheImportedRealWalkWithARampReplaysBitIdentical) {
       test::writeFile(dir / "fm.yaml", "extends: " + src + "/config/fault_manager.yaml\n" + domain);
   const std::string rec = (dir / "rec").string();
   test::ChildProcess import(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"import", src + "/config/datasets/walk_0827.yaml", "-o", rec, "--ramp", "10,2,40"},
       (dir / "import.log").string());
   ASSERT_EQ(import.wait(60s), 0) << test::readFile(dir / "import.log");
-  test::ChildProcess offline(NAVBUS_TOOL_EXE,
+  test::ChildProcess offline(navbus::test_paths::toolExe(),
                              {"offline", "--recording", rec, "--filter", filter_cfg,
                               "--fault-manager", fm_cfg, "-o", (dir / "offline").string()},
                              (dir / "offline.log").string());
@@ -237,10 +242,12 @@ TEST(Replay, TheImportedRealWalkWithARampReplaysBitIdentical) {
         }
         rows.push_back(records::csvRows(compared).at(0));
       });
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
+                        (dir / "fm.log").string());
   test::ChildProcess replay(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"-d", std::to_string(kDomain), "replay", rec, "--speed", "0", "--min-readers",
        "navbus/imu/increment_block=2", "--min-readers", "navbus/gnss/observations=2"},
       (dir / "replay.log").string());
@@ -296,8 +303,9 @@ TEST(Replay, AReaderThatFallsBehindSlowsTheReplayDownWithoutLosingSamples) {
   const auto dir = test::scratchDir("replay-slow-reader");
   const std::string rec = (dir / "rec").string();
   test::ChildProcess import(
-      NAVBUS_TOOL_EXE,
-      {"import", std::string(NAVBUS_SOURCE_DIR) + "/config/datasets/drive_0708.yaml", "-o", rec},
+      navbus::test_paths::toolExe(),
+      {"import", std::string(navbus::test_paths::sourceDir()) + "/config/datasets/drive_0708.yaml",
+       "-o", rec},
       (dir / "import.log").string());
   ASSERT_EQ(import.wait(60s), 0) << test::readFile(dir / "import.log");
 
@@ -308,7 +316,7 @@ TEST(Replay, AReaderThatFallsBehindSlowsTheReplayDownWithoutLosingSamples) {
       bus::topic::kGnssFix, bus::profile::kMeasurementReader,
       [&](const GnssFix& f, const auto&) { times_ns.push_back(f.time_gps_ns()); });
   test::ChildProcess replay(
-      NAVBUS_TOOL_EXE,
+      navbus::test_paths::toolExe(),
       {"-d", std::to_string(kDomain), "replay", rec, "--topics", "navbus/gnss/fix", "--speed", "0"},
       (dir / "replay.log").string());
   std::this_thread::sleep_for(3s);  // nothing taken: the reader has fallen behind

@@ -25,6 +25,7 @@
 #include "navbus/bus/conversions.hpp"
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sim/scenario_source.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -35,7 +36,7 @@ constexpr int kDomain = 91;
 constexpr const char* kSecureProfile = "navbus_participant_udp_loopback_secure";
 
 std::string identity(const std::string& name) {
-  return std::string(NAVBUS_CREDENTIALS_DIR) + "/" + name;
+  return std::string(navbus::test_paths::credentialsDir()) + "/" + name;
 }
 
 bus::Participant::Options secureParticipant(const std::string& name, const std::string& id) {
@@ -118,7 +119,8 @@ TEST(Security, ParticipantWithoutCredentialsGetsNothingAcceptedAndReadsNothing) 
       dir / "filter.yaml", test::filterConfig(kDomain) +
                                "mode: tightly_coupled\nparticipant_profile: " + kSecureProfile +
                                "\nsecurity_identity: " + identity("filter") + "\n");
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", cfg},
+                            (dir / "filter.log").string());
 
   bus::ShutdownSignal shutdown;
   bus::Participant sensors(secureParticipant("sensors", "simulator"), shutdown);

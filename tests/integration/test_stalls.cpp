@@ -14,6 +14,7 @@
 
 #include "harness.hpp"
 #include "navbus/records/formatters.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -98,14 +99,15 @@ void run(const LoadCase& c) {
                                           else
                                             decisions.push_back(row);
                                         });
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg.filter}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", cfg.fault_manager},
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", cfg.filter},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", cfg.fault_manager},
                         (dir / "fm.log").string());
   std::vector<std::unique_ptr<test::ChildProcess>> hogs;
   for (int k = 0; k < c.cpu_hogs; ++k)
     hogs.push_back(std::make_unique<test::ChildProcess>(
         "/bin/sh", std::vector<std::string>{"-c", "while :; do :; done"}, "/dev/null"));
-  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", cfg.sim, "--seed", "3"},
+  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", cfg.sim, "--seed", "3"},
                          (dir / "sim.log").string());
   // The stops, spread evenly over the solutions as they come (the filter's first, then the
   // fault manager's), while the data flows.

@@ -8,6 +8,7 @@
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "harness.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -60,10 +61,13 @@ TEST(ThreeProcesses, SolutionRateStreamLossDecisionModeChangeAndRecovery) {
   me.subscribe<ImuIncrementPubSubType>(bus::topic::kImuIncrement, bus::profile::kSensorReader,
                                        [&](const auto&, const auto&) { ++imu_seen; });
 
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE, {"-c", fm_cfg}, (dir / "fm.log").string());
-  auto sim = std::make_unique<test::ChildProcess>(
-      NAVBUS_SENSOR_SIM_EXE, std::vector<std::string>{"-c", sim_cfg}, (dir / "sim1.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
+                        (dir / "fm.log").string());
+  auto sim = std::make_unique<test::ChildProcess>(navbus::test_paths::sensorSimExe(),
+                                                  std::vector<std::string>{"-c", sim_cfg},
+                                                  (dir / "sim1.log").string());
 
   // Given the three participants running, solutions arrive at the configured 10 Hz.
   ASSERT_TRUE(test::spinUntil(me, 30s, [&] { return seen.solutions.size() >= 5; }))
@@ -126,8 +130,9 @@ TEST(ThreeProcesses, SolutionRateStreamLossDecisionModeChangeAndRecovery) {
 
   // When the simulator is started again,
   const std::size_t decisions_mid = seen.decisions.size();
-  sim = std::make_unique<test::ChildProcess>(
-      NAVBUS_SENSOR_SIM_EXE, std::vector<std::string>{"-c", sim_cfg}, (dir / "sim2.log").string());
+  sim = std::make_unique<test::ChildProcess>(navbus::test_paths::sensorSimExe(),
+                                             std::vector<std::string>{"-c", sim_cfg},
+                                             (dir / "sim2.log").string());
   // then the stream is declared restored and the filter is back to inertial navigation with
   // the stream-lost flag cleared.
   ASSERT_TRUE(test::spinUntil(

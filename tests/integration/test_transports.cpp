@@ -10,6 +10,7 @@
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "harness.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -63,9 +64,11 @@ TEST_P(FastPacing, NothingLostAndTheFilterKeepsUp) {
       bus::topic::kNavSolution, bus::profile::kSolutionReader,
       [&](const NavigationSolution& s, const auto&) { last_solution = s; });
 
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", filter_cfg}, (dir / "filter.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
+                            (dir / "filter.log").string());
   const auto start = std::chrono::steady_clock::now();
-  test::ChildProcess sim(NAVBUS_SENSOR_SIM_EXE, {"-c", sim_cfg}, (dir / "sim.log").string());
+  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg},
+                         (dir / "sim.log").string());
   const auto sim_exit = sim.wait(120s);
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

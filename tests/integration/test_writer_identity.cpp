@@ -12,6 +12,7 @@
 #include "navbus/bus/conversions.hpp"
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sim/scenario_source.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace std::chrono_literals;
@@ -25,11 +26,13 @@ TEST(WriterIdentity, SecondWriterOnASensorKeyIsKeptOutAndReported) {
   const auto dir = test::scratchDir("writer-identity");
   const std::string cfg =
       test::writeFile(dir / "filter.yaml", test::filterConfig(kDomain) + "mode: tightly_coupled\n");
-  test::ChildProcess filter(NAVBUS_FILTER_EXE, {"-c", cfg}, (dir / "filter.log").string());
-  test::ChildProcess fm(NAVBUS_FAULT_MANAGER_EXE,
-                        {"-c", std::string(NAVBUS_SOURCE_DIR) + "/config/fault_manager.yaml", "-d",
-                         std::to_string(kDomain)},
-                        (dir / "fm.log").string());
+  test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", cfg},
+                            (dir / "filter.log").string());
+  test::ChildProcess fm(
+      navbus::test_paths::faultManagerExe(),
+      {"-c", std::string(navbus::test_paths::sourceDir()) + "/config/fault_manager.yaml", "-d",
+       std::to_string(kDomain)},
+      (dir / "fm.log").string());
 
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(kDomain, "writer-identity-test"), shutdown);

@@ -20,15 +20,17 @@
 #include "navbus/importers/importer.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/records/csv_table.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using namespace navbus;
 
 namespace {
-const fs::path kConfig(NAVBUS_CONFIG_DIR);
+const fs::path kConfig(navbus::test_paths::configDir());
 
 fs::path workDir(const std::string& name) {
-  const fs::path dir = fs::path(NAVBUS_WORK_DIR) / (name + "-" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::path(navbus::test_paths::workDir()) / (name + "-" + std::to_string(getpid()));
   fs::remove_all(dir);
   return dir;
 }

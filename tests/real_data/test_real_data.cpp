@@ -13,6 +13,7 @@
 #include "navbus/evaluation/real_data.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/gnss_data/rinex2.hpp"
+#include "test_paths.hpp"
 
 namespace nb = navbus;
 using nb::gnss_data::readNavigationFile;
@@ -20,8 +21,8 @@ using nb::gnss_data::readObservationFile;
 
 namespace {
 
-const std::string kObs = std::string(NAVBUS_RINEX_DIR) + "/07590920.05o";
-const std::string kNav = std::string(NAVBUS_RINEX_DIR) + "/07590920.05n";
+const std::string kObs = std::string(navbus::test_paths::rinexDir()) + "/07590920.05o";
+const std::string kNav = std::string(navbus::test_paths::rinexDir()) + "/07590920.05n";
 const Eigen::Vector3d kReference(-3976219.5082, 3382372.5671, 3652512.9849);
 
 nb::evaluation::RealDataSetup loadSetup(bool with_fault_manager) {
@@ -31,8 +32,8 @@ nb::evaluation::RealDataSetup loadSetup(bool with_fault_manager) {
   s.nav = readNavigationFile(n, kNav);
   s.reference_ecef_m = kReference;
   if (with_fault_manager) {
-    s.fault_manager = nb::fault_manager::parseFaultManagerConfig(
-        nb::bus::loadYamlFile(std::string(NAVBUS_CONFIG_DIR) + "/fault_manager_static.yaml"));
+    s.fault_manager = nb::fault_manager::parseFaultManagerConfig(nb::bus::loadYamlFile(
+        std::string(navbus::test_paths::configDir()) + "/fault_manager_static.yaml"));
   }
   return s;
 }
@@ -44,12 +45,12 @@ struct RtklibFix {
 
 /// rnx2rtkp single point (broadcast ionosphere, Saastamoinen, 10 deg mask, ECEF output).
 std::vector<RtklibFix> runRtklib() {
-  const std::string rnx2rtkp = NAVBUS_RNX2RTKP;
+  const std::string rnx2rtkp = navbus::test_paths::rnx2rtkp();
   if (rnx2rtkp.empty() || rnx2rtkp.find("NOTFOUND") != std::string::npos) {
     ADD_FAILURE() << "rnx2rtkp not found: install Debian's rtklib (scripts/install-deps.sh)";
     return {};
   }
-  const std::string work = NAVBUS_WORK_DIR;
+  const std::string work = navbus::test_paths::workDir();
   std::filesystem::create_directories(work);
   std::ofstream(work + "/spp.conf") << "pos1-posmode =single\npos1-ionoopt =brdc\n"
                                        "pos1-tropopt =saas\npos1-elmask =10\n"
@@ -209,12 +210,12 @@ TEST(RealData, SlowRampIsDetectedLater) {
 // epochs, pseudoranges and Doppler (C1C/D1C against C1/D1), the same GPS ephemerides; the
 // other systems' satellites and records counted.
 TEST(Rinex3, TheWalksConvbinDefaultOutputReadsAsItsRinex2) {
-  const std::string convbin = NAVBUS_CONVBIN;
+  const std::string convbin = navbus::test_paths::convbin();
   ASSERT_FALSE(convbin.empty() || convbin.find("NOTFOUND") != std::string::npos)
       << "convbin not found: install Debian's rtklib (scripts/install-deps.sh)";
-  const std::string work = std::string(NAVBUS_WORK_DIR) + "/rinex3";
+  const std::string work = std::string(navbus::test_paths::workDir()) + "/rinex3";
   std::filesystem::create_directories(work);
-  const std::string real = std::string(NAVBUS_REAL_DIR) + "/walk_0827";
+  const std::string real = std::string(navbus::test_paths::realDir()) + "/walk_0827";
   const std::string command = convbin + " -r ubx -od -os -o " + work + "/walk.obs -n " + work +
                               "/walk.nav " + real + "/gnss_1730.ubx > " + work +
                               "/convbin.log 2>&1";

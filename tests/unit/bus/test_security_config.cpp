@@ -13,6 +13,7 @@
 #include "navbus/bus/qos_files.hpp"
 #include "navbus/bus/security.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 namespace fdds = eprosima::fastdds::dds;
@@ -80,7 +81,7 @@ TEST(SecurityConfig, ProfilesAndIdentitiesMustAgree) {
   q = secure;
   const std::size_t before = q.properties().properties().size();
   navbus::bus::applySecurityIdentity(q, "navbus_participant_udp_loopback_secure",
-                                     std::string(NAVBUS_CREDENTIALS_DIR) + "/filter");
+                                     std::string(navbus::test_paths::credentialsDir()) + "/filter");
   ASSERT_EQ(q.properties().properties().size(), before + 6);
   EXPECT_EQ(q.properties().properties().back().value().rfind("file:///", 0), 0u);
 }

@@ -11,6 +11,7 @@
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using navbus::bus::ConfigError;
@@ -48,8 +49,8 @@ class ConfigKeys : public ::testing::Test {
   fs::path dir_;
 };
 
-const std::string kSrc = NAVBUS_CONFIG_DIR;
-const std::string kScenarios = NAVBUS_SCENARIO_DIR;
+const std::string kSrc = navbus::test_paths::configDir();
+const std::string kScenarios = navbus::test_paths::scenarioDir();
 
 auto filter = [](const YAML::Node& n) { return navbus::nav_filter::parseFilterConfig(n); };
 auto faults = [](const YAML::Node& n) { return navbus::fault_manager::parseFaultManagerConfig(n); };

@@ -12,13 +12,14 @@
 #include "navbus/evaluation/evaluation.hpp"
 #include "navbus/evaluation/offline_runner.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
+#include "test_paths.hpp"
 
 namespace evaluation = navbus::evaluation;
 
 namespace {
 
-const std::string kScenarios = NAVBUS_SCENARIO_DIR;
-const std::string kConfig = NAVBUS_CONFIG_DIR;
+const std::string kScenarios = navbus::test_paths::scenarioDir();
+const std::string kConfig = navbus::test_paths::configDir();
 constexpr std::int64_t kStart = 1'400'000'000'000'000'000;  // the scenarios' start time
 
 evaluation::OfflineResult runLoop(const std::string& scenario, double duration_s,

@@ -10,14 +10,15 @@
 #include "navbus/core/math/units.hpp"
 #include "navbus/evaluation/evaluation.hpp"
 #include "navbus/evaluation/offline_runner.hpp"
+#include "test_paths.hpp"
 
 namespace evaluation = navbus::evaluation;
 namespace units = navbus::units;
 
 namespace {
 
-const std::string kScenarios = NAVBUS_SCENARIO_DIR;
-const std::string kConfig = NAVBUS_CONFIG_DIR;
+const std::string kScenarios = navbus::test_paths::scenarioDir();
+const std::string kConfig = navbus::test_paths::configDir();
 
 struct Errors {
   double pos_rms{0}, vel_rms{0}, att_rms_arcsec{0}, pos_max{0}, nees{0};

@@ -8,6 +8,7 @@
 #include "navbus/core/filter/integrated_filter.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
+#include "test_paths.hpp"
 
 namespace earth = navbus::core::earth;
 namespace layout = navbus::core::layout;
@@ -21,10 +22,10 @@ struct RunResult {
 };
 
 RunResult run(double seconds, std::uint64_t seed) {
-  auto c =
-      navbus::sensor_sim::parseSimConfig(
-          navbus::bus::loadYamlFile(std::string(NAVBUS_SCENARIO_DIR) + "/seed000_aircraft.yaml"))
-          .scenario;
+  auto c = navbus::sensor_sim::parseSimConfig(
+               navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) +
+                                         "/seed000_aircraft.yaml"))
+               .scenario;
   c.seed = seed;
   navbus::sim::ScenarioSource src(c);
   navbus::core::FilterTuning cfg;
@@ -173,7 +174,8 @@ TEST(AidingMeasurements, InnovationsEqualHTimesTheConstructedError) {
 TEST(IntegratedFilter, Seed001LooselyCoupledWithStarTrackerConverges) {
   // Seed 001's LEO with its tactical IMU, GNSS fixes and star tracker, 600 s, centralized.
   auto c = navbus::sensor_sim::parseSimConfig(
-               navbus::bus::loadYamlFile(std::string(NAVBUS_SCENARIO_DIR) + "/seed001_leo.yaml"))
+               navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) +
+                                         "/seed001_leo.yaml"))
                .scenario;
   navbus::sim::ScenarioSource src(c);
   navbus::sim::SensorFrame f = src.next();

@@ -21,6 +21,7 @@
 #include "navbus/importers/rtklib_pos.hpp"
 #include "navbus/importers/rtklib_time_tag.hpp"
 #include "navbus/records/csv_messages.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 using namespace navbus::importers;
@@ -28,8 +29,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kReal = fs::path(NAVBUS_SOURCE_DIR) / "tests/data/real";
-const fs::path kDatasets = fs::path(NAVBUS_CONFIG_DIR) / "datasets";
+const fs::path kReal = fs::path(navbus::test_paths::sourceDir()) / "tests/data/real";
+const fs::path kDatasets = fs::path(navbus::test_paths::configDir()) / "datasets";
 
 std::int64_t gpsNs(int y, int mo, int d, int h, int mi, double s) {
   return std::llround(gnss_data::gpsSecondsFromCalendar(y, mo, d, h, mi, 0.0)) * 1'000'000'000 +

@@ -14,6 +14,7 @@
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/scenario_source.hpp"
+#include "test_paths.hpp"
 
 #include <algorithm>
 #include <map>
@@ -78,7 +79,7 @@ nav_filter::FilterConfig imuOnlyConfig() {
 
 /// Seed 001's loosely coupled filter, without a fault monitor to wait for.
 nav_filter::FilterConfig seed001Filter() {
-  const std::string dir = NAVBUS_SCENARIO_DIR;
+  const std::string dir = navbus::test_paths::scenarioDir();
   auto cfg = nav_filter::parseFilterConfig(
       bus::loadYamlFile(dir + "/../../config/filter_seed001_lc.yaml"));
   cfg.fault_monitor.reset();
@@ -86,7 +87,7 @@ nav_filter::FilterConfig seed001Filter() {
 }
 
 sensor_sim::SimConfig seed001Sim() {
-  const std::string dir = NAVBUS_SCENARIO_DIR;
+  const std::string dir = navbus::test_paths::scenarioDir();
   return sensor_sim::parseSimConfig(bus::loadYamlFile(dir + "/seed001_leo.yaml"));
 }
 

@@ -19,6 +19,7 @@
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/scenario_source.hpp"
+#include "test_paths.hpp"
 
 using namespace navbus;
 
@@ -37,7 +38,7 @@ struct GapOutcome {
 };
 
 GapOutcome flyThroughGap(double max_bridged_s) {
-  const std::string src = NAVBUS_SOURCE_DIR;
+  const std::string src = navbus::test_paths::sourceDir();
   sensor_sim::SimConfig sim =
       sensor_sim::parseSimConfig(bus::loadYamlFile(src + "/sim/scenarios/seed000_aircraft.yaml"));
   sim.publish_raw = false;

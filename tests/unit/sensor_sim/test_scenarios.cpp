@@ -9,6 +9,7 @@
 #include "navbus/bus/config.hpp"
 #include "navbus/core/math/spectrum.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using navbus::sim::ScenarioConfig;
@@ -18,7 +19,7 @@ using navbus::sim::SensorFrame;
 namespace {
 ScenarioConfig load(const std::string& name) {
   return navbus::sensor_sim::parseSimConfig(
-             navbus::bus::loadYamlFile(std::string(NAVBUS_SCENARIO_DIR) + "/" + name))
+             navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) + "/" + name))
       .scenario;
 }
 double seconds(const ScenarioConfig& c, std::int64_t t_ns) {
@@ -28,7 +29,7 @@ double seconds(const ScenarioConfig& c, std::int64_t t_ns) {
 
 TEST(Scenarios, EveryScenarioFileLoads) {
   int n = 0;
-  for (const auto& e : fs::directory_iterator(NAVBUS_SCENARIO_DIR)) {
+  for (const auto& e : fs::directory_iterator(navbus::test_paths::scenarioDir())) {
     if (e.path().extension() != ".yaml") continue;
     EXPECT_NO_THROW(
         navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(e.path().string())))

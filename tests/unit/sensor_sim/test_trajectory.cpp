@@ -9,6 +9,7 @@
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/trajectory.hpp"
+#include "test_paths.hpp"
 
 namespace earth = navbus::core::earth;
 using navbus::sim::Segment;
@@ -48,7 +49,7 @@ Errors integrate(navbus::sim::Trajectory& truth, earth::GravityModel gravity, do
 
 navbus::sim::ScenarioConfig scenario(const std::string& file) {
   return navbus::sensor_sim::parseSimConfig(
-             navbus::bus::loadYamlFile(std::string(NAVBUS_SCENARIO_DIR) + "/" + file))
+             navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) + "/" + file))
       .scenario;
 }
 }  // namespace
