@@ -25,10 +25,9 @@ int runTool(const std::filesystem::path& dir, const std::string& log,
 TEST(CommandTool, AppliedRefusedAndBadOptions) {
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("command");
-  const std::string filter_cfg =
-      test::writeFile(dir / "filter.yaml",
-                      "extends: " + std::string(navbus::test_paths::sourceDir()) +
-                          "/config/filter.yaml\n" + "domain_id: " + std::to_string(kDomain) + "\n");
+  const std::string filter_cfg = test::writeFile(
+      dir / "filter.yaml", "extends: " + std::string(navbus::test_paths::configDir()) +
+                               "/filter.yaml\n" + "domain_id: " + std::to_string(kDomain) + "\n");
 
   // No filter yet: nobody reads the commands.
   EXPECT_EQ(runTool(dir, "none.log", {"RESET", "--match-timeout", "0.5"}), 1);

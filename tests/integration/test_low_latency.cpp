@@ -19,7 +19,7 @@ TEST(LowLatencyBus, EveryIncrementGetsItsOutputOverTheBus) {
   const auto dir = test::scratchDir("low-latency");
   const std::string cfg = test::writeFile(
       dir / "filter.yaml",
-      test::readFile(std::string(navbus::test_paths::sourceDir()) + "/config/filter_latency.yaml") +
+      test::readFile(std::string(navbus::test_paths::configDir()) + "/filter_latency.yaml") +
           "domain_id: " + std::to_string(kDomain) + "\n");
   test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", cfg},
                             (dir / "filter.log").string());

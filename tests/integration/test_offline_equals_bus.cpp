@@ -33,10 +33,8 @@ struct Case {
 void runCase(const Case& c) {
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("offline-" + std::to_string(c.domain));
-  const std::string scenario =
-      std::string(navbus::test_paths::sourceDir()) + "/sim/scenarios/" + c.scenario;
-  const std::string filter_base =
-      std::string(navbus::test_paths::sourceDir()) + "/config/" + c.filter;
+  const std::string scenario = std::string(navbus::test_paths::scenarioDir()) + "/" + c.scenario;
+  const std::string filter_base = std::string(navbus::test_paths::configDir()) + "/" + c.filter;
   const std::string domain = "domain_id: " + std::to_string(c.domain) + "\n";
   const std::string sim_cfg = test::writeFile(
       dir / "sim.yaml", "extends: " + scenario + "\n" + domain +
@@ -129,13 +127,13 @@ TEST(FusionSwitch, SelectFusionCommandsTakeEffectOverTheBus) {
   const auto dir = test::scratchDir("fusion-switch");
   const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
   const std::string sim_cfg = test::writeFile(
-      dir / "sim.yaml", "extends: " + std::string(navbus::test_paths::sourceDir()) +
-                            "/sim/scenarios/seed001_leo.yaml\n" + domain +
+      dir / "sim.yaml", "extends: " + std::string(navbus::test_paths::scenarioDir()) +
+                            "/seed001_leo.yaml\n" + domain +
                             "timing: {duration_s: 0, pacing: realtime,\n"
                             "  min_readers: {imu: 1, raw_imu: 0, gnss: 1, star_tracker: 1}}\n");
   const std::string filter_cfg = test::writeFile(
-      dir / "filter.yaml", "extends: " + std::string(navbus::test_paths::sourceDir()) +
-                               "/config/filter_seed001_lc.yaml\n" + domain);
+      dir / "filter.yaml", "extends: " + std::string(navbus::test_paths::configDir()) +
+                               "/filter_seed001_lc.yaml\n" + domain);
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(kDomain, "fusion-switch-test"), shutdown);
   std::vector<FusionStructure> seen;

@@ -304,8 +304,8 @@ TEST(Replay, AReaderThatFallsBehindSlowsTheReplayDownWithoutLosingSamples) {
   const std::string rec = (dir / "rec").string();
   test::ChildProcess import(
       navbus::test_paths::toolExe(),
-      {"import", std::string(navbus::test_paths::sourceDir()) + "/config/datasets/drive_0708.yaml",
-       "-o", rec},
+      {"import", std::string(navbus::test_paths::configDir()) + "/datasets/drive_0708.yaml", "-o",
+       rec},
       (dir / "import.log").string());
   ASSERT_EQ(import.wait(60s), 0) << test::readFile(dir / "import.log");
 

@@ -28,11 +28,10 @@ TEST(WriterIdentity, SecondWriterOnASensorKeyIsKeptOutAndReported) {
       test::writeFile(dir / "filter.yaml", test::filterConfig(kDomain) + "mode: tightly_coupled\n");
   test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", cfg},
                             (dir / "filter.log").string());
-  test::ChildProcess fm(
-      navbus::test_paths::faultManagerExe(),
-      {"-c", std::string(navbus::test_paths::sourceDir()) + "/config/fault_manager.yaml", "-d",
-       std::to_string(kDomain)},
-      (dir / "fm.log").string());
+  test::ChildProcess fm(navbus::test_paths::faultManagerExe(),
+                        {"-c", std::string(navbus::test_paths::configDir()) + "/fault_manager.yaml",
+                         "-d", std::to_string(kDomain)},
+                        (dir / "fm.log").string());
 
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(kDomain, "writer-identity-test"), shutdown);
