@@ -92,6 +92,23 @@ TEST(RealCar, TheDriveWithFifteenSecondOutagesScoresAsMeasured) {
   EXPECT_LT(value(1, "available_rms_m"), 0.08);
   EXPECT_LT(value(1, "rms_m"), 0.5 * rms);  // the smoother at least halves the causal RMS
 
+  // coverage.csv: the honesty table, causal and smoothed, outages and GNSS available.
+  const records::CsvTable coverage = records::readCsv(out / "coverage.csv");
+  ASSERT_EQ(coverage.rows.size(), 4u);
+  const auto cover = [&](std::size_t row, const char* column) {
+    return std::stod(coverage.rows[row][coverage.column(column)]);
+  };
+  EXPECT_EQ(coverage.rows[0][coverage.column("run")], "causal");
+  EXPECT_EQ(coverage.rows[0][coverage.column("group")], "outages");
+  EXPECT_EQ(cover(0, "epochs"), static_cast<double>(epochs));
+  EXPECT_NEAR(cover(0, "inside_3sigma_h"), value(0, "inside_3sigma"), 1e-4);
+  EXPECT_NEAR(cover(1, "inside_3sigma_h"), value(0, "available_inside_3sigma"), 1e-4);
+  EXPECT_NEAR(cover(2, "inside_3sigma_h"), value(1, "inside_3sigma"), 1e-4);
+  for (std::size_t r = 0; r < 4; ++r) {
+    EXPECT_LE(cover(r, "inside_1sigma_h"), cover(r, "inside_2sigma_h"));
+    EXPECT_LE(cover(r, "inside_2sigma_h"), cover(r, "inside_3sigma_h"));
+  }
+
   // The solution file: antenna positions at the IMU's rate with their sigmas.
   const records::CsvTable sol = records::readCsv(out / "solution.csv");
   EXPECT_GT(sol.rows.size(), 45'000u);

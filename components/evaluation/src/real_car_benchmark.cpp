@@ -13,6 +13,7 @@
 #include "navbus/core/gnss/gps_broadcast_ephemeris.hpp"
 #include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/units.hpp"
+#include "navbus/evaluation/coverage.hpp"
 #include "navbus/evaluation/recording_runner.hpp"
 #include "navbus/importers/importer.hpp"
 #include "navbus/importers/rtklib_pos.hpp"
@@ -47,15 +48,19 @@ struct AntennaPoint {
   Eigen::Vector3d vel_ned_mps;
   double sigma_h_m;  ///< sqrt(sigma_N^2 + sigma_E^2)
   double sigma_v_m;
+  bool valid;  ///< the solution's covariance_valid (true where a run has no such flag)
 };
 
 AntennaPoint antennaOf(const navbus::NavigationSolution& s, const Eigen::Vector3d& lever_b) {
   const Eigen::Quaterniond q(s.q_b_to_n()[0], s.q_b_to_n()[1], s.q_b_to_n()[2], s.q_b_to_n()[3]);
   const earth::Geodetic imu{s.latitude_rad(), s.longitude_rad(), s.height_m()};
   const auto& sd = s.pos_sigma_ned_m();
-  return {static_cast<std::int64_t>(s.time_gps_ns()), earth::offsetNed(imu, q * lever_b),
+  return {static_cast<std::int64_t>(s.time_gps_ns()),
+          earth::offsetNed(imu, q * lever_b),
           Eigen::Vector3d(s.vel_ned_mps()[0], s.vel_ned_mps()[1], s.vel_ned_mps()[2]),
-          std::hypot(sd[0], sd[1]), sd[2]};
+          std::hypot(sd[0], sd[1]),
+          sd[2],
+          s.covariance_valid()};
 }
 
 /// Horizontal error [m] of the antenna against a reference at its time, from the solutions
@@ -63,6 +68,7 @@ AntennaPoint antennaOf(const navbus::NavigationSolution& s, const Eigen::Vector3
 struct Judged {
   double horizontal_m;
   double sigma_h_m;
+  bool valid;  ///< covariance_valid of the solution(s) judged
 };
 std::optional<Judged> judge(const std::vector<AntennaPoint>& points, std::int64_t t,
                             const earth::Geodetic& reference) {
@@ -76,7 +82,7 @@ std::optional<Judged> judge(const std::vector<AntennaPoint>& points, std::int64_
   const Eigen::Vector3d ea = earth::differenceNed(a.position, reference);
   const Eigen::Vector3d eb = earth::differenceNed(b.position, reference);
   const Eigen::Vector3d e = (1.0 - w) * ea + w * eb;
-  return Judged{e.head<2>().norm(), (1.0 - w) * a.sigma_h_m + w * b.sigma_h_m};
+  return Judged{e.head<2>().norm(), (1.0 - w) * a.sigma_h_m + w * b.sigma_h_m, a.valid && b.valid};
 }
 
 /// Horizontal error [m] of the filter's solution once it took the fix of time t: the first
@@ -92,7 +98,7 @@ std::optional<Judged> judgeAfterFusion(const std::vector<AntennaPoint>& points, 
   const double back_s = 1e-9 * static_cast<double>(at->time_ns - t);
   const Eigen::Vector3d e =
       earth::differenceNed(at->position, reference) - at->vel_ned_mps * back_s;
-  return Judged{e.head<2>().norm(), at->sigma_h_m};
+  return Judged{e.head<2>().norm(), at->sigma_h_m, at->valid};
 }
 
 /// A solution of its own epochs (single point positioning): the one nearest t, within 20 ms.
@@ -107,7 +113,8 @@ std::optional<Judged> judgeNearest(const std::vector<AntennaPoint>& points, std:
   if (after != points.begin() && (best == nullptr || t - (after - 1)->time_ns < best->time_ns - t))
     best = &*(after - 1);
   if (best == nullptr || std::llabs(best->time_ns - t) > kToleranceNs) return std::nullopt;
-  return Judged{earth::differenceNed(best->position, reference).head<2>().norm(), best->sigma_h_m};
+  return Judged{earth::differenceNed(best->position, reference).head<2>().norm(), best->sigma_h_m,
+                best->valid};
 }
 
 struct OutageScore {
@@ -127,6 +134,7 @@ struct Scored {
   std::size_t available{0};
   double available_rms_m{0.0};
   double available_inside{0.0};  ///< share of GNSS-available epochs inside 3 sigma_h
+  CoverageTally outage_coverage, available_coverage;
   /// Every judged epoch (errors.csv): run, GPS s of week, outage (0: GNSS available), error
   /// and 1-sigma [m], the reference position [deg].
   fmt::memory_buffer epoch_lines;
@@ -134,8 +142,12 @@ struct Scored {
 
 AntennaPoint antennaOf(const core::SmoothedEpoch& e, const Eigen::Vector3d& lever_b) {
   const auto sd = e.sigma.segment<3>(core::layout::kPos.index);
-  return {e.time_ns, earth::offsetNed(e.state.position, e.state.q_b_to_n * lever_b),
-          e.state.vel_ned_mps, std::hypot(sd[0], sd[1]), sd[2]};
+  return {e.time_ns,
+          earth::offsetNed(e.state.position, e.state.q_b_to_n * lever_b),
+          e.state.vel_ned_mps,
+          std::hypot(sd[0], sd[1]),
+          sd[2],
+          true};
 }
 
 void appendPoint(const AntennaPoint& p, const std::string& tail, fmt::memory_buffer& out) {
@@ -185,6 +197,7 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
         available_sum += e->horizontal_m * e->horizontal_m;
         ++r.available;
         available_inside += e->horizontal_m <= 3.0 * e->sigma_h_m ? 1 : 0;
+        r.available_coverage.add(e->horizontal_m, e->sigma_h_m, e->valid);
         appendEpoch(run, t, 0, truth, *e, r.epoch_lines);
       }
       continue;
@@ -198,6 +211,7 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
     s.max_error_m = std::max(s.max_error_m, judged->horizontal_m);
     s.sum_squares += judged->horizontal_m * judged->horizontal_m;
     s.inside_3_sigma += judged->horizontal_m <= 3.0 * judged->sigma_h_m ? 1 : 0;
+    r.outage_coverage.add(judged->horizontal_m, judged->sigma_h_m, judged->valid);
   }
   double end_sum = 0.0, squares = 0.0;
   std::size_t inside = 0;
@@ -263,7 +277,63 @@ std::string scoreLine(const std::string& run, const Scored& r) {
                      r.available_rms_m, r.available_inside);
 }
 
+/// The honesty table (printed) and coverage.csv: the causal run and, when given, the smoothed
+/// one, over the outage epochs and the GNSS-available ones; the causal run's flagged share over
+/// every solution it published.
+std::string honestyReport(const Scored& causal, const Scored* smoothed,
+                          const std::vector<AntennaPoint>& points, bool outages,
+                          const std::filesystem::path& csv_file) {
+  std::ofstream csv(csv_file);
+  csv << kCoverageCsvHeader;
+  std::string text =
+      "honesty: horizontal error e against the solution's own sigma_h = sqrt(sN^2 + sE^2)\n" +
+      coverageHeader();
+  auto row = [&](const std::string& run, const std::string& group, const CoverageTally& t,
+                 bool flags) {
+    if (t.epochs() == 0) return;
+    text += coverageRow(run + ", " + group, t, flags);
+    csv << coverageCsvLine(run, group, t, flags);
+  };
+  if (outages) row("causal", "outages", causal.outage_coverage, true);
+  row("causal", "GNSS available", causal.available_coverage, true);
+  if (smoothed != nullptr) {
+    if (outages) row("smoothed", "outages", smoothed->outage_coverage, false);
+    row("smoothed", "GNSS available", smoothed->available_coverage, false);
+  }
+  text += coverageFooter();
+  const auto flagged = static_cast<std::size_t>(
+      std::count_if(points.begin(), points.end(), [](const AntennaPoint& p) { return !p.valid; }));
+  text += fmt::format(
+      "solutions published with covariance_valid false: {} of {} ({:.1f} %)\n", flagged,
+      points.size(),
+      points.empty() ? 0.0
+                     : 100.0 * static_cast<double>(flagged) / static_cast<double>(points.size()));
+  if (!csv) throw bus::ConfigError("cannot write " + csv_file.string());
+  return text;
+}
+
 }  // namespace
+
+std::vector<Outage> outageSchedule(const OutageSchedule& s, double last_sow) {
+  if (!(s.length_s > 0.0 && s.period_s > s.length_s))
+    throw bus::ConfigError(fmt::format(
+        "--outage-schedule: length {} s and period {} s must be positive with the length shorter "
+        "than the period",
+        s.length_s, s.period_s));
+  if (!(s.first_start_sow >= 0.0 && s.first_start_sow < last_sow))
+    throw bus::ConfigError(fmt::format(
+        "--outage-schedule: first start {} s of week is not within the log (last epoch {:.3f})",
+        s.first_start_sow, last_sow));
+  std::vector<Outage> out;
+  for (double start = s.first_start_sow; start + s.length_s <= last_sow; start += s.period_s)
+    out.push_back({start, start + s.length_s});
+  if (out.empty())
+    throw bus::ConfigError(fmt::format(
+        "--outage-schedule: no {} s outage from {} s of week ends before the log's last epoch "
+        "({:.3f})",
+        s.length_s, s.first_start_sow, last_sow));
+  return out;
+}
 
 std::vector<Outage> readOutages(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -302,8 +372,18 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     throw bus::ConfigError(o.dataset + ": the benchmark needs imu and gnss_solutions");
   const std::filesystem::path out_dir(o.out_dir);
   const importers::ImportReport imported = importers::importDataset(dataset, out_dir / "recording");
-  const std::vector<Outage> outages =
-      o.outages.empty() ? std::vector<Outage>{} : readOutages(o.outages);
+  // The reference: the fixed epochs of the same file, read as the import read them.
+  const importers::PosLog reference = importers::readPosFile(*dataset.gnss_solutions);
+  std::vector<Outage> outages;
+  if (!o.outages.empty()) {
+    outages = readOutages(o.outages);
+  } else if (o.schedule) {
+    if (reference.fixes.empty()) throw bus::ConfigError(o.dataset + ": no GNSS solution");
+    outages = outageSchedule(
+        *o.schedule, 1e-9 * static_cast<double>(secondsOfWeekNs(
+                                static_cast<std::int64_t>(reference.fixes.back().time_gps_ns()))));
+  }
+  const std::string outage_source = o.outages.empty() ? "--outage-schedule" : o.outages;
 
   RecordingSetup setup;
   setup.dir = out_dir / "recording";
@@ -327,8 +407,6 @@ int runRealCarBenchmark(const RealCarOptions& o) {
   });
   sol.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
 
-  // The reference: the fixed epochs of the same file, read as the import read them.
-  const importers::PosLog reference = importers::readPosFile(*dataset.gnss_solutions);
   std::string text = fmt::format("{}{}\n{} fixes withheld in {} outages\n", imported.text,
                                  run.summary, run.fixes_withheld, outages.size());
   std::ofstream scores(out_dir / "scores.csv");
@@ -336,13 +414,14 @@ int runRealCarBenchmark(const RealCarOptions& o) {
             "available_epochs,available_rms_m,available_inside_3sigma\n";
   const Scored causal = score("filter", points, reference, outages, Judging::kAfterFusion);
   text += report("the filter (causal)", causal, Judging::kAfterFusion, outages,
-                 out_dir / "outages.csv", o.outages);
+                 out_dir / "outages.csv", outage_source);
   scores << scoreLine("filter", causal);
   std::ofstream epochs(out_dir / "errors.csv");
   epochs << "run,gpst_s,outage,error_h_m,sigma_h_m,ref_lat_deg,ref_lon_deg\n";
   epochs.write(causal.epoch_lines.data(), static_cast<std::streamsize>(causal.epoch_lines.size()));
   std::string written = outages.empty() ? "solution.csv, scores.csv, errors.csv"
                                         : "solution.csv, outages.csv, scores.csv, errors.csv";
+  std::optional<Scored> backward;
   if (o.smooth) {
     std::vector<AntennaPoint> smoothed;
     smoothed.reserve(run.smoothed.size());
@@ -354,15 +433,18 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     std::ofstream file(out_dir / "smoothed.csv");
     file << "gpst_s,lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m,smoothed\n";
     file.write(lines.data(), static_cast<std::streamsize>(lines.size()));
-    const Scored backward = score("smoothed", smoothed, reference, outages, Judging::kInterpolated);
+    backward = score("smoothed", smoothed, reference, outages, Judging::kInterpolated);
     text += run.smoother_summary + "\n";
-    text += report("smoothed (--smooth)", backward, Judging::kInterpolated, outages,
-                   out_dir / "smoothed_outages.csv", o.outages);
-    scores << scoreLine("smoothed", backward);
-    epochs.write(backward.epoch_lines.data(),
-                 static_cast<std::streamsize>(backward.epoch_lines.size()));
+    text += report("smoothed (--smooth)", *backward, Judging::kInterpolated, outages,
+                   out_dir / "smoothed_outages.csv", outage_source);
+    scores << scoreLine("smoothed", *backward);
+    epochs.write(backward->epoch_lines.data(),
+                 static_cast<std::streamsize>(backward->epoch_lines.size()));
     written += outages.empty() ? ", smoothed.csv" : ", smoothed.csv, smoothed_outages.csv";
   }
+  text += honestyReport(causal, backward ? &*backward : nullptr, points, !outages.empty(),
+                        out_dir / "coverage.csv");
+  written += ", coverage.csv";
   if (dataset.gnss_observations) {
     // The receiver's own pseudoranges alone, epoch by epoch: what the filter adds to them.
     const importers::ObservationLog log =
@@ -370,11 +452,11 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     std::vector<AntennaPoint> spp;
     for (const importers::SinglePointEpoch& e : log.single_point)
       spp.push_back({e.time_ns, core::earth::ecefToGeodetic(e.pos_ecef_m), Eigen::Vector3d::Zero(),
-                     e.sigma_h_m, e.sigma_v_m});
+                     e.sigma_h_m, e.sigma_v_m, true});
     const Scored single = score("spp", spp, reference, {}, Judging::kNearest);
     text += report("single point positioning of the same pseudoranges (" +
                        std::to_string(spp.size()) + " epochs solved)",
-                   single, Judging::kNearest, {}, {}, o.outages);
+                   single, Judging::kNearest, {}, {}, outage_source);
     scores << scoreLine("spp", single);
     epochs.write(single.epoch_lines.data(),
                  static_cast<std::streamsize>(single.epoch_lines.size()));

@@ -4,6 +4,8 @@
 // scores the filter on one with GNSS outages (evaluation/real_car_benchmark.hpp).
 #include <cmath>
 #include <cstdio>
+#include <optional>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -60,6 +62,21 @@ class ImportCommand final : public Subcommand {
   std::vector<double> ramp_;
 };
 
+/// `--outage-schedule LENGTH,PERIOD,FIRST`: a regular schedule instead of an outage list.
+CLI::Option* addSchedule(CLI::App& app, std::vector<double>& values) {
+  return app
+      .add_option("--outage-schedule", values,
+                  "LENGTH,PERIOD,FIRST: outages of LENGTH [s] every PERIOD [s] from FIRST [GPS s "
+                  "of week] to the log's end (15,45,243298.499 is the shipped drive_0708 list)")
+      ->expected(3)
+      ->delimiter(',');
+}
+
+std::optional<evaluation::OutageSchedule> scheduleOf(const std::vector<double>& v) {
+  if (v.empty()) return std::nullopt;
+  return evaluation::OutageSchedule{v[0], v[1], v[2]};
+}
+
 /// `navbus benchmark`, the parent of the real-log benchmarks (made by the first one added).
 CLI::App* benchmarkApp(CLI::App& app) {
   for (CLI::App* existing : app.get_subcommands({})) {
@@ -83,11 +100,12 @@ class RealCarBenchmarkCommand final : public Subcommand {
     cli_->add_option("--filter", o_.filter, "navbus-filter YAML (config/filter_drive_0708.yaml)")
         ->required()
         ->check(CLI::ExistingFile);
-    cli_->add_option("--outages", o_.outages,
-                     "outage list: `START END` per line, GPS seconds of week, # comments "
-                     "(config/datasets/drive_0708_outages.txt)")
-        ->required()
-        ->check(CLI::ExistingFile);
+    CLI::Option* list =
+        cli_->add_option("--outages", o_.outages,
+                         "outage list: `START END` per line, GPS seconds of "
+                         "week, # comments (config/datasets/drive_0708_outages.txt)")
+            ->check(CLI::ExistingFile);
+    addSchedule(*cli_, schedule_)->excludes(list);
     cli_->add_option("-o,--out", o_.out_dir,
                      "output directory: solution.csv (antenna, IMU rate), outages.csv, "
                      "scores.csv, the imported recording")
@@ -98,11 +116,15 @@ class RealCarBenchmarkCommand final : public Subcommand {
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    if (o_.outages.empty() && schedule_.empty())
+      throw bus::ConfigError("benchmark real-car needs --outages FILE or --outage-schedule");
+    o_.schedule = scheduleOf(schedule_);
     return evaluation::runRealCarBenchmark(o_);
   }
 
  private:
   evaluation::RealCarOptions o_;
+  std::vector<double> schedule_;
 };
 
 class RealDataBenchmarkCommand final : public Subcommand {
@@ -117,7 +139,9 @@ class RealDataBenchmarkCommand final : public Subcommand {
     cli_->add_option("--filter", o_.filter, "navbus-filter YAML (config/filter_walk_0827_tc.yaml)")
         ->required()
         ->check(CLI::ExistingFile);
-    cli_->add_option("--outages", o_.outages, "outage list (optional)")->check(CLI::ExistingFile);
+    CLI::Option* list = cli_->add_option("--outages", o_.outages, "outage list (optional)")
+                            ->check(CLI::ExistingFile);
+    addSchedule(*cli_, schedule_)->excludes(list);
     cli_->add_option("-o,--out", o_.out_dir,
                      "output directory: solution.csv, scores.csv, errors.csv, the recording")
         ->required();
@@ -125,11 +149,13 @@ class RealDataBenchmarkCommand final : public Subcommand {
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    o_.schedule = scheduleOf(schedule_);
     return evaluation::runRealCarBenchmark(o_);
   }
 
  private:
   evaluation::RealCarOptions o_;
+  std::vector<double> schedule_;
 };
 
 class AllanCommand final : public Subcommand {

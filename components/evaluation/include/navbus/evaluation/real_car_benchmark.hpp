@@ -10,6 +10,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,10 +27,23 @@ struct Outage {
 /// and the line.
 std::vector<Outage> readOutages(const std::filesystem::path& file);
 
+/// A regular schedule: outages of `length_s` every `period_s` from `first_start_sow` [GPS s of
+/// week], as many as end before the log's last epoch.
+struct OutageSchedule {
+  double length_s{0.0};
+  double period_s{0.0};
+  double first_start_sow{0.0};
+};
+
+/// The schedule's outages up to `last_sow`; throws bus::ConfigError naming the bad value.
+std::vector<Outage> outageSchedule(const OutageSchedule& s, double last_sow);
+
 struct RealCarOptions {
   std::string dataset;  ///< data set YAML (config/datasets/)
   std::string filter;   ///< navbus-filter YAML
-  std::string outages;  ///< outage list; empty: every fixed epoch is scored with GNSS
+  std::string outages;  ///< outage list; empty: the schedule, or none
+  /// A regular schedule instead of a list; neither: every fixed epoch is scored with GNSS.
+  std::optional<OutageSchedule> schedule;
   std::string out_dir;  ///< solution.csv, outages.csv, scores.csv, the recording
   bool smooth{false};   ///< also the smoothed run: smoothed.csv, smoothed_outages.csv
 };
