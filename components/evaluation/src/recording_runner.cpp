@@ -131,6 +131,9 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
   }
   pipeline.flush(events.back().time_ns);
   result.summary = pipeline.summary();
+  result.consistency = pipeline.engine().consistency().counters();
+  result.fix_position_nis = pipeline.engine().counters().fix_position_nis;
+  result.fix_velocity_nis = pipeline.engine().counters().fix_velocity_nis;
   if (setup.smooth) {
     std::uint64_t singular = 0;
     result.smoothed = core::smoothFixedInterval(smoothing_log.records(), &singular);

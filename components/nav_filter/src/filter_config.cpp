@@ -7,6 +7,7 @@
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/key_reader.hpp"
 #include "navbus/core/filter/innovation_window.hpp"
+#include "navbus/core/ins/velocity_history.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
 
@@ -36,7 +37,11 @@ std::optional<InputConfig> input(const YAML::Node& inputs, const std::string& ke
     return std::nullopt;
   }
   const std::string where = "inputs." + key;
-  bus::checkKeys(n, where, {"id", "period_s", "time_offset_s"});
+  if (key == "gnss_fix") {
+    bus::checkKeys(n, where, {"id", "period_s", "time_offset_s", "velocity_time_offset_s"});
+  } else {
+    bus::checkKeys(n, where, {"id", "period_s", "time_offset_s"});
+  }
   InputConfig c;
   c.id = bus::require<std::uint32_t>(n, where, "id");
   c.period_ns = seconds(
@@ -44,6 +49,10 @@ std::optional<InputConfig> input(const YAML::Node& inputs, const std::string& ke
   if (n["time_offset_s"])
     c.time_offset_ns = seconds(bus::checkRange(bus::require<double>(n, where, "time_offset_s"),
                                                -10.0, 10.0, where + ".time_offset_s"));
+  if (n["velocity_time_offset_s"])
+    c.velocity_time_offset_ns =
+        seconds(bus::checkRange(bus::require<double>(n, where, "velocity_time_offset_s"), -1.0, 0.0,
+                                where + ".velocity_time_offset_s"));
   return c;
 }
 }  // namespace
@@ -202,6 +211,15 @@ void parseInputs(const YAML::Node& inputs, FilterConfig& c) {
   c.engine.imu_period_s = 1e-9 * static_cast<double>(c.imu.period_ns);
   c.gnss_observations = input(inputs, "gnss_observations", false);
   c.gnss_fix = input(inputs, "gnss_fix", false);
+  // The engine brings a lagging fix velocity forward through its velocity history.
+  const std::int64_t reach_ns = (core::VelocityHistory::kLength - 2) * c.imu.period_ns;
+  if (c.gnss_fix && -c.gnss_fix->velocity_time_offset_ns > reach_ns)
+    throw bus::ConfigError(
+        "configuration inputs.gnss_fix.velocity_time_offset_s " +
+        std::to_string(1e-9 * static_cast<double>(c.gnss_fix->velocity_time_offset_ns)) +
+        " reaches further back than the velocity history (" +
+        std::to_string(core::VelocityHistory::kLength - 2) + " IMU periods, " +
+        std::to_string(1e-9 * static_cast<double>(reach_ns)) + " s)");
   c.star_tracker = input(inputs, "star_tracker", false);
 }
 

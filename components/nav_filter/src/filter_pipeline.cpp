@@ -171,6 +171,7 @@ void FilterPipeline::onGnssFix(const navbus::GnssFix& m) {
 void FilterPipeline::useGnssFix(const navbus::GnssFix& m) {
   core::GnssFixMeasurement fix = bus::toCore(m);
   fix.time_ns += config_.gnss_fix->time_offset_ns;
+  fix.velocity_time_offset_ns = config_.gnss_fix->velocity_time_offset_ns;
   queue(gnss_fix_gate_, {kRankGnssFix, m.receiver_id()}, fix.time_ns, fix);
 }
 

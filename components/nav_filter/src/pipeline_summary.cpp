@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "navbus/nav_filter/solution_messages.hpp"
 
 namespace navbus::nav_filter {
@@ -17,7 +19,10 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
       << " (propagated across " << n.gaps_bridged << ")"
       << ", consistency: epochs tested " << v.engine.consistency().counters().epochs_tested
       << " inconsistent " << v.engine.consistency().counters().epochs_inconsistent << " alarms "
-      << v.engine.consistency().counters().alarms << ", re-initialisations asked "
+      << v.engine.consistency().counters().alarms << ", mean NIS of the fixes' position rows "
+      << fmt::format("{:.3f}", n.fix_position_nis.mean()) << " velocity rows "
+      << fmt::format("{:.3f}", n.fix_velocity_nis.mean()) << " (velocities older than the history "
+      << n.fix_velocities_beyond_history << "), re-initialisations asked "
       << n.reinitialisations_asked << " done " << n.reinitialisations_done << ", GNSS epochs fused "
       << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
       << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates

@@ -13,6 +13,7 @@
 
 #include "navbus/evaluation/imu_noise_survey.hpp"
 #include "navbus/evaluation/real_car_benchmark.hpp"
+#include "navbus/evaluation/time_offset_calibration.hpp"
 #include "navbus/importers/importer.hpp"
 #include "subcommand.hpp"
 
@@ -158,6 +159,50 @@ class RealDataBenchmarkCommand final : public Subcommand {
   std::vector<double> schedule_;
 };
 
+void addGrid(CLI::App& app, const char* name, evaluation::Grid& grid, const char* text) {
+  app.add_option_function<std::vector<double>>(
+         name,
+         [&grid](const std::vector<double>& v) {
+           grid = {v[0], v[1], v[2]};
+         },
+         text)
+      ->expected(3)
+      ->delimiter(',');
+}
+
+class TimeOffsetCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    CLI::App* calibrate = app.add_subcommand(
+        "calibrate", "settings of the filter configuration derived from a real log");
+    calibrate->require_subcommand(1);
+    cli_ = calibrate->add_subcommand(
+        "time-offset",
+        "the IMU's time offset against the GNSS solutions: the offset (added to "
+        "inputs.imu.time_offset_s) that minimizes the filter's mean normalized innovation "
+        "squared over the whole log, GNSS never withheld");
+    cli_->add_option("dataset", o_.dataset, "data set YAML")->required()->check(CLI::ExistingFile);
+    cli_->add_option("--filter", o_.filter, "navbus-filter YAML")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cli_->add_option("-o,--out", o_.out_dir, "output directory: time_offset.csv, the recording")
+        ->required();
+    addGrid(*cli_, "--imu-grid", o_.imu,
+            "FROM,TO,STEP: offsets added to inputs.imu.time_offset_s [s] (-0.3,0.3,0.02)");
+    addGrid(*cli_, "--velocity-grid", o_.velocity,
+            "FROM,TO,STEP: inputs.gnss_fix.velocity_time_offset_s tried [s] (-0.3,0,0.02)");
+    cli_->add_option("--rounds", o_.rounds, "the two searches alternated this often (2)")
+        ->check(CLI::Range(1, 10));
+  }
+  bool usesBus() const override { return false; }
+  int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    return evaluation::runTimeOffsetCommand(o_);
+  }
+
+ private:
+  evaluation::TimeOffsetOptions o_;
+};
+
 class AllanCommand final : public Subcommand {
  public:
   void add(CLI::App& app) override {
@@ -195,6 +240,7 @@ void addRealDataSubcommands(Subcommands& out) {
   out.push_back(std::make_unique<ImportCommand>());
   out.push_back(std::make_unique<RealCarBenchmarkCommand>());
   out.push_back(std::make_unique<RealDataBenchmarkCommand>());
+  out.push_back(std::make_unique<TimeOffsetCommand>());
 }
 
 }  // namespace navbus::tool::cli

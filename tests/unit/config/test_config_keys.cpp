@@ -165,3 +165,25 @@ TEST_F(ConfigKeys, EveryShippedConfigurationPasses) {
   }
   EXPECT_GE(n, 30);
 }
+
+TEST_F(ConfigKeys, AFixVelocityOffsetIsALagTheVelocityHistoryReaches) {
+  const auto with = [&](const std::string& name, const std::string& value) {
+    return write(name,
+                 "mode: loosely_coupled\ninputs: {imu: {id: 1, period_s: 0.01}, gnss_fix: "
+                 "{id: 1, period_s: 0.25, velocity_time_offset_s: " +
+                     value + "}}\n");
+  };
+  const auto c = navbus::bus::parseFile(with("ok.yaml", "-0.132"), filter);
+  EXPECT_EQ(c.gnss_fix->velocity_time_offset_ns, -132'000'000);
+  // A velocity valid after its stamp is not a lag: refused, naming the key and the value.
+  const std::string ahead = errorOf(with("ahead.yaml", "0.1"), filter);
+  EXPECT_NE(ahead.find("inputs.gnss_fix.velocity_time_offset_s"), std::string::npos) << ahead;
+  // Further back than 62 IMU periods (0.62 s at 100 Hz): refused with the history's reach.
+  const std::string far = errorOf(with("far.yaml", "-0.7"), filter);
+  EXPECT_NE(far.find("reaches further back than the velocity history"), std::string::npos) << far;
+  // The key belongs to the fix only.
+  const std::string imu = write("imu.yaml",
+                                "inputs: {imu: {id: 1, period_s: 0.01, "
+                                "velocity_time_offset_s: -0.1}}\n");
+  EXPECT_TRUE(names(errorOf(imu, filter), "inputs.imu.velocity_time_offset_s", imu));
+}

@@ -173,7 +173,10 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
   const bool suspended = config_.aiding == AidingMode::kMultiDimensional &&
                          config_.mdf.policy != MdfPolicy::kMultiDimensional &&
                          stages_->stage() == MdfStage::kF4Constraint;
+  const Eigen::Vector3d vel_before_ned_mps = filter_->state().vel_ned_mps;
   filter_->propagate(inc, suspended);
+  velocity_history_.add(filter_->state().time_ns,
+                        filter_->state().vel_ned_mps - vel_before_ned_mps);
   ++counters_.imu_used;
   if (mode_ == EngineMode::kInitializing || mode_ == EngineMode::kInertialLost) {
     // Back to inertial navigation; aided modes resume with the next measurement.
@@ -231,6 +234,7 @@ void NavigationEngine::crossGap(std::int64_t start_ns) {
 void NavigationEngine::start(const NavState& state, double clock_bias_m, double clock_drift_mps,
                              const StateMatrix& initial_covariance) {
   filter_->setSmoothingLog(config_.smoothing_log);
+  velocity_history_.clear();
   filter_->initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
                       config_.fusion, initial_covariance);
   filter_->keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled);
@@ -480,6 +484,16 @@ earth::Geodetic NavigationEngine::fixPositionAtStateTime(const GnssFixMeasuremen
   return earth::offsetNed(fix.position, fix.vel_ned_mps * dt_s);
 }
 
+Eigen::Vector3d NavigationEngine::fixVelocityAtStateTime(const GnssFixMeasurement& fix) {
+  if (fix.velocity_time_offset_ns == 0) return fix.vel_ned_mps;
+  Eigen::Vector3d dv_ned_mps;
+  if (!velocity_history_.changeSince(fix.time_ns + fix.velocity_time_offset_ns, dv_ned_mps)) {
+    ++counters_.fix_velocities_beyond_history;
+    return fix.vel_ned_mps;
+  }
+  return fix.vel_ned_mps + dv_ned_mps;
+}
+
 Eigen::Vector3d NavigationEngine::bodyRate() const {
   if (!last_increment_ || !(last_increment_->interval_s > 0.0)) return Eigen::Vector3d::Zero();
   return last_increment_->delta_angle_b_rad / last_increment_->interval_s - filter_->gyroBias();
@@ -519,13 +533,17 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
                                                      fix.pos_sigma_ned_m, lever_b),
                                  AidingKind::kPosition);
   countGated(p.data(), 3);
-  const auto v = filter_->update(velocityMeasurement(filter_->state(), fix.vel_ned_mps,
+  const auto v = filter_->update(velocityMeasurement(filter_->state(), fixVelocityAtStateTime(fix),
                                                      fix.vel_sigma_ned_mps, lever_b, bodyRate()),
                                  AidingKind::kVelocity);
   countGated(v.data(), 3);
   std::array<ScalarUpdateResult, 6> rows{};
   std::copy(p.begin(), p.end(), rows.begin());
   std::copy(v.begin(), v.end(), rows.begin() + 3);
+  for (int i = 0; i < 3; ++i) {
+    counters_.fix_position_nis.add(p[i].innovation, p[i].innovation_var);
+    counters_.fix_velocity_nis.add(v[i].innovation, v[i].innovation_var);
+  }
   checkConsistency(fix.time_ns, rows.data(), 6);
   ++counters_.fixes_fused;
   if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();

@@ -15,6 +15,7 @@
 #include <navbus_idl/Navigation.h>
 
 #include "navbus/core/filter/rts_smoother.hpp"
+#include "navbus/core/integrity/consistency_monitor.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 
@@ -36,6 +37,10 @@ struct RecordingResult {
   std::string inputs;  ///< what the recording held, per topic
   std::uint64_t fixes_withheld{0};
   std::string summary;  ///< the filter pipeline's counters
+  /// The filter's test of its own innovations over the run (mean NIS per row: nis_sum / rows).
+  core::ConsistencyCounters consistency;
+  /// The fixes' position and velocity rows' normalized innovations squared.
+  core::InnovationStatistics fix_position_nis, fix_velocity_nis;
   std::string fault_summary;
   std::vector<navbus::FaultDecision> decisions;
   std::vector<navbus::FilterCommand> commands;

@@ -23,6 +23,9 @@ struct InputConfig {
   /// Added to every sample's time as it enters the merge [ns]: a sensor whose stamps are late
   /// or early by a known delay (a logger's buffering, a receiver's output latency).
   std::int64_t time_offset_ns{0};
+  /// gnss_fix only: the fix's velocity is valid at its (offset) time plus this [ns], negative
+  /// for a receiver whose velocity lags its position (navbus calibrate time-offset).
+  std::int64_t velocity_time_offset_ns{0};
 };
 
 /// The fault manager whose health reports (navbus/health) show that faults are monitored.

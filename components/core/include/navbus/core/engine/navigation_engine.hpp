@@ -21,6 +21,7 @@
 #include "navbus/core/ins/gap_bridge.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/ins/strapdown.hpp"
+#include "navbus/core/ins/velocity_history.hpp"
 #include "navbus/core/integrity/consistency_monitor.hpp"
 #include "navbus/core/integrity/protection_level_config.hpp"
 #include "navbus/core/math/indirect.hpp"
@@ -126,6 +127,11 @@ struct EngineCounters {
   /// Re-initialisations from a GNSS solution: asked for (a gap beyond the bridge, a lasting
   /// inconsistency) and done.
   std::uint64_t reinitialisations_asked{0}, reinitialisations_done{0};
+  /// The fixes' position and velocity rows: normalized innovations squared (mean about 1 when
+  /// the covariance explains them; navbus calibrate time-offset minimizes them).
+  InnovationStatistics fix_position_nis, fix_velocity_nis;
+  /// Fix velocities older than the velocity history reaches (compared as they are).
+  std::uint64_t fix_velocities_beyond_history{0};
 };
 
 class NavigationEngine {
@@ -278,6 +284,10 @@ class NavigationEngine {
   Eigen::Vector3d bodyRate() const;
   /// The fix's position brought to the filter state's time along the fix's velocity.
   earth::Geodetic fixPositionAtStateTime(const GnssFixMeasurement& fix) const;
+  /// The fix's velocity brought from its time of validity to the state's time by the velocity
+  /// change the mechanization integrated in between (GnssFixMeasurement::velocity_time_offset_ns).
+  Eigen::Vector3d fixVelocityAtStateTime(const GnssFixMeasurement& fix);
+  VelocityHistory velocity_history_;
   std::int64_t next_constraint_ns_{0};
   bool course_check_armed_{false};             ///< checkHeadingFromCourse still to come
   double gyrocompass_heading_sigma_rad_{0.0};  ///< the aligned start's heading sigma

@@ -18,6 +18,9 @@ struct GnssFixMeasurement {
   Eigen::Vector3d vel_ned_mps{Eigen::Vector3d::Zero()};        ///< w.r.t. Earth, NED
   Eigen::Vector3d pos_sigma_ned_m{Eigen::Vector3d::Ones()};    ///< 1 sigma per NED axis
   Eigen::Vector3d vel_sigma_ned_mps{Eigen::Vector3d::Ones()};  ///< 1 sigma per NED axis
+  /// The velocity is valid at time_ns plus this [ns]: negative for a receiver whose velocity
+  /// lags its position (the engine brings it to the state's time, ins/velocity_history.hpp).
+  std::int64_t velocity_time_offset_ns{0};
 };
 
 /// A star tracker's attitude, already rotated into the IMU body frame.

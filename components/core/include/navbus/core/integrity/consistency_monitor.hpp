@@ -32,6 +32,20 @@ struct ConsistencyCounters {
   std::uint64_t rows{0};                 ///< ... over this many rows (mean NIS per row: ~1)
 };
 
+/// The normalized innovations squared of one kind of aiding row, summed over a run: a mean of
+/// about 1 says the covariance and the measurement noise explain that stream's innovations.
+struct InnovationStatistics {
+  double nis_sum{0.0};
+  std::uint64_t rows{0};
+  /// One row with innovation nu and its variance V = H P H^T + R (V <= 0: not offered).
+  void add(double innovation, double innovation_var) {
+    if (!(innovation_var > 0.0)) return;
+    nis_sum += innovation * innovation / innovation_var;
+    ++rows;
+  }
+  double mean() const { return rows > 0 ? nis_sum / static_cast<double>(rows) : 0.0; }
+};
+
 class ConsistencyMonitor {
  public:
   static constexpr int kMaxWindow = 64;
