@@ -177,7 +177,6 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
   Scored r;
   r.outages.resize(outages.size());
   double available_sum = 0.0;
-  std::size_t available_inside = 0;
   for (std::size_t i = 0; i < reference.fixes.size(); ++i) {
     if (reference.quality[i] != kQualityFix) continue;
     const navbus::GnssFix& f = reference.fixes[i];
@@ -196,7 +195,6 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
       if (e) {
         available_sum += e->horizontal_m * e->horizontal_m;
         ++r.available;
-        available_inside += e->horizontal_m <= 3.0 * e->sigma_h_m ? 1 : 0;
         r.available_coverage.add(e->horizontal_m, e->sigma_h_m, e->valid);
         appendEpoch(run, t, 0, truth, *e, r.epoch_lines);
       }
@@ -214,7 +212,6 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
     r.outage_coverage.add(judged->horizontal_m, judged->sigma_h_m, judged->valid);
   }
   double end_sum = 0.0, squares = 0.0;
-  std::size_t inside = 0;
   for (const OutageScore& s : r.outages) {
     if (s.epochs == 0) continue;
     ++r.scored;
@@ -223,16 +220,15 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
     r.max_worst_m = std::max(r.max_worst_m, s.max_error_m);
     squares += s.sum_squares;
     r.epochs += s.epochs;
-    inside += s.inside_3_sigma;
   }
   if (r.scored > 0) {
     r.end_mean_m = end_sum / static_cast<double>(r.scored);
     r.rms_m = std::sqrt(squares / static_cast<double>(r.epochs));
-    r.inside = static_cast<double>(inside) / static_cast<double>(r.epochs);
+    r.inside = r.outage_coverage.insideShare(3);
   }
   if (r.available > 0) {
     r.available_rms_m = std::sqrt(available_sum / static_cast<double>(r.available));
-    r.available_inside = static_cast<double>(available_inside) / static_cast<double>(r.available);
+    r.available_inside = r.available_coverage.insideShare(3);
   }
   return r;
 }

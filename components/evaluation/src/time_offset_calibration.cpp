@@ -71,8 +71,11 @@ std::int64_t nanoseconds(double s) {
   return std::llround(s * 1e9);
 }
 
+/// One search's grid as text and CSV lines; `upper_edge_is_bound`: a minimum at the grid's last
+/// offset is a real answer (the velocity's lag is at most 0), not a grid to widen.
 std::string table(const std::string& key, const char* rows, const char* other,
-                  const OffsetSearch& s, const std::string& stage, std::ofstream& csv) {
+                  const OffsetSearch& s, const std::string& stage, bool upper_edge_is_bound,
+                  std::ofstream& csv) {
   std::string text = fmt::format(
       "{:>40}  mean NIS: {} rows ({})  windows failing the consistency test\n", key, rows, other);
   for (const OffsetTrial& t : s.trials) {
@@ -85,7 +88,10 @@ std::string table(const std::string& key, const char* rows, const char* other,
     csv << fmt::format("{},{:.4f},{:.5f},{:.5f},{},{},{}\n", stage, t.offset_s, t.mean_nis,
                        t.other_nis, t.rows, t.epochs_tested, t.epochs_inconsistent);
   }
-  if (s.at_edge) {
+  if (s.at_edge && upper_edge_is_bound && s.best + 1 == s.trials.size()) {
+    text += fmt::format("smallest at {:.3f} s, the grid's upper bound: no lag\n",
+                        s.trials[s.best].offset_s);
+  } else if (s.at_edge) {
     text += fmt::format("the smallest mean NIS is at the grid's edge ({:.3f} s): widen the grid\n",
                         s.trials[s.best].offset_s);
   } else {
@@ -145,7 +151,7 @@ int runTimeOffsetCommand(const TimeOffsetOptions& o) {
                    setup.filter.gnss_fix ? setup.filter.gnss_fix->velocity_time_offset_ns : 0));
     imu = searchImuTimeOffset(setup, o.imu);
     text += table("inputs.imu.time_offset_s", "position", "velocity", imu,
-                  fmt::format("{} imu", round), csv);
+                  fmt::format("{} imu", round), false, csv);
     if (imu.at_edge) {
       std::fputs(text.c_str(), stdout);
       return 1;
@@ -156,7 +162,11 @@ int runTimeOffsetCommand(const TimeOffsetOptions& o) {
         imu.refined_s);
     velocity = searchVelocityTimeOffset(setup, o.velocity);
     text += table("inputs.gnss_fix.velocity_time_offset_s", "velocity", "position", velocity,
-                  fmt::format("{} velocity", round), csv);
+                  fmt::format("{} velocity", round), true, csv);
+    if (velocity.at_edge && velocity.best == 0) {  // below the grid's lowest lag: widen it
+      std::fputs(text.c_str(), stdout);
+      return 1;
+    }
     setup.filter.gnss_fix->velocity_time_offset_ns = nanoseconds(velocity.refined_s);
   }
   if (!csv) throw bus::ConfigError("cannot write into " + o.out_dir);
@@ -165,7 +175,7 @@ int runTimeOffsetCommand(const TimeOffsetOptions& o) {
       "written into {}: time_offset.csv, the recording\n",
       imu.refined_s, velocity.refined_s, o.out_dir);
   std::fputs(text.c_str(), stdout);
-  return velocity.at_edge && velocity.best == 0 ? 1 : 0;
+  return 0;
 }
 
 }  // namespace navbus::evaluation

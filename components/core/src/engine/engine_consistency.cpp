@@ -12,31 +12,20 @@
 
 namespace navbus::core {
 
-namespace {
-/// Adds one row's normalized innovation squared (a row with no variance was not offered).
-void addRow(const ScalarUpdateResult& r, double& nis, int& dof) {
-  if (!(r.innovation_var > 0.0)) return;
-  nis += r.innovation * r.innovation / r.innovation_var;
-  ++dof;
-}
-}  // namespace
-
 void NavigationEngine::checkConsistency(std::int64_t time_ns, const ScalarUpdateResult* rows,
                                         int n) {
-  double nis = 0.0;
-  int dof = 0;
-  for (int i = 0; i < n; ++i) addRow(rows[i], nis, dof);
-  judgeConsistency(time_ns, nis, dof);
+  InnovationStatistics epoch;  // a row with no variance was not offered
+  for (int i = 0; i < n; ++i) epoch.add(rows[i].innovation, rows[i].innovation_var);
+  judgeConsistency(time_ns, epoch.nis_sum, static_cast<int>(epoch.rows));
 }
 
 void NavigationEngine::checkConsistency(std::int64_t time_ns,
                                         const std::vector<MeasurementReport>& reports) {
-  double nis = 0.0;
-  int dof = 0;
+  InnovationStatistics epoch;
   for (const MeasurementReport& r : reports) {
-    if (r.fused) addRow(r.result, nis, dof);
+    if (r.fused) epoch.add(r.result.innovation, r.result.innovation_var);
   }
-  judgeConsistency(time_ns, nis, dof);
+  judgeConsistency(time_ns, epoch.nis_sum, static_cast<int>(epoch.rows));
 }
 
 void NavigationEngine::judgeConsistency(std::int64_t time_ns, double nis, int dof) {

@@ -28,8 +28,8 @@ class VelocityHistory {
     if (count_ < kLength) ++count_;
   }
   /// The velocity change integrated from `from_ns` to the latest increment's end, linear within
-  /// the increment holding `from_ns`; nullopt-like false when the history does not reach back
-  /// that far (or holds fewer than two increments).
+  /// the increment holding `from_ns`, into `dv_ned_mps`; false (nothing written) when the
+  /// history does not reach back that far or holds fewer than two increments.
   bool changeSince(std::int64_t from_ns, Eigen::Vector3d& dv_ned_mps) const {
     if (count_ < 2) return false;
     const Entry& latest = at(count_ - 1);
