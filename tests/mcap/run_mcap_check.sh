@@ -81,7 +81,9 @@ YAML
 echo "domain_id: $domain" > "$work/fm.yaml"
 # Every solution to both recorders, as slow as either is: the default solution writer keeps
 # the last 50 (a latest-value stream), which a recorder behind on a loaded machine misses.
-printf 'extends: %s\ndomain_id: %s\nsolution_writer_profile: navbus_solution_writer_lossless\n' \
+# The same for the diagnostics, which the CSV recorder writes as text: with the default
+# writer's last 20 epochs it once missed 2 of 120.
+printf 'extends: %s\ndomain_id: %s\nsolution_writer_profile: navbus_solution_writer_lossless\ndiagnostics_writer_profile: navbus_diagnostics_writer_lossless\n' \
   "$src/config/filter_demo.yaml" $domain > "$work/filter.yaml"
 "$bin/navbus-filter" -c "$work/filter.yaml" > "$work/filter.log" 2>&1 &
 filter=$!

@@ -33,7 +33,7 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
       diagnostics_writer_(
           publishesDiagnostics(config)
               ? p.createWriter<navbus::FilterDiagnosticsPubSubType>(
-                    bus::topic::kFilterDiagnostics, bus::profile::kDiagnosticsWriter)
+                    bus::topic::kFilterDiagnostics, config.diagnostics_writer_profile)
               : bus::Writer<navbus::FilterDiagnostics>()),
       low_latency_writer_(
           config.low_latency_output

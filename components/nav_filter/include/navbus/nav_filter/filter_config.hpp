@@ -65,6 +65,10 @@ struct FilterConfig {
   /// QoS profile of the solution writer (qos/navbus_qos.xml): navbus_solution_writer, or
   /// navbus_solution_writer_lossless for recording fast-paced runs.
   std::string solution_writer_profile{bus::profile::kSolutionWriter};
+  /// QoS profile of the diagnostics writer: navbus_diagnostics_writer (the last 20 epochs for a
+  /// reader that falls behind), or navbus_diagnostics_writer_lossless for recording fast-paced
+  /// runs.
+  std::string diagnostics_writer_profile{bus::profile::kDiagnosticsWriter};
   /// Issuers whose commands the filter accepts (FilterCommand.issuer); others are refused and
   /// counted. Without DDS Security the issuer is what the sender claims: this stops a
   /// misconfigured or stray tool, not an attacker (docs/security.md).
