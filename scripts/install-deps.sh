@@ -20,7 +20,7 @@ if [ "${1:-}" != --package ]; then
     iproute2                                               # network namespaces for the topology test
     time                                                   # GNU time: peak RSS in scripts/bench.sh
     rtklib                                                 # rnx2rtkp: independent GPS fixes for the real-data test
-    python3-matplotlib python3-yaml                        # demo summary and figures (scripts/*.py)
+    python3-matplotlib python3-yaml python3-numpy          # demo summary, figures, pseudorange errors (scripts/*.py)
   )
 fi
 if [ "${1:-}" = --sanitizers ]; then

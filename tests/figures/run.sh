@@ -39,6 +39,12 @@ $py "$src/scripts/plot_navbus.py" spectrum "$work/raw/imu_raw.csv" --before 40 -
   --axis x -o "$work/fig"
 $py "$src/scripts/plot_navbus.py" glr "$work/with" -o "$work/fig" --scenario "$scenario"
 $py "$src/scripts/plot_navbus.py" montecarlo "$work/mc" -o "$work/fig"
+# The walk's pseudorange errors against its RTK reference (docs/real_data.md section 6): 4
+# satellites, sigma 5.47 m, the figure behind ekf.pseudorange_error_sigma_m.
+$py "$src/scripts/pseudorange_errors.py" "$work/walk/recording" | tee "$work/pr.log"
+[ "$(grep -c '^ *[0-9]\+ \+349 ' "$work/pr.log")" -eq 4 ] || { echo "pseudorange_errors.py: not 4 satellites"; exit 1; }
+grep -q "RMS over satellites: sigma 5.4[0-9] m" "$work/pr.log" ||
+  { echo "pseudorange_errors.py: sigma not 5.4x m"; exit 1; }
 for f in errors with_without_fault_manager spectrum_x glr nees detection_delay drive_0708 walk_0827; do
   size=$(stat -c %s "$work/fig/$f.png" 2>/dev/null || echo 0)
   echo "figure $f.png: $size bytes"

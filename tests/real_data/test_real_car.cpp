@@ -191,12 +191,14 @@ TEST(RealWalk, TightlyCoupledOnItsOwnPseudorangesBesideSinglePointPositioning) {
       "sigma %.1f %% / %.1f %%\n",
       filter_rms, spp_rms, 100.0 * value(0, "available_inside_3sigma"),
       100.0 * value(1, "available_inside_3sigma"));
-  // Measured 7.70 m against 8.29 m (349 fixed epochs; the filter aligns after 12.6 s, 296).
+  // Measured 7.67 m against 8.29 m (349 fixed epochs; the filter aligns after 12.6 s, 296).
   EXPECT_LT(filter_rms, spp_rms);
-  // Single point positioning's own sigma holds its error; the filter's does not (docs:
-  // the 4 satellites' errors are slow biases, which white measurement noise does not model).
+  // Both sigmas hold their errors: the 4 satellites' errors are slow biases, which the filter
+  // models as Gauss-Markov states (measured 100 % inside 3 sigma, 44 % inside 1 sigma; 0.7 %
+  // inside 3 sigma with white measurement noise only).
   EXPECT_GT(value(1, "available_inside_3sigma"), 0.95);
-  EXPECT_LT(filter_rms, 8.0);
+  EXPECT_GE(value(0, "available_inside_3sigma"), 0.90);
+  EXPECT_LE(filter_rms, 7.69);  // no worse than with white noise only
   EXPECT_GT(value(0, "available_epochs"), 290.0);
   EXPECT_EQ(value(1, "available_epochs"), 349.0);
   fs::remove_all(out);
@@ -231,7 +233,7 @@ TEST(RealWalk, TheGlrOnTheCleanWalkAndOnARampInOneRealSatellite) {
   std::printf("walk_0827, 2 m/s ramp into G10 from 40 s: decided %.1f s after the onset\n",
               after_onset_s);
   EXPECT_GT(after_onset_s, 0.0);
-  EXPECT_LT(after_onset_s, 15.0);  // measured 5.2 s
+  EXPECT_LT(after_onset_s, 15.0);  // measured 8.2 s (5.2 s with white range errors only)
   const auto exclusion =
       std::find_if(ramp.commands.begin(), ramp.commands.end(), [&](const navbus::FilterCommand& c) {
         return c.kind() == navbus::CMD_EXCLUDE_SATELLITE && c.decision_id() == g10->decision_id();

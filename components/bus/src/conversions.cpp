@@ -97,7 +97,8 @@ constexpr LayoutEntry kStateLayout[] = {
     {"gyro_bias", core::layout::kGyroBias, "rad/s"},
     {"star_tracker_bias", core::layout::kStarTrackerBias, "rad"},
     {"clock_bias", core::layout::kClockBias, "m"},
-    {"clock_drift", core::layout::kClockDrift, "m/s"}};
+    {"clock_drift", core::layout::kClockDrift, "m/s"},
+    {"pseudorange_error", core::layout::kPseudorangeError, "m"}};
 }  // namespace
 
 void fillStateLayout(navbus::FilterDiagnostics& msg) {

@@ -287,6 +287,10 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
               kArcsecond)
       .number("star_tracker_bias_correlation_time_s", t.star_tracker_bias_correlation_time_s,
               {1.0, 1e7})
+      // Each satellite's time-correlated pseudorange error, states when its sigma is positive.
+      .number("pseudorange_error_sigma_m", t.pseudorange_error_sigma_m, {0.0, 1000.0})
+      .number("pseudorange_error_correlation_time_s", t.pseudorange_error_correlation_time_s,
+              {1.0, 1e7})
       .number("initial_clock_bias_m", e.initial_clock_bias_m, {-1e9, 1e9})
       .number("initial_clock_drift_mps", e.initial_clock_drift_mps, {-1e6, 1e6})
       .finish();
@@ -308,6 +312,11 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
   if (t.star_tracker_bias_sigma_rad > 0.0 && !e.use_star_tracker) {
     throw bus::ConfigError(
         "configuration ekf.star_tracker_bias_sigma_arcsec needs star_tracker_updates = true");
+  }
+  if (t.pseudorange_error_sigma_m > 0.0 && e.aiding != core::AidingMode::kTightlyCoupled) {
+    throw bus::ConfigError("configuration ekf.pseudorange_error_sigma_m (" +
+                           std::to_string(t.pseudorange_error_sigma_m) +
+                           " m) needs mode: tightly_coupled (pseudoranges are fused only there)");
   }
 }
 

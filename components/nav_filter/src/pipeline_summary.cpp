@@ -26,7 +26,9 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
       << n.reinitialisations_asked << " done " << n.reinitialisations_done << ", GNSS epochs fused "
       << n.gnss_epochs_fused << ", fixes fused " << n.fixes_fused
       << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
-      << ", NHC updates " << n.nonholonomic_updates << ", rows gated " << n.rows_gated
+      << ", NHC updates " << n.nonholonomic_updates
+      << ", pseudoranges without an error state (every state taken) "
+      << v.engine.pseudorangesWithoutErrorState() << ", rows gated " << n.rows_gated
       << ", stage switches " << n.stage_switches << ", decisions seen " << p.decisions_seen
       << ", commands applied " << k.applied << " refused " << k.refused << " (unauthorized issuer "
       << k.unauthorized << ", issuer not the writer's identity " << k.impersonated << ", stale "

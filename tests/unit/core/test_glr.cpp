@@ -131,8 +131,11 @@ LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& fault
   for (int k = 0; k < epochs; ++k) {
     loop.nextEpoch();
     // Interval (k-1, k]: a state fault starting at epoch `onset` enters at its start.
-    StateVector w;
-    for (int i = 0; i < nc::layout::kSize; ++i) w[i] = std::sqrt(loop.q()(i, i)) * n(rng);
+    // The loop's rows never reach the pseudorange-error states: they stay at 0, and the noise
+    // stream is the same whatever the layout adds there.
+    StateVector w = StateVector::Zero();
+    for (int i = 0; i < nc::layout::kPseudorangeError.index; ++i)
+      w[i] = std::sqrt(loop.q()(i, i)) * n(rng);
     StateVector before = dx;
     for (const Fault& f : faults) {
       if (f.h.isImu() && k == f.onset_epoch) before[biasState(f.h)] -= f.magnitude;

@@ -123,10 +123,17 @@ void NavigationEngine::reset() {
   consistency_.restart();
 }
 
+std::uint64_t NavigationEngine::pseudorangesWithoutErrorState() const {
+  return filter_->pseudorangeErrors().unmodelled();
+}
+
 StateMask NavigationEngine::baseMask() const {
   // The receiver clock is a state only when pseudoranges are used.
   if (config_.aiding == AidingMode::kTightlyCoupled || config_.aiding == AidingMode::kInertialOnly)
-    return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift});
+    return config_.tuning.pseudorange_error_sigma_m > 0.0
+               ? maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift,
+                         kPseudorangeError})
+               : maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift});
   // The star tracker's bias where it is modelled and the tracker used.
   if (config_.use_star_tracker && config_.tuning.star_tracker_bias_sigma_rad > 0.0)
     return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kStarTrackerBias});

@@ -34,6 +34,8 @@ StateVector IntegratedFilter::initialSigma(const FilterTuning& tuning) {
                                                             : 1.0);
   sigma[kClockBias.index] = tuning.clock_bias_sigma_m;
   sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
+  sigma.segment<kPseudorangeError.dof>(kPseudorangeError.index)
+      .setConstant(tuning.pseudorange_error_sigma_m > 0.0 ? tuning.pseudorange_error_sigma_m : 1.0);
   return sigma;
 }
 
@@ -57,6 +59,7 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   accel_bias_.setZero();
   gyro_bias_.setZero();
   star_tracker_bias_.setZero();
+  pseudorange_errors_.clear();
   central_.initialize(initial_covariance, active);
   const Eigen::Vector3d floor_pos = Eigen::Vector3d::Constant(tuning.adaptive_floor_position_m);
   windows_[0].configure(tuning.adaptive_window, floor_pos);
@@ -119,6 +122,17 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
     const double sigma = tuning_.star_tracker_bias_sigma_rad;
     star_tracker_bias_ *= decay;
     for (int i = kStarTrackerBias.index; i < kStarTrackerBias.end(); ++i) {
+      Phi(i, i) = decay;
+      q[i] = sigma * sigma * (1.0 - decay * decay);
+    }
+  }
+  if (modelsPseudorangeErrors()) {
+    // Each satellite's pseudorange error: first-order Gauss-Markov, exactly discretized as the
+    // star-tracker bias above. A free state stays at the prior (variance sigma^2, estimate 0).
+    const double decay = std::exp(-dt / tuning_.pseudorange_error_correlation_time_s);
+    const double sigma = tuning_.pseudorange_error_sigma_m;
+    pseudorange_errors_.decay(decay);
+    for (int i = kPseudorangeError.index; i < kPseudorangeError.end(); ++i) {
       Phi(i, i) = decay;
       q[i] = sigma * sigma * (1.0 - decay * decay);
     }
@@ -217,6 +231,7 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   d.innovation.resize(m);
   d.h.resize(m, kSize);
   Eigen::VectorXd r(m);
+  const std::vector<int>& error_state = pseudorangeErrorStates(sats);
   for (std::size_t i = 0; i < sats.size(); ++i) {
     const auto& sat = sats[i];
     const RangePrediction p =
@@ -227,6 +242,12 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
     d.innovation[row + 1] = p.pseudorange_rate_mps - sat.pseudorange_rate_mps;
     d.h.row(row) = p.h_range;
     d.h.row(row + 1) = p.h_rate;
+    if (error_state[i] >= 0) {
+      // The predicted pseudorange includes the satellite's estimated error; its error (estimate
+      // minus truth) enters the innovation with +1.
+      d.innovation[row] += pseudorange_errors_.estimate(error_state[i]);
+      d.h(row, error_state[i]) = 1.0;
+    }
     r[row] = sat.pseudorange_sigma_m * sat.pseudorange_sigma_m;
     r[row + 1] = sat.pseudorange_rate_sigma_mps * sat.pseudorange_rate_sigma_mps;
     d.sv_ids.insert(d.sv_ids.end(), {sat.sv_id, sat.sv_id});
@@ -265,6 +286,24 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   applied_gain_.compute(last_epoch_, prior_P_);
   closeUpdate();
   return reports_;
+}
+
+bool IntegratedFilter::modelsPseudorangeErrors() const {
+  return central_.active()[static_cast<std::size_t>(kPseudorangeError.index)] &&
+         tuning_.pseudorange_error_sigma_m > 0.0;
+}
+
+const std::vector<int>& IntegratedFilter::pseudorangeErrorStates(
+    const std::vector<SatelliteObservation>& sats) {
+  if (!modelsPseudorangeErrors()) {
+    no_error_states_.assign(sats.size(), -1);
+    return no_error_states_;
+  }
+  epoch_sv_ids_.clear();
+  for (const SatelliteObservation& sat : sats) epoch_sv_ids_.push_back(sat.sv_id);
+  const PseudorangeErrorSlots::Assignment& a = pseudorange_errors_.assign(epoch_sv_ids_);
+  for (const int i : a.fresh) resetState(i, tuning_.pseudorange_error_sigma_m);
+  return a.state_index;
 }
 
 void IntegratedFilter::closeUpdate() {
@@ -325,6 +364,7 @@ void IntegratedFilter::feedback(const StateVector& dx) {
   star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);
   clock_bias_m_ -= dx[kClockBias.index];
   clock_drift_mps_ -= dx[kClockDrift.index];
+  pseudorange_errors_.correct(dx.segment<kPseudorangeError.dof>(kPseudorangeError.index));
 }
 
 void IntegratedFilter::setActive(const StateMask& active) {

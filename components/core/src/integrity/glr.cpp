@@ -337,7 +337,7 @@ void GlrMonitor::propagate() {
   const auto in = mu_.leftCols(columns);
   auto out = mu_next_.leftCols(columns);
   if (biasAndClockRowsSparse()) {
-    // Bias and clock rows: B = [0 I 0] + B(:, support): 11 x 11 per column instead of 11 x n.
+    // Bias and receiver rows: B = [0 I 0] + B(:, support): support-wide per column, not n-wide.
     constexpr int kNav = layout::kAtt.end();  // position, velocity, attitude rows
     constexpr int kLower = kStates - kNav;    // bias and clock rows
     // (Eigen's kernels work on blocks of 4 rows: 8 rows as a product, the 9th alone.)

@@ -205,6 +205,8 @@ class NavigationEngine {
   const EngineConfig& config() const { return config_; }
   std::uint32_t status() const { return status_; }
   const EngineCounters& counters() const { return counters_; }
+  /// Satellite epochs whose pseudorange error had no state (every state taken) since the start.
+  std::uint64_t pseudorangesWithoutErrorState() const;
   /// The latest fused pseudorange epoch's diagnostics (innovations, S, H, K, Phi).
   const EpochDiagnostics& lastEpoch() const;
   /// StartSource::kAligned: where the alignment stands, and once aligned what it started from

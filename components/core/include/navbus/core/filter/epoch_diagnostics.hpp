@@ -35,7 +35,9 @@ class AppliedGain {
 
  private:
   Eigen::MatrixXd cov_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
+  /// Factorized once at construction (of nothing), so that every member is set: a default
+  /// LLT leaves its status unset, which GCC reports when a filter is assigned.
+  Eigen::LLT<Eigen::MatrixXd> llt_{Eigen::MatrixXd(0, 0)};
 };
 
 }  // namespace navbus::core

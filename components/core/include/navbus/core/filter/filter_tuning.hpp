@@ -36,6 +36,11 @@ struct FilterTuning {
   // modelled, the states stay inactive).
   double star_tracker_bias_sigma_rad{0.0};             ///< stationary 1 sigma per axis [rad]
   double star_tracker_bias_correlation_time_s{300.0};  ///< [s]
+  // Time-correlated pseudorange errors (tight coupling): a first-order Gauss-Markov state per
+  // tracked satellite (layout::kPseudorangeError, pseudorange_error_slots.hpp) when the sigma
+  // is positive (0: not modelled, pseudoranges fused with their white sigma only).
+  double pseudorange_error_sigma_m{0.0};               ///< stationary 1 sigma [m]
+  double pseudorange_error_correlation_time_s{300.0};  ///< [s]
   // Adaptive structure (seed 001 eqs. 30-34).
   int adaptive_window{50};                ///< innovations per estimate [epochs]
   double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]

@@ -23,6 +23,7 @@
 #include "navbus/core/filter/error_state.hpp"
 #include "navbus/core/filter/filter_tuning.hpp"
 #include "navbus/core/filter/innovation_window.hpp"
+#include "navbus/core/filter/pseudorange_error_slots.hpp"
 #include "navbus/core/filter/rts_smoother.hpp"
 #include "navbus/core/gnss/gnss_measurement.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
@@ -43,10 +44,12 @@ struct MeasurementReport {
 
 class IntegratedFilter {
  public:
-  /// Number of leading states the federated master fuses: all but the receiver clock, which
-  /// only the GNSS local filter observes.
+  /// Number of leading states the federated master fuses: all but the receiver's (clock and
+  /// pseudorange errors), which only the GNSS local filter observes.
   static constexpr int kFusedStates = layout::kClockBias.index;
-  static_assert(layout::kClockDrift.end() == layout::kSize, "the clock must trail the layout");
+  static_assert(layout::kClockDrift.end() == layout::kPseudorangeError.index &&
+                    layout::kPseudorangeError.end() == layout::kSize,
+                "the receiver's states must trail the layout");
 
   /// Starts from `state` with the tuning's initial sigmas (initialSigma).
   void initialize(const NavState& state, double clock_bias_m, double clock_drift_mps,
@@ -133,6 +136,8 @@ class IntegratedFilter {
   const Eigen::Vector3d& starTrackerBias() const { return star_tracker_bias_; }
   double clockBias() const { return clock_bias_m_; }
   double clockDrift() const { return clock_drift_mps_; }
+  /// The satellites' time-correlated pseudorange errors (tight coupling, when modelled).
+  const PseudorangeErrorSlots& pseudorangeErrors() const { return pseudorange_errors_; }
   /// Whether the transition since the last update is kept for the pseudorange epochs'
   /// diagnostics (the GLR's Phi): on for tightly coupled aiding, off otherwise (it costs a third
   /// of the covariance propagation).
@@ -157,6 +162,11 @@ class IntegratedFilter {
   /// P's attitude rows and columns through the reset of a heading correction (before
   /// feedback): turned by R_D(dpsi) with the frame the INS computes.
   void turnAttitudeCovariance(double dpsi_rad);
+  /// Whether the satellites' pseudorange errors are states (layout::kPseudorangeError active).
+  bool modelsPseudorangeErrors() const;
+  /// Gives this epoch's satellites their pseudorange-error states (a new one starts from the
+  /// prior); returns each satellite's state index, -1 where none is modelled.
+  const std::vector<int>& pseudorangeErrorStates(const std::vector<SatelliteObservation>& sats);
   InnovationWindow<3>* window(AidingKind kind);
   /// Smoothing log: the record of the epoch reached (at an increment's start, when the epoch
   /// had updates or the log's interval has passed).
@@ -176,11 +186,14 @@ class IntegratedFilter {
   StateMatrix prior_P_{StateMatrix::Zero()};  ///< P- of the latest GNSS epoch
   AppliedGain applied_gain_;                  ///< the diagnostics' K from the sequential updates
   std::vector<MeasurementReport> reports_;
+  std::vector<int> epoch_sv_ids_;     ///< the satellites of the epoch being processed
+  std::vector<int> no_error_states_;  ///< -1 per satellite: errors not modelled
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d star_tracker_bias_{Eigen::Vector3d::Zero()};
   double clock_bias_m_{0.0};
   double clock_drift_mps_{0.0};
+  PseudorangeErrorSlots pseudorange_errors_;
   /// What the next smoothing record gathers since the last one.
   struct SmoothingPending {
     StateMatrix transition{StateMatrix::Identity()};

@@ -17,7 +17,10 @@ struct StateBlock {
 /// computed body-to-NED rotation is (I - [phi x]) times the true one], accelerometer bias
 /// [m/s^2, body], gyro bias [rad/s, body], star-tracker bias [rad, star-tracker body axes: a
 /// small rotation of the measured attitude, first-order Gauss-Markov], receiver clock bias c*b
-/// [m] and drift c*f [m/s]. All errors are estimate minus truth. Seed 000 orders dV, dR, Psi,
+/// [m] and drift c*f [m/s], and the time-correlated pseudorange errors of up to
+/// kPseudorangeError.dof satellites [m, one first-order Gauss-Markov state per tracked
+/// satellite, assigned by pseudorange_error_slots.hpp]. All errors are estimate minus truth. Seed
+/// 000 orders dV, dR, Psi,
 /// ...; the order here is position first, which only permutes the matrices. A configuration
 /// uses the blocks it has sensors for (the others are inactive, error_state.hpp): the 17
 /// states of seed 000 without the star-tracker bias, seed 001 without the clock.
@@ -30,16 +33,18 @@ inline constexpr StateBlock kGyroBias{12, 3};
 inline constexpr StateBlock kStarTrackerBias{15, 3};
 inline constexpr StateBlock kClockBias{18, 1};
 inline constexpr StateBlock kClockDrift{19, 1};
-inline constexpr int kSize = 20;
+inline constexpr StateBlock kPseudorangeError{20, 12};
+inline constexpr int kSize = 32;
 /// The leading states the error dynamics couple (position, velocity, attitude). No navigation
-/// error drives the trailing ones (biases, clock), so every transition matrix is block upper
-/// triangular at this size (ins_error_model.hpp, tested).
+/// error drives the trailing ones (biases, clock, pseudorange errors), so every transition matrix
+/// is block upper triangular at this size (ins_error_model.hpp, tested).
 inline constexpr int kCoupledSize = kAtt.end();
 static_assert(kPos.end() == kVel.index && kVel.end() == kAtt.index &&
                   kAtt.end() == kAccelBias.index && kAccelBias.end() == kGyroBias.index &&
                   kGyroBias.end() == kStarTrackerBias.index &&
                   kStarTrackerBias.end() == kClockBias.index &&
-                  kClockBias.end() == kClockDrift.index && kClockDrift.end() == kSize,
+                  kClockBias.end() == kClockDrift.index &&
+                  kClockDrift.end() == kPseudorangeError.index && kPseudorangeError.end() == kSize,
               "the layout's blocks must tile the state vector");
 }  // namespace layout
 
