@@ -15,6 +15,7 @@
 #include "navbus/core/math/units.hpp"
 #include "navbus/evaluation/coverage.hpp"
 #include "navbus/evaluation/recording_runner.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/importers/importer.hpp"
 #include "navbus/importers/rtklib_pos.hpp"
 
@@ -49,6 +50,9 @@ struct AntennaPoint {
   double sigma_h_m;  ///< sqrt(sigma_N^2 + sigma_E^2)
   double sigma_v_m;
   bool valid;  ///< the solution's covariance_valid (true where a run has no such flag)
+  /// The solution's integrity and protection levels (NOT_MONITORED where a run has none).
+  navbus::IntegrityState integrity{navbus::INTEGRITY_NOT_MONITORED};
+  double hpl_m{0.0}, vpl_m{0.0};
 };
 
 AntennaPoint antennaOf(const navbus::NavigationSolution& s, const Eigen::Vector3d& lever_b) {
@@ -60,7 +64,10 @@ AntennaPoint antennaOf(const navbus::NavigationSolution& s, const Eigen::Vector3
           Eigen::Vector3d(s.vel_ned_mps()[0], s.vel_ned_mps()[1], s.vel_ned_mps()[2]),
           std::hypot(sd[0], sd[1]),
           sd[2],
-          s.covariance_valid()};
+          s.covariance_valid(),
+          s.integrity(),
+          s.horizontal_protection_level_m(),
+          s.vertical_protection_level_m()};
 }
 
 /// Horizontal error [m] of the antenna against a reference at its time, from the solutions
@@ -68,8 +75,29 @@ AntennaPoint antennaOf(const navbus::NavigationSolution& s, const Eigen::Vector3
 struct Judged {
   double horizontal_m;
   double sigma_h_m;
-  bool valid;  ///< covariance_valid of the solution(s) judged
+  bool valid;              ///< covariance_valid of the solution(s) judged
+  double vertical_m{0.0};  ///< |error| along the vertical [m]
+  /// Integrity of the solution(s) judged: AVAILABLE only when each was, with the smaller
+  /// levels (the stricter test of the error against them).
+  navbus::IntegrityState integrity{navbus::INTEGRITY_NOT_MONITORED};
+  double hpl_m{0.0}, vpl_m{0.0};
 };
+
+/// The integrity fields of a judgement from one solution, or from two (interpolated).
+void takeIntegrity(const AntennaPoint& p, Judged& j) {
+  j.integrity = p.integrity;
+  j.hpl_m = p.hpl_m;
+  j.vpl_m = p.vpl_m;
+}
+void takeIntegrity(const AntennaPoint& a, const AntennaPoint& b, Judged& j) {
+  j.integrity = a.integrity == b.integrity ? a.integrity
+                : (a.integrity == navbus::INTEGRITY_NOT_MONITORED ||
+                   b.integrity == navbus::INTEGRITY_NOT_MONITORED)
+                    ? navbus::INTEGRITY_NOT_MONITORED
+                    : navbus::INTEGRITY_UNAVAILABLE;
+  j.hpl_m = std::min(a.hpl_m, b.hpl_m);
+  j.vpl_m = std::min(a.vpl_m, b.vpl_m);
+}
 std::optional<Judged> judge(const std::vector<AntennaPoint>& points, std::int64_t t,
                             const earth::Geodetic& reference) {
   const auto after =
@@ -82,7 +110,10 @@ std::optional<Judged> judge(const std::vector<AntennaPoint>& points, std::int64_
   const Eigen::Vector3d ea = earth::differenceNed(a.position, reference);
   const Eigen::Vector3d eb = earth::differenceNed(b.position, reference);
   const Eigen::Vector3d e = (1.0 - w) * ea + w * eb;
-  return Judged{e.head<2>().norm(), (1.0 - w) * a.sigma_h_m + w * b.sigma_h_m, a.valid && b.valid};
+  Judged j{e.head<2>().norm(), (1.0 - w) * a.sigma_h_m + w * b.sigma_h_m, a.valid && b.valid,
+           std::abs(e.z())};
+  takeIntegrity(a, b, j);
+  return j;
 }
 
 /// Horizontal error [m] of the filter's solution once it took the fix of time t: the first
@@ -98,7 +129,9 @@ std::optional<Judged> judgeAfterFusion(const std::vector<AntennaPoint>& points, 
   const double back_s = 1e-9 * static_cast<double>(at->time_ns - t);
   const Eigen::Vector3d e =
       earth::differenceNed(at->position, reference) - at->vel_ned_mps * back_s;
-  return Judged{e.head<2>().norm(), at->sigma_h_m, at->valid};
+  Judged j{e.head<2>().norm(), at->sigma_h_m, at->valid, std::abs(e.z())};
+  takeIntegrity(*at, j);
+  return j;
 }
 
 /// A solution of its own epochs (single point positioning): the one nearest t, within 20 ms.
@@ -113,9 +146,53 @@ std::optional<Judged> judgeNearest(const std::vector<AntennaPoint>& points, std:
   if (after != points.begin() && (best == nullptr || t - (after - 1)->time_ns < best->time_ns - t))
     best = &*(after - 1);
   if (best == nullptr || std::llabs(best->time_ns - t) > kToleranceNs) return std::nullopt;
-  return Judged{earth::differenceNed(best->position, reference).head<2>().norm(), best->sigma_h_m,
-                best->valid};
+  const Eigen::Vector3d e = earth::differenceNed(best->position, reference);
+  Judged j{e.head<2>().norm(), best->sigma_h_m, best->valid, std::abs(e.z())};
+  takeIntegrity(*best, j);
+  return j;
 }
+
+/// Protection levels against the true error over the judged epochs (seed 000's integrity
+/// claim): an epoch whose solution says AVAILABLE must have its horizontal error within HPL and
+/// its vertical error within VPL; one that does not is misleading.
+struct ProtectionTally {
+  std::size_t epochs{0};
+  std::size_t monitored{0};  ///< with levels computed
+  std::size_t available{0};
+  std::size_t misleading_h{0}, misleading_v{0};
+  double worst_h_ratio{0.0}, worst_v_ratio{0.0};  ///< largest e / PL while available
+
+  void add(const Judged& j) {
+    ++epochs;
+    // Monitored: levels computed (0 while not monitored or initializing; an untrustworthy
+    // solution is UNAVAILABLE whether monitored or not).
+    if (!(j.hpl_m > 0.0 && j.vpl_m > 0.0)) return;
+    ++monitored;
+    if (j.integrity != navbus::INTEGRITY_AVAILABLE) return;
+    ++available;
+    misleading_h += j.horizontal_m > j.hpl_m ? 1 : 0;
+    misleading_v += j.vertical_m > j.vpl_m ? 1 : 0;
+    worst_h_ratio = std::max(worst_h_ratio, j.horizontal_m / j.hpl_m);
+    worst_v_ratio = std::max(worst_v_ratio, j.vertical_m / j.vpl_m);
+  }
+  double availableShare() const {
+    return epochs == 0 ? 0.0 : static_cast<double>(available) / static_cast<double>(epochs);
+  }
+  std::string line() const {
+    if (monitored == 0)
+      return fmt::format(
+          "protection levels: not monitored in any of the {} judged epochs (the filter has no "
+          "integrity block, or the mode has no fault detector on its measurements: only "
+          "tightly coupled has)\n",
+          epochs);
+    return fmt::format(
+        "protection levels: {} judged epochs, monitored {}, available {} ({:.1f} %); while "
+        "available, error beyond HPL {} and beyond VPL {} (largest e_h / HPL {:.2f}, e_v / VPL "
+        "{:.2f})\n",
+        epochs, monitored, available, 100.0 * availableShare(), misleading_h, misleading_v,
+        worst_h_ratio, worst_v_ratio);
+  }
+};
 
 struct OutageScore {
   std::size_t epochs{0};
@@ -135,6 +212,7 @@ struct Scored {
   double available_rms_m{0.0};
   double available_inside{0.0};  ///< share of GNSS-available epochs inside 3 sigma_h
   CoverageTally outage_coverage, available_coverage;
+  ProtectionTally protection;  ///< every judged epoch, outages and GNSS available
   /// Every judged epoch (errors.csv): run, GPS s of week, outage (0: GNSS available), error
   /// and 1-sigma [m], the reference position [deg].
   fmt::memory_buffer epoch_lines;
@@ -196,6 +274,7 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
         available_sum += e->horizontal_m * e->horizontal_m;
         ++r.available;
         r.available_coverage.add(e->horizontal_m, e->sigma_h_m, e->valid);
+        r.protection.add(*e);
         appendEpoch(run, t, 0, truth, *e, r.epoch_lines);
       }
       continue;
@@ -210,6 +289,7 @@ Scored score(const std::string& run, const std::vector<AntennaPoint>& points,
     s.sum_squares += judged->horizontal_m * judged->horizontal_m;
     s.inside_3_sigma += judged->horizontal_m <= 3.0 * judged->sigma_h_m ? 1 : 0;
     r.outage_coverage.add(judged->horizontal_m, judged->sigma_h_m, judged->valid);
+    r.protection.add(*judged);
   }
   double end_sum = 0.0, squares = 0.0;
   for (const OutageScore& s : r.outages) {
@@ -268,9 +348,11 @@ std::string report(const std::string& title, const Scored& r, Judging judging,
 }
 
 std::string scoreLine(const std::string& run, const Scored& r) {
-  return fmt::format("{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.4f},{:.4f}\n", run, r.scored,
-                     r.end_mean_m, r.end_worst_m, r.max_worst_m, r.rms_m, r.inside, r.available,
-                     r.available_rms_m, r.available_inside);
+  const ProtectionTally& p = r.protection;
+  return fmt::format("{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.4f},{:.4f},{},{},{},{},{}\n",
+                     run, r.scored, r.end_mean_m, r.end_worst_m, r.max_worst_m, r.rms_m, r.inside,
+                     r.available, r.available_rms_m, r.available_inside, p.epochs, p.monitored,
+                     p.available, p.misleading_h, p.misleading_v);
 }
 
 /// The honesty table (printed) and coverage.csv: the causal run and, when given, the smoothed
@@ -388,6 +470,8 @@ int runRealCarBenchmark(const RealCarOptions& o) {
     return outageOf(static_cast<std::int64_t>(f.time_gps_ns()), outages) >= 0;
   };
   setup.smooth = o.smooth;
+  if (!o.fault_manager.empty())
+    setup.fault_manager = bus::parseFile(o.fault_manager, fault_manager::parseFaultManagerConfig);
   const Eigen::Vector3d lever_b = setup.filter.engine.antenna_lever_arm_b_m;
   std::vector<AntennaPoint> points;
   std::ofstream sol(out_dir / "solution.csv");
@@ -407,10 +491,12 @@ int runRealCarBenchmark(const RealCarOptions& o) {
                                  run.summary, run.fixes_withheld, outages.size());
   std::ofstream scores(out_dir / "scores.csv");
   scores << "run,outages_scored,end_mean_m,end_worst_m,max_worst_m,rms_m,inside_3sigma,"
-            "available_epochs,available_rms_m,available_inside_3sigma\n";
+            "available_epochs,available_rms_m,available_inside_3sigma,pl_epochs,pl_monitored,"
+            "pl_available,pl_misleading_h,pl_misleading_v\n";
   const Scored causal = score("filter", points, reference, outages, Judging::kAfterFusion);
   text += report("the filter (causal)", causal, Judging::kAfterFusion, outages,
                  out_dir / "outages.csv", outage_source);
+  text += causal.protection.line();
   scores << scoreLine("filter", causal);
   std::ofstream epochs(out_dir / "errors.csv");
   epochs << "run,gpst_s,outage,error_h_m,sigma_h_m,ref_lat_deg,ref_lon_deg\n";

@@ -88,6 +88,16 @@ CLI::App* benchmarkApp(CLI::App& app) {
   return benchmark;
 }
 
+/// --fault-manager of the real-log benchmarks: the GLR beside the filter, so that its
+/// protection levels are published and scored.
+void addFaultManager(CLI::App& app, evaluation::RealCarOptions& o) {
+  app.add_option("--fault-manager", o.fault_manager,
+                 "navbus-fault-manager YAML (config/fault_manager.yaml): run the fault pipeline "
+                 "beside the filter, its decisions acting on it as on the bus (the protection "
+                 "levels of a filter with an integrity block are scored either way)")
+      ->check(CLI::ExistingFile);
+}
+
 class RealCarBenchmarkCommand final : public Subcommand {
  public:
   void add(CLI::App& app) override {
@@ -114,6 +124,7 @@ class RealCarBenchmarkCommand final : public Subcommand {
     cli_->add_flag("--smooth", o_.smooth,
                    "also score the fixed-interval (Rauch-Tung-Striebel) smoother over the same "
                    "forward run: smoothed.csv, smoothed_outages.csv");
+    addFaultManager(*cli_, o_);
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
@@ -147,6 +158,7 @@ class RealDataBenchmarkCommand final : public Subcommand {
                      "output directory: solution.csv, scores.csv, errors.csv, the recording")
         ->required();
     cli_->add_flag("--smooth", o_.smooth, "also score the fixed-interval smoother");
+    addFaultManager(*cli_, o_);
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {

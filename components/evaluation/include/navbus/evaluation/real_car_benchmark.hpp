@@ -46,6 +46,10 @@ struct RealCarOptions {
   std::optional<OutageSchedule> schedule;
   std::string out_dir;  ///< solution.csv, outages.csv, scores.csv, the recording
   bool smooth{false};   ///< also the smoothed run: smoothed.csv, smoothed_outages.csv
+  /// navbus-fault-manager YAML: the fault pipeline (GLR) runs beside the filter and its
+  /// decisions act on it (empty: the filter alone). Protection levels, published by a filter
+  /// with an `integrity` block, are scored either way.
+  std::string fault_manager;
 };
 
 int runRealCarBenchmark(const RealCarOptions& o);
