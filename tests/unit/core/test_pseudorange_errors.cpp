@@ -14,9 +14,9 @@ namespace layout = navbus::core::layout;
 using navbus::core::PseudorangeErrorSlots;
 
 namespace {
-constexpr int kFirst = layout::kPseudorangeError.index;
+constexpr int kFirstRangeError = layout::kPseudorangeError.index;
 
-navbus::core::NavState atRest() {
+navbus::core::NavState restingReceiver() {
   navbus::core::NavState s;
   s.time_ns = 1'400'000'000'000'000'000;
   s.position = {36.5 * M_PI / 180, 127.5 * M_PI / 180, 100.0};
@@ -25,8 +25,8 @@ navbus::core::NavState atRest() {
 
 /// The visible satellites with noise-free pseudoranges from `truth`, clock bias 0, plus
 /// `extra_m` on the first one.
-std::vector<navbus::core::SatelliteObservation> satellites(const navbus::core::NavState& truth,
-                                                           double extra_m) {
+std::vector<navbus::core::SatelliteObservation> satellitesWithRangeError(
+    const navbus::core::NavState& truth, double extra_m) {
   navbus::sim::Constellation c(navbus::sim::ConstellationConfig{});
   const Eigen::Vector3d r = earth::geodeticToEcef(truth.position);
   std::vector<navbus::core::SatelliteObservation> out;
@@ -46,7 +46,7 @@ std::vector<navbus::core::SatelliteObservation> satellites(const navbus::core::N
   return out;
 }
 
-navbus::core::FilterTuning tuning() {
+navbus::core::FilterTuning rangeErrorTuning() {
   navbus::core::FilterTuning t;
   t.pos_sigma_m = 10.0;
   t.clock_bias_sigma_m = 10.0;
@@ -56,7 +56,7 @@ navbus::core::FilterTuning tuning() {
   return t;
 }
 
-navbus::core::StateMask tightlyCoupledWithRangeErrors() {
+navbus::core::StateMask rangeErrorMask() {
   using namespace layout;
   return navbus::core::maskOf(
       {kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift, kPseudorangeError});
@@ -66,15 +66,17 @@ navbus::core::StateMask tightlyCoupledWithRangeErrors() {
 TEST(PseudorangeErrorSlots, SatellitesTakeFreeStatesAndGiveThemUpWhenTheyGo) {
   PseudorangeErrorSlots slots;
   auto a = slots.assign({5, 9, 12});
-  EXPECT_EQ(a.state_index, (std::vector<int>{kFirst, kFirst + 1, kFirst + 2}));
+  EXPECT_EQ(a.state_index,
+            (std::vector<int>{kFirstRangeError, kFirstRangeError + 1, kFirstRangeError + 2}));
   EXPECT_EQ(a.fresh, a.state_index);
   // 9 is gone: its state is free for 20, the others keep theirs and are not fresh.
   a = slots.assign({12, 20, 5});
-  EXPECT_EQ(a.state_index, (std::vector<int>{kFirst + 2, kFirst + 1, kFirst}));
-  EXPECT_EQ(a.fresh, (std::vector<int>{kFirst + 1}));
+  EXPECT_EQ(a.state_index,
+            (std::vector<int>{kFirstRangeError + 2, kFirstRangeError + 1, kFirstRangeError}));
+  EXPECT_EQ(a.fresh, (std::vector<int>{kFirstRangeError + 1}));
   // 9 comes back: a new satellite to the slots, from the prior.
   a = slots.assign({12, 20, 5, 9});
-  EXPECT_EQ(a.fresh, (std::vector<int>{kFirst + 3}));
+  EXPECT_EQ(a.fresh, (std::vector<int>{kFirstRangeError + 3}));
   EXPECT_EQ(slots.unmodelled(), 0u);
   // More satellites than states: the rest are counted, not modelled.
   std::vector<int> many;
@@ -88,14 +90,14 @@ TEST(PseudorangeErrorStates, EachSatellitesRangeRowReachesItsOwnStateOnly) {
   // An 8 m error on one satellite gives its state an estimate; in the next epoch each
   // satellite's range row has 1 in its own state's column of H and 0 in the others', and the
   // rate rows none.
-  const navbus::core::NavState truth = atRest();
-  const auto sats = satellites(truth, 8.0);
+  const navbus::core::NavState truth = restingReceiver();
+  const auto sats = satellitesWithRangeError(truth, 8.0);
   ASSERT_GE(sats.size(), 5u);
   navbus::core::IntegratedFilter f;
-  f.initialize(truth, 0.0, 0.0, tuning(), tightlyCoupledWithRangeErrors());
+  f.initialize(truth, 0.0, 0.0, rangeErrorTuning(), rangeErrorMask());
   f.update(sats);
   const auto& held = f.pseudorangeErrors().satellites();
-  const int state = kFirst;  // the first satellite took the first state
+  const int state = kFirstRangeError;  // the first satellite took the first state
   ASSERT_EQ(held[0], sats[0].sv_id);
   const double estimate = f.pseudorangeErrors().estimate(state);
   EXPECT_GT(estimate, 0.5);  // part of the 8 m (the rest goes to position and clock)
@@ -103,10 +105,10 @@ TEST(PseudorangeErrorStates, EachSatellitesRangeRowReachesItsOwnStateOnly) {
   const auto& d = f.lastEpoch();
   for (std::size_t i = 0; i < sats.size(); ++i) {
     const auto row = static_cast<Eigen::Index>(2 * i);
-    const int s = kFirst + static_cast<int>(i);
+    const int s = kFirstRangeError + static_cast<int>(i);
     EXPECT_DOUBLE_EQ(d.h(row, s), 1.0) << "satellite " << sats[i].sv_id;
     EXPECT_DOUBLE_EQ(d.h(row + 1, s), 0.0) << "the rate row does not see the range error";
-    for (int other = kFirst; other < layout::kPseudorangeError.end(); ++other) {
+    for (int other = kFirstRangeError; other < layout::kPseudorangeError.end(); ++other) {
       if (other != s) {
         EXPECT_DOUBLE_EQ(d.h(row, other), 0.0);
       }
@@ -119,21 +121,21 @@ TEST(PseudorangeErrorStates, TheInnovationMovesOneForOneWithTheEstimate) {
   // is the first satellite's estimated error (learned from a +8 m and a +10 m range): the
   // innovations of that row differ by the estimates' difference, every other row's by the
   // position and clock estimates' share only.
-  const navbus::core::NavState truth = atRest();
+  const navbus::core::NavState truth = restingReceiver();
   navbus::core::IntegratedFilter a, b;
-  a.initialize(truth, 0.0, 0.0, tuning(), tightlyCoupledWithRangeErrors());
-  b.initialize(truth, 0.0, 0.0, tuning(), tightlyCoupledWithRangeErrors());
-  a.update(satellites(truth, 8.0));
-  b.update(satellites(truth, 10.0));
-  const auto sats = satellites(truth, 0.0);
+  a.initialize(truth, 0.0, 0.0, rangeErrorTuning(), rangeErrorMask());
+  b.initialize(truth, 0.0, 0.0, rangeErrorTuning(), rangeErrorMask());
+  a.update(satellitesWithRangeError(truth, 8.0));
+  b.update(satellitesWithRangeError(truth, 10.0));
+  const auto sats = satellitesWithRangeError(truth, 0.0);
   const auto innovation_without_error = [&](const navbus::core::IntegratedFilter& f,
                                             std::size_t i) {
     return navbus::core::predictRange(f.state(), f.clockBias(), f.clockDrift(), sats[i])
                .pseudorange_m -
            sats[i].pseudorange_m;
   };
-  const double ea = a.pseudorangeErrors().estimate(kFirst);
-  const double eb = b.pseudorangeErrors().estimate(kFirst);
+  const double ea = a.pseudorangeErrors().estimate(kFirstRangeError);
+  const double eb = b.pseudorangeErrors().estimate(kFirstRangeError);
   const double za = innovation_without_error(a, 0);
   const double zb = innovation_without_error(b, 0);
   a.update(sats);
@@ -147,14 +149,14 @@ TEST(PseudorangeErrorStates, DecayAsAGaussMarkovProcessAndKeepTheirStationaryVar
   // Phi's diagonal element exp(-dt / tau), Q = sigma^2 (1 - exp(-2 dt / tau)): over T the
   // estimate falls by exp(-T / tau), a held state's variance relaxes towards sigma^2 by the
   // same law, and a free state stays at sigma^2.
-  const navbus::core::NavState truth = atRest();
-  const navbus::core::FilterTuning t = tuning();
+  const navbus::core::NavState truth = restingReceiver();
+  const navbus::core::FilterTuning t = rangeErrorTuning();
   navbus::core::IntegratedFilter f;
-  f.initialize(truth, 0.0, 0.0, t, tightlyCoupledWithRangeErrors());
-  const auto sats = satellites(truth, 8.0);
+  f.initialize(truth, 0.0, 0.0, t, rangeErrorMask());
+  const auto sats = satellitesWithRangeError(truth, 8.0);
   f.update(sats);
-  const int held = kFirst;
-  const int free = kFirst + static_cast<int>(sats.size());
+  const int held = kFirstRangeError;
+  const int free = kFirstRangeError + static_cast<int>(sats.size());
   const double e0 = f.pseudorangeErrors().estimate(held);
   const double v0 = f.covariance()(held, held);
   const double sigma2 = t.pseudorange_error_sigma_m * t.pseudorange_error_sigma_m;
