@@ -74,14 +74,14 @@ def main():
     print(f"{used} epochs against fixed reference positions")
     print("  sv   epochs  track [s]  RMS [m]  mean [m]  std about the mean [m]  "
           "its correlation time [s]")
-    sigmas, taus = [], []
+    sigmas = []
     for sv in sorted(series):
         ts = np.array([p[0] for p in series[sv]])
         v = np.array([p[1] for p in series[sv]])
         if v.size < 10:
             continue
         dt = np.median(np.diff(ts))
-        sigma = math.sqrt(np.mean(v ** 2))  # about 0: the error, not its spread about a mean
+        sigma = math.sqrt(np.mean(v ** 2))  # RMS about 0: the error itself, mean included
         c = v - v.mean()
         ac = np.correlate(c, c, "full")[c.size - 1:] / (c @ c)
         below = np.nonzero(ac < 1 / math.e)[0]
@@ -89,8 +89,6 @@ def main():
         tau = f"{below[0] * dt:8.1f}" if below.size else f">= {track:5.0f}"
         print(f"  {sv:3d} {v.size:7d} {track:10.1f} {sigma:8.2f} {v.mean():9.2f} {v.std():23.2f}  {tau}")
         sigmas.append(sigma)
-        if below.size:
-            taus.append(below[0] * dt)
     if sigmas:
         print(f"RMS over satellites: sigma {math.sqrt(np.mean(np.square(sigmas))):.2f} m")
 
