@@ -157,11 +157,13 @@ TEST(RealCar, TheImportedRecordingRunsOfflineWithEveryIncrement) {
 // on the clean walk, and on a ramp injected into one real satellite.
 namespace {
 
-evaluation::RecordingResult runWalk(const fs::path& recording, bool with_fault_manager) {
+evaluation::RecordingResult runWalk(const fs::path& recording, bool with_fault_manager,
+                                    bool adaptive_noise = false) {
   evaluation::RecordingSetup setup;
   setup.dir = recording;
   setup.filter = bus::parseFile((kConfig / "filter_walk_0827_tc.yaml").string(),
                                 nav_filter::parseFilterConfig);
+  setup.filter.engine.adaptive_noise.enabled = adaptive_noise;
   if (with_fault_manager)
     setup.fault_manager = bus::parseFile((kConfig / "fault_manager.yaml").string(),
                                          fault_manager::parseFaultManagerConfig);
@@ -248,6 +250,38 @@ TEST(RealWalk, TheGlrOnTheCleanWalkAndOnARampInOneRealSatellite) {
   EXPECT_EQ(exclusion->sv_id(), 10);
   EXPECT_EQ(exclusion->scope(), navbus::SCOPE_PSEUDORANGE);
   fs::remove_all(clean_dir);
+  fs::remove_all(ramp_dir);
+}
+
+// Bounded adaptive noise does not adapt a fault away: with every stream's R adapting (window
+// 20 epochs, ceiling 9), the 2 m/s ramp into G10 is still decided and G10 excluded, and the
+// pseudoranges' scale stays at its ceiling or below while it grows.
+TEST(RealWalk, AdaptiveNoiseLeavesTheRampVisible) {
+  const fs::path ramp_dir = workDir("walk-ramp-adaptive");
+  auto d = importers::readDatasetDescription(kConfig / "datasets/walk_0827.yaml");
+  d.gnss_observations->ramp = importers::PseudorangeRamp{10, 2.0, 40.0};
+  importers::importDataset(d, ramp_dir);
+  const evaluation::RecordingResult ramp = runWalk(ramp_dir, true, true);
+  const double first_epoch_s = 1440437439.748;
+  const auto g10 = std::find_if(ramp.decisions.begin(), ramp.decisions.end(), [](const auto& x) {
+    return x.event() == navbus::EVENT_FAULT_DETECTED && x.sv_id() == 10;
+  });
+  ASSERT_NE(g10, ramp.decisions.end()) << ramp.fault_summary;
+  const double after_onset_s =
+      1e-9 * static_cast<double>(g10->time_gps_ns()) - first_epoch_s - 40.0;
+  std::printf(
+      "walk_0827 with adaptive noise, 2 m/s ramp into G10: decided %.1f s after the onset\n",
+      after_onset_s);
+  EXPECT_GT(after_onset_s, 0.0);
+  EXPECT_LT(after_onset_s, 15.0);
+  // The diagnostics carry every stream's scale, bounded; the summary counts them.
+  ASSERT_EQ(ramp.last_noise_scales.size(), 7u);
+  for (const navbus::NoiseScale& n : ramp.last_noise_scales) {
+    EXPECT_GE(n.scale(), 1.0);
+    EXPECT_LE(n.scale(), 9.0);
+  }
+  EXPECT_NE(ramp.summary.find("adaptive noise"), std::string::npos) << ramp.summary;
+  EXPECT_NE(ramp.summary.find("pseudorange_rate"), std::string::npos) << ramp.summary;
   fs::remove_all(ramp_dir);
 }
 

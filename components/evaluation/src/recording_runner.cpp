@@ -102,7 +102,10 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
   std::function<void(const navbus::FilterDiagnostics&)> on_diagnostics;
   std::function<void(const navbus::FilterCommandOutcome&)> on_outcome;
   if (faults) {
-    on_diagnostics = [&](const navbus::FilterDiagnostics& d) { faults->onDiagnostics(d); };
+    on_diagnostics = [&](const navbus::FilterDiagnostics& d) {
+      result.last_noise_scales = d.noise_scales();
+      faults->onDiagnostics(d);
+    };
     on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };
   }
   core::SmoothingLog smoothing_log;

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/key_reader.hpp"
 #include "navbus/core/filter/innovation_window.hpp"
@@ -126,6 +128,50 @@ void parseConsistency(const YAML::Node& node, core::ConsistencyConfig& k) {
       .number("false_alarm_probability", k.false_alarm_probability, {1e-15, 0.5})
       .number("reinitialise_after_s", k.reinitialise_after_s, {0.0, 86400.0})
       .finish();
+}
+/// adaptive_noise.streams: the names of the streams that adapt (default: all).
+void parseNoiseStreams(const YAML::Node& list, std::bitset<core::kNoiseStreams>& streams) {
+  if (!list.IsSequence())
+    throw bus::ConfigError("configuration adaptive_noise.streams must be a list of stream names");
+  streams.reset();
+  for (const YAML::Node& item : list) {
+    if (!item.IsScalar())
+      throw bus::ConfigError("configuration adaptive_noise.streams: every item must be a name");
+    const std::string name = item.Scalar();
+    int found = -1;
+    std::string names;
+    for (int i = 0; i < core::kNoiseStreams; ++i) {
+      const char* n = core::noiseStreamName(static_cast<core::NoiseStream>(i));
+      names += names.empty() ? n : std::string(" | ") + n;
+      if (name == n) found = i;
+    }
+    if (found < 0)
+      throw bus::ConfigError("configuration adaptive_noise.streams: '" + name + "' is not one of " +
+                             names);
+    streams.set(static_cast<std::size_t>(found));
+  }
+}
+
+/// Bounded adaptive measurement noise (core/filter/adaptive_noise_scale.hpp). The adaptive
+/// fusion structure adapts R its own way (seed 001): the two together are refused.
+void parseAdaptiveNoise(const YAML::Node& node, core::EngineConfig& e) {
+  core::NoiseScaleConfig& n = e.adaptive_noise;
+  bus::KeyReader r(node, "adaptive_noise");
+  r.value("enabled", n.enabled)
+      .integer("window_epochs", n.window_epochs,
+               {1.0, static_cast<double>(core::NoiseScaleEstimator::kMaxWindow)})
+      .number("floor", n.floor, {1e-3, 1e6})
+      .number("ceiling", n.ceiling, {1e-3, 1e6})
+      .finish({"streams"});
+  if (node && node["streams"]) parseNoiseStreams(node["streams"], e.adaptive_noise_streams);
+  if (n.ceiling < n.floor)
+    throw bus::ConfigError(
+        fmt::format("configuration adaptive_noise.ceiling: {} is below adaptive_noise.floor: {}",
+                    n.ceiling, n.floor));
+  if (n.enabled && e.fusion == core::FusionStructure::kAdaptive)
+    throw bus::ConfigError(
+        "configuration adaptive_noise.enabled: true with fusion: adaptive (the adaptive "
+        "structure estimates R itself; use one or the other)");
 }
 }  // namespace
 
@@ -413,7 +459,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       .value("star_tracker_updates", e.use_star_tracker)
       .nested({"low_latency_output", "recovery", "time_jump", "fault_monitor", "initial_state",
                "inputs", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional",
-               "alignment", "integrity", "consistency", "geometry"})
+               "alignment", "integrity", "consistency", "adaptive_noise", "geometry"})
       .finish(bus::kParticipantKeys);
   parseLowLatency(root["low_latency_output"], c);
   parseRecovery(root["recovery"], c);
@@ -429,6 +475,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   parseAlignment(root["alignment"], e);
   parseIntegrity(root["integrity"], e);
   parseConsistency(root["consistency"], e.consistency);
+  parseAdaptiveNoise(root["adaptive_noise"], e);
   parseGeometry(root["geometry"], c);
   return c;
 }

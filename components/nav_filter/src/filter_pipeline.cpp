@@ -301,8 +301,10 @@ void FilterPipeline::publishDiagnostics() {
   if (!sinks_.diagnostics) return;
   owed_judgement_ns_ = engine_.state().time_ns;
   sequencer_.owe(kCommandStream, owed_judgement_ns_);  // a command may answer it
-  sinks_.diagnostics(bus::toIdl(engine_.lastEpoch(), config_.vehicle_id, ++diagnostics_seq_,
-                                engine_.state().time_ns));
+  navbus::FilterDiagnostics msg = bus::toIdl(engine_.lastEpoch(), config_.vehicle_id,
+                                             ++diagnostics_seq_, engine_.state().time_ns);
+  appendNoiseScales(engine_, msg);
+  sinks_.diagnostics(msg);
 }
 
 bool FilterPipeline::monitored() const {

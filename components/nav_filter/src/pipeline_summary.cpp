@@ -40,6 +40,22 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
       << ", solutions published not trustworthy " << p.solutions_untrusted;
 }
 
+/// Each stream that fed the adaptive noise: its scale now, the largest applied, and how many
+/// of its epochs were fused with a scale other than 1 and at the ceiling.
+std::string describeAdaptiveNoise(const core::NavigationEngine& engine) {
+  std::string out =
+      "adaptive noise (scale on R now / largest; epochs scaled, at the ceiling, of all):";
+  for (int i = 0; i < core::kNoiseStreams; ++i) {
+    const auto s = static_cast<core::NoiseStream>(i);
+    const core::NoiseScaleEstimator& e = engine.noiseScale(s);
+    const core::NoiseScaleCounters& c = e.counters();
+    if (c.epochs == 0) continue;
+    out += fmt::format(" {} {:.2f} / {:.2f}; {}, {}, of {}", core::noiseStreamName(s), e.scale(),
+                       c.max_scale, c.epochs_scaled, c.epochs_at_ceiling, c.epochs);
+  }
+  return out;
+}
+
 void describeOptional(const PipelineView& v, std::ostringstream& out) {
   const PipelineCounters& p = v.counters;
   if (p.stalls > 0) {
@@ -54,6 +70,7 @@ void describeOptional(const PipelineView& v, std::ostringstream& out) {
     out << ", fault monitor found not alive " << v.flags.monitorLosses() << " time(s)"
         << (v.flags.faultMonitorAlive() ? "" : " (still not)");
   }
+  if (v.config.engine.adaptive_noise.enabled) out << ", " << describeAdaptiveNoise(v.engine);
   if (v.config.engine.start == core::StartSource::kAligned)
     out << ", " << describeAlignment(v.engine);
   if (v.config.engine.integrity.enabled) {

@@ -165,4 +165,37 @@ navbus::FusionStructure toIdl(core::FusionStructure s, core::AidingMode aiding) 
   return navbus::FUSION_NONE;
 }
 
+navbus::MeasurementKind toIdl(core::NoiseStream s) {
+  switch (s) {
+    case core::NoiseStream::kFixPosition:
+      return navbus::MEAS_POSITION;
+    case core::NoiseStream::kFixVelocity:
+      return navbus::MEAS_VELOCITY;
+    case core::NoiseStream::kPseudorange:
+      return navbus::MEAS_PSEUDORANGE;
+    case core::NoiseStream::kPseudorangeRate:
+      return navbus::MEAS_PSEUDORANGE_RATE;
+    case core::NoiseStream::kZeroVelocity:
+      return navbus::MEAS_ZERO_VELOCITY;
+    case core::NoiseStream::kNonHolonomic:
+      return navbus::MEAS_NONHOLONOMIC;
+    case core::NoiseStream::kStarAttitude:
+      return navbus::MEAS_ATTITUDE;
+  }
+  return navbus::MEAS_POSITION;
+}
+
+void appendNoiseScales(const core::NavigationEngine& engine, navbus::FilterDiagnostics& msg) {
+  const core::EngineConfig& c = engine.config();
+  if (!c.adaptive_noise.enabled) return;
+  for (int i = 0; i < core::kNoiseStreams; ++i) {
+    if (!c.adaptive_noise_streams[static_cast<std::size_t>(i)]) continue;
+    const auto s = static_cast<core::NoiseStream>(i);
+    navbus::NoiseScale n;
+    n.stream(toIdl(s));
+    n.scale(engine.noiseScale(s).scale());
+    msg.noise_scales().push_back(n);
+  }
+}
+
 }  // namespace navbus::nav_filter

@@ -187,3 +187,36 @@ TEST_F(ConfigKeys, AFixVelocityOffsetIsALagTheVelocityHistoryReaches) {
                                 "velocity_time_offset_s: -0.1}}\n");
   EXPECT_TRUE(names(errorOf(imu, filter), "inputs.imu.velocity_time_offset_s", imu));
 }
+
+TEST_F(ConfigKeys, AdaptiveNoiseNamesItsStreamsAndKeepsItsBoundsInOrder) {
+  const auto with = [&](const std::string& name, const std::string& block,
+                        const std::string& fusion = "centralized") {
+    return write(name, "mode: loosely_coupled\nfusion: " + fusion +
+                           "\ninputs: {imu: {id: 1, period_s: 0.01}, gnss_fix: {id: 1, "
+                           "period_s: 0.25}}\nadaptive_noise: " +
+                           block + "\n");
+  };
+  const auto c = navbus::bus::parseFile(
+      with("ok.yaml", "{enabled: true, window_epochs: 4, floor: 1, ceiling: 16, streams: "
+                      "[fix_position, non_holonomic]}"),
+      filter);
+  EXPECT_TRUE(c.engine.adaptive_noise.enabled);
+  EXPECT_EQ(c.engine.adaptive_noise.window_epochs, 4);
+  EXPECT_DOUBLE_EQ(c.engine.adaptive_noise.ceiling, 16.0);
+  EXPECT_EQ(c.engine.adaptive_noise_streams.count(), 2u);
+  EXPECT_TRUE(c.engine.adaptive_noise_streams[static_cast<std::size_t>(
+      navbus::core::NoiseStream::kNonHolonomic)]);
+  const std::string unknown =
+      errorOf(with("unknown.yaml", "{enabled: true, streams: [fix_heading]}"), filter);
+  EXPECT_NE(unknown.find("adaptive_noise.streams: 'fix_heading' is not one of"), std::string::npos)
+      << unknown;
+  const std::string order =
+      errorOf(with("order.yaml", "{enabled: true, floor: 4, ceiling: 2}"), filter);
+  EXPECT_NE(order.find("adaptive_noise.ceiling: 2 is below adaptive_noise.floor: 4"),
+            std::string::npos)
+      << order;
+  // The adaptive structure estimates R itself: not both.
+  const std::string both = errorOf(with("both.yaml", "{enabled: true}", "adaptive"), filter);
+  EXPECT_NE(both.find("adaptive_noise.enabled: true with fusion: adaptive"), std::string::npos)
+      << both;
+}

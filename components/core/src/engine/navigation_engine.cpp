@@ -38,6 +38,11 @@ NavigationEngine::NavigationEngine(const EngineConfig& config)
       stages_(std::in_place) {
   integrity_->configure(config.integrity);
   consistency_.configure(config.consistency);
+  for (std::size_t i = 0; i < noise_scales_.size(); ++i) {
+    NoiseScaleConfig stream = config.adaptive_noise;
+    stream.enabled = stream.enabled && config.adaptive_noise_streams[i];
+    noise_scales_[i].configure(stream);
+  }
   used_.reserve(32);
   reset();
 }
@@ -121,6 +126,7 @@ void NavigationEngine::reset() {
   stages_->configure(config_.mdf);
   stages_->restart();
   consistency_.restart();
+  for (NoiseScaleEstimator& n : noise_scales_) n.restart();
 }
 
 std::uint64_t NavigationEngine::pseudorangesWithoutErrorState() const {
@@ -400,19 +406,53 @@ void NavigationEngine::constraintUpdate() {
       t + static_cast<std::int64_t>(std::llround(config_.mdf.constraint_period_s * 1e9));
   const MdfStage stage = stages_->stage();
   if (stage == MdfStage::kF1ZeroVelocity) {
-    const auto r =
-        filter_->update(zeroVelocityMeasurement(filter_->state(), config_.mdf.zupt_sigma_mps),
-                        AidingKind::kZeroVelocity);
+    const auto r = filter_->update(
+        zeroVelocityMeasurement(filter_->state(), config_.mdf.zupt_sigma_mps *
+                                                      noiseSigmaFactor(NoiseStream::kZeroVelocity)),
+        AidingKind::kZeroVelocity);
     countGated(r.data(), 3);
+    adaptNoise(NoiseStream::kZeroVelocity, r.data(), 3);
     ++counters_.zero_velocity_updates;
   } else if (stage == MdfStage::kF4Constraint &&
              config_.mdf.policy == MdfPolicy::kMultiDimensional) {
-    const auto r =
-        filter_->update(nonHolonomicMeasurement(filter_->state(), config_.mdf.nhc_sigma_mps),
-                        AidingKind::kNonHolonomic);
+    const auto r = filter_->update(
+        nonHolonomicMeasurement(filter_->state(), config_.mdf.nhc_sigma_mps *
+                                                      noiseSigmaFactor(NoiseStream::kNonHolonomic)),
+        AidingKind::kNonHolonomic);
     countGated(r.data(), 2);
+    adaptNoise(NoiseStream::kNonHolonomic, r.data(), 2);
     ++counters_.nonholonomic_updates;
   }
+}
+
+const char* noiseStreamName(NoiseStream s) {
+  switch (s) {
+    case NoiseStream::kFixPosition:
+      return "fix_position";
+    case NoiseStream::kFixVelocity:
+      return "fix_velocity";
+    case NoiseStream::kPseudorange:
+      return "pseudorange";
+    case NoiseStream::kPseudorangeRate:
+      return "pseudorange_rate";
+    case NoiseStream::kZeroVelocity:
+      return "zero_velocity";
+    case NoiseStream::kNonHolonomic:
+      return "non_holonomic";
+    case NoiseStream::kStarAttitude:
+      return "star_attitude";
+  }
+  return "unknown";
+}
+
+double NavigationEngine::noiseSigmaFactor(NoiseStream s) const {
+  return std::sqrt(noise_scales_[static_cast<std::size_t>(s)].scale());
+}
+
+void NavigationEngine::adaptNoise(NoiseStream s, const ScalarUpdateResult* rows, int n) {
+  NoiseScaleEstimator& e = noise_scales_[static_cast<std::size_t>(s)];
+  for (int i = 0; i < n; ++i) e.addRow(rows[i]);
+  e.closeEpoch();
 }
 
 void NavigationEngine::countGated(const ScalarUpdateResult* results, int n) {
@@ -463,11 +503,23 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
         pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_->state().position));
     if (pf.valid) checkHeadingFromCourse(pf.fix.vel_ned_mps, pf.fix.vel_sigma_ned_mps.x());
   }
+  const double range_factor = noiseSigmaFactor(NoiseStream::kPseudorange);
+  const double rate_factor = noiseSigmaFactor(NoiseStream::kPseudorangeRate);
+  for (SatelliteObservation& o : used_) {
+    o.pseudorange_sigma_m *= range_factor;
+    o.pseudorange_rate_sigma_mps *= rate_factor;
+  }
   const std::vector<MeasurementReport>& reports =
       filter_->update(used_, AntennaArm{config_.antenna_lever_arm_b_m, bodyRate()});
   for (const auto& rep : reports) {
     counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
+    if (!rep.fused) continue;
+    noise_scales_[static_cast<std::size_t>(rep.rate ? NoiseStream::kPseudorangeRate
+                                                    : NoiseStream::kPseudorange)]
+        .addRow(rep.result);
   }
+  noise_scales_[static_cast<std::size_t>(NoiseStream::kPseudorange)].closeEpoch();
+  noise_scales_[static_cast<std::size_t>(NoiseStream::kPseudorangeRate)].closeEpoch();
   checkConsistency(time_ns, reports);
   ++counters_.gnss_epochs_fused;
   mode_ = aidedMode();
@@ -536,14 +588,20 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
     checkHeadingFromCourse(fix.vel_ned_mps, fix.vel_sigma_ned_mps.head<2>().maxCoeff());
   }
   const Eigen::Vector3d& lever_b = config_.antenna_lever_arm_b_m;
-  const auto p = filter_->update(positionMeasurement(filter_->state(), fixPositionAtStateTime(fix),
-                                                     fix.pos_sigma_ned_m, lever_b),
-                                 AidingKind::kPosition);
+  const auto p = filter_->update(
+      positionMeasurement(filter_->state(), fixPositionAtStateTime(fix),
+                          fix.pos_sigma_ned_m * noiseSigmaFactor(NoiseStream::kFixPosition),
+                          lever_b),
+      AidingKind::kPosition);
   countGated(p.data(), 3);
-  const auto v = filter_->update(velocityMeasurement(filter_->state(), fixVelocityAtStateTime(fix),
-                                                     fix.vel_sigma_ned_mps, lever_b, bodyRate()),
-                                 AidingKind::kVelocity);
+  adaptNoise(NoiseStream::kFixPosition, p.data(), 3);
+  const auto v = filter_->update(
+      velocityMeasurement(filter_->state(), fixVelocityAtStateTime(fix),
+                          fix.vel_sigma_ned_mps * noiseSigmaFactor(NoiseStream::kFixVelocity),
+                          lever_b, bodyRate()),
+      AidingKind::kVelocity);
   countGated(v.data(), 3);
+  adaptNoise(NoiseStream::kFixVelocity, v.data(), 3);
   std::array<ScalarUpdateResult, 6> rows{};
   std::copy(p.begin(), p.end(), rows.begin());
   std::copy(v.begin(), v.end(), rows.begin() + 3);
@@ -566,11 +624,14 @@ void NavigationEngine::addStarAttitude(const StarAttitudeMeasurement& st) {
       config_.aiding == AidingMode::kInertialOnly ||
       config_.aiding == AidingMode::kMultiDimensional)
     return;
-  const auto a = filter_->update(
-      attitudeMeasurement(filter_->state(), st.q_b_to_i, starTrackerWhiteSigma(st.sigma_b_rad),
-                          filter_->starTrackerBias()),
-      AidingKind::kAttitude);
+  const auto a =
+      filter_->update(attitudeMeasurement(filter_->state(), st.q_b_to_i,
+                                          starTrackerWhiteSigma(st.sigma_b_rad) *
+                                              noiseSigmaFactor(NoiseStream::kStarAttitude),
+                                          filter_->starTrackerBias()),
+                      AidingKind::kAttitude);
   countGated(a.data(), 3);
+  adaptNoise(NoiseStream::kStarAttitude, a.data(), 3);
   ++counters_.star_fused;
   mode_ = aidedMode();
 }

@@ -44,6 +44,9 @@ struct RecordingResult {
   std::string fault_summary;
   std::vector<navbus::FaultDecision> decisions;
   std::vector<navbus::FilterCommand> commands;
+  /// With a fault manager: the adaptive noise scales of the last diagnostics the filter
+  /// published (empty when its noise does not adapt).
+  std::vector<navbus::NoiseScale> last_noise_scales;
   /// With RecordingSetup::smooth: one epoch per forward record, and what the smoother says.
   std::vector<core::SmoothedEpoch> smoothed;
   std::string smoother_summary;

@@ -27,6 +27,11 @@ navbus::NavigationSolution lowLatencySolution(const navbus::NavigationSolution& 
 /// Where the alignment stands, and what it started from.
 std::string describeAlignment(const core::NavigationEngine& engine);
 
+/// Appends the scale of every stream whose noise adapts to a diagnostics message (nothing when
+/// adaptive noise is off).
+void appendNoiseScales(const core::NavigationEngine& engine, navbus::FilterDiagnostics& msg);
+navbus::MeasurementKind toIdl(core::NoiseStream s);
+
 /// The solution's fault flags for the engine's status bits.
 std::uint32_t faultFlags(std::uint32_t engine_status);
 navbus::FilterMode toIdl(core::EngineMode mode);

@@ -175,6 +175,9 @@ IfMessage<M, navbus::FilterDiagnostics> visitFields(M& m, V& v) {
   v("k", m.k());
   v("phi", m.phi());
   v("test_ratio", m.test_ratio());
+  std::ostringstream scales;
+  for (const auto& n : m.noise_scales()) scales << enumName(n.stream()) << ":" << n.scale() << " ";
+  v.text("noise_scales", scales.str());
 }
 template <class M, class V>
 IfMessage<M, navbus::FaultDecision> visitFields(M& m, V& v) {

@@ -5,6 +5,8 @@
 // runner call the same engine with the same inputs, which is what makes them bit-identical.
 #pragma once
 
+#include <array>
+#include <bitset>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -13,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "navbus/core/engine/alignment_config.hpp"
+#include "navbus/core/filter/adaptive_noise_scale.hpp"
 #include "navbus/core/filter/aiding_inputs.hpp"
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 #include "navbus/core/filter/filter_tuning.hpp"
@@ -45,6 +48,21 @@ enum class AidingMode {
   kLooselyCoupled,   ///< GNSS position/velocity fixes (+ star tracker when enabled; seed 001)
   kMultiDimensional  ///< land vehicle: fixes, ZUPT, NHC with the stage logic (seed 004)
 };
+
+/// The aiding streams whose measurement noise adapts (adaptive_noise_scale.hpp), each with its
+/// own scale on its own R.
+enum class NoiseStream : int {
+  kFixPosition,
+  kFixVelocity,
+  kPseudorange,
+  kPseudorangeRate,
+  kZeroVelocity,
+  kNonHolonomic,
+  kStarAttitude,
+};
+inline constexpr int kNoiseStreams = 7;
+/// The stream's name in summaries and configuration ("fix_position", ...).
+const char* noiseStreamName(NoiseStream s);
 
 enum class EngineMode {
   kInitializing,
@@ -101,6 +119,10 @@ struct EngineConfig {
   IntegrityConfig integrity;
   /// The filter's test of its own innovations, and when it re-initialises.
   ConsistencyConfig consistency;
+  /// Bounded adaptive measurement noise: one scale per aiding stream (adaptive_noise_scale.hpp),
+  /// on the streams set here (bit i: NoiseStream i; default all).
+  NoiseScaleConfig adaptive_noise;
+  std::bitset<kNoiseStreams> adaptive_noise_streams{(1u << kNoiseStreams) - 1u};
   /// The GNSS antenna's offset from the IMU [m, body axes]: fixes and pseudoranges are of the
   /// antenna.
   Eigen::Vector3d antenna_lever_arm_b_m{Eigen::Vector3d::Zero()};
@@ -201,6 +223,10 @@ class NavigationEngine {
     return (status_ & (kStatusInconsistent | kStatusReinitialising)) == 0;
   }
   const ConsistencyMonitor& consistency() const { return consistency_; }
+  /// The adaptive noise of one aiding stream: its current scale on R and its counters.
+  const NoiseScaleEstimator& noiseScale(NoiseStream s) const {
+    return noise_scales_[static_cast<std::size_t>(s)];
+  }
   FusionStructure fusion() const;
   const EngineConfig& config() const { return config_; }
   std::uint32_t status() const { return status_; }
@@ -268,6 +294,11 @@ class NavigationEngine {
   Indirect<StationarityDetector> stationarity_;
   Indirect<StageSelector> stages_;
   ConsistencyMonitor consistency_;
+  std::array<NoiseScaleEstimator, kNoiseStreams> noise_scales_;
+  /// The stream's sigma factor for this epoch: sqrt of its scale on R.
+  double noiseSigmaFactor(NoiseStream s) const;
+  /// The epoch's rows fused with that stream's scale: they feed its next estimate.
+  void adaptNoise(NoiseStream s, const ScalarUpdateResult* rows, int n);
   EngineMode mode_{EngineMode::kInitializing};
   std::uint32_t status_{0};
   EngineCounters counters_;
