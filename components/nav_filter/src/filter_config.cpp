@@ -302,6 +302,30 @@ void checkModeAgainstInputs(const YAML::Node& root, const FilterConfig& c) {
   }
 }
 
+/// The fix's position error states: only where fixes are fused, with both sigmas given.
+void checkFixPositionError(const core::EngineConfig& e) {
+  const core::FilterTuning& t = e.tuning;
+  if (!(t.fix_position_error_sigma_h_m > 0.0)) {
+    if (t.fix_position_error_sigma_v_m > 0.0)
+      throw bus::ConfigError(fmt::format(
+          "configuration ekf.fix_position_error_sigma_v_m ({} m) needs "
+          "ekf.fix_position_error_sigma_h_m > 0 (the horizontal sigma turns the states on)",
+          t.fix_position_error_sigma_v_m));
+    return;
+  }
+  if (e.aiding != core::AidingMode::kLooselyCoupled &&
+      e.aiding != core::AidingMode::kMultiDimensional)
+    throw bus::ConfigError(fmt::format(
+        "configuration ekf.fix_position_error_sigma_h_m ({} m) needs mode: loosely_coupled or "
+        "multi_dimensional (fixes are fused only there)",
+        t.fix_position_error_sigma_h_m));
+  if (!(t.fix_position_error_sigma_v_m > 0.0))
+    throw bus::ConfigError(
+        fmt::format("configuration ekf.fix_position_error_sigma_v_m ({} m) must be positive with "
+                    "ekf.fix_position_error_sigma_h_m ({} m)",
+                    t.fix_position_error_sigma_v_m, t.fix_position_error_sigma_h_m));
+}
+
 /// EKF parameters, in the units of the papers' error budgets.
 void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
   core::FilterTuning& t = e.tuning;
@@ -337,6 +361,12 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
       .number("pseudorange_error_sigma_m", t.pseudorange_error_sigma_m, {0.0, 1000.0})
       .number("pseudorange_error_correlation_time_s", t.pseudorange_error_correlation_time_s,
               {1.0, 1e7})
+      // The fix's time-correlated position error (loose coupling), states when its sigma is
+      // positive.
+      .number("fix_position_error_sigma_h_m", t.fix_position_error_sigma_h_m, {0.0, 1000.0})
+      .number("fix_position_error_sigma_v_m", t.fix_position_error_sigma_v_m, {0.0, 1000.0})
+      .number("fix_position_error_correlation_time_s", t.fix_position_error_correlation_time_s,
+              {1.0, 1e7})
       .number("initial_clock_bias_m", e.initial_clock_bias_m, {-1e9, 1e9})
       .number("initial_clock_drift_mps", e.initial_clock_drift_mps, {-1e6, 1e6})
       .finish();
@@ -364,6 +394,7 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
                            std::to_string(t.pseudorange_error_sigma_m) +
                            " m) needs mode: tightly_coupled (pseudoranges are fused only there)");
   }
+  checkFixPositionError(e);
 }
 
 /// A failed IMU axis (CMD_FAIL_SENSOR_AXIS): its error is a random-walk bias.

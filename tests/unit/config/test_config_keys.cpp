@@ -197,8 +197,9 @@ TEST_F(ConfigKeys, AdaptiveNoiseNamesItsStreamsAndKeepsItsBoundsInOrder) {
                            block + "\n");
   };
   const auto c = navbus::bus::parseFile(
-      with("ok.yaml", "{enabled: true, window_epochs: 4, floor: 1, ceiling: 16, streams: "
-                      "[fix_position, non_holonomic]}"),
+      with("ok.yaml",
+           "{enabled: true, window_epochs: 4, floor: 1, ceiling: 16, streams: "
+           "[fix_position, non_holonomic]}"),
       filter);
   EXPECT_TRUE(c.engine.adaptive_noise.enabled);
   EXPECT_EQ(c.engine.adaptive_noise.window_epochs, 4);
@@ -219,4 +220,29 @@ TEST_F(ConfigKeys, AdaptiveNoiseNamesItsStreamsAndKeepsItsBoundsInOrder) {
   const std::string both = errorOf(with("both.yaml", "{enabled: true}", "adaptive"), filter);
   EXPECT_NE(both.find("adaptive_noise.enabled: true with fusion: adaptive"), std::string::npos)
       << both;
+}
+
+TEST_F(ConfigKeys, TheFixPositionErrorBelongsToLooseCouplingWithBothSigmas) {
+  const auto with = [&](const std::string& name, const std::string& mode, const std::string& ekf) {
+    return write(name, "mode: " + mode + "\ninputs: {imu: {id: 1, period_s: 0.01}, " +
+                           (mode == "tightly_coupled" ? "gnss_observations" : "gnss_fix") +
+                           ": {id: 1, period_s: 0.25}}\nekf: " + ekf + "\n");
+  };
+  const auto c = navbus::bus::parseFile(
+      with("ok.yaml", "loosely_coupled",
+           "{fix_position_error_sigma_h_m: 0.03, fix_position_error_sigma_v_m: 0.05}"),
+      filter);
+  EXPECT_DOUBLE_EQ(c.engine.tuning.fix_position_error_sigma_h_m, 0.03);
+  EXPECT_DOUBLE_EQ(c.engine.tuning.fix_position_error_correlation_time_s, 30.0);
+  const std::string tc =
+      errorOf(with("tc.yaml", "tightly_coupled",
+                   "{fix_position_error_sigma_h_m: 0.03, fix_position_error_sigma_v_m: 0.05}"),
+              filter);
+  EXPECT_NE(tc.find("ekf.fix_position_error_sigma_h_m (0.03 m) needs mode: loosely_coupled"),
+            std::string::npos)
+      << tc;
+  const std::string no_v =
+      errorOf(with("no_v.yaml", "loosely_coupled", "{fix_position_error_sigma_h_m: 0.03}"), filter);
+  EXPECT_NE(no_v.find("ekf.fix_position_error_sigma_v_m (0 m) must be positive"), std::string::npos)
+      << no_v;
 }

@@ -141,9 +141,12 @@ StateMask NavigationEngine::baseMask() const {
                          kPseudorangeError})
                : maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift});
   // The star tracker's bias where it is modelled and the tracker used.
+  StateMask m = maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias});
   if (config_.use_star_tracker && config_.tuning.star_tracker_bias_sigma_rad > 0.0)
-    return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kStarTrackerBias});
-  return maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias});
+    m |= maskOf({kStarTrackerBias});
+  // The fix's time-correlated position error, where it is modelled (loose coupling).
+  if (config_.tuning.fix_position_error_sigma_h_m > 0.0) m |= maskOf({kFixPositionError});
+  return m;
 }
 
 bool NavigationEngine::addImu(const ImuIncrement& raw) {
@@ -361,10 +364,15 @@ void NavigationEngine::applyStage(const StageDecision& d) {
   ++counters_.stage_switches;
   const FilterTuning& t = config_.tuning;
   if (config_.mdf.policy == MdfPolicy::kMultiDimensional) {
+    StateMask m = stageMask(d.stage);
+    // The stages that fuse fixes estimate their position error too, where it is modelled.
+    if ((d.stage == MdfStage::kF2Gnss || d.stage == MdfStage::kF3Recovery) &&
+        config_.tuning.fix_position_error_sigma_h_m > 0.0)
+      m |= maskOf({kFixPositionError});
     if (config_.mdf.unestimated == ReducedStates::kConsidered)
-      filter_->setEstimated(stageMask(d.stage));
+      filter_->setEstimated(m);
     else
-      filter_->setActive(stageMask(d.stage));
+      filter_->setActive(m);
   }
   const StateBlock horizontal_att{kAtt.index, 2};
   const StateBlock heading{kAtt.index + 2, 1};
@@ -589,9 +597,10 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   }
   const Eigen::Vector3d& lever_b = config_.antenna_lever_arm_b_m;
   const auto p = filter_->update(
-      positionMeasurement(filter_->state(), fixPositionAtStateTime(fix),
-                          fix.pos_sigma_ned_m * noiseSigmaFactor(NoiseStream::kFixPosition),
-                          lever_b),
+      positionMeasurement(
+          filter_->state(), fixPositionAtStateTime(fix),
+          fix.pos_sigma_ned_m * noiseSigmaFactor(NoiseStream::kFixPosition), lever_b,
+          filter_->modelsFixPositionError() ? &filter_->fixPositionError() : nullptr),
       AidingKind::kPosition);
   countGated(p.data(), 3);
   adaptNoise(NoiseStream::kFixPosition, p.data(), 3);

@@ -10,13 +10,18 @@ using namespace layout;
 
 VectorMeasurement positionMeasurement(const NavState& ins, const earth::Geodetic& fix,
                                       const Eigen::Vector3d& sigma,
-                                      const Eigen::Vector3d& lever_arm_b) {
+                                      const Eigen::Vector3d& lever_arm_b,
+                                      const Eigen::Vector3d* fix_error_ned_m) {
   VectorMeasurement m;
   const Eigen::Vector3d lever_n = ins.q_b_to_n * lever_arm_b;
   m.z = earth::differenceNed(ins.position, fix) + lever_n;
   m.h.setZero();
   m.h.block<3, 3>(0, kPos.index).setIdentity();
   m.h.block<3, 3>(0, kAtt.index) = skew(lever_n);
+  if (fix_error_ned_m != nullptr) {
+    m.z += *fix_error_ned_m;
+    m.h.block<3, 3>(0, kFixPositionError.index).setIdentity();
+  }
   m.r = sigma.array().square().matrix().asDiagonal();
   return m;
 }

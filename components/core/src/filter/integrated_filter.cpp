@@ -36,6 +36,9 @@ StateVector IntegratedFilter::initialSigma(const FilterTuning& tuning) {
   sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
   sigma.segment<kPseudorangeError.dof>(kPseudorangeError.index)
       .setConstant(tuning.pseudorange_error_sigma_m > 0.0 ? tuning.pseudorange_error_sigma_m : 1.0);
+  if (tuning.fix_position_error_sigma_h_m > 0.0 && !(tuning.pseudorange_error_sigma_m > 0.0))
+    sigma.segment<3>(kFixPositionError.index) << tuning.fix_position_error_sigma_h_m,
+        tuning.fix_position_error_sigma_h_m, tuning.fix_position_error_sigma_v_m;
   return sigma;
 }
 
@@ -59,6 +62,7 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   accel_bias_.setZero();
   gyro_bias_.setZero();
   star_tracker_bias_.setZero();
+  fix_position_error_ned_m_.setZero();
   pseudorange_errors_.clear();
   central_.initialize(initial_covariance, active);
   const Eigen::Vector3d floor_pos = Eigen::Vector3d::Constant(tuning.adaptive_floor_position_m);
@@ -135,6 +139,19 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
     for (int i = kPseudorangeError.index; i < kPseudorangeError.end(); ++i) {
       Phi(i, i) = decay;
       q[i] = sigma * sigma * (1.0 - decay * decay);
+    }
+  }
+  if (modelsFixPositionError()) {
+    // The fix's position error per NED axis: first-order Gauss-Markov, exactly discretized as
+    // the star-tracker bias above.
+    const double decay = std::exp(-dt / tuning_.fix_position_error_correlation_time_s);
+    fix_position_error_ned_m_ *= decay;
+    const Eigen::Vector3d sigma(tuning_.fix_position_error_sigma_h_m,
+                                tuning_.fix_position_error_sigma_h_m,
+                                tuning_.fix_position_error_sigma_v_m);
+    for (int i = 0; i < 3; ++i) {
+      Phi(kFixPositionError.index + i, kFixPositionError.index + i) = decay;
+      q[kFixPositionError.index + i] = sigma[i] * sigma[i] * (1.0 - decay * decay);
     }
   }
   for (int a = 0; a < 3; ++a) {
@@ -288,6 +305,11 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   return reports_;
 }
 
+bool IntegratedFilter::modelsFixPositionError() const {
+  return central_.active()[static_cast<std::size_t>(kFixPositionError.index)] &&
+         tuning_.fix_position_error_sigma_h_m > 0.0 && !(tuning_.pseudorange_error_sigma_m > 0.0);
+}
+
 bool IntegratedFilter::modelsPseudorangeErrors() const {
   return central_.active()[static_cast<std::size_t>(kPseudorangeError.index)] &&
          tuning_.pseudorange_error_sigma_m > 0.0;
@@ -364,7 +386,11 @@ void IntegratedFilter::feedback(const StateVector& dx) {
   star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);
   clock_bias_m_ -= dx[kClockBias.index];
   clock_drift_mps_ -= dx[kClockDrift.index];
-  pseudorange_errors_.correct(dx.segment<kPseudorangeError.dof>(kPseudorangeError.index));
+  if (modelsFixPositionError()) {
+    fix_position_error_ned_m_ -= dx.segment<3>(kFixPositionError.index);
+  } else {
+    pseudorange_errors_.correct(dx.segment<kPseudorangeError.dof>(kPseudorangeError.index));
+  }
 }
 
 void IntegratedFilter::setActive(const StateMask& active) {

@@ -25,9 +25,13 @@ using VectorMeasurement = AidingMeasurement<3>;
 /// position + C_b_n l_b - fix position) in NED metres. With C_b_n,est = (I - [phi x]) C_b_n the
 /// antenna term's error is -phi x (C_b_n l) = [(C_b_n l) x] phi: H is I on the position error
 /// and [(C_b_n l) x] on the attitude error.
+/// With `fix_error_ned_m` (the estimated fix position error b^, layout::kFixPositionError) the
+/// predicted fix includes it: z gains b^ and H has I on those states (the fix is the antenna
+/// plus its error b; z = dp + (b^ - b) - v).
 VectorMeasurement positionMeasurement(
     const NavState& ins, const earth::Geodetic& fix, const Eigen::Vector3d& sigma_ned_m,
-    const Eigen::Vector3d& lever_arm_b_m = Eigen::Vector3d::Zero());
+    const Eigen::Vector3d& lever_arm_b_m = Eigen::Vector3d::Zero(),
+    const Eigen::Vector3d* fix_error_ned_m = nullptr);
 
 /// GNSS velocity of the antenna: z = INS velocity + C_b_n (w_nb_b x l_b) - fix velocity [m/s,
 /// NED], w_nb_b the body's angular rate relative to NED (the gyro rate less the Earth and

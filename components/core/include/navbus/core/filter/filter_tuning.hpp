@@ -41,6 +41,12 @@ struct FilterTuning {
   // is positive (0: not modelled, pseudoranges fused with their white sigma only).
   double pseudorange_error_sigma_m{0.0};               ///< stationary 1 sigma [m]
   double pseudorange_error_correlation_time_s{300.0};  ///< [s]
+  // Time-correlated error of the GNSS fix's position (loose coupling, layout::kFixPositionError):
+  // a first-order Gauss-Markov state per NED axis when the horizontal sigma is positive (0: not
+  // modelled, the fixes fused with their white sigmas only).
+  double fix_position_error_sigma_h_m{0.0};            ///< stationary 1 sigma, N and E [m]
+  double fix_position_error_sigma_v_m{0.0};            ///< stationary 1 sigma, D [m]
+  double fix_position_error_correlation_time_s{30.0};  ///< [s]
   // Adaptive structure (seed 001 eqs. 30-34).
   int adaptive_window{50};                ///< innovations per estimate [epochs]
   double adaptive_floor_position_m{0.3};  ///< sqrt(xi) for position [m]

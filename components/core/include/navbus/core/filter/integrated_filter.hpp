@@ -134,6 +134,11 @@ class IntegratedFilter {
   /// The star tracker's estimated bias [rad, star-tracker axes], subtracted from its
   /// measurements (attitudeMeasurement()); 0 while the bias is not modelled.
   const Eigen::Vector3d& starTrackerBias() const { return star_tracker_bias_; }
+  /// Estimated error of the GNSS fix's position [m, NED] (zero when not modelled).
+  const Eigen::Vector3d& fixPositionError() const { return fix_position_error_ned_m_; }
+  /// The fix's position error is a state (tuning sigma positive, block active, no pseudorange
+  /// errors sharing the block).
+  bool modelsFixPositionError() const;
   double clockBias() const { return clock_bias_m_; }
   double clockDrift() const { return clock_drift_mps_; }
   /// The satellites' time-correlated pseudorange errors (tight coupling, when modelled).
@@ -191,6 +196,7 @@ class IntegratedFilter {
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d star_tracker_bias_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d fix_position_error_ned_m_{Eigen::Vector3d::Zero()};
   double clock_bias_m_{0.0};
   double clock_drift_mps_{0.0};
   PseudorangeErrorSlots pseudorange_errors_;

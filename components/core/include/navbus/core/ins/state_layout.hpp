@@ -35,6 +35,11 @@ inline constexpr StateBlock kClockBias{18, 1};
 inline constexpr StateBlock kClockDrift{19, 1};
 inline constexpr StateBlock kPseudorangeError{20, 12};
 inline constexpr int kSize = 32;
+/// Loose coupling has no pseudoranges: there the first three states of the receiver's error
+/// block are the GNSS fix's position error [m, NED, first-order Gauss-Markov; estimate minus
+/// truth]. The aiding mode says which meaning the block has; the two are never active together
+/// (the configuration refuses each error model outside its mode).
+inline constexpr StateBlock kFixPositionError{kPseudorangeError.index, 3};
 /// The leading states the error dynamics couple (position, velocity, attitude). No navigation
 /// error drives the trailing ones (biases, clock, pseudorange errors), so every transition matrix
 /// is block upper triangular at this size (ins_error_model.hpp, tested).
@@ -46,6 +51,8 @@ static_assert(kPos.end() == kVel.index && kVel.end() == kAtt.index &&
                   kClockBias.end() == kClockDrift.index &&
                   kClockDrift.end() == kPseudorangeError.index && kPseudorangeError.end() == kSize,
               "the layout's blocks must tile the state vector");
+static_assert(kFixPositionError.end() <= kPseudorangeError.end(),
+              "the fix's position error shares the receiver's error block");
 }  // namespace layout
 
 /// Which states of the layout a filter estimates (the others are inactive, error_state.hpp).
