@@ -1,10 +1,13 @@
 #include "navbus/nav_filter/filter_config.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bitset>
 
 #include <cmath>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/key_reader.hpp"
@@ -129,27 +132,32 @@ void parseConsistency(const YAML::Node& node, core::ConsistencyConfig& k) {
       .number("reinitialise_after_s", k.reinitialise_after_s, {0.0, 86400.0})
       .finish();
 }
-/// adaptive_noise.streams: the names of the streams that adapt (default: all).
-void parseNoiseStreams(const YAML::Node& list, std::bitset<core::kNoiseStreams>& streams) {
+/// A list of names out of `names` (e.g. adaptive_noise.streams) as the set of their indexes.
+template <std::size_t N>
+std::bitset<N> parseNameList(const YAML::Node& list, const std::string& key,
+                             const std::array<const char*, N>& names) {
   if (!list.IsSequence())
-    throw bus::ConfigError("configuration adaptive_noise.streams must be a list of stream names");
-  streams.reset();
+    throw bus::ConfigError("configuration " + key + " must be a list of names");
+  std::bitset<N> set;
   for (const YAML::Node& item : list) {
     if (!item.IsScalar())
-      throw bus::ConfigError("configuration adaptive_noise.streams: every item must be a name");
+      throw bus::ConfigError("configuration " + key + ": every item must be a name");
     const std::string name = item.Scalar();
-    int found = -1;
-    std::string names;
-    for (int i = 0; i < core::kNoiseStreams; ++i) {
-      const char* n = core::noiseStreamName(static_cast<core::NoiseStream>(i));
-      names += names.empty() ? n : std::string(" | ") + n;
-      if (name == n) found = i;
-    }
-    if (found < 0)
-      throw bus::ConfigError("configuration adaptive_noise.streams: '" + name + "' is not one of " +
-                             names);
-    streams.set(static_cast<std::size_t>(found));
+    const auto found =
+        std::find_if(names.begin(), names.end(), [&](const char* n) { return name == n; });
+    if (found == names.end())
+      throw bus::ConfigError(fmt::format("configuration {}: '{}' is not one of {}", key, name,
+                                         fmt::join(names, " | ")));
+    set.set(static_cast<std::size_t>(found - names.begin()));
   }
+  return set;
+}
+
+std::array<const char*, core::kNoiseStreams> noiseStreamNames() {
+  std::array<const char*, core::kNoiseStreams> names{};
+  for (int i = 0; i < core::kNoiseStreams; ++i)
+    names[static_cast<std::size_t>(i)] = core::noiseStreamName(static_cast<core::NoiseStream>(i));
+  return names;
 }
 
 /// Bounded adaptive measurement noise (core/filter/adaptive_noise_scale.hpp). The adaptive
@@ -163,7 +171,9 @@ void parseAdaptiveNoise(const YAML::Node& node, core::EngineConfig& e) {
       .number("floor", n.floor, {1e-3, 1e6})
       .number("ceiling", n.ceiling, {1e-3, 1e6})
       .finish({"streams"});
-  if (node && node["streams"]) parseNoiseStreams(node["streams"], e.adaptive_noise_streams);
+  if (node && node["streams"])
+    e.adaptive_noise_streams =
+        parseNameList(node["streams"], "adaptive_noise.streams", noiseStreamNames());
   if (n.ceiling < n.floor)
     throw bus::ConfigError(
         fmt::format("configuration adaptive_noise.ceiling: {} is below adaptive_noise.floor: {}",
@@ -432,9 +442,10 @@ void parseMultiDimensional(const YAML::Node& node, core::MdfConfig& m) {
            {{"mdf", core::MdfPolicy::kMultiDimensional},
             {"continue", core::MdfPolicy::kContinue},
             {"reset_all", core::MdfPolicy::kResetAll}})
-      .choice(
-          "unestimated_states", m.unestimated,
-          {{"consider", core::ReducedStates::kConsidered}, {"drop", core::ReducedStates::kDropped}})
+      .choice("unestimated_states", m.unestimated,
+              {{"consider", core::ReducedStates::kConsidered},
+               {"drop", core::ReducedStates::kDropped},
+               {"none", core::ReducedStates::kNone}})
       .choice("resets", m.reset_form,
               {{"inflate", core::ResetForm::kInflate}, {"paper", core::ResetForm::kPaper}})
       .number("recovery_s", m.recovery_s, {0.0, 600.0})
@@ -443,7 +454,10 @@ void parseMultiDimensional(const YAML::Node& node, core::MdfConfig& m) {
       .number("zupt_sigma_mps", m.zupt_sigma_mps, {1e-6, 10.0})
       .number("nhc_sigma_mps", m.nhc_sigma_mps, {1e-6, 10.0})
       .nested({"stationary"})
-      .finish();
+      .finish({"reset_states"});
+  if (node && node["reset_states"])
+    m.reset_blocks = parseNameList(node["reset_states"], "multi_dimensional.reset_states",
+                                   core::kResetBlockNames);
   bus::KeyReader st(node ? node["stationary"] : YAML::Node(), "multi_dimensional.stationary");
   st.number("window_s", m.stationarity.window_s, {0.05, 10.0})
       .number("accel_std_mps2", m.stationarity.accel_std_mps2, kAnyNonNegative)

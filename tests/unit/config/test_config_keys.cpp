@@ -188,6 +188,36 @@ TEST_F(ConfigKeys, AFixVelocityOffsetIsALagTheVelocityHistoryReaches) {
   EXPECT_TRUE(names(errorOf(imu, filter), "inputs.imu.velocity_time_offset_s", imu));
 }
 
+TEST_F(ConfigKeys, TheMultiDimensionalFilterNamesTheStatesItsResetsTouch) {
+  const auto with = [&](const std::string& name, const std::string& block) {
+    return write(name,
+                 "mode: multi_dimensional\ninputs: {imu: {id: 1, period_s: 0.01}, gnss_fix: "
+                 "{id: 1, period_s: 0.25}}\nmulti_dimensional: " +
+                     block + "\n");
+  };
+  const auto c = navbus::bus::parseFile(
+      with("ok.yaml", "{unestimated_states: none, reset_states: [velocity, heading]}"), filter);
+  EXPECT_EQ(c.engine.mdf.unestimated, navbus::core::ReducedStates::kNone);
+  EXPECT_EQ(c.engine.mdf.reset_blocks.count(), 2u);
+  EXPECT_TRUE(
+      c.engine.mdf.reset_blocks[static_cast<std::size_t>(navbus::core::ResetBlock::kHeading)]);
+  EXPECT_FALSE(
+      c.engine.mdf.reset_blocks[static_cast<std::size_t>(navbus::core::ResetBlock::kPosition)]);
+  const auto defaults = navbus::bus::parseFile(with("defaults.yaml", "{}"), filter);
+  EXPECT_EQ(defaults.engine.mdf.reset_blocks.count(), 4u);
+  EXPECT_EQ(defaults.engine.mdf.unestimated, navbus::core::ReducedStates::kConsidered);
+  const std::string unknown =
+      errorOf(with("unknown.yaml", "{reset_states: [position, attitude]}"), filter);
+  EXPECT_NE(unknown.find("multi_dimensional.reset_states: 'attitude' is not one of position | "
+                         "velocity | level | heading"),
+            std::string::npos)
+      << unknown;
+  const std::string scalar = errorOf(with("scalar.yaml", "{reset_states: position}"), filter);
+  EXPECT_NE(scalar.find("multi_dimensional.reset_states must be a list of names"),
+            std::string::npos)
+      << scalar;
+}
+
 TEST_F(ConfigKeys, AdaptiveNoiseNamesItsStreamsAndKeepsItsBoundsInOrder) {
   const auto with = [&](const std::string& name, const std::string& block,
                         const std::string& fusion = "centralized") {

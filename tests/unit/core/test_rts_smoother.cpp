@@ -1,7 +1,10 @@
 // The fixed-interval smoother's backward pass against the closed form of a random walk observed
-// at both ends, the log's handling of a re-processed stretch, and no smoothing across a restart.
+// at both ends, the log's handling of a re-processed stretch, no smoothing across a restart, and
+// the forward filter's records of its covariance jumps.
 #include <gtest/gtest.h>
 
+#include "navbus/core/filter/aiding_measurements.hpp"
+#include "navbus/core/filter/integrated_filter.hpp"
 #include "navbus/core/filter/rts_smoother.hpp"
 #include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/units.hpp"
@@ -106,11 +109,11 @@ TEST(SmoothingLog, ARewoundPassReplacesWhatTheAbandonedOneRecorded) {
   core::SmoothingRecord r;
   for (int k = 0; k < 5; ++k) {
     r.time_ns = k * kStepNs;
-    log.add(r, k == 0 ? -1 : (k - 1) * kStepNs);
+    log.add(r, k == 0 ? -1 : k);
   }
   // A filter restored to its snapshot after record 1 records at 2.5 steps: 2, 3, 4 go.
   r.time_ns = 5 * kStepNs / 2;
-  log.add(r, kStepNs);
+  log.add(r, 2);
   ASSERT_EQ(log.records().size(), 3u);
   EXPECT_EQ(log.records().back().time_ns, 5 * kStepNs / 2);
   EXPECT_EQ(log.dropped(), 3u);
@@ -119,6 +122,104 @@ TEST(SmoothingLog, ARewoundPassReplacesWhatTheAbandonedOneRecorded) {
   log.add(r, -1);
   EXPECT_EQ(log.records().size(), 2u);
   EXPECT_EQ(log.dropped(), 5u);
+}
+
+/// A parked car's filter that records for the smoother, and its position fixes.
+struct RecordingFilter {
+  core::SmoothingLog log;
+  core::IntegratedFilter filter;
+  core::NavState start;
+  std::int64_t step{0};
+
+  RecordingFilter() {
+    start.time_ns = 1'400'000'000'000'000'000;
+    start.position = {40.0966 * units::kDeg, -105.1474 * units::kDeg, 1580.0};
+    core::FilterTuning t;
+    t.gate_sigma = 0.0;
+    filter.initialize(start, 0.0, 0.0, t,
+                      core::maskOf({layout::kPos, layout::kVel, layout::kAtt, layout::kAccelBias,
+                                    layout::kGyroBias}));
+    filter.setSmoothingLog(&log);
+  }
+  void propagate() {
+    core::ImuIncrement inc;
+    inc.interval_s = 0.01;
+    inc.time_ns = start.time_ns + (++step) * 10'000'000;
+    inc.delta_vel_b_mps = Eigen::Vector3d(0.0, 0.0, -9.80 * inc.interval_s);
+    filter.propagate(inc);
+  }
+  void update(double north_m = 0.05) {
+    filter.update(core::positionMeasurement(
+                      filter.state(), earth::offsetNed(start.position, {north_m, 0.0, 0.0}),
+                      Eigen::Vector3d::Constant(0.02), Eigen::Vector3d::Zero()),
+                  core::AidingKind::kPosition);
+  }
+};
+
+constexpr int kNorth = layout::kPos.index;
+
+TEST(SmoothingRecords, AJumpBeforeTheUpdatesIsInTheirPredictedCovariance) {
+  RecordingFilter r;
+  r.propagate();
+  r.propagate();
+  const core::StateMatrix propagated = r.filter.covariance();
+  r.filter.addVariance(kNorth, 4.0);  // a stage switch's inflation, before the epoch's fix
+  r.update();
+  const core::StateMatrix updated = r.filter.covariance();
+  r.propagate();  // records the epoch
+  const core::SmoothingRecord& rec = r.log.records().back();
+  EXPECT_EQ(rec.time_ns, r.start.time_ns + 2 * 10'000'000);
+  EXPECT_NEAR(rec.predicted(kNorth, kNorth), propagated(kNorth, kNorth) + 4.0, 1e-12);
+  EXPECT_NEAR(rec.covariance(kNorth, kNorth), updated(kNorth, kNorth), 1e-15);
+  EXPECT_TRUE(rec.continues);
+}
+
+TEST(SmoothingRecords, AJumpBetweenTwoUpdatesOfAnEpochSplitsItIntoTwoRecords) {
+  RecordingFilter r;
+  r.propagate();
+  const core::StateMatrix propagated = r.filter.covariance();
+  r.update();  // e.g. a constraint at the increment
+  const core::StateMatrix first = r.filter.covariance();
+  const std::size_t before = r.log.records().size();
+  r.filter.addVariance(kNorth, 4.0);              // the stage switch the fix then brings
+  ASSERT_EQ(r.log.records().size(), before + 1);  // the updates so far: their own record
+  r.update(0.10);  // this fix reads 5 cm further north: the estimate (error) moves
+  const core::StateMatrix second = r.filter.covariance();
+  r.propagate();
+  ASSERT_EQ(r.log.records().size(), before + 2);
+  const core::SmoothingRecord& a = r.log.records()[before];
+  const core::SmoothingRecord& b = r.log.records()[before + 1];
+  EXPECT_EQ(a.time_ns, b.time_ns);
+  EXPECT_NEAR(a.predicted(kNorth, kNorth), propagated(kNorth, kNorth), 1e-15);
+  EXPECT_NEAR(a.covariance(kNorth, kNorth), first(kNorth, kNorth), 1e-15);
+  // Between the two: no motion, the jump as process noise.
+  EXPECT_TRUE(b.transition.isIdentity(0.0));
+  EXPECT_NEAR(b.predicted(kNorth, kNorth), first(kNorth, kNorth) + 4.0, 1e-12);
+  EXPECT_NEAR(b.predicted(kNorth + 1, kNorth + 1), first(kNorth + 1, kNorth + 1), 1e-15);
+  EXPECT_NEAR(b.covariance(kNorth, kNorth), second(kNorth, kNorth), 1e-15);
+  EXPECT_TRUE(b.continues);
+  EXPECT_LT(b.correction[kNorth], -0.02);  // the second fix's share of its 5 cm, its own
+  // The smoothed run has one epoch per time: the later record's.
+  r.filter.closeSmoothingRecord();
+  const auto smoothed = core::smoothFixedInterval(r.log.records());
+  EXPECT_EQ(smoothed.size(), r.log.records().size() - 1);
+  for (std::size_t k = 1; k < smoothed.size(); ++k)
+    EXPECT_LT(smoothed[k - 1].time_ns, smoothed[k].time_ns) << k;
+}
+
+TEST(SmoothingRecords, AResetNoNoiseGivesIsNotSmoothedAcross) {
+  RecordingFilter r;
+  r.propagate();
+  r.update();
+  const std::size_t before = r.log.records().size();
+  r.filter.resetVariances(layout::kVel, 0.01);  // the paper's reset: variances set
+  r.propagate();
+  r.update();
+  r.propagate();
+  const auto& records = r.log.records();
+  ASSERT_EQ(records.size(), before + 2);
+  EXPECT_TRUE(records[before].continues);  // the epoch before the reset, with its update
+  EXPECT_FALSE(records[before + 1].continues);
 }
 
 }  // namespace

@@ -364,12 +364,14 @@ void NavigationEngine::applyStage(const StageDecision& d) {
   ++counters_.stage_switches;
   const FilterTuning& t = config_.tuning;
   if (config_.mdf.policy == MdfPolicy::kMultiDimensional) {
-    StateMask m = stageMask(d.stage);
+    StateMask m = config_.mdf.unestimated == ReducedStates::kNone
+                      ? stageMask(MdfStage::kF2Gnss)  // every navigation state
+                      : stageMask(d.stage);
     // The stages that fuse fixes estimate their position error too, where it is modelled.
     if ((d.stage == MdfStage::kF2Gnss || d.stage == MdfStage::kF3Recovery) &&
         config_.tuning.fix_position_error_sigma_h_m > 0.0)
       m |= maskOf({kFixPositionError});
-    if (config_.mdf.unestimated == ReducedStates::kConsidered)
+    if (config_.mdf.unestimated != ReducedStates::kDropped)
       filter_->setEstimated(m);
     else
       filter_->setActive(m);
@@ -379,7 +381,8 @@ void NavigationEngine::applyStage(const StageDecision& d) {
   // Cases I and II are the paper's comparison: always its resets.
   const bool paper = config_.mdf.reset_form == ResetForm::kPaper ||
                      config_.mdf.policy != MdfPolicy::kMultiDimensional;
-  const auto reset = [&](const StateBlock& b, double sigma) {
+  const auto reset = [&](ResetBlock which, const StateBlock& b, double sigma) {
+    if (!config_.mdf.reset_blocks[static_cast<std::size_t>(which)]) return;
     if (paper)
       filter_->resetVariances(b, sigma);
     else
@@ -391,18 +394,22 @@ void NavigationEngine::applyStage(const StageDecision& d) {
     case CovarianceReset::kFs:
       break;
     case CovarianceReset::kFsA:
-      reset(horizontal_att, t.level_sigma_rad);
-      reset(kVel, t.vel_sigma_mps);
+      reset(ResetBlock::kLevel, horizontal_att, t.level_sigma_rad);
+      reset(ResetBlock::kVelocity, kVel, t.vel_sigma_mps);
       break;
-    case CovarianceReset::kAll:
-      reset(kAccelBias, t.accel_bias_sigma_mps2);
-      reset(kGyroBias, t.gyro_bias_sigma_radps);
-      [[fallthrough]];
+    case CovarianceReset::kAll:  // the comparison case II: everything, whatever the list
+      filter_->resetVariances(kAccelBias, t.accel_bias_sigma_mps2);
+      filter_->resetVariances(kGyroBias, t.gyro_bias_sigma_radps);
+      filter_->resetVariances(kPos, t.pos_sigma_m);
+      filter_->resetVariances(kVel, t.vel_sigma_mps);
+      filter_->resetVariances(horizontal_att, t.level_sigma_rad);
+      filter_->resetVariances(heading, t.heading_sigma_rad);
+      break;
     case CovarianceReset::kFsI:
-      reset(kPos, t.pos_sigma_m);
-      reset(kVel, t.vel_sigma_mps);
-      reset(horizontal_att, t.level_sigma_rad);
-      reset(heading, t.heading_sigma_rad);
+      reset(ResetBlock::kPosition, kPos, t.pos_sigma_m);
+      reset(ResetBlock::kVelocity, kVel, t.vel_sigma_mps);
+      reset(ResetBlock::kLevel, horizontal_att, t.level_sigma_rad);
+      reset(ResetBlock::kHeading, heading, t.heading_sigma_rad);
       break;
   }
 }

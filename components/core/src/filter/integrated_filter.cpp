@@ -72,9 +72,10 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   windows_[2].configure(tuning.adaptive_window,
                         Eigen::Vector3d::Constant(tuning.adaptive_floor_attitude_rad));
   phi_since_update_.setIdentity();
-  const std::int64_t last_record_ns = smoothing_.last_record_ns;
+  const SmoothingPending before = smoothing_;
   smoothing_ = SmoothingPending{};  // a new run: nothing smoothed across its start
-  smoothing_.last_record_ns = last_record_ns;
+  smoothing_.last_record_ns = before.last_record_ns;
+  smoothing_.records_kept = before.records_kept;
   structure_ = FusionStructure::kCentralized;
   setStructure(structure);
 }
@@ -177,9 +178,8 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
     if (smoothing_log_ != nullptr) smoothing_.transition = sparse.times(smoothing_.transition);
   }
   if (smoothing_log_ != nullptr) {
-    // P(k|k-1) as the propagation made it: the stage logic's resets and inflations that may
-    // follow before the updates are the forward filter's own device; the smoother's gain
-    // needs the covariance that Phi and Q give.
+    // P(k|k-1) as the propagation made it; a covariance jump before the updates replaces it
+    // with P after the jump (endCovarianceJump).
     smoothing_.predicted = central_.P();
     smoothing_.predicted_taken = true;
   }
@@ -210,11 +210,31 @@ void IntegratedFilter::emitSmoothingRecord() {
   r.correction = smoothing_.correction;
   r.active = central_.active();
   r.continues = smoothing_.continues;
-  smoothing_log_->add(r, smoothing_.last_record_ns);
+  smoothing_log_->add(r, smoothing_.records_kept);
   smoothing_ = SmoothingPending{};
   smoothing_.continues = true;
   smoothing_.starts_run = false;
   smoothing_.last_record_ns = r.time_ns;
+  smoothing_.records_kept = static_cast<std::int64_t>(smoothing_log_->records().size());
+}
+
+void IntegratedFilter::beginCovarianceJump() {
+  // The updates already taken at this epoch stay before the jump: their record first.
+  if (smoothing_log_ != nullptr && smoothing_.updated) emitSmoothingRecord();
+}
+
+void IntegratedFilter::endCovarianceJump(int replaced_state) {
+  if (smoothing_log_ == nullptr) return;
+  // Nothing changed P since the propagation or the last record but the jump: the prior of the
+  // next updates (or the next propagation's start) is P as it now is.
+  if (replaced_state >= 0) smoothing_.transition.row(replaced_state).setZero();
+  smoothing_.predicted = central_.P();
+  smoothing_.predicted_taken = true;
+}
+
+void IntegratedFilter::breakSmoothing() {
+  beginCovarianceJump();
+  smoothing_.continues = false;
 }
 
 ErrorState& IntegratedFilter::target(AidingKind kind) {
@@ -404,6 +424,7 @@ void IntegratedFilter::setEstimated(const StateMask& estimated) {
 }
 
 void IntegratedFilter::zeroOffDiagonal() {
+  breakSmoothing();  // no process noise gives it
   central_.zeroOffDiagonal();
   for (ErrorState& l : local_) l.zeroOffDiagonal();
 }
@@ -419,8 +440,10 @@ void IntegratedFilter::setAxisFailed(bool accelerometer, int axis, bool failed) 
 }
 
 void IntegratedFilter::addVariance(int state, double variance) {
+  beginCovarianceJump();  // process noise of the smoother's model
   central_.P()(state, state) += variance;
   for (ErrorState& l : local_) l.P()(state, state) += variance * tuning_.federated_share;
+  endCovarianceJump();
 }
 
 bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, double course_rad,
@@ -466,7 +489,9 @@ void IntegratedFilter::floorEarthRateRemainderVariance() {
   const Eigen::Vector3d u_b = ins_.state().q_b_to_n.conjugate() * Eigen::Vector3d::UnitX();
   const double now = u_b.dot(P.block<3, 3>(kGyroBias.index, kGyroBias.index) * u_b);
   if (now >= required) return;
+  beginCovarianceJump();
   P.block<3, 3>(kGyroBias.index, kGyroBias.index) += (required - now) * u_b * u_b.transpose();
+  endCovarianceJump();
 }
 
 void IntegratedFilter::floorGyrocompassHeadingVariance(double heading_sigma_rad) {
@@ -485,7 +510,9 @@ void IntegratedFilter::floorGyrocompassHeadingVariance(double heading_sigma_rad)
   d[heading] = 1.0;
   d.segment<3>(kGyroBias.index) =
       ins_.state().q_b_to_n.conjugate() * Eigen::Vector3d(0.0, -w_h, 0.0);
+  beginCovarianceJump();
   P += (heading_sigma_rad * heading_sigma_rad - P(heading, heading)) * d * d.transpose();
+  endCovarianceJump();
 }
 
 void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
@@ -496,7 +523,7 @@ void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
 }
 
 void IntegratedFilter::resetNavigation(const GnssFixMeasurement& fix) {
-  smoothing_.continues = false;  // what the filter knew of position and velocity is dropped
+  breakSmoothing();  // what the filter knew of position and velocity is dropped
   NavState s = ins_.state();
   s.position = fix.position;
   s.vel_ned_mps = fix.vel_ned_mps;
@@ -516,13 +543,16 @@ void IntegratedFilter::resetClock(double bias_m, double drift_mps, double bias_s
 }
 
 void IntegratedFilter::resetState(int i, double sigma) {
+  beginCovarianceJump();  // a fresh state: a zero row of Phi and the prior as process noise
   central_.resetState(i, sigma);
   for (ErrorState& l : local_) {  // a local filter that does not carry the state keeps 0
     if (l.P()(i, i) > 0.0) l.resetState(i, sigma * std::sqrt(tuning_.federated_share));
   }
+  endCovarianceJump(i);
 }
 
 void IntegratedFilter::resetVariances(const StateBlock& block, double sigma) {
+  breakSmoothing();  // variances set, correlations kept: no process noise gives it
   central_.setVariances(block, sigma);
   for (ErrorState& l : local_) l.setVariances(block, sigma * std::sqrt(tuning_.federated_share));
 }

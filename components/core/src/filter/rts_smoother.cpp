@@ -6,16 +6,15 @@
 
 namespace navbus::core {
 
-void SmoothingLog::add(const SmoothingRecord& r, std::int64_t previous_ns) {
+void SmoothingLog::add(const SmoothingRecord& r, std::int64_t kept) {
   // Kept: the records up to the one r continues from, or (a filter that starts afresh) those
   // before r.
   const auto keep_end =
-      previous_ns >= 0
-          ? std::upper_bound(records_.begin(), records_.end(), previous_ns,
-                             [](std::int64_t t, const SmoothingRecord& x) { return t < x.time_ns; })
-          : std::lower_bound(
-                records_.begin(), records_.end(), r.time_ns,
-                [](const SmoothingRecord& x, std::int64_t t) { return x.time_ns < t; });
+      kept >= 0 ? records_.begin() +
+                      std::min<std::ptrdiff_t>(kept, static_cast<std::ptrdiff_t>(records_.size()))
+                : std::lower_bound(
+                      records_.begin(), records_.end(), r.time_ns,
+                      [](const SmoothingRecord& x, std::int64_t t) { return x.time_ns < t; });
   dropped_ += static_cast<std::uint64_t>(records_.end() - keep_end);
   records_.erase(keep_end, records_.end());
   records_.push_back(r);
@@ -93,6 +92,13 @@ std::vector<SmoothedEpoch> smoothFixedInterval(const std::vector<SmoothingRecord
     out[k] = corrected(now, error, smoothed_cov);
   }
   if (singular != nullptr) *singular = failed;
+  // One epoch per time: a jump between two updates of an epoch recorded it twice.
+  const auto same_time = [](const SmoothedEpoch& a, const SmoothedEpoch& b) {
+    return a.time_ns == b.time_ns;
+  };
+  std::reverse(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end(), same_time), out.end());
+  std::reverse(out.begin(), out.end());
   return out;
 }
 

@@ -177,6 +177,14 @@ class IntegratedFilter {
   /// had updates or the log's interval has passed).
   void recordForSmoothing();
   void emitSmoothingRecord();
+  /// Covariance jumps: every change of P outside propagation and updates goes between
+  /// beginCovarianceJump() and endCovarianceJump(), so that the smoother's model has it (the
+  /// updates already taken at the epoch get their record first; the predicted covariance of
+  /// the next record includes the jump; a replaced state zeroes its row of the transition).
+  /// A reset no process noise gives breaks the smoothing instead (rts_smoother.hpp).
+  void beginCovarianceJump();
+  void endCovarianceJump(int replaced_state = -1);
+  void breakSmoothing();
 
   FilterTuning tuning_;
   std::array<bool, 6> axis_failed_{};  ///< accelerometers x y z, gyros x y z
@@ -210,6 +218,7 @@ class IntegratedFilter {
     bool continues{false};  ///< false: no smoothing across the previous record
     bool starts_run{true};  ///< the first record of a run is due
     std::int64_t last_record_ns{-1};
+    std::int64_t records_kept{-1};  ///< the log's size after the last record (-1: none yet)
   };
   SmoothingLog* smoothing_log_{nullptr};
   SmoothingPending smoothing_;

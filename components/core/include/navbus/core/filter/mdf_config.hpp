@@ -3,6 +3,10 @@
 // counts as stationary, and the stage timing and constraint sigmas.
 #pragma once
 
+#include <array>
+#include <bitset>
+#include <cstddef>
+
 #include "navbus/core/math/units.hpp"
 
 namespace navbus::core {
@@ -21,7 +25,10 @@ enum class MdfPolicy { kMultiDimensional, kContinue, kResetAll };
 /// biases F1 leaves out, and F4's frozen position variance stops growing while the position
 /// error does. As consider states (Schmidt-Kalman) they are propagated and correlated like the
 /// 15-state filter's but never corrected, so each stage still estimates only its own states.
-enum class ReducedStates { kDropped, kConsidered };
+/// None: every stage estimates the 15 navigation states and chooses only its constraints and
+/// resets (on drive_0708 the consider states held the outage epochs inside 3 sigma_h 90.0 % of
+/// the time and every stage estimating all 95.2 %: docs/real_data.md).
+enum class ReducedStates { kDropped, kConsidered, kNone };
 
 /// How a stage switch's covariance reset (eq. 12) is applied: as the paper writes it (zero
 /// every off-diagonal element, then set the listed variances), or by raising each listed
@@ -30,6 +37,13 @@ enum class ReducedStates { kDropped, kConsidered };
 /// and with their correlation zeroed the filter is overconfident about their difference (tilt
 /// NEES 2-4 per axis after the start, 40 runs).
 enum class ResetForm { kPaper, kInflate };
+
+/// The blocks a stage switch's reset may touch (FS/A: velocity and level; FS/I: all four);
+/// MdfConfig::reset_blocks says which of them it does touch.
+enum class ResetBlock { kPosition, kVelocity, kLevel, kHeading };
+inline constexpr std::size_t kResetBlocks = 4;
+inline constexpr std::array<const char*, kResetBlocks> kResetBlockNames{"position", "velocity",
+                                                                        "level", "heading"};
 
 enum class CovarianceReset { kNone, kFs, kFsA, kFsI, kAll };
 
@@ -46,6 +60,10 @@ struct MdfConfig {
   MdfPolicy policy{MdfPolicy::kMultiDimensional};
   ReducedStates unestimated{ReducedStates::kConsidered};
   ResetForm reset_form{ResetForm::kInflate};
+  /// Which blocks the resets touch (default all). Every block a reset raises is, to the
+  /// smoother, process noise at the switch: a raised position variance says the vehicle may have
+  /// jumped, and the fixes after an outage then no longer correct it backward.
+  std::bitset<kResetBlocks> reset_blocks{(1u << kResetBlocks) - 1u};
   StationarityConfig stationarity;
   double recovery_s{5.0};           ///< F3 duration after GNSS returns (seed 004: 5 s)
   double gnss_timeout_s{1.5};       ///< GNSS counts as lost after this long without a fix

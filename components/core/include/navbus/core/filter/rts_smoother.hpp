@@ -10,8 +10,14 @@
 //   P(k|N)  = P(k|k) + A(k) (P(k+1|N) - P(k+1|k)) A(k)^T           (its covariance)
 // e(k|N) is the smoothed error (estimate minus truth) of the forward state at k; dx(k+1) the
 // correction the forward filter applied at k+1 (its prior at k+1 was that much further from
-// truth than its posterior). Where the forward filter restarted, re-initialised or suspended its
-// covariance between two records, nothing is smoothed across: the backward pass starts again.
+// truth than its posterior). A change of the covariance outside propagation and updates (the
+// multi-dimensional filter's inflations at its stage changes, a state replaced by a fresh one)
+// is a jump of the model between two records: added variance is process noise, a replaced
+// state a zero row of Phi, and the forward filter records the predicted covariance after it
+// (IntegratedFilter, "covariance jumps"); a jump between two updates of one epoch splits that
+// epoch into two records of the same time. Where the forward filter restarted, re-initialised,
+// suspended its covariance or reset it in a way no such model gives, nothing is smoothed
+// across: the backward pass starts again.
 #pragma once
 
 #include <cstdint>
@@ -38,17 +44,19 @@ struct SmoothingRecord {
   bool continues{false};
 };
 
-/// The forward pass's records in time order. A filter restored to an earlier snapshot (a
-/// rewind that re-processes late data) records again from there: add() drops what the
-/// abandoned pass recorded after the record it continues from.
+/// The forward pass's records in time order (two records may share a time: a covariance jump
+/// between updates). A filter restored to an earlier snapshot (a rewind that re-processes late
+/// data) records again from there: add() drops what the abandoned pass recorded after the
+/// record it continues from.
 class SmoothingLog {
  public:
   /// The longest time between two records [ns] (records at every update in any case).
   explicit SmoothingLog(std::int64_t interval_ns = 100'000'000) : interval_ns_(interval_ns) {}
   std::int64_t interval() const { return interval_ns_; }
-  /// Appends r after dropping every record later than previous_ns (the record r continues
-  /// from; -1: a filter that starts afresh, which drops those at or after r's time).
-  void add(const SmoothingRecord& r, std::int64_t previous_ns);
+  /// Appends r after dropping every record after the first `kept` (the records r's pass
+  /// continues from: records().size() when its previous record was added; -1: a filter that
+  /// starts afresh, which drops those at or after r's time).
+  void add(const SmoothingRecord& r, std::int64_t kept);
   const std::vector<SmoothingRecord>& records() const { return records_; }
   std::uint64_t dropped() const { return dropped_; }  ///< records of abandoned passes
 
@@ -67,7 +75,8 @@ struct SmoothedEpoch {
   bool smoothed{false};  ///< false: the last record of a run, the forward estimate as it was
 };
 
-/// The backward pass over the records; one smoothed epoch per record. The count of records
+/// The backward pass over the records; one smoothed epoch per record time (of records that
+/// share a time, the last: the epoch after all its updates). The count of records
 /// whose gain could not be formed (P(k+1|k) not positive definite) goes to *singular.
 std::vector<SmoothedEpoch> smoothFixedInterval(const std::vector<SmoothingRecord>& records,
                                                std::uint64_t* singular = nullptr);
