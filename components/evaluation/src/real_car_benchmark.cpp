@@ -527,6 +527,8 @@ int runRealCarBenchmark(const RealCarOptions& o) {
   text += honestyReport(causal, backward ? &*backward : nullptr, points, !outages.empty(),
                         out_dir / "coverage.csv");
   written += ", coverage.csv";
+  writeFixInnovationsCsv(out_dir / "innovations.csv", run.fix_innovations);
+  written += ", innovations.csv";
   if (dataset.gnss_observations) {
     // The receiver's own pseudoranges alone, epoch by epoch: what the filter adds to them.
     const importers::ObservationLog log =

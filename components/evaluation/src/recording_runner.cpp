@@ -109,8 +109,10 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
     on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };
   }
   core::SmoothingLog smoothing_log;
+  core::FixInnovationLog innovation_log;
   nav_filter::FilterConfig filter_config = setup.filter;
   if (setup.smooth) filter_config.engine.smoothing_log = &smoothing_log;
+  filter_config.engine.fix_innovation_log = &innovation_log;
   nav_filter::FilterPipeline pipeline(filter_config, health,
                                       {[&](const navbus::NavigationSolution& s) {
                                          ++result.solutions;
@@ -137,6 +139,7 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
   result.consistency = pipeline.engine().consistency().counters();
   result.fix_position_nis = pipeline.engine().counters().fix_position_nis;
   result.fix_velocity_nis = pipeline.engine().counters().fix_velocity_nis;
+  result.fix_innovations = innovation_log.records();
   if (setup.smooth) {
     std::uint64_t singular = 0;
     result.smoothed = core::smoothFixedInterval(smoothing_log.records(), &singular);
@@ -179,6 +182,39 @@ void writeSmoothedCsv(const std::filesystem::path& file,
   if (!out) throw bus::ConfigError("cannot write " + file.string());
 }
 
+void writeFixInnovationsCsv(const std::filesystem::path& file,
+                            const std::vector<core::FixInnovation>& fixes) {
+  std::ofstream out(file);
+  if (!out) throw bus::ConfigError("cannot write " + file.string());
+  out << "gpst_s,vel_n_mps,vel_e_mps,vel_d_mps,pos_n_m,pos_e_m,pos_d_m,sigma_pos_n_m,"
+         "sigma_pos_e_m,sigma_pos_d_m,vel_inn_n_mps,vel_inn_e_mps,vel_inn_d_mps,"
+         "sigma_vel_n_mps,sigma_vel_e_mps,sigma_vel_d_mps,along_track_m,cross_track_m,"
+         "consistent\n";
+  constexpr double kMinTrackSpeedMps = 1.0;
+  constexpr std::int64_t kWeekNs =
+      static_cast<std::int64_t>(core::gps::kSecondsPerWeek) * 1'000'000'000;
+  fmt::memory_buffer buffer;
+  for (const core::FixInnovation& f : fixes) {
+    const Eigen::Vector2d v = f.filter_vel_ned_mps.head<2>();
+    const double speed = v.norm();
+    const Eigen::Vector2d along =
+        speed >= kMinTrackSpeedMps ? Eigen::Vector2d(v / speed) : Eigen::Vector2d::Zero();
+    const Eigen::Vector2d cross(-along.y(), along.x());  // to the right of the track
+    const Eigen::Vector2d p = f.position_m.head<2>();
+    fmt::format_to(fmt::appender(buffer), "{:.3f},{:.4f},{:.4f},{:.4f}",
+                   1e-9 * static_cast<double>(f.time_ns % kWeekNs), f.filter_vel_ned_mps[0],
+                   f.filter_vel_ned_mps[1], f.filter_vel_ned_mps[2]);
+    for (const Eigen::Vector3d* row :
+         {&f.position_m, &f.position_sigma_m, &f.velocity_mps, &f.velocity_sigma_mps})
+      fmt::format_to(fmt::appender(buffer), ",{:.5f},{:.5f},{:.5f}", (*row)[0], (*row)[1],
+                     (*row)[2]);
+    fmt::format_to(fmt::appender(buffer), ",{:.5f},{:.5f},{}\n", along.dot(p), cross.dot(p),
+                   f.consistent ? 1 : 0);
+  }
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  if (!out) throw bus::ConfigError("cannot write " + file.string());
+}
+
 int runRecordingCommand(const RecordingOptions& o) {
   RecordingSetup setup;
   setup.smooth = o.smooth;
@@ -207,6 +243,11 @@ int runRecordingCommand(const RecordingOptions& o) {
   std::printf("%s%s\n%s%s%zu solutions written to %s\n", r.inputs.c_str(), r.summary.c_str(),
               r.fault_summary.c_str(), r.fault_summary.empty() ? "" : "\n",
               static_cast<std::size_t>(r.solutions), path.c_str());
+  if (o.innovations) {
+    writeFixInnovationsCsv(o.out_dir + "/innovations.csv", r.fix_innovations);
+    std::printf("%zu fused fixes' innovations written to %s/innovations.csv\n",
+                r.fix_innovations.size(), o.out_dir.c_str());
+  }
   if (o.smooth) {
     writeSmoothedCsv(o.out_dir + "/smoothed.csv", r.smoothed);
     std::printf("%s\nsmoothed epochs written to %s/smoothed.csv\n", r.smoother_summary.c_str(),

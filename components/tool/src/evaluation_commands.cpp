@@ -32,6 +32,11 @@ class OfflineCommand final : public Subcommand {
                          "them; --start, --seed and --duration do not apply")
             ->check(CLI::ExistingDirectory);
     scenario->excludes(recording);
+    cli_->add_flag("--innovations", recording_.innovations,
+                   "with --recording: also write innovations.csv, every fused GNSS fix's "
+                   "position and velocity innovations with their sigmas, along and across the "
+                   "track (the fix's error model is read from them: docs/real_data.md)")
+        ->needs(recording);
     cli_->add_flag("--smooth", recording_.smooth,
                    "with --recording: a fixed-interval (Rauch-Tung-Striebel) smoother runs "
                    "backward over the forward filter's states and covariances; writes "

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "navbus/core/integrity/consistency_monitor.hpp"
+#include "navbus/core/integrity/fix_innovation_log.hpp"
 
 using navbus::core::ConsistencyConfig;
 using navbus::core::ConsistencyMonitor;
@@ -83,4 +84,22 @@ TEST(ConsistencyMonitor, DisabledOrEmptyEpochsTestNothing) {
   m.configure(ConsistencyConfig{});
   for (int k = 0; k < 100; ++k) m.onEpoch(k * kEpochNs, 0.0, 0);
   EXPECT_EQ(m.counters().epochs_tested, 0u);
+}
+
+TEST(FixInnovationLog, ARewoundPassReplacesWhatTheAbandonedOneRecorded) {
+  navbus::core::FixInnovationLog log;
+  navbus::core::FixInnovation f;
+  for (int k = 0; k < 5; ++k) {
+    f.time_ns = k * 250'000'000;
+    log.add(f);
+  }
+  // Re-processed from 0.6 s: the fixes of 0.75 and 1.0 s go, and come again.
+  f.time_ns = 750'000'000;
+  log.add(f);
+  EXPECT_EQ(log.records().size(), 4u);
+  EXPECT_EQ(log.dropped(), 2u);
+  f.time_ns = 1'000'000'000;
+  log.add(f);
+  EXPECT_EQ(log.records().size(), 5u);
+  EXPECT_EQ(log.dropped(), 2u);
 }

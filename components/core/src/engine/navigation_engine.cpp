@@ -603,19 +603,20 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
     checkHeadingFromCourse(fix.vel_ned_mps, fix.vel_sigma_ned_mps.head<2>().maxCoeff());
   }
   const Eigen::Vector3d& lever_b = config_.antenna_lever_arm_b_m;
+  const Eigen::Vector3d pos_sigma_m =
+      fix.pos_sigma_ned_m * noiseSigmaFactor(NoiseStream::kFixPosition);
+  const Eigen::Vector3d vel_sigma_mps =
+      fix.vel_sigma_ned_mps * noiseSigmaFactor(NoiseStream::kFixVelocity);
   const auto p = filter_->update(
       positionMeasurement(
-          filter_->state(), fixPositionAtStateTime(fix),
-          fix.pos_sigma_ned_m * noiseSigmaFactor(NoiseStream::kFixPosition), lever_b,
+          filter_->state(), fixPositionAtStateTime(fix), pos_sigma_m, lever_b,
           filter_->modelsFixPositionError() ? &filter_->fixPositionError() : nullptr),
       AidingKind::kPosition);
   countGated(p.data(), 3);
   adaptNoise(NoiseStream::kFixPosition, p.data(), 3);
-  const auto v = filter_->update(
-      velocityMeasurement(filter_->state(), fixVelocityAtStateTime(fix),
-                          fix.vel_sigma_ned_mps * noiseSigmaFactor(NoiseStream::kFixVelocity),
-                          lever_b, bodyRate()),
-      AidingKind::kVelocity);
+  const auto v = filter_->update(velocityMeasurement(filter_->state(), fixVelocityAtStateTime(fix),
+                                                     vel_sigma_mps, lever_b, bodyRate()),
+                                 AidingKind::kVelocity);
   countGated(v.data(), 3);
   adaptNoise(NoiseStream::kFixVelocity, v.data(), 3);
   std::array<ScalarUpdateResult, 6> rows{};
@@ -626,8 +627,29 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
     counters_.fix_velocity_nis.add(v[i].innovation, v[i].innovation_var);
   }
   checkConsistency(fix.time_ns, rows.data(), 6);
+  if (config_.fix_innovation_log != nullptr) logFixInnovations(p, pos_sigma_m, v, vel_sigma_mps);
   ++counters_.fixes_fused;
   if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();
+}
+
+void NavigationEngine::logFixInnovations(const std::array<ScalarUpdateResult, 3>& position,
+                                         const Eigen::Vector3d& pos_sigma_m,
+                                         const std::array<ScalarUpdateResult, 3>& velocity,
+                                         const Eigen::Vector3d& vel_sigma_mps) {
+  // The updates whiten each row by its R (error_state.hpp, diagonal here): back to metres.
+  FixInnovation f;
+  f.time_ns = filter_->state().time_ns;
+  for (int i = 0; i < 3; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    f.position_m[i] = position[k].innovation * pos_sigma_m[i];
+    f.position_sigma_m[i] = std::sqrt(std::max(position[k].innovation_var, 0.0)) * pos_sigma_m[i];
+    f.velocity_mps[i] = velocity[k].innovation * vel_sigma_mps[i];
+    f.velocity_sigma_mps[i] =
+        std::sqrt(std::max(velocity[k].innovation_var, 0.0)) * vel_sigma_mps[i];
+  }
+  f.filter_vel_ned_mps = filter_->state().vel_ned_mps;
+  f.consistent = !consistency_.inconsistent();
+  config_.fix_innovation_log->add(f);
 }
 
 void NavigationEngine::addStarAttitude(const StarAttitudeMeasurement& st) {

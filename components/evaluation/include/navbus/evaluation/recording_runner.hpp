@@ -16,6 +16,7 @@
 
 #include "navbus/core/filter/rts_smoother.hpp"
 #include "navbus/core/integrity/consistency_monitor.hpp"
+#include "navbus/core/integrity/fix_innovation_log.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 
@@ -50,6 +51,8 @@ struct RecordingResult {
   /// With RecordingSetup::smooth: one epoch per forward record, and what the smoother says.
   std::vector<core::SmoothedEpoch> smoothed;
   std::string smoother_summary;
+  /// Every fused GNSS fix's innovations (core/integrity/fix_innovation_log.hpp).
+  std::vector<core::FixInnovation> fix_innovations;
 };
 
 using RecordedSolutionHook = std::function<void(const navbus::NavigationSolution&)>;
@@ -63,13 +66,22 @@ struct RecordingOptions {
   std::string filter;
   std::string fault_manager;
   std::string out_dir;
-  bool smooth{false};  ///< also write smoothed.csv
+  bool smooth{false};       ///< also write smoothed.csv
+  bool innovations{false};  ///< also write innovations.csv
 };
 
 /// The smoothed epochs as CSV (smoothed.csv): GPS time [s of week], the IMU's position, velocity
 /// and attitude, their smoothed 1-sigma, and whether the epoch is smoothed.
 void writeSmoothedCsv(const std::filesystem::path& file,
                       const std::vector<core::SmoothedEpoch>& epochs);
+
+/// The fused fixes' innovations as CSV (innovations.csv): GPS time [s of week], the filter's
+/// NED velocity after the fix, and per NED row the position and velocity innovation (predicted
+/// minus measured) with its sigma sqrt(H P- H^T + R); the along- and cross-track position
+/// innovations (the filter's horizontal course; 0 below 1 m/s), and the consistency monitor's
+/// verdict.
+void writeFixInnovationsCsv(const std::filesystem::path& file,
+                            const std::vector<core::FixInnovation>& fixes);
 
 /// `navbus offline --recording`: writes solution.csv (and decisions.csv, commands.csv with a
 /// fault manager) into out_dir; returns an exit code.

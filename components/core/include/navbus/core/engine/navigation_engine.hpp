@@ -26,6 +26,7 @@
 #include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/ins/velocity_history.hpp"
 #include "navbus/core/integrity/consistency_monitor.hpp"
+#include "navbus/core/integrity/fix_innovation_log.hpp"
 #include "navbus/core/integrity/protection_level_config.hpp"
 #include "navbus/core/math/indirect.hpp"
 
@@ -130,6 +131,9 @@ struct EngineConfig {
   /// (rts_smoother.hpp); nullptr (the default, and always on the bus): nothing recorded.
   /// Not owned; must outlive every engine made from this configuration.
   SmoothingLog* smoothing_log{nullptr};
+  /// Post-processing: where each fused GNSS fix's innovations go (fix_innovation_log.hpp);
+  /// nullptr (the default, and always on the bus): nothing recorded. Not owned.
+  FixInnovationLog* fix_innovation_log{nullptr};
 };
 
 struct EngineCounters {
@@ -279,6 +283,11 @@ class NavigationEngine {
   /// asks for re-initialisation (engine_consistency.cpp).
   void checkConsistency(std::int64_t time_ns, const ScalarUpdateResult* rows, int n);
   void checkConsistency(std::int64_t time_ns, const std::vector<MeasurementReport>& reports);
+  /// A fused fix's innovations (whitened rows, R's sigmas) into config_.fix_innovation_log.
+  void logFixInnovations(const std::array<ScalarUpdateResult, 3>& position,
+                         const Eigen::Vector3d& pos_sigma_m,
+                         const std::array<ScalarUpdateResult, 3>& velocity,
+                         const Eigen::Vector3d& vel_sigma_mps);
   void judgeConsistency(std::int64_t time_ns, double nis, int dof);
   void askReinitialisation();
   /// While re-initialisation is asked: from this epoch's pseudorange solution (false: not
