@@ -67,7 +67,7 @@ ImuNoiseSurvey surveyImuNoise(const std::string& recording_dir, double from_s, d
   if (interval_sum < 3.0)
     throw bus::ConfigError(
         fmt::format("{}: {:.2f} s of increments between {} s and {} s; the "
-                    "survey needs at least 3 s at rest",
+                    "survey needs at least 3 s",
                     recording_dir, interval_sum, from_s, to_s));
   s.period_s = interval_sum / static_cast<double>(s.increments);
   s.flicker_floor.fill(INFINITY);
@@ -108,6 +108,40 @@ std::string formatSurvey(const ImuNoiseSurvey& s) {
       accel, gyro / units::kDeg, rms3(s.flicker_floor, 0), rms3(s.flicker_floor, 3) / units::kDeg,
       accel / units::kMicroG, gyro / units::kDeg * 60.0);
   return out;
+}
+
+MotionNoise motionNoise(const ImuNoiseSurvey& rest, const ImuNoiseSurvey& motion) {
+  const AllanPoint& r = rest.curve.front();
+  const AllanPoint& m = motion.curve.front();
+  if (std::abs(r.tau_s - m.tau_s) > 0.01 * r.tau_s)
+    throw bus::ConfigError(fmt::format(
+        "the stretch in motion is sampled every {:.4f} s, the one at rest every {:.4f} s: their "
+        "one-sample Allan deviations do not compare",
+        m.tau_s, r.tau_s));
+  MotionNoise n;
+  n.accel_one_sample_rest = rms3(r.deviation, 0);
+  n.accel_one_sample_motion = rms3(m.deviation, 0);
+  n.gyro_one_sample_rest = rms3(r.deviation, 3);
+  n.gyro_one_sample_motion = rms3(m.deviation, 3);
+  n.accel_ratio = n.accel_one_sample_motion / n.accel_one_sample_rest;
+  n.gyro_ratio = n.gyro_one_sample_motion / n.gyro_one_sample_rest;
+  n.accel_density = n.accel_ratio * rms3(rest.white_noise, 0);
+  n.gyro_density = n.gyro_ratio * rms3(rest.white_noise, 3);
+  return n;
+}
+
+std::string formatMotionNoise(const ImuNoiseSurvey& motion, const MotionNoise& n) {
+  return fmt::format(
+      "in motion from {} s to {} s ({} increments): sigma_A at one sample ({:.3f} s), RMS of the "
+      "axes: accel {:.3e} m/s^2 ({:.3e} at rest, {:.2f} times), gyro {:.3e} deg/s ({:.3e} at "
+      "rest, {:.2f} times)\nwhite noise in motion (the 1-s densities at rest times those "
+      "ratios): accel {:.3e} m/s^2/sqrt(Hz), gyro {:.3e} deg/s/sqrt(Hz)\nekf (in motion):\n"
+      "  accel_noise_ug_per_sqrthz: {:.0f}\n  gyro_arw_deg_per_sqrth: {:.3g}\n",
+      motion.from_s, motion.to_s, motion.increments, motion.curve.front().tau_s,
+      n.accel_one_sample_motion, n.accel_one_sample_rest, n.accel_ratio,
+      n.gyro_one_sample_motion / units::kDeg, n.gyro_one_sample_rest / units::kDeg, n.gyro_ratio,
+      n.accel_density, n.gyro_density / units::kDeg, n.accel_density / units::kMicroG,
+      n.gyro_density / units::kDeg * 60.0);
 }
 
 }  // namespace navbus::evaluation

@@ -220,8 +220,8 @@ class AllanCommand final : public Subcommand {
   void add(CLI::App& app) override {
     cli_ = app.add_subcommand(
         "allan",
-        "noise densities of a recorded IMU from the Allan deviation of a stretch at rest, as the "
-        "filter configuration's ekf keys");
+        "noise densities of a recorded IMU from the Allan deviation of a stretch at rest (and, "
+        "with --motion-from/--motion-to, in motion), as the filter configuration's ekf keys");
     cli_->add_option("recording", dir_, "recording directory (navbus import, navbus record)")
         ->required()
         ->check(CLI::ExistingDirectory);
@@ -231,11 +231,28 @@ class AllanCommand final : public Subcommand {
     cli_->add_option("--to", to_s_, "its end [s after the first increment]")
         ->required()
         ->check(CLI::Range(0.0, 1e7));
+    auto* motion_from =
+        cli_->add_option("--motion-from", motion_from_s_,
+                         "start of a stretch in motion: the vibration there against the stretch "
+                         "at rest gives the densities in motion [s after the first increment]")
+            ->check(CLI::Range(0.0, 1e7));
+    auto* motion_to =
+        cli_->add_option("--motion-to", motion_to_s_, "its end [s after the first increment]")
+            ->check(CLI::Range(0.0, 1e7));
+    motion_from->needs(motion_to);
+    motion_to->needs(motion_from);
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
-    std::fputs(evaluation::formatSurvey(evaluation::surveyImuNoise(dir_, from_s_, to_s_)).c_str(),
-               stdout);
+    const evaluation::ImuNoiseSurvey rest = evaluation::surveyImuNoise(dir_, from_s_, to_s_);
+    std::fputs(evaluation::formatSurvey(rest).c_str(), stdout);
+    if (motion_to_s_ > 0.0) {
+      const evaluation::ImuNoiseSurvey motion =
+          evaluation::surveyImuNoise(dir_, motion_from_s_, motion_to_s_);
+      std::fputs(
+          evaluation::formatMotionNoise(motion, evaluation::motionNoise(rest, motion)).c_str(),
+          stdout);
+    }
     return 0;
   }
 
@@ -243,6 +260,8 @@ class AllanCommand final : public Subcommand {
   std::string dir_;
   double from_s_{0.0};
   double to_s_{0.0};
+  double motion_from_s_{0.0};
+  double motion_to_s_{0.0};
 };
 
 }  // namespace
