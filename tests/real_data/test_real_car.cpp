@@ -167,7 +167,9 @@ TEST(RealCar, TheImportedRecordingRunsOfflineWithEveryIncrement) {
   }
   EXPECT_NEAR(position_nis, r.fix_position_nis.nis_sum, 1e-9 * r.fix_position_nis.nis_sum);
   EXPECT_NEAR(velocity_nis, r.fix_velocity_nis.nis_sum, 1e-9 * r.fix_velocity_nis.nis_sum);
-  EXPECT_LT(alarmed, r.fix_innovations.size() / 50);  // the monitor's alarms: under 2 %
+  // The monitor's verdict is carried: measured 14 of 1,910 fixes fused during an alarm.
+  EXPECT_GT(alarmed, 0u);
+  EXPECT_LT(alarmed, r.fix_innovations.size() / 50);
   // The fixed epochs fuse to about 2 cm: the innovations' sigmas say so, in metres.
   EXPECT_LT(r.fix_innovations.back().position_sigma_m.maxCoeff(), 0.1);
 
