@@ -97,6 +97,22 @@ rec_csv=$!
   > "$work/record_mcap.log" 2>&1 &
 rec_mcap=$!
 pids=($filter $fm $rec_csv $rec_mcap)
+# The recorders' readers are volatile: what the filter and the fault manager write before their
+# writers matched a recorder is not recorded. The simulator waits for the recorders' sensor
+# readers, not for these: wait until each recorder says it matched them.
+matched() {  # LOG TOPIC...
+  local topic deadline=$((SECONDS + 60))
+  for topic in "${@:2}"; do
+    until grep -q "$topic: [1-9][0-9]* writer(s) matched" "$1"; do
+      [ $SECONDS -lt $deadline ] || fail "$1: no writer of $topic matched within 60 s"
+      sleep 0.1
+    done
+  done
+}
+for log in "$work/record_csv.log" "$work/record_mcap.log"; do
+  matched "$log" navbus/nav/solution navbus/nav/diagnostics navbus/nav/command_outcome \
+    navbus/fault/decision navbus/filter/command
+done
 timeout 120 "$bin/navbus-sensor-sim" -c "$work/sim.yaml" > "$work/sim.log" 2>&1 || fail "simulator"
 sleep 1
 stop $filter $fm

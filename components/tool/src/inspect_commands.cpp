@@ -12,7 +12,9 @@
 #include <set>
 #include <sstream>
 
+#include <spdlog/spdlog.h>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
 
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
@@ -167,6 +169,33 @@ class EchoCommand final : public Subcommand {
   double duration_s{0.0};
 };
 
+/// Says when the number of writers matched to a recorded topic changes, so that a user (or a
+/// test) knows from when on a topic's samples are recorded: readers are volatile, so what a
+/// writer published before it matched the recorder is not in the recording.
+class WriterMatchLog {
+ public:
+  void add(const std::string& topic, eprosima::fastdds::dds::DataReader* reader) {
+    readers_.push_back({topic, reader, 0});
+  }
+  void update() {
+    for (auto& r : readers_) {
+      eprosima::fastdds::dds::SubscriptionMatchedStatus status;
+      r.reader->get_subscription_matched_status(status);
+      if (status.current_count == r.writers) continue;
+      r.writers = status.current_count;
+      spdlog::info("{}: {} writer(s) matched", r.topic, r.writers);
+    }
+  }
+
+ private:
+  struct Matched {
+    std::string topic;
+    eprosima::fastdds::dds::DataReader* reader;
+    std::int32_t writers;
+  };
+  std::vector<Matched> readers_;
+};
+
 class RecordCommand final : public Subcommand {
  public:
   void add(CLI::App& app) override {
@@ -208,12 +237,14 @@ class RecordCommand final : public Subcommand {
     if (record_topics.empty()) {
       throw nb::bus::ConfigError("record: name the topics, or --all");
     }
+    WriterMatchLog matches;
     for (const auto& t : record_topics) {
       entries.push_back(&requireTopic(t));
       sink.open(*entries.back());
-      entries.back()->subscribe(p, sink);
+      matches.add(t, entries.back()->subscribe(p, sink));
     }
     auto all_counted = [&] {
+      matches.update();
       if (idle_s > 0.0 && sink.idleSeconds() >= idle_s) return true;
       if (count == 0) return false;
       for (const auto* e : entries)

@@ -29,7 +29,8 @@ TopicEntry entry(const char* topic, const char* profile) {
   return TopicEntry{
       topic, type.getName(), profile, records::csvHeader<T>(),
       [topic, profile](bus::Participant& p, SampleSink& sink) {
-        p.subscribe<PubSubType>(topic, profile, [topic, &sink](const T& m, const auto& info) {
+        return p.subscribe<
+            PubSubType>(topic, profile, [topic, &sink](const T& m, const auto& info) {
           const SampleTimes times{info.source_timestamp.to_ns(), info.reception_timestamp.to_ns()};
           sink.onSample(
               topic, times,

@@ -39,7 +39,8 @@ struct TopicEntry {
   std::string type_name;
   std::string reader_profile;
   std::string csv_header;
-  std::function<void(bus::Participant&, SampleSink&)> subscribe;
+  /// Subscribes the sink to the topic; returns the reader (owned by the participant).
+  std::function<eprosima::fastdds::dds::DataReader*(bus::Participant&, SampleSink&)> subscribe;
 };
 
 const std::vector<TopicEntry>& topicRegistry();
