@@ -98,7 +98,9 @@ constexpr LayoutEntry kStateLayout[] = {
     {"star_tracker_bias", core::layout::kStarTrackerBias, "rad"},
     {"clock_bias", core::layout::kClockBias, "m"},
     {"clock_drift", core::layout::kClockDrift, "m/s"},
-    {"pseudorange_error", core::layout::kPseudorangeError, "m"}};
+    {"pseudorange_error", core::layout::kPseudorangeError, "m"},
+    {"accel_scale", core::layout::kAccelScale, "1"},
+    {"gyro_scale", core::layout::kGyroScale, "1"}};
 }  // namespace
 
 void fillStateLayout(navbus::FilterDiagnostics& msg) {

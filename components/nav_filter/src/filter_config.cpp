@@ -23,6 +23,7 @@ namespace {
 constexpr bus::FileUnit kMicroG{[](double v) { return v * units::kMicroG; }};
 constexpr bus::FileUnit kMilliG{[](double v) { return v * units::kMilliG; }};
 constexpr bus::FileUnit kMilliRad{[](double v) { return v * 1e-3; }};
+constexpr bus::FileUnit kPartsPerMillion{[](double v) { return v * units::kPpm; }};
 constexpr bus::FileUnit kDegree{[](double v) { return v * units::kDeg; }};
 constexpr bus::FileUnit kArcsecond{[](double v) { return v * units::kArcsec; }};
 constexpr bus::FileUnit kDegPerHour{[](double v) { return v * units::kDegPerHour; }};
@@ -362,6 +363,9 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
       .number("initial_clock_bias_sigma_m", t.clock_bias_sigma_m, kAnyNonNegative)
       .number("initial_clock_drift_sigma_mps", t.clock_drift_sigma_mps, kAnyNonNegative)
       .number("gate_sigma", t.gate_sigma, kAnyNonNegative)
+      // The IMU's scale-factor errors, states when their sigma is positive.
+      .number("accel_scale_factor_sigma_ppm", t.accel_scale_sigma, {0.0, 1e5}, kPartsPerMillion)
+      .number("gyro_scale_factor_sigma_ppm", t.gyro_scale_sigma, {0.0, 1e5}, kPartsPerMillion)
       // The star tracker's Gauss-Markov bias, modelled as states when its sigma is positive.
       .number("star_tracker_bias_sigma_arcsec", t.star_tracker_bias_sigma_rad, {0.0, 3600.0},
               kArcsecond)

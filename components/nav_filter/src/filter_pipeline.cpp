@@ -322,7 +322,7 @@ void FilterPipeline::publishSolution() {
   counters_.solutions_untrusted += sol.covariance_valid() ? 0 : 1;
   sinks_.solution(sol);
   if (config_.low_latency_output && sinks_.low_latency) {
-    predictor_.setAnchor({engine_.state(), engine_.accelBias(), engine_.gyroBias()});
+    predictor_.setAnchor({engine_.state(), engine_.imuCorrection()});
     anchor_solution_ = sol;
   }
 }

@@ -25,6 +25,17 @@ navbus::NavigationSolution buildSolution(const core::NavigationEngine& engine,
   sol.att_sigma_ned_rad(sigma3(core::layout::kAtt));
   sol.accel_bias_sigma_b_mps2(sigma3(core::layout::kAccelBias));
   sol.gyro_bias_sigma_b_radps(sigma3(core::layout::kGyroBias));
+  const core::StateMask& active = engine.activeStates();
+  auto modelled = [&active](const core::StateBlock& b) {
+    return active[static_cast<std::size_t>(b.index)];
+  };
+  const core::ImuCorrection imu = engine.imuCorrection();
+  sol.accel_scale_b(bus::toArray(imu.accel_scale_b));
+  sol.gyro_scale_b(bus::toArray(imu.gyro_scale_b));
+  sol.accel_scale_sigma_b(modelled(core::layout::kAccelScale) ? sigma3(core::layout::kAccelScale)
+                                                              : std::array<double, 3>{});
+  sol.gyro_scale_sigma_b(modelled(core::layout::kGyroScale) ? sigma3(core::layout::kGyroScale)
+                                                            : std::array<double, 3>{});
   sol.clock_bias_m(engine.clockBias());
   sol.clock_drift_mps(engine.clockDrift());
   sol.clock_bias_sigma_m(

@@ -171,7 +171,7 @@ void parseTriad(const YAML::Node& imu, const std::string& prefix, double bias_un
   t.bias_correlation_time_s = checkRange(get<double>(imu, w, "bias_correlation_time_s", 100.0),
                                          1e-3, 1e7, "imu.bias_correlation_time_s");
   t.random_walk = get<double>(imu, w, rw_key, 0.0) * rw_unit;
-  t.scale_factor = bus::getVector3(imu, w, prefix + "scale_factor_ppm", 1e-6);
+  t.scale_factor = bus::getVector3(imu, w, prefix + "scale_factor_ppm", units::kPpm);
   const auto mis =
       get<std::vector<double>>(imu, w, prefix + "misalignment_urad", {0, 0, 0, 0, 0, 0});
   if (mis.size() != 6)

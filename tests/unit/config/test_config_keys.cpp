@@ -218,6 +218,26 @@ TEST_F(ConfigKeys, TheMultiDimensionalFilterNamesTheStatesItsResetsTouch) {
       << scalar;
 }
 
+TEST_F(ConfigKeys, ScaleFactorSigmasAreInPartsPerMillionAndBounded) {
+  const auto with = [&](const std::string& name, const std::string& block) {
+    return write(name,
+                 "mode: loosely_coupled\ninputs: {imu: {id: 1, period_s: 0.01}, gnss_fix: "
+                 "{id: 1, period_s: 0.25}}\nekf: " +
+                     block + "\n");
+  };
+  const auto c = navbus::bus::parseFile(
+      with("ok.yaml", "{accel_scale_factor_sigma_ppm: 1000, gyro_scale_factor_sigma_ppm: 250}"),
+      filter);
+  EXPECT_DOUBLE_EQ(c.engine.tuning.accel_scale_sigma, 1e-3);
+  EXPECT_DOUBLE_EQ(c.engine.tuning.gyro_scale_sigma, 2.5e-4);
+  const auto off = navbus::bus::parseFile(with("off.yaml", "{}"), filter);
+  EXPECT_EQ(off.engine.tuning.accel_scale_sigma, 0.0);
+  const std::string negative =
+      errorOf(with("negative.yaml", "{gyro_scale_factor_sigma_ppm: -5}"), filter);
+  EXPECT_NE(negative.find("ekf.gyro_scale_factor_sigma_ppm"), std::string::npos) << negative;
+  EXPECT_NE(negative.find("-5"), std::string::npos) << negative;
+}
+
 TEST_F(ConfigKeys, AdaptiveNoiseNamesItsStreamsAndKeepsItsBoundsInOrder) {
   const auto with = [&](const std::string& name, const std::string& block,
                         const std::string& fusion = "centralized") {

@@ -167,6 +167,7 @@ TEST(JosephUpdate, StaysSymmetricPositiveDefiniteAndGatesOutliers) {
   EXPECT_EQ(P, P0);
 }
 
+#include "navbus/core/ins/imu_correction.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/sim/trajectory.hpp"
@@ -194,9 +195,9 @@ StateVec errorOf(const navbus::core::NavState& est, const navbus::core::NavState
 
 namespace {
 /// Mechanizes the truth and an estimate started at the error dx0 (position, velocity,
-/// attitude; its bias estimates are the truth's plus dx0's bias errors) from the same perfect
-/// increments of `traj`, and expects the linear prediction Phi dx0 of every navigation block
-/// to match their nonlinear difference within `tolerance` (relative).
+/// attitude; its bias and scale-factor estimates are the truth's plus dx0's errors) from the same
+/// perfect increments of `traj`, and expects the linear prediction Phi dx0 of every navigation
+/// block to match their nonlinear difference within `tolerance` (relative).
 void expectLinearPredictionMatches(navbus::sim::Trajectory& traj, earth::GravityModel gravity,
                                    const StateVec& dx0, int steps, double dt, double tolerance,
                                    const char* label) {
@@ -215,13 +216,17 @@ void expectLinearPredictionMatches(navbus::sim::Trajectory& traj, earth::Gravity
                                  inc.delta_vel_b_mps, inc.delta_angle_b_rad};
     // The truth's state at the start of the step drives F.
     Phi = navbus::core::transitionMatrix(
-              navbus::core::errorDynamics(truth.state(), inc.delta_vel_b_mps / dt, gravity), dt) *
+              navbus::core::errorDynamics(truth.state(), inc.delta_vel_b_mps / dt,
+                                          inc.delta_angle_b_rad / dt, gravity),
+              dt) *
           Phi;
     truth.propagate(m);
-    // The estimate corrects its increments with its bias estimates (truth + error).
-    m.delta_vel_b_mps -= dx0.segment<3>(layout::kAccelBias.index) * dt;
-    m.delta_angle_b_rad -= dx0.segment<3>(layout::kGyroBias.index) * dt;
-    est.propagate(m);
+    // The estimate corrects its increments with its bias and scale-factor estimates (the
+    // truth's, 0, plus the error).
+    const navbus::core::ImuCorrection estimated{
+        dx0.segment<3>(layout::kAccelBias.index), dx0.segment<3>(layout::kGyroBias.index),
+        dx0.segment<3>(layout::kAccelScale.index), dx0.segment<3>(layout::kGyroScale.index)};
+    est.propagate(estimated.applied(m));
   }
   const StateVec actual = errorOf(est.state(), truth.state());
   const StateVec predicted = Phi * dx0;
@@ -261,6 +266,30 @@ TEST(InsErrorModel, TransitionMatrixPredictsTheNonlinearErrorGrowth) {
                                 "aircraft");
 }
 
+TEST(InsErrorModel, TransitionMatrixPredictsTheErrorGrowthOfScaleFactors) {
+  // Given a car-like drive (a 20 s acceleration, a 90 deg turn at 9 deg/s, a roll-in) and an
+  // estimate whose only errors are scale factors on every accelerometer and gyro axis (the F
+  // columns -C_b_n diag(f_b) and C_b_n diag(w_ib_b)), both mechanized from the same perfect
+  // increments for 30 s,
+  navbus::sim::VehicleStart start;
+  start.position = {40.1 * M_PI / 180, -105.1 * M_PI / 180, 1580.0};
+  start.speed_mps = 5.0;
+  std::vector<navbus::sim::Segment> segs(3);
+  segs[0].duration_s = 10.0;
+  segs[0].accel_mps2 = 1.0;
+  segs[1].duration_s = 2.0;
+  segs[1].roll_rate_radps = 2.0 * M_PI / 180;
+  segs[2].duration_s = 20.0;
+  segs[2].heading_rate_radps = segs[2].yaw_rate_radps = 9.0 * M_PI / 180;
+  navbus::sim::VehicleTrajectory traj(start, segs, earth::GravityModel::kWgs84Normal);
+  StateVec dx0 = StateVec::Zero();
+  dx0.segment<3>(layout::kAccelScale.index) << 2e-3, -1e-3, 3e-3;
+  dx0.segment<3>(layout::kGyroScale.index) << -2e-3, 4e-3, 1e-2;
+  // then the linear prediction Phi dx0 matches the nonlinear difference within a few percent.
+  expectLinearPredictionMatches(traj, earth::GravityModel::kWgs84Normal, dx0, 3000, 0.01, 0.03,
+                                "car, scale factors");
+}
+
 TEST(InsErrorModel, TransitionMatrixPredictsTheErrorGrowthInOrbit) {
   // Given seed 001's circular orbit (7.6 km/s: the transport rate and its dependence on the
   // position and velocity errors are 50 times an aircraft's) and an estimate with position,
@@ -288,6 +317,7 @@ TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
     s.q_b_to_n =
         navbus::core::quaternionFromRotationVector(Eigen::Vector3d(u(rng), u(rng), u(rng)));
     const StateMat F = navbus::core::errorDynamics(s, Eigen::Vector3d(u(rng), u(rng), -9.8),
+                                                   0.1 * Eigen::Vector3d(u(rng), u(rng), u(rng)),
                                                    earth::GravityModel::kWgs84Normal);
     StateMat Phi = navbus::core::transitionMatrix(F, 0.005);
     if (trial % 2 == 1) {
@@ -334,7 +364,8 @@ TEST(ErrorState, InactiveStatesKeepTheirVarianceAndStayOutOfTheCoupling) {
   core::NavState s = ins();
   s.q_b_to_n = core::quaternionFromRotationVector(Eigen::Vector3d(0.3, -0.2, 1.1));
   StateMat Phi = core::transitionMatrix(
-      core::errorDynamics(s, Eigen::Vector3d(0.2, 0.1, -9.8), earth::GravityModel::kWgs84Normal),
+      core::errorDynamics(s, Eigen::Vector3d(0.2, 0.1, -9.8), Eigen::Vector3d(0.01, 0.02, -0.03),
+                          earth::GravityModel::kWgs84Normal),
       0.01);
   for (int i = layout::kStarTrackerBias.index; i < layout::kStarTrackerBias.end(); ++i)
     Phi(i, i) = 0.9;

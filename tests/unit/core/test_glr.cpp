@@ -110,7 +110,9 @@ struct LoopRun {
 };
 
 int biasState(const GlrHypothesis& h) {
-  return (h.fault == GlrFault::kAccelStep ? 9 : 12) + h.axis;
+  return (h.fault == GlrFault::kAccelStep ? nc::layout::kAccelBias.index
+                                          : nc::layout::kGyroBias.index) +
+         h.axis;
 }
 
 int rowOf(const GlrHypothesis& h) {
@@ -131,11 +133,13 @@ LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& fault
   for (int k = 0; k < epochs; ++k) {
     loop.nextEpoch();
     // Interval (k-1, k]: a state fault starting at epoch `onset` enters at its start.
-    // The loop's rows never reach the pseudorange-error states: they stay at 0, and the noise
-    // stream is the same whatever the layout adds there.
+    // The loop's rows never reach the IMU's scale factors or the pseudorange-error states: they
+    // stay at 0, and the noise stream is the same whatever the layout adds there.
     StateVector w = StateVector::Zero();
-    for (int i = 0; i < nc::layout::kPseudorangeError.index; ++i)
+    for (int i = 0; i < nc::layout::kPseudorangeError.index; ++i) {
+      if (i >= nc::layout::kAccelScale.index && i < nc::layout::kGyroScale.end()) continue;
       w[i] = std::sqrt(loop.q()(i, i)) * n(rng);
+    }
     StateVector before = dx;
     for (const Fault& f : faults) {
       if (f.h.isImu() && k == f.onset_epoch) before[biasState(f.h)] -= f.magnitude;

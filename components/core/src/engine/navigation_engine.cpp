@@ -71,6 +71,12 @@ Eigen::Vector3d NavigationEngine::accelBias() const {
 Eigen::Vector3d NavigationEngine::gyroBias() const {
   return filter_->gyroBias() + gyro_compensation_;
 }
+ImuCorrection NavigationEngine::imuCorrection() const {
+  ImuCorrection c = filter_->imuCorrection();
+  c.accel_bias_b_mps2 += accel_compensation_;
+  c.gyro_bias_b_radps += gyro_compensation_;
+  return c;
+}
 Eigen::Vector3d NavigationEngine::starTrackerBias() const {
   return filter_->starTrackerBias();
 }
@@ -134,14 +140,18 @@ std::uint64_t NavigationEngine::pseudorangesWithoutErrorState() const {
 }
 
 StateMask NavigationEngine::baseMask() const {
-  // The receiver clock is a state only when pseudoranges are used.
-  if (config_.aiding == AidingMode::kTightlyCoupled || config_.aiding == AidingMode::kInertialOnly)
-    return config_.tuning.pseudorange_error_sigma_m > 0.0
-               ? maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift,
-                         kPseudorangeError})
-               : maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias, kClockBias, kClockDrift});
-  // The star tracker's bias where it is modelled and the tracker used.
   StateMask m = maskOf({kPos, kVel, kAtt, kAccelBias, kGyroBias});
+  // The IMU's scale factors, where they are modelled.
+  if (config_.tuning.accel_scale_sigma > 0.0) m |= maskOf({kAccelScale});
+  if (config_.tuning.gyro_scale_sigma > 0.0) m |= maskOf({kGyroScale});
+  // The receiver clock is a state only when pseudoranges are used.
+  if (config_.aiding == AidingMode::kTightlyCoupled ||
+      config_.aiding == AidingMode::kInertialOnly) {
+    m |= maskOf({kClockBias, kClockDrift});
+    if (config_.tuning.pseudorange_error_sigma_m > 0.0) m |= maskOf({kPseudorangeError});
+    return m;
+  }
+  // The star tracker's bias where it is modelled and the tracker used.
   if (config_.use_star_tracker && config_.tuning.star_tracker_bias_sigma_rad > 0.0)
     m |= maskOf({kStarTrackerBias});
   // The fix's time-correlated position error, where it is modelled (loose coupling).
@@ -371,6 +381,9 @@ void NavigationEngine::applyStage(const StageDecision& d) {
     if ((d.stage == MdfStage::kF2Gnss || d.stage == MdfStage::kF3Recovery) &&
         config_.tuning.fix_position_error_sigma_h_m > 0.0)
       m |= maskOf({kFixPositionError});
+    // The stages that estimate every bias estimate the scale factors too, where modelled.
+    if (m[static_cast<std::size_t>(kAccelBias.index)])
+      m |= baseMask() & maskOf({kAccelScale, kGyroScale});
     if (config_.mdf.unestimated != ReducedStates::kDropped)
       filter_->setEstimated(m);
     else
@@ -400,6 +413,8 @@ void NavigationEngine::applyStage(const StageDecision& d) {
     case CovarianceReset::kAll:  // the comparison case II: everything, whatever the list
       filter_->resetVariances(kAccelBias, t.accel_bias_sigma_mps2);
       filter_->resetVariances(kGyroBias, t.gyro_bias_sigma_radps);
+      if (t.accel_scale_sigma > 0.0) filter_->resetVariances(kAccelScale, t.accel_scale_sigma);
+      if (t.gyro_scale_sigma > 0.0) filter_->resetVariances(kGyroScale, t.gyro_scale_sigma);
       filter_->resetVariances(kPos, t.pos_sigma_m);
       filter_->resetVariances(kVel, t.vel_sigma_mps);
       filter_->resetVariances(horizontal_att, t.level_sigma_rad);
@@ -570,7 +585,8 @@ Eigen::Vector3d NavigationEngine::fixVelocityAtStateTime(const GnssFixMeasuremen
 
 Eigen::Vector3d NavigationEngine::bodyRate() const {
   if (!last_increment_ || !(last_increment_->interval_s > 0.0)) return Eigen::Vector3d::Zero();
-  return last_increment_->delta_angle_b_rad / last_increment_->interval_s - filter_->gyroBias();
+  return filter_->imuCorrection().applied(*last_increment_).delta_angle_b_rad /
+         last_increment_->interval_s;
 }
 
 void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {

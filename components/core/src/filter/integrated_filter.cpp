@@ -29,6 +29,11 @@ StateVector IntegratedFilter::initialSigma(const FilterTuning& tuning) {
   sigma.segment<3>(kAccelBias.index).setConstant(tuning.accel_bias_sigma_mps2);
   sigma.segment<3>(kGyroBias.index).setConstant(tuning.gyro_bias_sigma_radps);
   // Not modelled: inactive states, whose variance only has to keep P invertible.
+  sigma.segment<3>(kAccelScale.index)
+      .setConstant(tuning.accel_scale_sigma > 0.0 ? tuning.accel_scale_sigma : 1.0);
+  sigma.segment<3>(kGyroScale.index)
+      .setConstant(tuning.gyro_scale_sigma > 0.0 ? tuning.gyro_scale_sigma : 1.0);
+  // Not modelled: inactive states, whose variance only has to keep P invertible.
   sigma.segment<3>(kStarTrackerBias.index)
       .setConstant(tuning.star_tracker_bias_sigma_rad > 0.0 ? tuning.star_tracker_bias_sigma_rad
                                                             : 1.0);
@@ -61,6 +66,8 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   clock_drift_mps_ = clock_drift_mps;
   accel_bias_.setZero();
   gyro_bias_.setZero();
+  accel_scale_.setZero();
+  gyro_scale_.setZero();
   star_tracker_bias_.setZero();
   fix_position_error_ned_m_.setZero();
   pseudorange_errors_.clear();
@@ -97,14 +104,13 @@ void IntegratedFilter::setStructure(FusionStructure s) {
 
 void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   if (smoothing_log_ != nullptr) recordForSmoothing();
-  ImuIncrement inc = raw;
-  inc.delta_vel_b_mps -= accel_bias_ * inc.interval_s;
-  inc.delta_angle_b_rad -= gyro_bias_ * inc.interval_s;
+  const ImuIncrement inc = imuCorrection().applied(raw);
   const double dt = inc.interval_s;
   // F at the state at the start of the interval (first-order hold of the error dynamics).
   const earth::LocalEarth at_state = ins_.earthAtState();
-  StateMatrix Phi =
-      transitionMatrix(errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, at_state), dt);
+  StateMatrix Phi = transitionMatrix(
+      errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, inc.delta_angle_b_rad / dt, at_state),
+      dt);
   ins_.propagate(inc, at_state);
   clock_bias_m_ += clock_drift_mps_ * dt;
   if (suspend_filter) {
@@ -403,6 +409,8 @@ void IntegratedFilter::feedback(const StateVector& dx) {
   ins_.correct(correctedState(ins_.state(), dx));
   accel_bias_ -= dx.segment<3>(kAccelBias.index);
   gyro_bias_ -= dx.segment<3>(kGyroBias.index);
+  accel_scale_ -= dx.segment<3>(kAccelScale.index);
+  gyro_scale_ -= dx.segment<3>(kGyroScale.index);
   star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);
   clock_bias_m_ -= dx[kClockBias.index];
   clock_drift_mps_ -= dx[kClockDrift.index];

@@ -8,12 +8,12 @@
 namespace navbus::core {
 
 StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
-                          earth::GravityModel gravity) {
-  return errorDynamics(s, f_b, earth::localEarth(gravity, s.position, s.vel_ned_mps));
+                          const Eigen::Vector3d& w_ib_b, earth::GravityModel gravity) {
+  return errorDynamics(s, f_b, w_ib_b, earth::localEarth(gravity, s.position, s.vel_ned_mps));
 }
 
 StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
-                          const earth::LocalEarth& at_state) {
+                          const Eigen::Vector3d& w_ib_b, const earth::LocalEarth& at_state) {
   using namespace layout;
   const Eigen::Matrix3d C_b_n = s.q_b_to_n.toRotationMatrix();
   const Eigen::Vector3d f_n = C_b_n * f_b;
@@ -67,11 +67,13 @@ StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
   F.block<3, 3>(kVel.index, kVel.index) = -skew(2.0 * w_ie + w_en) + skew(v) * dwen_dv;
   F.block<3, 3>(kVel.index, kAtt.index) = skew(f_n);
   F.block<3, 3>(kVel.index, kAccelBias.index) = -C_b_n;
+  F.block<3, 3>(kVel.index, kAccelScale.index) = -C_b_n * f_b.asDiagonal();
   // Attitude, phi' = -w_in x phi + dw_in + C_b_n e_g.
   F.block<3, 3>(kAtt.index, kPos.index) = dwie_dr + dwen_dr;
   F.block<3, 3>(kAtt.index, kVel.index) = dwen_dv;
   F.block<3, 3>(kAtt.index, kAtt.index) = -skew(w_ie + w_en);
   F.block<3, 3>(kAtt.index, kGyroBias.index) = C_b_n;
+  F.block<3, 3>(kAtt.index, kGyroScale.index) = C_b_n * w_ib_b.asDiagonal();
   F(kClockBias.index, kClockDrift.index) = 1.0;
   return F;
 }
@@ -90,14 +92,15 @@ StateMatrix transitionMatrix(const StateMatrix& F, double dt) {
 
 namespace {
 /// F at a state where every term of errorDynamics() is nonzero: off the equator and the
-/// meridians, moving in all three axes, rotated about a skew axis, a specific force with
-/// three components.
+/// meridians, moving in all three axes, rotated about a skew axis, a specific force and an
+/// angular rate with three components.
 StateMatrix genericErrorDynamics() {
   NavState s;
   s.position = {0.6, 2.2, 1000.0};
   s.vel_ned_mps = Eigen::Vector3d(120.0, -80.0, 15.0);
   s.q_b_to_n = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
-  return errorDynamics(s, Eigen::Vector3d(0.3, -0.2, -9.7), earth::GravityModel::kWgs84Normal);
+  return errorDynamics(s, Eigen::Vector3d(0.3, -0.2, -9.7), Eigen::Vector3d(0.01, -0.02, 0.03),
+                       earth::GravityModel::kWgs84Normal);
 }
 }  // namespace
 

@@ -39,10 +39,7 @@ bool OutputPredictor::step(const ImuIncrement& raw) {
   // The same continuity rule as the engine: the interval starts at the state time (half an
   // interval of jitter allowed).
   if (std::llabs(start_ns - ins_.state().time_ns) > interval_ns / 2) return false;
-  ImuIncrement inc = raw;
-  inc.delta_vel_b_mps -= anchor_->accel_bias_b_mps2 * raw.interval_s;
-  inc.delta_angle_b_rad -= anchor_->gyro_bias_b_radps * raw.interval_s;
-  ins_.propagate(inc);
+  ins_.propagate(anchor_->correction.applied(raw));
   return true;
 }
 

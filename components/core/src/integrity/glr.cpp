@@ -20,14 +20,17 @@ constexpr int kRangeRamp = 1;
 constexpr double kStepInput = -1.0;
 constexpr int kRateStep = 2;
 
-/// The sensor bias states between attitude and clock: accelerometer, gyro and star tracker
-/// (random constants, or an inactive star-tracker bias, in the filters the GLR watches).
+/// The sensor error states between attitude and clock: accelerometer, gyro and star-tracker
+/// biases and the IMU's scale factors (random constants, or inactive states, in the filters the
+/// GLR watches).
 constexpr int kBiasIndex = layout::kAccelBias.index;
 constexpr int kBiasStates = kSupportTail.index - kBiasIndex;
 static_assert(layout::kGyroBias.index == layout::kAccelBias.end() &&
               layout::kAtt.end() == kBiasIndex &&
               layout::kStarTrackerBias.index == layout::kGyroBias.end() &&
-              layout::kStarTrackerBias.end() == kSupportTail.index);
+              layout::kAccelScale.index == layout::kStarTrackerBias.end() &&
+              layout::kGyroScale.index == layout::kAccelScale.end() &&
+              layout::kGyroScale.end() == kSupportTail.index);
 
 /// Index of a satellite slot's direction in f (three per slot).
 constexpr int satColumn(int slot, int direction) {

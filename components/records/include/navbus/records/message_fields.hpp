@@ -141,6 +141,10 @@ IfMessage<M, navbus::NavigationSolution> visitFields(M& m, V& v) {
   v("gyro_bias_b_radps", m.gyro_bias_b_radps());
   v("accel_bias_sigma_b_mps2", m.accel_bias_sigma_b_mps2());
   v("gyro_bias_sigma_b_radps", m.gyro_bias_sigma_b_radps());
+  v("accel_scale_b", m.accel_scale_b());
+  v("gyro_scale_b", m.gyro_scale_b());
+  v("accel_scale_sigma_b", m.accel_scale_sigma_b());
+  v("gyro_scale_sigma_b", m.gyro_scale_sigma_b());
   v("mode", m.mode());
   v("fusion", m.fusion());
   v("covariance_valid", m.covariance_valid());

@@ -22,6 +22,7 @@
 #include "navbus/core/filter/mdf_config.hpp"
 #include "navbus/core/gnss/gnss_measurement.hpp"
 #include "navbus/core/ins/gap_bridge.hpp"
+#include "navbus/core/ins/imu_correction.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/ins/velocity_history.hpp"
@@ -214,6 +215,9 @@ class NavigationEngine {
   /// [m/s^2, body], gyro [rad/s, body].
   Eigen::Vector3d accelBias() const;
   Eigen::Vector3d gyroBias() const;
+  /// What the engine and its filter remove from each raw increment (the biases above and the
+  /// filter's scale factors): what an output propagated from the state must remove too.
+  ImuCorrection imuCorrection() const;
   /// Estimated star-tracker bias [rad, star-tracker body axes] (zero when not modelled).
   Eigen::Vector3d starTrackerBias() const;
   double clockBias() const;   ///< receiver clock bias c*b [m]

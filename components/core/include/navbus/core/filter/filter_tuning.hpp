@@ -30,7 +30,11 @@ struct FilterTuning {
   double gyro_bias_sigma_radps{1.0 * units::kDeg / 3600.0};  ///< 1 deg/h
   double clock_bias_sigma_m{3000.0};
   double clock_drift_sigma_mps{1.0};
-  double gate_sigma{5.0};  ///< innovation gate in standard deviations; <= 0: no gate
+  // Scale-factor errors of the accelerometers and gyros (layout::kAccelScale, kGyroScale): a
+  // random constant per axis when its sigma is positive (0: not modelled, the states inactive).
+  double accel_scale_sigma{0.0};  ///< 1 sigma [1] (1e-3: 1000 ppm)
+  double gyro_scale_sigma{0.0};   ///< 1 sigma [1]
+  double gate_sigma{5.0};         ///< innovation gate in standard deviations; <= 0: no gate
   // Star-tracker bias (seed 001): a first-order Gauss-Markov rotation about each star-tracker
   // axis, modelled as the layout's kStarTrackerBias states when its sigma is positive (0: not
   // modelled, the states stay inactive).

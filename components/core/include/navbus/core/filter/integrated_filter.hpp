@@ -26,6 +26,7 @@
 #include "navbus/core/filter/pseudorange_error_slots.hpp"
 #include "navbus/core/filter/rts_smoother.hpp"
 #include "navbus/core/gnss/gnss_measurement.hpp"
+#include "navbus/core/ins/imu_correction.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/math/kalman_update.hpp"
 
@@ -62,9 +63,9 @@ class IntegratedFilter {
                   const StateMatrix& initial_covariance);
   /// The tuning's initial 1-sigma of every state (the configured start).
   static StateVector initialSigma(const FilterTuning& tuning);
-  /// Mechanizes one increment (bias-corrected) and propagates the clock and, unless
-  /// `suspend_filter` (the filter is not run: seed 004's case I during an outage), the
-  /// covariance(s).
+  /// Mechanizes one increment (compensated for the biases and scale factors) and propagates the
+  /// clock and, unless `suspend_filter` (the filter is not run: seed 004's case I during an
+  /// outage), the covariance(s).
   void propagate(const ImuIncrement& raw, bool suspend_filter = false);
   /// Processes one epoch of pseudoranges and rates; returns one report per row (a buffer
   /// reused from epoch to epoch, valid until the next call). Rows a satellite's use_range /
@@ -131,6 +132,13 @@ class IntegratedFilter {
   const ErrorState& local(int i) const { return local_[static_cast<std::size_t>(i)]; }
   const Eigen::Vector3d& accelBias() const { return accel_bias_; }
   const Eigen::Vector3d& gyroBias() const { return gyro_bias_; }
+  /// Estimated scale-factor errors [1, body] (0 while not modelled).
+  const Eigen::Vector3d& accelScale() const { return accel_scale_; }
+  const Eigen::Vector3d& gyroScale() const { return gyro_scale_; }
+  /// What propagate() removes from each increment.
+  ImuCorrection imuCorrection() const {
+    return {accel_bias_, gyro_bias_, accel_scale_, gyro_scale_};
+  }
   /// The star tracker's estimated bias [rad, star-tracker axes], subtracted from its
   /// measurements (attitudeMeasurement()); 0 while the bias is not modelled.
   const Eigen::Vector3d& starTrackerBias() const { return star_tracker_bias_; }
@@ -203,6 +211,8 @@ class IntegratedFilter {
   std::vector<int> no_error_states_;  ///< -1 per satellite: errors not modelled
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d accel_scale_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d gyro_scale_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d star_tracker_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d fix_position_error_ned_m_{Eigen::Vector3d::Zero()};
   double clock_bias_m_{0.0};

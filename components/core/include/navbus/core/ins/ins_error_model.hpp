@@ -16,18 +16,22 @@ namespace navbus::core {
 
 using StateMatrix = Eigen::Matrix<double, layout::kSize, layout::kSize>;
 
-/// F of dx/dt = F dx at `state`, with the specific force in the body frame `f_b`:
+/// F of dx/dt = F dx at `state`, with the compensated specific force `f_b` and angular rate
+/// `w_ib_b` in the body frame:
 ///   d(dr)/dt  = -[w_en x] dr + dv
-///   d(dv)/dt  = [f_n x] phi - (2 w_ie + w_en) x dv - C_b_n dba + (2 g / R) dr_D e_D
-///   d(phi)/dt = -w_in x phi + d(w_en)/d(dv) dv + C_b_n dbg
+///   d(dv)/dt  = [f_n x] phi - (2 w_ie + w_en) x dv - C_b_n (dba + diag(f_b) dsa)
+///               + (2 g / R) dr_D e_D
+///   d(phi)/dt = -w_in x phi + d(w_en)/d(dv) dv + C_b_n (dbg + diag(w_ib_b) dsg)
 ///   d(cb)/dt  = cd,  d(cd)/dt = 0           (seed 000 eq. 3)
-/// Errors are estimate minus truth; biases are random constants (seed 000 eq. 1). The small
-/// couplings of position error into the Earth and transport rates are neglected.
+/// Errors are estimate minus truth; biases and scale factors (dsa, dsg: a sensor that reads
+/// (1 + s) times the truth plus the bias, compensated as (reading - b) / (1 + s)) are random
+/// constants (seed 000 eq. 1). The small couplings of position error into the Earth and
+/// transport rates are neglected.
 StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
-                          earth::GravityModel gravity);
+                          const Eigen::Vector3d& w_ib_b, earth::GravityModel gravity);
 /// The same with the Earth at the state already computed (earth::localEarth).
 StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
-                          const earth::LocalEarth& at_state);
+                          const Eigen::Vector3d& w_ib_b, const earth::LocalEarth& at_state);
 
 /// Transition matrix over dt: I + F dt + (F dt)^2 / 2.
 StateMatrix transitionMatrix(const StateMatrix& F, double dt);

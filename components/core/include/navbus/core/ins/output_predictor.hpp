@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 
+#include "navbus/core/ins/imu_correction.hpp"
 #include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/math/ring_buffer.hpp"
 
@@ -25,9 +26,8 @@ namespace navbus::core {
 
 /// The deterministic solution an output is propagated from.
 struct OutputAnchor {
-  NavState state;                                              ///< at state.time_ns
-  Eigen::Vector3d accel_bias_b_mps2{Eigen::Vector3d::Zero()};  ///< removed from increments
-  Eigen::Vector3d gyro_bias_b_radps{Eigen::Vector3d::Zero()};  ///< removed from increments
+  NavState state;            ///< at state.time_ns
+  ImuCorrection correction;  ///< removed from increments
 };
 
 struct OutputPredictorCounters {

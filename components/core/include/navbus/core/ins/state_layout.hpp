@@ -16,10 +16,12 @@ struct StateBlock {
 /// position error [m, N E D], velocity error [m/s, NED], attitude error phi [rad, NED; the
 /// computed body-to-NED rotation is (I - [phi x]) times the true one], accelerometer bias
 /// [m/s^2, body], gyro bias [rad/s, body], star-tracker bias [rad, star-tracker body axes: a
-/// small rotation of the measured attitude, first-order Gauss-Markov], receiver clock bias c*b
-/// [m] and drift c*f [m/s], and the time-correlated pseudorange errors of up to
-/// kPseudorangeError.dof satellites [m, one first-order Gauss-Markov state per tracked
-/// satellite, assigned by pseudorange_error_slots.hpp]. All errors are estimate minus truth. Seed
+/// small rotation of the measured attitude, first-order Gauss-Markov], the accelerometer and
+/// gyro scale-factor errors [1, body; a sensor reads (1 + s) times the truth plus its bias, per
+/// axis], receiver clock bias c*b [m] and drift c*f [m/s], and the time-correlated pseudorange
+/// errors of up to kPseudorangeError.dof satellites [m, one first-order Gauss-Markov state per
+/// tracked satellite, assigned by pseudorange_error_slots.hpp]. All errors are estimate minus
+/// truth. Seed
 /// 000 orders dV, dR, Psi,
 /// ...; the order here is position first, which only permutes the matrices. A configuration
 /// uses the blocks it has sensors for (the others are inactive, error_state.hpp): the 17
@@ -31,23 +33,26 @@ inline constexpr StateBlock kAtt{6, 3};
 inline constexpr StateBlock kAccelBias{9, 3};
 inline constexpr StateBlock kGyroBias{12, 3};
 inline constexpr StateBlock kStarTrackerBias{15, 3};
-inline constexpr StateBlock kClockBias{18, 1};
-inline constexpr StateBlock kClockDrift{19, 1};
-inline constexpr StateBlock kPseudorangeError{20, 12};
-inline constexpr int kSize = 32;
+inline constexpr StateBlock kAccelScale{18, 3};
+inline constexpr StateBlock kGyroScale{21, 3};
+inline constexpr StateBlock kClockBias{24, 1};
+inline constexpr StateBlock kClockDrift{25, 1};
+inline constexpr StateBlock kPseudorangeError{26, 12};
+inline constexpr int kSize = 38;
 /// Loose coupling has no pseudoranges: there the first three states of the receiver's error
 /// block are the GNSS fix's position error [m, NED, first-order Gauss-Markov; estimate minus
 /// truth]. The aiding mode says which meaning the block has; the two are never active together
 /// (the configuration refuses each error model outside its mode).
 inline constexpr StateBlock kFixPositionError{kPseudorangeError.index, 3};
 /// The leading states the error dynamics couple (position, velocity, attitude). No navigation
-/// error drives the trailing ones (biases, clock, pseudorange errors), so every transition matrix
-/// is block upper triangular at this size (ins_error_model.hpp, tested).
+/// error drives the trailing ones (biases, clock, pseudorange errors, scale factors), so every
+/// transition matrix is block upper triangular at this size (ins_error_model.hpp, tested).
 inline constexpr int kCoupledSize = kAtt.end();
 static_assert(kPos.end() == kVel.index && kVel.end() == kAtt.index &&
                   kAtt.end() == kAccelBias.index && kAccelBias.end() == kGyroBias.index &&
                   kGyroBias.end() == kStarTrackerBias.index &&
-                  kStarTrackerBias.end() == kClockBias.index &&
+                  kStarTrackerBias.end() == kAccelScale.index &&
+                  kAccelScale.end() == kGyroScale.index && kGyroScale.end() == kClockBias.index &&
                   kClockBias.end() == kClockDrift.index &&
                   kClockDrift.end() == kPseudorangeError.index && kPseudorangeError.end() == kSize,
               "the layout's blocks must tile the state vector");

@@ -12,5 +12,6 @@ inline constexpr double kMicroG = 1e-6 * kStandardGravity;  ///< [m/s^2] per ug
 inline constexpr double kDeg = M_PI / 180.0;                ///< [rad] per degree
 inline constexpr double kArcsec = kDeg / 3600.0;            ///< [rad] per arcsecond
 inline constexpr double kDegPerHour = kDeg / 3600.0;        ///< [rad/s] per deg/h
+inline constexpr double kPpm = 1e-6;                        ///< [1] per part per million
 
 }  // namespace navbus::units
