@@ -10,8 +10,10 @@
 #include <fmt/format.h>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/core/math/units.hpp"
 
 #include "navbus/evaluation/imu_noise_survey.hpp"
+#include "navbus/evaluation/mounting_calibration.hpp"
 #include "navbus/evaluation/real_car_benchmark.hpp"
 #include "navbus/evaluation/time_offset_calibration.hpp"
 #include "navbus/importers/importer.hpp"
@@ -215,6 +217,39 @@ class TimeOffsetCommand final : public Subcommand {
   evaluation::TimeOffsetOptions o_;
 };
 
+/// Under `navbus calibrate`, which TimeOffsetCommand creates (added before this one).
+class MountingCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = app.get_subcommand("calibrate")
+               ->add_subcommand("mounting",
+                                "the IMU mounting's residual pitch and yaw against the vehicle's "
+                                "direction of travel (what the non-holonomic constraint needs), "
+                                "from the smoothed solution, GNSS never withheld, over the "
+                                "epochs driven straight");
+    cli_->add_option("dataset", o_.dataset, "data set YAML")->required()->check(CLI::ExistingFile);
+    cli_->add_option("--filter", o_.filter, "navbus-filter YAML")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cli_->add_option("-o,--out", o_.out_dir, "output directory: the recording")->required();
+    cli_->add_option("--min-speed", o_.straight.min_speed_mps,
+                     "epochs below this speed are left out [m/s] (5)")
+        ->check(CLI::Range(0.5, 100.0));
+    cli_->add_option("--max-heading-rate", heading_rate_dps_,
+                     "epochs turning faster are left out [deg/s] (2)")
+        ->check(CLI::Range(0.01, 90.0));
+  }
+  bool usesBus() const override { return false; }
+  int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
+    o_.straight.max_heading_rate_radps = heading_rate_dps_ * units::kDeg;
+    return evaluation::runMountingCommand(o_);
+  }
+
+ private:
+  evaluation::MountingOptions o_;
+  double heading_rate_dps_{2.0};
+};
+
 class AllanCommand final : public Subcommand {
  public:
   void add(CLI::App& app) override {
@@ -272,6 +307,7 @@ void addRealDataSubcommands(Subcommands& out) {
   out.push_back(std::make_unique<RealCarBenchmarkCommand>());
   out.push_back(std::make_unique<RealDataBenchmarkCommand>());
   out.push_back(std::make_unique<TimeOffsetCommand>());
+  out.push_back(std::make_unique<MountingCommand>());
 }
 
 }  // namespace navbus::tool::cli

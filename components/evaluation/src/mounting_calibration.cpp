@@ -1,0 +1,128 @@
+#include "navbus/evaluation/mounting_calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/core/math/rotation.hpp"
+#include "navbus/core/math/units.hpp"
+#include "navbus/evaluation/recording_runner.hpp"
+#include "navbus/importers/importer.hpp"
+
+namespace navbus::evaluation {
+
+namespace {
+
+/// The q-quantile of `values` (nearest rank); `values` is reordered.
+double quantile(std::vector<double>& values, double q) {
+  const auto k = static_cast<std::size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+/// The course of the velocity [rad from north].
+double courseOf(const core::SmoothedEpoch& e) {
+  return std::atan2(e.state.vel_ned_mps.y(), e.state.vel_ned_mps.x());
+}
+
+/// Change of the course per second between two epochs (the difference wrapped to (-pi, pi]).
+double headingRate(const core::SmoothedEpoch& a, const core::SmoothedEpoch& b) {
+  const double dt = 1e-9 * static_cast<double>(b.time_ns - a.time_ns);
+  if (!(dt > 0.0)) return 0.0;
+  return std::remainder(courseOf(b) - courseOf(a), 2.0 * M_PI) / dt;
+}
+
+}  // namespace
+
+MountingResidual mountingResidual(const std::vector<core::SmoothedEpoch>& epochs,
+                                  const StraightDriving& straight) {
+  std::vector<double> pitch, yaw;
+  for (std::size_t i = 1; i < epochs.size(); ++i) {
+    const core::SmoothedEpoch& e = epochs[i];
+    if (!e.smoothed || !epochs[i - 1].smoothed) continue;
+    if (e.state.vel_ned_mps.norm() < straight.min_speed_mps) continue;
+    if (std::abs(headingRate(epochs[i - 1], e)) > straight.max_heading_rate_radps) continue;
+    const Eigen::Vector3d v_b = e.state.q_b_to_n.conjugate() * e.state.vel_ned_mps;
+    // Forward, right, down: climbing in body axes is a negative z component.
+    pitch.push_back(std::atan2(-v_b.z(), std::hypot(v_b.x(), v_b.y())));
+    yaw.push_back(std::atan2(v_b.y(), v_b.x()));
+  }
+  MountingResidual r;
+  r.epochs = pitch.size();
+  if (pitch.empty()) return r;
+  r.pitch_rad = quantile(pitch, 0.5);
+  r.pitch_q1_rad = quantile(pitch, 0.25);
+  r.pitch_q3_rad = quantile(pitch, 0.75);
+  r.yaw_rad = quantile(yaw, 0.5);
+  r.yaw_q1_rad = quantile(yaw, 0.25);
+  r.yaw_q3_rad = quantile(yaw, 0.75);
+  // Body to vehicle axes: R^T, R = Rz(yaw) Ry(pitch) (correctedMountingRpy).
+  const Eigen::Matrix3d to_vehicle =
+      core::dcmFromEuler(Eigen::Vector3d(0.0, r.pitch_rad, r.yaw_rad)).transpose();
+  Eigen::Vector2d configured = Eigen::Vector2d::Zero(), corrected = Eigen::Vector2d::Zero();
+  for (const core::SmoothedEpoch& e : epochs) {
+    if (!e.smoothed || e.state.vel_ned_mps.norm() < straight.min_speed_mps) continue;
+    const Eigen::Vector3d v_b = e.state.q_b_to_n.conjugate() * e.state.vel_ned_mps;
+    configured += v_b.tail<2>().cwiseAbs2();
+    corrected += (to_vehicle * v_b).tail<2>().cwiseAbs2();
+    ++r.moving_epochs;
+  }
+  const double n = static_cast<double>(r.moving_epochs);
+  r.configured_rms_mps = (configured / n).cwiseSqrt();
+  r.corrected_rms_mps = (corrected / n).cwiseSqrt();
+  return r;
+}
+
+Eigen::Vector3d correctedMountingRpy(const Eigen::Matrix3d& sensor_to_body,
+                                     const MountingResidual& residual) {
+  // The vehicle's forward axis in body axes is R x, R = Rz(yaw) Ry(pitch); the vehicle's axes
+  // are the body's turned by R: body-to-vehicle R^T. The new sensor-to-body rotation is
+  // R^T C_s_b, and the angles' rotation (body to sensor, ImuMounting) its transpose C_b_s R.
+  const Eigen::Matrix3d R =
+      core::dcmFromEuler(Eigen::Vector3d(0.0, residual.pitch_rad, residual.yaw_rad));
+  return core::eulerFromDcm(sensor_to_body.transpose() * R);
+}
+
+int runMountingCommand(const MountingOptions& o) {
+  const importers::DatasetDescription dataset = importers::readDatasetDescription(o.dataset);
+  const std::filesystem::path out_dir(o.out_dir);
+  const importers::ImportReport imported = importers::importDataset(dataset, out_dir / "recording");
+  RecordingSetup setup;
+  setup.dir = out_dir / "recording";
+  setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
+  setup.smooth = true;
+  const RecordingResult run = runRecording(setup);
+  const MountingResidual r = mountingResidual(run.smoothed, o.straight);
+  std::string text = imported.text;
+  if (r.epochs == 0) {
+    text += fmt::format(
+        "no smoothed epoch above {:.1f} m/s with a heading rate below {:.2f} deg/s: nothing to "
+        "calibrate on\n",
+        o.straight.min_speed_mps, o.straight.max_heading_rate_radps / units::kDeg);
+    std::fputs(text.c_str(), stdout);
+    return 1;
+  }
+  const Eigen::Vector3d rpy =
+      correctedMountingRpy(setup.filter.imu_mounting.sensor_to_body, r) / units::kDeg;
+  text += fmt::format(
+      "the vehicle's forward axis in body axes, over {} smoothed epochs driven straight (above "
+      "{:.1f} m/s, heading rate below {:.2f} deg/s):\n"
+      "  pitch {:+.3f} deg (quartiles {:+.3f} .. {:+.3f}), yaw {:+.3f} deg (quartiles {:+.3f} .. "
+      "{:+.3f})\n"
+      "the velocity across and below the forward axis over {} smoothed epochs above {:.1f} m/s "
+      "(turns included), RMS: {:.3f} / {:.3f} m/s in the configured axes, {:.3f} / {:.3f} m/s "
+      "corrected (what multi_dimensional.nhc_sigma_mps has to allow)\n"
+      "geometry:\n  imu_mounting_rpy_deg: [{:.2f}, {:.2f}, {:.2f}]\n",
+      r.epochs, o.straight.min_speed_mps, o.straight.max_heading_rate_radps / units::kDeg,
+      r.pitch_rad / units::kDeg, r.pitch_q1_rad / units::kDeg, r.pitch_q3_rad / units::kDeg,
+      r.yaw_rad / units::kDeg, r.yaw_q1_rad / units::kDeg, r.yaw_q3_rad / units::kDeg,
+      r.moving_epochs, o.straight.min_speed_mps, r.configured_rms_mps.x(), r.configured_rms_mps.y(),
+      r.corrected_rms_mps.x(), r.corrected_rms_mps.y(), rpy.x(), rpy.y(), rpy.z());
+  std::fputs(text.c_str(), stdout);
+  return 0;
+}
+
+}  // namespace navbus::evaluation
