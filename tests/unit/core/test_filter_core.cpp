@@ -346,6 +346,13 @@ TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
     const navbus::core::SparseRows<layout::kSize> structural(Phi,
                                                              navbus::core::transitionPattern());
     EXPECT_EQ(structural.sandwichBlockTriangular<layout::kCoupledSize>(P), sandwich);
+    // A running product of transitions kept transposed, C^T <- C^T Phi^T, equals the dense one.
+    const StateMat Ct = (Phi * Phi).transpose();
+    EXPECT_LT(
+        (structural.timesTransposedBlockTriangular<layout::kCoupledSize>(Ct) - Ct * Phi.transpose())
+            .cwiseAbs()
+            .maxCoeff(),
+        1e-12);
     // Phi is block upper triangular at the coupled size (no navigation error drives a bias or
     // the clock), and at no smaller one.
     EXPECT_TRUE(navbus::core::transitionPattern().isBlockUpperTriangular(layout::kCoupledSize));

@@ -78,7 +78,7 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
                         Eigen::Vector3d::Constant(tuning.adaptive_floor_velocity_mps));
   windows_[2].configure(tuning.adaptive_window,
                         Eigen::Vector3d::Constant(tuning.adaptive_floor_attitude_rad));
-  phi_since_update_.setIdentity();
+  phi_since_update_t_.setIdentity();
   const SmoothingPending before = smoothing_;
   smoothing_ = SmoothingPending{};  // a new run: nothing smoothed across its start
   smoothing_.last_record_ns = before.last_record_ns;
@@ -180,8 +180,12 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   central_.predict(Phi, q);
   if (keep_transition_ || smoothing_log_ != nullptr) {
     const SparseRows<layout::kSize> sparse(Phi, transitionPattern());
-    if (keep_transition_) phi_since_update_ = sparse.times(phi_since_update_);
-    if (smoothing_log_ != nullptr) smoothing_.transition = sparse.times(smoothing_.transition);
+    if (keep_transition_)
+      phi_since_update_t_ =
+          sparse.timesTransposedBlockTriangular<kCoupledSize>(phi_since_update_t_);
+    if (smoothing_log_ != nullptr)
+      smoothing_.transition_t =
+          sparse.timesTransposedBlockTriangular<kCoupledSize>(smoothing_.transition_t);
   }
   if (smoothing_log_ != nullptr) {
     // P(k|k-1) as the propagation made it; a covariance jump before the updates replaces it
@@ -212,7 +216,7 @@ void IntegratedFilter::emitSmoothingRecord() {
   r.gyro_bias_radps = gyro_bias_;
   r.covariance = central_.P();
   r.predicted = smoothing_.predicted_taken ? smoothing_.predicted : central_.P();
-  r.transition = smoothing_.transition;
+  r.transition = smoothing_.transition_t.transpose();
   r.correction = smoothing_.correction;
   r.active = central_.active();
   r.continues = smoothing_.continues;
@@ -233,7 +237,7 @@ void IntegratedFilter::endCovarianceJump(int replaced_state) {
   if (smoothing_log_ == nullptr) return;
   // Nothing changed P since the propagation or the last record but the jump: the prior of the
   // next updates (or the next propagation's start) is P as it now is.
-  if (replaced_state >= 0) smoothing_.transition.row(replaced_state).setZero();
+  if (replaced_state >= 0) smoothing_.transition_t.col(replaced_state).setZero();
   smoothing_.predicted = central_.P();
   smoothing_.predicted_taken = true;
 }
@@ -300,7 +304,7 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   // sequential (exact for the diagonal R) so that each row can be gated on its own.
   d.innovation_cov = d.h * es.P() * d.h.transpose();
   d.innovation_cov.diagonal() += r;
-  d.phi = phi_since_update_;
+  d.phi = phi_since_update_t_.transpose();
   prior_P_ = es.P();
   std::vector<MeasurementReport>& reports = reports_;
   reports.clear();
@@ -376,7 +380,7 @@ void IntegratedFilter::closeUpdate() {
     feedback(central_.x());
     central_.x().setZero();
   }
-  phi_since_update_.setIdentity();
+  phi_since_update_t_.setIdentity();
 }
 
 void IntegratedFilter::turnAttitudeCovariance(double dpsi_rad) {

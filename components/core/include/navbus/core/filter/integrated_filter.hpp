@@ -201,7 +201,9 @@ class IntegratedFilter {
   ErrorState central_;               ///< centralized/adaptive filter; master result (federated)
   std::array<ErrorState, 2> local_;  ///< federated: [0] GNSS/INS, [1] star tracker/INS
   std::array<InnovationWindow<3>, 3> windows_;  ///< adaptive: position, velocity, attitude
-  StateMatrix phi_since_update_{StateMatrix::Identity()};
+  /// The transition accumulated since the last update, transposed (the product's cheap form,
+  /// SparseRows::timesTransposedBlockTriangular).
+  StateMatrix phi_since_update_t_{StateMatrix::Identity()};
   bool keep_transition_{true};
   EpochDiagnostics last_epoch_;
   StateMatrix prior_P_{StateMatrix::Zero()};  ///< P- of the latest GNSS epoch
@@ -220,7 +222,7 @@ class IntegratedFilter {
   PseudorangeErrorSlots pseudorange_errors_;
   /// What the next smoothing record gathers since the last one.
   struct SmoothingPending {
-    StateMatrix transition{StateMatrix::Identity()};
+    StateMatrix transition_t{StateMatrix::Identity()};  ///< since the last record, transposed
     StateMatrix predicted{StateMatrix::Zero()};
     StateVector correction{StateVector::Zero()};
     bool predicted_taken{false};

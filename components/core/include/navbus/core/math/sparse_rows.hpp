@@ -163,6 +163,32 @@ class SparseRows {
     return out;
   }
 
+  /// B A^T for A block upper triangular at `Lead` ([A11 A12; 0 A22]) and B its transpose's
+  /// kind, block lower triangular ([B11 0; B21 B22]; the transpose of a product of such A):
+  /// the leading columns as timesTransposed(), the trailing ones only on the trailing rows
+  /// (A22's rows reach B's trailing columns, whose leading rows are 0). A running product
+  /// of transition matrices kept transposed (C^T <- C^T A^T) costs this instead of a dense
+  /// product and two transposes.
+  template <int Lead>
+  Square timesTransposedBlockTriangular(const Square& B) const {
+    static_assert(Lead > 0 && Lead < N, "the leading block must be a proper one");
+    constexpr int Trail = N - Lead;
+    assert(p_->isBlockUpperTriangular(Lead));
+    Square out;
+    for (int i = 0; i < Lead; ++i) out.col(i) = sumOfColumns(i, B);
+    const auto B2 = B.template bottomRows<Trail>();
+    for (int i = Lead; i < N; ++i) {
+      out.col(i).template head<Lead>().setZero();
+      Eigen::Matrix<double, Trail, 1> c = Eigen::Matrix<double, Trail, 1>::Zero();
+      for (int n = 0; n < p_->count(i); ++n) {
+        const int k = p_->col(i, n);
+        c += a_(i, k) * B2.col(k);
+      }
+      out.col(i).template tail<Trail>() = c;
+    }
+    return out;
+  }
+
   /// Elements of A in its pattern.
   int nonZeros() const { return p_->nonZeros(); }
 
