@@ -457,6 +457,8 @@ void parseMultiDimensional(const YAML::Node& node, core::MdfConfig& m) {
       .rateHz("constraint_rate_hz", m.constraint_period_s, {0.1, 1000.0})
       .number("zupt_sigma_mps", m.zupt_sigma_mps, {1e-6, 10.0})
       .number("nhc_sigma_mps", m.nhc_sigma_mps, {1e-6, 10.0})
+      .number("nhc_velocity_pitch_per_accel_deg_per_mps2",
+              m.nhc_velocity_pitch_per_accel_rad_per_mps2, {-10.0, 10.0}, kDegree)
       .nested({"stationary"})
       .finish({"reset_states"});
   if (node && node["reset_states"])

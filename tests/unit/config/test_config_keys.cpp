@@ -195,9 +195,13 @@ TEST_F(ConfigKeys, TheMultiDimensionalFilterNamesTheStatesItsResetsTouch) {
                  "{id: 1, period_s: 0.25}}\nmulti_dimensional: " +
                      block + "\n");
   };
-  const auto c = navbus::bus::parseFile(
-      with("ok.yaml", "{unestimated_states: none, reset_states: [velocity, heading]}"), filter);
+  const auto c =
+      navbus::bus::parseFile(with("ok.yaml",
+                                  "{unestimated_states: none, reset_states: [velocity, heading], "
+                                  "nhc_velocity_pitch_per_accel_deg_per_mps2: -0.34}"),
+                             filter);
   EXPECT_EQ(c.engine.mdf.unestimated, navbus::core::ReducedStates::kNone);
+  EXPECT_DOUBLE_EQ(c.engine.mdf.nhc_velocity_pitch_per_accel_rad_per_mps2, -0.34 * M_PI / 180);
   EXPECT_EQ(c.engine.mdf.reset_blocks.count(), 2u);
   EXPECT_TRUE(
       c.engine.mdf.reset_blocks[static_cast<std::size_t>(navbus::core::ResetBlock::kHeading)]);

@@ -73,6 +73,26 @@ TEST(AidingMeasurements, NonHolonomicAndZeroVelocityInnovationsEqualHTimesTheErr
   EXPECT_LT((zupt.z - zupt.h * dx).norm(), 1e-12);
 }
 
+TEST(AidingMeasurements, TheConstraintExpectsTheVelocityPitchedAsConfigured) {
+  // Given a car whose velocity lies 0.4 deg below its body's forward axis (its nose up as it
+  // speeds up), seen without error and with a velocity and attitude error,
+  const double pitch_v = -0.4 * M_PI / 180;
+  const Eigen::Vector3d rpy(0.02, 0.03, -1.1);
+  const Eigen::Vector3d v_b(12.0 * std::cos(pitch_v), 0.0, -12.0 * std::sin(pitch_v));
+  const core::NavState truth = movingTruth(rpy, core::dcmFromEuler(rpy) * v_b);
+  // when the constraint expects that pitch, then the true state meets it exactly,
+  const auto exact = core::nonHolonomicMeasurement(truth, 0.1, pitch_v);
+  EXPECT_LT(exact.z.norm(), 1e-12);
+  EXPECT_GT(std::abs(core::nonHolonomicMeasurement(truth, 0.1).z[1]), 0.08);  // a rigid body's
+  // and the erroneous state's innovation is H dx to first order.
+  core::StateVector dx = core::StateVector::Zero();
+  dx.segment<3>(layout::kVel.index) << 0.05, -0.04, 0.02;
+  dx.segment<3>(layout::kAtt.index) << 2e-3, -1e-3, 3e-3;
+  const auto nhc = core::nonHolonomicMeasurement(withError(truth, dx), 0.1, pitch_v);
+  EXPECT_LT((nhc.z - nhc.h * dx).norm(), 1e-3 * nhc.z.norm() + 1e-4);
+  EXPECT_GT(nhc.z.norm(), 0.02);
+}
+
 TEST(IntegratedFilter, EveryUpdateTypeReducesAConstructedError) {
   const Eigen::Vector3d rpy(0.1, -0.05, 2.0);
   const core::NavState truth =

@@ -80,6 +80,26 @@ TEST(MountingCalibration, TheResidualIsTheVehiclesForwardAxisInBodyAxes) {
   EXPECT_LT(r.corrected_rms_mps.y(), 0.03);
 }
 
+TEST(MountingCalibration, TheVelocitysPitchFollowsTheLongitudinalAcceleration) {
+  // Given straight driving whose speed swings between 10 and 14 m/s (accelerations up to
+  // +-0.6 m/s^2), the body pitched against the track by -0.3 deg per m/s^2 plus a fixed 0.2 deg,
+  const double k = -0.3 * kDeg;
+  std::vector<core::SmoothedEpoch> epochs;
+  for (int i = 0; i < 2000; ++i) {
+    const double t = 0.1 * i;
+    const double speed = 12.0 + 2.0 * std::sin(0.3 * t), accel = 0.6 * std::cos(0.3 * t);
+    const Eigen::Matrix3d forward_in_body =
+        core::dcmFromEuler(Eigen::Vector3d(0.0, 0.2 * kDeg + k * accel, 0.0));
+    epochs.push_back(
+        drivingEpoch(static_cast<std::int64_t>(i) * 100'000'000, 0.7, 0.0, speed, forward_in_body));
+  }
+  // when calibrated, then the slope is the configured one within 1 %, strongly correlated.
+  const MountingResidual r = mountingResidual(epochs, StraightDriving{});
+  EXPECT_NEAR(r.velocity_pitch_per_accel_rad_per_mps2, k, 0.01 * std::abs(k));
+  EXPECT_LT(r.velocity_pitch_accel_correlation, -0.99);
+  EXPECT_NEAR(r.pitch_rad, 0.2 * kDeg, 0.05 * kDeg);
+}
+
 TEST(MountingCalibration, TheCorrectedAnglesTurnTheForwardAxisOntoTheBodysX) {
   // Given the drive's published mounting (upside down, yawed 185 deg, pitched -6.79 deg) and a
   // residual of 0.4 deg pitch and 0.9 deg yaw,

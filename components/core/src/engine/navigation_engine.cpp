@@ -429,6 +429,19 @@ void NavigationEngine::applyStage(const StageDecision& d) {
   }
 }
 
+double NavigationEngine::longitudinalAcceleration() const {
+  const NavState& s = filter_->state();
+  const double speed = s.vel_ned_mps.norm();
+  if (!last_increment_ || !(last_increment_->interval_s > 0.0) || !(speed > 0.0)) return 0.0;
+  // The acceleration over the latest increment, C_b_n f_b + g (Coriolis and transport terms,
+  // below 1e-3 m/s^2 at car speeds, left out), along the velocity.
+  const ImuIncrement inc = filter_->imuCorrection().applied(*last_increment_);
+  const Eigen::Vector3d f_n = s.q_b_to_n * (inc.delta_vel_b_mps / inc.interval_s);
+  const Eigen::Vector3d g_n =
+      earth::localEarth(config_.tuning.gravity, s.position, s.vel_ned_mps).g_ned;
+  return (f_n + g_n).dot(s.vel_ned_mps) / speed;
+}
+
 void NavigationEngine::constraintUpdate() {
   const std::int64_t t = filter_->state().time_ns;
   if (t < next_constraint_ns_) return;
@@ -445,10 +458,14 @@ void NavigationEngine::constraintUpdate() {
     ++counters_.zero_velocity_updates;
   } else if (stage == MdfStage::kF4Constraint &&
              config_.mdf.policy == MdfPolicy::kMultiDimensional) {
-    const auto r = filter_->update(
-        nonHolonomicMeasurement(filter_->state(), config_.mdf.nhc_sigma_mps *
-                                                      noiseSigmaFactor(NoiseStream::kNonHolonomic)),
-        AidingKind::kNonHolonomic);
+    const double velocity_pitch_b_rad =
+        config_.mdf.nhc_velocity_pitch_per_accel_rad_per_mps2 * longitudinalAcceleration();
+    const auto r =
+        filter_->update(nonHolonomicMeasurement(filter_->state(),
+                                                config_.mdf.nhc_sigma_mps *
+                                                    noiseSigmaFactor(NoiseStream::kNonHolonomic),
+                                                velocity_pitch_b_rad),
+                        AidingKind::kNonHolonomic);
     countGated(r.data(), 2);
     adaptNoise(NoiseStream::kNonHolonomic, r.data(), 2);
     ++counters_.nonholonomic_updates;

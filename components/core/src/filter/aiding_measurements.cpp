@@ -72,14 +72,21 @@ VectorMeasurement zeroVelocityMeasurement(const NavState& ins, double sigma_mps)
   return m;
 }
 
-AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps) {
+AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps,
+                                             double velocity_pitch_b_rad) {
   AidingMeasurement<2> m;
   const Eigen::Matrix3d C_n_b = ins.q_b_to_n.toRotationMatrix().transpose();
   const Eigen::Vector3d v_b = C_n_b * ins.vel_ned_mps;
-  m.z = v_b.tail<2>();
+  // d(v_b)/d(dV) = C_n_b and d(v_b)/d(phi) = -C_n_b [V x], per body axis (row).
+  const Eigen::Matrix3d dvb_dv = C_n_b;
+  const Eigen::Matrix3d dvb_dphi = -C_n_b * skew(ins.vel_ned_mps);
+  const double tan_pitch = std::tan(velocity_pitch_b_rad);
+  m.z << v_b.y(), v_b.z() + v_b.x() * tan_pitch;
   m.h.setZero();
-  m.h.block<2, 3>(0, kVel.index) = C_n_b.bottomRows<2>();
-  m.h.block<2, 3>(0, kAtt.index) = -(C_n_b * skew(ins.vel_ned_mps)).bottomRows<2>();
+  m.h.block<2, 3>(0, kVel.index) = dvb_dv.bottomRows<2>();
+  m.h.block<2, 3>(0, kAtt.index) = dvb_dphi.bottomRows<2>();
+  m.h.block<1, 3>(1, kVel.index) += tan_pitch * dvb_dv.row(0);
+  m.h.block<1, 3>(1, kAtt.index) += tan_pitch * dvb_dphi.row(0);
   m.r = Eigen::Matrix2d::Identity() * sigma_mps * sigma_mps;
   return m;
 }

@@ -42,6 +42,12 @@ struct MountingResidual {
   std::size_t moving_epochs{0};
   Eigen::Vector2d configured_rms_mps{Eigen::Vector2d::Zero()};  ///< lateral, vertical
   Eigen::Vector2d corrected_rms_mps{Eigen::Vector2d::Zero()};
+  /// Over the straight epochs: the least-squares slope of the velocity's pitch in body axes
+  /// against the longitudinal acceleration (the speed's change over +-0.5 s) [rad per m/s^2],
+  /// with its correlation coefficient; a car's body pitches against its track as it speeds up
+  /// or brakes.
+  double velocity_pitch_per_accel_rad_per_mps2{0.0};
+  double velocity_pitch_accel_correlation{0.0};
 };
 
 /// The residual from smoothed epochs (only those with `smoothed` true count).

@@ -262,6 +262,8 @@ class NavigationEngine {
   Eigen::Vector3d starTrackerWhiteSigma(const Eigen::Vector3d& sigma_b_rad) const;
   EngineMode aidedMode() const;
   void applyStage(const StageDecision& d);
+  /// Along the velocity, from the latest increment [m/s^2] (0 standing still).
+  double longitudinalAcceleration() const;
   void constraintUpdate();
   void countGated(const ScalarUpdateResult* results, int n);
   void start(const NavState& state, double clock_bias_m, double clock_drift_mps,

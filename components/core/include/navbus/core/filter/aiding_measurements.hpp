@@ -62,7 +62,11 @@ VectorMeasurement zeroVelocityMeasurement(const NavState& ins, double sigma_mps)
 /// Non-holonomic constraint of a land vehicle (seed 004 eq. 6): the lateral and vertical body
 /// velocities are zero, z = (C_n_b V_INS)_{y,z} [m/s, body]. With C_b_n,est = (I - [phi x])
 /// C_b_n, the body velocity error is C_n_b dV - C_n_b [V x] phi, which gives the velocity and
-/// attitude columns of H.
-AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps);
+/// attitude columns of H. With `velocity_pitch_b_rad` the vertical row expects the velocity
+/// that far above the forward axis (the body pitched against the track, as a car's under
+/// acceleration): z_D = v_b,z + v_b,x tan(velocity_pitch_b_rad), H's vertical row gaining
+/// tan() times the forward row.
+AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps,
+                                             double velocity_pitch_b_rad = 0.0);
 
 }  // namespace navbus::core

@@ -70,6 +70,10 @@ struct MdfConfig {
   double constraint_period_s{0.1};  ///< ZUPT / NHC update period
   double zupt_sigma_mps{0.01};
   double nhc_sigma_mps{0.1};
+  /// The pitch of the velocity in body axes per unit of longitudinal acceleration [rad per
+  /// m/s^2]: a car's body pitches against its track as it speeds up or brakes (navbus
+  /// calibrate mounting measures it); the constraint's vertical row expects it. 0: a rigid body.
+  double nhc_velocity_pitch_per_accel_rad_per_mps2{0.0};
 };
 
 }  // namespace navbus::core
