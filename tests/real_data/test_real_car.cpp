@@ -205,7 +205,7 @@ TEST(RealCar, TheImportedRecordingRunsOfflineWithEveryIncrement) {
 TEST(RealCar, TwentySecondOutagesStayInsideTheirOwnThreeSigma) {
   // The 20 s every 60 s schedule (another the shipped list was not tuned on), same
   // configuration: measured 99.7 % of the outage epochs inside 3 sigma_h (91.7 % before the
-  // constraint took the body's squat), ends 3.38 / 14.35 m mean / worst.
+  // constraint took the body's squat), ends 3.36 / 14.33 m mean / worst.
   const fs::path out = workDir("real-car-20s");
   evaluation::RealCarOptions o;
   o.dataset = (kConfig / "datasets/drive_0708.yaml").string();

@@ -431,15 +431,15 @@ void NavigationEngine::applyStage(const StageDecision& d) {
 
 double NavigationEngine::longitudinalAcceleration() const {
   const NavState& s = filter_->state();
-  const double speed = s.vel_ned_mps.norm();
-  if (!last_increment_ || !(last_increment_->interval_s > 0.0) || !(speed > 0.0)) return 0.0;
+  if (!last_increment_ || !(last_increment_->interval_s > 0.0)) return 0.0;
   // The acceleration over the latest increment, C_b_n f_b + g (Coriolis and transport terms,
-  // below 1e-3 m/s^2 at car speeds, left out), along the velocity.
+  // below 1e-3 m/s^2 at car speeds, left out), along the body's forward axis: signed by the
+  // force on the body, so that speeding up in reverse pitches the nose down as braking does.
   const ImuIncrement inc = filter_->imuCorrection().applied(*last_increment_);
   const Eigen::Vector3d f_n = s.q_b_to_n * (inc.delta_vel_b_mps / inc.interval_s);
   const Eigen::Vector3d g_n =
       earth::localEarth(config_.tuning.gravity, s.position, s.vel_ned_mps).g_ned;
-  return (f_n + g_n).dot(s.vel_ned_mps) / speed;
+  return (f_n + g_n).dot(s.q_b_to_n * Eigen::Vector3d::UnitX());
 }
 
 void NavigationEngine::constraintUpdate() {

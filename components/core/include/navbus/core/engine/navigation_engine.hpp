@@ -262,7 +262,7 @@ class NavigationEngine {
   Eigen::Vector3d starTrackerWhiteSigma(const Eigen::Vector3d& sigma_b_rad) const;
   EngineMode aidedMode() const;
   void applyStage(const StageDecision& d);
-  /// Along the velocity, from the latest increment [m/s^2] (0 standing still).
+  /// Along the body's forward axis, from the latest increment [m/s^2].
   double longitudinalAcceleration() const;
   void constraintUpdate();
   void countGated(const ScalarUpdateResult* results, int n);
