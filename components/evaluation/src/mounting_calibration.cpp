@@ -13,7 +13,6 @@
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/evaluation/recording_runner.hpp"
-#include "navbus/importers/importer.hpp"
 
 namespace navbus::evaluation {
 
@@ -134,16 +133,12 @@ Eigen::Vector3d correctedMountingRpy(const Eigen::Matrix3d& sensor_to_body,
 }
 
 int runMountingCommand(const MountingOptions& o) {
-  const importers::DatasetDescription dataset = importers::readDatasetDescription(o.dataset);
-  const std::filesystem::path out_dir(o.out_dir);
-  const importers::ImportReport imported = importers::importDataset(dataset, out_dir / "recording");
-  RecordingSetup setup;
-  setup.dir = out_dir / "recording";
-  setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
+  ImportedRun imported = importForRun(o.dataset, o.filter, o.out_dir);
+  RecordingSetup& setup = imported.setup;
   setup.smooth = true;
   const RecordingResult run = runRecording(setup);
   const MountingResidual r = mountingResidual(run.smoothed, o.straight);
-  std::string text = imported.text;
+  std::string text = imported.import_text;
   if (r.epochs == 0) {
     text += fmt::format(
         "no smoothed epoch above {:.1f} m/s with a heading rate below {:.2f} deg/s: nothing to "

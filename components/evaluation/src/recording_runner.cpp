@@ -14,6 +14,7 @@
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
+#include "navbus/importers/importer.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/records/csv_messages.hpp"
 #include "navbus/records/formatters.hpp"
@@ -57,6 +58,16 @@ void load(const std::filesystem::path& dir, const char* topic, int rank, std::ve
 }
 
 }  // namespace
+
+ImportedRun importForRun(const std::string& dataset_yaml, const std::string& filter_yaml,
+                         const std::filesystem::path& out_dir) {
+  const importers::DatasetDescription dataset = importers::readDatasetDescription(dataset_yaml);
+  ImportedRun run;
+  run.import_text = importers::importDataset(dataset, out_dir / "recording").text;
+  run.setup.dir = out_dir / "recording";
+  run.setup.filter = bus::parseFile(filter_yaml, nav_filter::parseFilterConfig);
+  return run;
+}
 
 RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolutionHook& hook) {
   RecordingResult result;

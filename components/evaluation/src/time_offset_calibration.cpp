@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 
 #include "navbus/bus/config.hpp"
-#include "navbus/importers/importer.hpp"
 
 namespace navbus::evaluation {
 
@@ -126,17 +125,14 @@ OffsetSearch searchVelocityTimeOffset(const RecordingSetup& base, const Grid& gr
 }
 
 int runTimeOffsetCommand(const TimeOffsetOptions& o) {
-  const importers::DatasetDescription dataset = importers::readDatasetDescription(o.dataset);
   const std::filesystem::path out_dir(o.out_dir);
-  const importers::ImportReport imported = importers::importDataset(dataset, out_dir / "recording");
-  RecordingSetup setup;
-  setup.dir = out_dir / "recording";
-  setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
+  ImportedRun imported = importForRun(o.dataset, o.filter, out_dir);
+  RecordingSetup& setup = imported.setup;
 
   std::ofstream csv(out_dir / "time_offset.csv");
   csv << "round_stage,offset_s,mean_nis,other_rows_mean_nis,rows,epochs_tested,epochs_"
          "inconsistent\n";
-  std::string text = imported.text;
+  std::string text = imported.import_text;
   // Coordinate descent: each offset's misfit leaks into the other's rows a little, so the two
   // searches alternate (the IMU grid is always about the configured offset).
   const std::int64_t configured_imu_ns = setup.filter.imu.time_offset_ns;

@@ -458,8 +458,9 @@ void NavigationEngine::constraintUpdate() {
     ++counters_.zero_velocity_updates;
   } else if (stage == MdfStage::kF4Constraint &&
              config_.mdf.policy == MdfPolicy::kMultiDimensional) {
+    const double per_accel = config_.mdf.nhc_velocity_pitch_per_accel_rad_per_mps2;
     const double velocity_pitch_b_rad =
-        config_.mdf.nhc_velocity_pitch_per_accel_rad_per_mps2 * longitudinalAcceleration();
+        per_accel != 0.0 ? per_accel * longitudinalAcceleration() : 0.0;  // 0: a rigid body
     const auto r =
         filter_->update(nonHolonomicMeasurement(filter_->state(),
                                                 config_.mdf.nhc_sigma_mps *

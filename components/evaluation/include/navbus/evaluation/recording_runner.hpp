@@ -61,6 +61,15 @@ using RecordedSolutionHook = std::function<void(const navbus::NavigationSolution
 /// not read as its topic.
 RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolutionHook& hook = {});
 
+/// A data set (its YAML) imported into out_dir/recording, with the filter configuration read
+/// from its YAML: the start of the calibration commands. `import_text` is the import's report.
+struct ImportedRun {
+  RecordingSetup setup;
+  std::string import_text;
+};
+ImportedRun importForRun(const std::string& dataset_yaml, const std::string& filter_yaml,
+                         const std::filesystem::path& out_dir);
+
 struct RecordingOptions {
   std::string recording;
   std::string filter;
