@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -390,6 +391,74 @@ std::string honestyReport(const Scored& causal, const Scored* smoothed,
   return text;
 }
 
+/// With an injected IMU step: when the filter first flagged its solution after the onset, and
+/// what it published unflagged until then, judged at the fixed epochs as the scores judge them.
+struct StepScore {
+  std::int64_t onset_ns{0};
+  std::optional<double> first_flag_s;  ///< after the onset; nullopt: never flagged
+  std::size_t judged{0};               ///< fixed epochs judged unflagged before the flag
+  std::size_t outside{0};              ///< ... of them outside 3 sigma_h
+  double largest_m{0.0}, largest_ratio{0.0};
+  std::size_t solutions{0}, flagged{0};  ///< from the onset on
+};
+
+StepScore scoreStep(const std::vector<AntennaPoint>& points, const importers::PosLog& reference,
+                    const std::vector<Outage>& outages, std::int64_t onset_ns) {
+  StepScore r;
+  r.onset_ns = onset_ns;
+  const auto after_onset =
+      std::lower_bound(points.begin(), points.end(), onset_ns,
+                       [](const AntennaPoint& p, std::int64_t v) { return p.time_ns < v; });
+  const auto first_flag =
+      std::find_if(after_onset, points.end(), [](const AntennaPoint& p) { return !p.valid; });
+  std::int64_t flag_ns = std::numeric_limits<std::int64_t>::max();
+  if (first_flag != points.end()) {
+    flag_ns = first_flag->time_ns;
+    r.first_flag_s = 1e-9 * static_cast<double>(flag_ns - onset_ns);
+  }
+  r.solutions = static_cast<std::size_t>(points.end() - after_onset);
+  r.flagged = static_cast<std::size_t>(
+      std::count_if(after_onset, points.end(), [](const AntennaPoint& p) { return !p.valid; }));
+  for (std::size_t i = 0; i < reference.fixes.size(); ++i) {
+    const auto t = static_cast<std::int64_t>(reference.fixes[i].time_gps_ns());
+    if (reference.quality[i] != kQualityFix || t < onset_ns || t >= flag_ns) continue;
+    const navbus::GnssFix& f = reference.fixes[i];
+    const earth::Geodetic truth{f.latitude_rad(), f.longitude_rad(), f.height_m()};
+    const auto e =
+        outageOf(t, outages) >= 0 ? judge(points, t, truth) : judgeAfterFusion(points, t, truth);
+    if (!e || !e->valid) continue;
+    ++r.judged;
+    r.outside += e->horizontal_m > 3.0 * e->sigma_h_m ? 1 : 0;
+    r.largest_m = std::max(r.largest_m, e->horizontal_m);
+    r.largest_ratio = std::max(r.largest_ratio, e->horizontal_m / e->sigma_h_m);
+  }
+  return r;
+}
+
+/// The step's score, printed and as step.csv.
+std::string stepReport(const StepScore& r, const std::filesystem::path& csv_file) {
+  const double onset_sow = 1e-9 * static_cast<double>(secondsOfWeekNs(r.onset_ns));
+  std::ofstream csv(csv_file);
+  csv << "onset_sow,first_flag_after_s,judged_unflagged,outside_3sigma,largest_error_m,"
+         "largest_ratio,solutions,flagged\n"
+      << fmt::format("{:.3f},{},{},{},{:.4f},{:.3f},{},{}\n", onset_sow,
+                     r.first_flag_s ? fmt::format("{:.3f}", *r.first_flag_s) : "", r.judged,
+                     r.outside, r.largest_m, r.largest_ratio, r.solutions, r.flagged);
+  if (!csv) throw bus::ConfigError("cannot write " + csv_file.string());
+  std::string text =
+      r.first_flag_s
+          ? fmt::format(
+                "injected IMU step from {:.3f} s of week: first flagged {:.2f} s after the onset",
+                onset_sow, *r.first_flag_s)
+          : fmt::format("injected IMU step from {:.3f} s of week: never flagged after the onset",
+                        onset_sow);
+  return text + fmt::format(
+                    "; before that, {} fixed epochs judged unflagged, {} outside 3 sigma_h "
+                    "(largest error {:.3f} m, largest e / sigma_h {:.2f}); {} of the {} "
+                    "solutions from the onset on flagged\n",
+                    r.judged, r.outside, r.largest_m, r.largest_ratio, r.flagged, r.solutions);
+}
+
 }  // namespace
 
 std::vector<Outage> outageSchedule(const OutageSchedule& s, double last_sow) {
@@ -445,9 +514,10 @@ std::vector<Outage> readOutages(const std::filesystem::path& file) {
 }
 
 int runRealCarBenchmark(const RealCarOptions& o) {
-  const importers::DatasetDescription dataset = importers::readDatasetDescription(o.dataset);
+  importers::DatasetDescription dataset = importers::readDatasetDescription(o.dataset);
   if (!dataset.imu || !dataset.gnss_solutions)
     throw bus::ConfigError(o.dataset + ": the benchmark needs imu and gnss_solutions");
+  dataset.imu->step = o.imu_step;
   const std::filesystem::path out_dir(o.out_dir);
   const importers::ImportReport imported = importers::importDataset(dataset, out_dir / "recording");
   // The reference: the fixed epochs of the same file, read as the import read them.
@@ -526,6 +596,11 @@ int runRealCarBenchmark(const RealCarOptions& o) {
   }
   text += honestyReport(causal, backward ? &*backward : nullptr, points, !outages.empty(),
                         out_dir / "coverage.csv");
+  if (imported.imu_step_onset_gps_ns >= 0) {
+    text += stepReport(scoreStep(points, reference, outages, imported.imu_step_onset_gps_ns),
+                       out_dir / "step.csv");
+    written += ", step.csv";
+  }
   written += ", coverage.csv";
   writeFixInnovationsCsv(out_dir / "innovations.csv", run.fix_innovations);
   written += ", innovations.csv";

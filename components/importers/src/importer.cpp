@@ -1,9 +1,12 @@
 #include "navbus/importers/importer.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/topics.hpp"
+#include "navbus/core/math/units.hpp"
 #include "navbus/importers/imu_csv.hpp"
 #include "navbus/importers/imu_increments.hpp"
 #include "navbus/importers/rtklib_pos.hpp"
@@ -23,11 +26,24 @@ void write(const std::filesystem::path& dir, const char* topic, const std::vecto
   text += fmt::format("wrote {} samples of {} to {}\n", messages.size(), topic, path.string());
 }
 
+/// Adds the step to every sample from its onset on; counts the samples changed.
+void injectStep(const ImuStep& step, std::vector<ImuSample>& samples, ImportReport& report) {
+  if (samples.empty()) return;
+  report.imu_step_onset_gps_ns =
+      samples.front().time_gps_ns + std::llround(step.onset_after_start_s * 1e9);
+  for (ImuSample& s : samples) {
+    if (s.time_gps_ns < report.imu_step_onset_gps_ns) continue;
+    (step.gyro ? s.rate_s_radps : s.specific_force_s_mps2)[step.axis] += step.step;
+    ++report.imu_samples_injected;
+  }
+}
+
 void importImu(const ImuCsvDescription& d, const std::filesystem::path& out_dir,
                ImportReport& report) {
-  const ImuLog log = readImuCsv(d);
+  ImuLog log = readImuCsv(d);
   for (const auto& s : log.skipped) report.text += s + "\n";
   for (const auto& s : log.notes) report.text += s + "\n";
+  if (d.step) injectStep(*d.step, log.samples, report);
   const auto increments = incrementsFromSamples(log.samples, d.sensor_id);
   const auto blocks = blocksOf(increments, d.block_s);
   report.imu_samples = log.samples.size();
@@ -40,6 +56,13 @@ void importImu(const ImuCsvDescription& d, const std::filesystem::path& out_dir,
       "in {} blocks\n",
       d.file.string(), log.samples.size(), span_s, static_cast<double>(increments.size()) / span_s,
       d.sample_rate_hz, increments.size(), blocks.size());
+  if (d.step)
+    report.text += fmt::format(
+        "injected: {} step of {:g} {} on sensor axis {} from {:g} s after the first sample ({} "
+        "samples changed)\n",
+        d.step->gyro ? "a gyro" : "an accelerometer",
+        d.step->gyro ? d.step->step / units::kDeg : d.step->step, d.step->gyro ? "deg/s" : "m/s^2",
+        "xyz"[d.step->axis], d.step->onset_after_start_s, report.imu_samples_injected);
   write(out_dir, bus::topic::kImuIncrementBlock, blocks, report.text);
 }
 

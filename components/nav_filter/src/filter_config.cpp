@@ -131,6 +131,7 @@ void parseConsistency(const YAML::Node& node, core::ConsistencyConfig& k) {
                {1.0, static_cast<double>(core::ConsistencyMonitor::kMaxWindow)})
       .number("false_alarm_probability", k.false_alarm_probability, {1e-15, 0.5})
       .number("reinitialise_after_s", k.reinitialise_after_s, {0.0, 86400.0})
+      .value("inflate_imu_biases_on_alarm", k.inflate_imu_biases_on_alarm)
       .finish();
 }
 /// A list of names out of `names` (e.g. adaptive_noise.streams) as the set of their indexes.

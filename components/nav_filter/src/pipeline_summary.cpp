@@ -19,7 +19,8 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
       << " (propagated across " << n.gaps_bridged << ")"
       << ", consistency: epochs tested " << v.engine.consistency().counters().epochs_tested
       << " inconsistent " << v.engine.consistency().counters().epochs_inconsistent << " alarms "
-      << v.engine.consistency().counters().alarms << ", mean NIS of the fixes' position rows "
+      << v.engine.consistency().counters().alarms << " (IMU bias sigmas raised at "
+      << n.bias_inflations << "), mean NIS of the fixes' position rows "
       << fmt::format("{:.3f}", n.fix_position_nis.mean()) << " velocity rows "
       << fmt::format("{:.3f}", n.fix_velocity_nis.mean()) << " (velocities older than the history "
       << n.fix_velocities_beyond_history << "), re-initialisations asked "

@@ -22,6 +22,38 @@
 namespace navbus::tool::cli {
 namespace {
 
+/// --accel-step / --gyro-step AXIS,STEP,ONSET: an IMU bias step injected by the import.
+struct ImuStepOptions {
+  std::vector<double> accel, gyro;
+
+  void add(CLI::App& app) {
+    CLI::Option* a =
+        app.add_option("--accel-step", accel,
+                       "AXIS,STEP,ONSET: add STEP [m/s^2] to the accelerometer's sensor axis AXIS "
+                       "(0 x, 1 y, 2 z of the file's columns) from ONSET [s after the first IMU "
+                       "sample] (a fault for the detectors to find)")
+            ->expected(3)
+            ->delimiter(',');
+    app.add_option("--gyro-step", gyro, "AXIS,STEP,ONSET: the same for the gyro, STEP in deg/s")
+        ->expected(3)
+        ->delimiter(',')
+        ->excludes(a);
+  }
+
+  /// The step in SI, or nullopt; throws bus::ConfigError naming the option and the value.
+  std::optional<importers::ImuStep> step() const {
+    const bool gyro_step = !gyro.empty();
+    const std::vector<double>& v = gyro_step ? gyro : accel;
+    if (v.empty()) return std::nullopt;
+    if (!(v[0] == 0 || v[0] == 1 || v[0] == 2) || !std::isfinite(v[1]) || !(v[2] >= 0.0))
+      throw bus::ConfigError(
+          fmt::format("--{}-step {},{},{}: AXIS must be 0, 1 or 2, STEP finite, ONSET >= 0 s",
+                      gyro_step ? "gyro" : "accel", v[0], v[1], v[2]));
+    return importers::ImuStep{gyro_step, static_cast<int>(v[0]),
+                              gyro_step ? v[1] * units::kDeg : v[1], v[2]};
+  }
+};
+
 class ImportCommand final : public Subcommand {
  public:
   void add(CLI::App& app) override {
@@ -38,10 +70,16 @@ class ImportCommand final : public Subcommand {
                      "for the GLR to find; needs gnss_observations in the data set)")
         ->expected(3)
         ->delimiter(',');
+    imu_step_.add(*cli_);
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
     auto description = importers::readDatasetDescription(dataset_);
+    if (const auto step = imu_step_.step()) {
+      if (!description.imu)
+        throw bus::ConfigError("--accel-step/--gyro-step: " + dataset_ + " has no imu");
+      description.imu->step = step;
+    }
     if (!ramp_.empty()) {
       if (!description.gnss_observations)
         throw bus::ConfigError("--ramp: " + dataset_ + " has no gnss_observations to inject into");
@@ -63,6 +101,7 @@ class ImportCommand final : public Subcommand {
   std::string dataset_;
   std::string out_dir_;
   std::vector<double> ramp_;
+  ImuStepOptions imu_step_;
 };
 
 /// `--outage-schedule LENGTH,PERIOD,FIRST`: a regular schedule instead of an outage list.
@@ -127,18 +166,21 @@ class RealCarBenchmarkCommand final : public Subcommand {
                    "also score the fixed-interval (Rauch-Tung-Striebel) smoother over the same "
                    "forward run: smoothed.csv, smoothed_outages.csv");
     addFaultManager(*cli_, o_);
+    imu_step_.add(*cli_);
   }
   bool usesBus() const override { return false; }
   int run(bus::Participant::Options& /*options*/, bus::ShutdownSignal& /*shutdown*/) override {
     if (o_.outages.empty() && schedule_.empty())
       throw bus::ConfigError("benchmark real-car needs --outages FILE or --outage-schedule");
     o_.schedule = scheduleOf(schedule_);
+    o_.imu_step = imu_step_.step();
     return evaluation::runRealCarBenchmark(o_);
   }
 
  private:
   evaluation::RealCarOptions o_;
   std::vector<double> schedule_;
+  ImuStepOptions imu_step_;
 };
 
 class RealDataBenchmarkCommand final : public Subcommand {

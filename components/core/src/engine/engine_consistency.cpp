@@ -29,7 +29,16 @@ void NavigationEngine::checkConsistency(std::int64_t time_ns,
 }
 
 void NavigationEngine::judgeConsistency(std::int64_t time_ns, double nis, int dof) {
+  const std::uint64_t alarms_before = consistency_.counters().alarms;
   consistency_.onEpoch(time_ns, nis, dof);
+  if (consistency_.counters().alarms != alarms_before &&
+      config_.consistency.inflate_imu_biases_on_alarm) {
+    // The model stopped fitting: let the biases be learnt again (a shifted sensor bias is
+    // what the filter can recover from; its solution stays flagged while the window fails).
+    filter_->inflateVariances(layout::kAccelBias, config_.tuning.accel_bias_sigma_mps2);
+    filter_->inflateVariances(layout::kGyroBias, config_.tuning.gyro_bias_sigma_radps);
+    ++counters_.bias_inflations;
+  }
   if (consistency_.inconsistent()) {
     status_ |= kStatusInconsistent;
   } else {

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "navbus/importers/dataset.hpp"
+
 namespace navbus::evaluation {
 
 /// One outage [start, end) in GPS seconds of week: a solution epoch t is withheld when
@@ -50,6 +52,9 @@ struct RealCarOptions {
   /// decisions act on it (empty: the filter alone). Protection levels, published by a filter
   /// with an `integrity` block, are scored either way.
   std::string fault_manager;
+  /// An IMU bias step injected by the import: the benchmark then says when the filter flagged
+  /// its solution after the onset, and what it published unflagged before that.
+  std::optional<importers::ImuStep> imu_step;
 };
 
 int runRealCarBenchmark(const RealCarOptions& o);

@@ -15,6 +15,16 @@
 
 namespace navbus::importers {
 
+/// A fault added to one axis of the written IMU samples: a constant `step` in the sensor's axes
+/// from the onset on (an accelerometer [m/s^2] or gyro [rad/s] bias step, for the detectors to
+/// find on real data).
+struct ImuStep {
+  bool gyro{false};                 ///< false: the accelerometer
+  int axis{0};                      ///< sensor axis 0..2 (x y z of the file's columns)
+  double step{0.0};                 ///< [m/s^2] or [rad/s]
+  double onset_after_start_s{0.0};  ///< after the first sample of the file
+};
+
 /// Where an IMU sample's GPS time comes from.
 enum class ImuTimeSource {
   kDeviceTicks,       ///< a device counter column mapped by an RTKLIB time-tag file
@@ -40,6 +50,7 @@ struct ImuCsvDescription {
   std::uint32_t gps_week{0};       ///< seconds of week: the week
   double time_offset_s{0.0};       ///< added to every sample's time (logging delays)
   double block_s{0.1};             ///< increments per recorded block, as time
+  std::optional<ImuStep> step;     ///< a fault injected into the written samples
 };
 
 /// How one RTKLIB solution quality is used: its sigmas are the file's times `sigma_scale`, at

@@ -154,6 +154,9 @@ struct EngineCounters {
   /// Re-initialisations from a GNSS solution: asked for (a gap beyond the bridge, a lasting
   /// inconsistency) and done.
   std::uint64_t reinitialisations_asked{0}, reinitialisations_done{0};
+  /// Alarms at which the IMU bias sigmas were raised (ConsistencyConfig::
+  /// inflate_imu_biases_on_alarm).
+  std::uint64_t bias_inflations{0};
   /// The fixes' position and velocity rows: normalized innovations squared (mean about 1 when
   /// the covariance explains them; navbus calibrate time-offset minimizes them).
   InnovationStatistics fix_position_nis, fix_velocity_nis;

@@ -21,6 +21,11 @@ struct ConsistencyConfig {
   int window_epochs{10};                 ///< N: epochs summed per test (1..kMaxWindow)
   double false_alarm_probability{1e-4};  ///< alpha per tested epoch on a consistent filter
   double reinitialise_after_s{10.0};     ///< an alarm this long asks for re-initialisation [s]
+  /// At each alarm the filter raises its accelerometer and gyro bias sigmas to at least their
+  /// turn-on sigmas (ekf.accel_bias_sigma_ug, gyro_bias_sigma_deg_per_h): the model stopped
+  /// fitting, and a sensor whose bias shifted is what an inertial filter can learn again. Not
+  /// the ConsistencyMonitor's concern (it only judges); the engine acts on it.
+  bool inflate_imu_biases_on_alarm{false};
 };
 
 struct ConsistencyCounters {
