@@ -132,10 +132,16 @@ Eigen::Vector3d correctedMountingRpy(const Eigen::Matrix3d& sensor_to_body,
   return core::eulerFromDcm(sensor_to_body.transpose() * R);
 }
 
+void configureMountingRun(RecordingSetup& setup) {
+  setup.smooth = true;
+  setup.withhold = {};
+  setup.filter.engine.consistency.inflate_imu_biases_on_alarm = false;
+}
+
 int runMountingCommand(const MountingOptions& o) {
   ImportedRun imported = importForRun(o.dataset, o.filter, o.out_dir);
   RecordingSetup& setup = imported.setup;
-  setup.smooth = true;
+  configureMountingRun(setup);
   const RecordingResult run = runRecording(setup);
   const MountingResidual r = mountingResidual(run.smoothed, o.straight);
   std::string text = imported.import_text;

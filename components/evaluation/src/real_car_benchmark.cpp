@@ -160,6 +160,7 @@ struct ProtectionTally {
   std::size_t epochs{0};
   std::size_t monitored{0};  ///< with levels computed
   std::size_t available{0};
+  std::size_t initializing{0};  ///< monitored, the detector's hypotheses not yet formed
   std::size_t misleading_h{0}, misleading_v{0};
   double worst_h_ratio{0.0}, worst_v_ratio{0.0};  ///< largest e / PL while available
 
@@ -169,6 +170,7 @@ struct ProtectionTally {
     // solution is UNAVAILABLE whether monitored or not).
     if (!(j.hpl_m > 0.0 && j.vpl_m > 0.0)) return;
     ++monitored;
+    initializing += j.integrity == navbus::INTEGRITY_INITIALIZING ? 1 : 0;
     if (j.integrity != navbus::INTEGRITY_AVAILABLE) return;
     ++available;
     misleading_h += j.horizontal_m > j.hpl_m ? 1 : 0;
@@ -183,15 +185,15 @@ struct ProtectionTally {
     if (monitored == 0)
       return fmt::format(
           "protection levels: not monitored in any of the {} judged epochs (the filter has no "
-          "integrity block, or the mode has no fault detector on its measurements: only "
-          "tightly coupled has)\n",
+          "integrity block, or no fault manager judged its pseudorange epochs)\n",
           epochs);
     return fmt::format(
-        "protection levels: {} judged epochs, monitored {}, available {} ({:.1f} %); while "
-        "available, error beyond HPL {} and beyond VPL {} (largest e_h / HPL {:.2f}, e_v / VPL "
-        "{:.2f})\n",
-        epochs, monitored, available, 100.0 * availableShare(), misleading_h, misleading_v,
-        worst_h_ratio, worst_v_ratio);
+        "protection levels: {} judged epochs, monitored {}, available {} ({:.1f} %; "
+        "initializing {}, unavailable {}); while available, error beyond HPL {} and beyond VPL "
+        "{} (largest e_h / HPL {:.2f}, e_v / VPL {:.2f})\n",
+        epochs, monitored, available, 100.0 * availableShare(), initializing,
+        monitored - available - initializing, misleading_h, misleading_v, worst_h_ratio,
+        worst_v_ratio);
   }
 };
 

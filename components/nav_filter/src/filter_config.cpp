@@ -118,10 +118,16 @@ void parseIntegrity(const YAML::Node& node, core::EngineConfig& e) {
                  {"window_epochs", "threshold", "ambiguity_margin", "ambiguity_correlation",
                   "rank_tolerance", "hypotheses"});
   bus::parseGlrStatistics(d, "integrity.detector", i.detector);
-  if (i.enabled && e.aiding != core::AidingMode::kTightlyCoupled)
+  if (i.enabled && e.aiding == core::AidingMode::kInertialOnly)
     throw bus::ConfigError(
-        "configuration integrity.enabled: true needs mode: tightly_coupled (the protection "
-        "levels come from the GLR on pseudoranges)");
+        "configuration integrity.enabled: true needs GNSS (mode: tightly_coupled, "
+        "loosely_coupled or multi_dimensional): the protection levels come from the GLR on its "
+        "measurements");
+  if (i.enabled && e.aiding != core::AidingMode::kTightlyCoupled &&
+      e.fusion != core::FusionStructure::kCentralized)
+    throw bus::ConfigError(
+        "configuration integrity.enabled: true on GNSS fixes needs fusion: centralized (the "
+        "detector follows the one filter's gain)");
 }
 /// The filter's test of its own innovations (core/integrity/consistency_monitor.hpp).
 void parseConsistency(const YAML::Node& node, core::ConsistencyConfig& k) {

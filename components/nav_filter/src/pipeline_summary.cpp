@@ -76,7 +76,8 @@ void describeOptional(const PipelineView& v, std::ostringstream& out) {
     out << ", " << describeAlignment(v.engine);
   if (v.config.engine.integrity.enabled) {
     out << ", protection-level epochs " << v.engine.protectionLevelEpochs() << " refused "
-        << v.engine.protectionLevelEpochsRefused();
+        << v.engine.protectionLevelEpochsRefused() << " with a fault declared "
+        << v.engine.protectionLevelDetections();
   }
   if (v.config.low_latency_output) {
     const core::OutputPredictorCounters& l = v.low_latency;

@@ -51,7 +51,9 @@ navbus::NavigationSolution buildSolution(const core::NavigationEngine& engine,
   sol.active_fault_flags(pipeline_flags | faultFlags(engine.status()));
   sol.imu_samples_used(engine.counters().imu_used);
   sol.start_source(toIdl(config.start, engine.alignedStart().attitude_source));
-  if (fault_monitor_alive) {
+  // Tightly coupled, the levels assume the fault manager's GLR acts; on fixes the engine's own
+  // detector is the monitor.
+  if (fault_monitor_alive || config.aiding != core::AidingMode::kTightlyCoupled) {
     const core::ProtectionLevels pl = engine.protectionLevels();
     sol.integrity(engine.trustworthy() ? toIdl(pl.state) : navbus::INTEGRITY_UNAVAILABLE);
     sol.horizontal_protection_level_m(pl.horizontal_m);

@@ -242,6 +242,28 @@ TEST_F(ConfigKeys, ScaleFactorSigmasAreInPartsPerMillionAndBounded) {
   EXPECT_NE(negative.find("-5"), std::string::npos) << negative;
 }
 
+TEST_F(ConfigKeys, ProtectionLevelsOnFixesNeedTheCentralizedFilter) {
+  const auto with = [&](const std::string& name, const std::string& mode,
+                        const std::string& fusion) {
+    return write(name, "mode: " + mode + "\nfusion: " + fusion +
+                           "\ninputs: {imu: {id: 1, period_s: 0.01}, gnss_fix: {id: 1, "
+                           "period_s: 0.25}}\nintegrity: {detector: {window_epochs: 20}}\n"
+                           "consistency: {inflate_imu_biases_on_alarm: true}\n");
+  };
+  const auto loose =
+      navbus::bus::parseFile(with("lc.yaml", "loosely_coupled", "centralized"), filter);
+  EXPECT_TRUE(loose.engine.integrity.enabled);
+  EXPECT_TRUE(loose.engine.consistency.inflate_imu_biases_on_alarm);
+  const auto mdf =
+      navbus::bus::parseFile(with("mdf.yaml", "multi_dimensional", "centralized"), filter);
+  EXPECT_TRUE(mdf.engine.integrity.enabled);
+  const std::string adaptive =
+      errorOf(with("adaptive.yaml", "loosely_coupled", "adaptive"), filter);
+  EXPECT_NE(adaptive.find("integrity.enabled: true on GNSS fixes needs fusion: centralized"),
+            std::string::npos)
+      << adaptive;
+}
+
 TEST_F(ConfigKeys, AdaptiveNoiseNamesItsStreamsAndKeepsItsBoundsInOrder) {
   const auto with = [&](const std::string& name, const std::string& block,
                         const std::string& fusion = "centralized") {

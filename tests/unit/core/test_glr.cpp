@@ -12,6 +12,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
+#include "navbus/core/filter/epoch_diagnostics.hpp"
+#include "navbus/core/filter/error_state.hpp"
 #include "navbus/core/integrity/glr.hpp"
 #include "navbus/core/integrity/glr_protection_level.hpp"
 #include "navbus/core/math/chi_square.hpp"
@@ -486,4 +488,59 @@ TEST(GlrProtection, LevelsAreTheFaultFreeBoundOrTheWorstUndetectedFault) {
   EXPECT_GT(faulted_h, fault_free_h);
   EXPECT_NEAR(l.horizontal_m, faulted_h, 1e-9);
   EXPECT_NEAR(l.vertical_m, std::max(3.0 * 5.45131, b.vertical_m + 3.0 * 3.290527), 1e-4);
+}
+
+TEST(GlrProtection, AFixEpochCarriesTheGainItsTwoUpdatesApplied) {
+  // A loosely coupled fix is fused as two sequential updates (position, then velocity); the
+  // epoch the levels' GLR sees is their batch form from the prior: with the two applied to the
+  // same error state (no feedback between them, a linear model), K z is the estimate they left.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n01;
+  StateMatrix a;
+  for (int i = 0; i < a.size(); ++i) a.data()[i] = n01(rng);
+  const StateMatrix prior_P = a * a.transpose() / nc::layout::kSize + 0.1 * StateMatrix::Identity();
+  nc::VectorMeasurement position, velocity;
+  for (nc::VectorMeasurement* m : {&position, &velocity}) {
+    m->h.setZero();
+    for (int i = 0; i < 3; ++i) m->z[i] = n01(rng);
+    m->r = Eigen::Vector3d(0.2, 0.3, 0.4).asDiagonal();
+  }
+  position.h.block<3, 3>(0, nc::layout::kPos.index).setIdentity();
+  position.h.block<3, 3>(0, nc::layout::kAtt.index) << 0, 0.3, -0.1, -0.3, 0, 0.2, 0.1, -0.2, 0;
+  position.h.block<3, 3>(0, nc::layout::kFixPositionError.index).setIdentity();
+  velocity.h.block<3, 3>(0, nc::layout::kVel.index).setIdentity();
+  velocity.h.block<3, 3>(0, nc::layout::kAtt.index) << 0, 0.5, 0.1, -0.5, 0, 0.4, -0.1, -0.4, 0;
+  const nc::StateMask active = nc::StateMask().set();
+  nc::ErrorState es;
+  es.initialize(prior_P, active);
+  const auto p = es.update(position, 0.0);
+  const auto v = es.update(velocity, 0.0);
+
+  const StateMatrix phi = StateMatrix::Identity();
+  nc::FixEpochInput in;
+  in.position = &position;
+  in.velocity = &velocity;
+  in.prior_P = &prior_P;
+  in.phi = &phi;
+  in.active = active;
+  in.estimated = active;
+  for (std::size_t i = 0; i < 3; ++i) {
+    in.used[i] = p[i].accepted;
+    in.used[i + 3] = v[i].accepted;
+  }
+  nc::AppliedGain gain;
+  nc::EpochDiagnostics d;
+  nc::fixEpochDiagnostics(in, gain, d);
+  ASSERT_EQ(d.innovation.size(), 6);
+  EXPECT_EQ(d.sv_ids, (std::vector<int>{1, 2, 3, 1, 2, 3}));
+  EXPECT_EQ(d.is_rate, (std::vector<bool>{false, false, false, true, true, true}));
+  const StateVector batch = d.k * d.innovation;
+  EXPECT_LT((batch - es.x()).cwiseAbs().maxCoeff(), 1e-9 * es.x().cwiseAbs().maxCoeff())
+      << "batch " << batch.transpose() << "\nsequential " << es.x().transpose();
+  EXPECT_NEAR(d.innovation_cov(4, 4),
+              (velocity.h.row(1) * prior_P * velocity.h.row(1).transpose())(0, 0) + 0.3, 1e-12);
+  // A row the update refused carries no gain.
+  in.used[4] = false;
+  nc::fixEpochDiagnostics(in, gain, d);
+  EXPECT_EQ(d.k.col(4).cwiseAbs().maxCoeff(), 0.0);
 }

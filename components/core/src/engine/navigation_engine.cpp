@@ -107,6 +107,9 @@ std::uint64_t NavigationEngine::protectionLevelEpochs() const {
 std::uint64_t NavigationEngine::protectionLevelEpochsRefused() const {
   return integrity_->refused();
 }
+std::uint64_t NavigationEngine::protectionLevelDetections() const {
+  return integrity_->detections();
+}
 bool NavigationEngine::aligning() const {
   return config_.start == StartSource::kAligned && !filter_->initialized();
 }
@@ -263,7 +266,10 @@ void NavigationEngine::start(const NavState& state, double clock_bias_m, double 
   velocity_history_.clear();
   filter_->initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
                       config_.fusion, initial_covariance);
-  filter_->keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled);
+  // The GLRs' Phi between epochs: the fault manager's (pseudoranges) and the protection
+  // levels' own on fixes.
+  filter_->keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled ||
+                                     config_.integrity.enabled);
   integrity_->reset();  // the hypotheses describe the previous run of the filter
   for (int i = 0; i < 6; ++i) {
     if (failed_axes_ & (1u << i)) filter_->setAxisFailed(i < 3, i % 3, true);
@@ -372,6 +378,12 @@ void NavigationEngine::applyStage(const StageDecision& d) {
   mode_ = stageMode(d.stage);
   if (!d.changed) return;
   ++counters_.stage_switches;
+  // Between the fixes of two stages that fuse them came ZUPT or NHC updates that the
+  // detector's recursion does not carry: its hypotheses start again with the first fix of
+  // such a stage. In between (standing, outages) the levels keep the last fix's fault biases.
+  if (config_.integrity.enabled && !integrityOnPseudoranges() &&
+      (d.stage == MdfStage::kF2Gnss || d.stage == MdfStage::kF3Recovery))
+    integrity_->reset();
   const FilterTuning& t = config_.tuning;
   if (config_.mdf.policy == MdfPolicy::kMultiDimensional) {
     StateMask m = config_.mdf.unestimated == ReducedStates::kNone
@@ -576,10 +588,17 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
 }
 
 ProtectionLevels NavigationEngine::protectionLevels() const {
-  if (!config_.integrity.enabled || config_.aiding != AidingMode::kTightlyCoupled ||
-      !filter_->initialized())
-    return {};
-  return integrity_->levels(filter_->covariance().block<3, 3>(kPos.index, kPos.index));
+  if (!config_.integrity.enabled || !filter_->initialized()) return {};
+  ProtectionLevels pl =
+      integrity_->levels(filter_->covariance().block<3, 3>(kPos.index, kPos.index));
+  // On fixes the detector is the levels' own (no fault manager watches fixes, and nothing can
+  // be excluded): while it declares a fault, the levels do not bound the error.
+  if (!integrityOnPseudoranges() && integrity_->detected()) pl.state = IntegrityState::kUnavailable;
+  return pl;
+}
+
+bool NavigationEngine::integrityOnPseudoranges() const {
+  return config_.aiding == AidingMode::kTightlyCoupled;
 }
 
 earth::Geodetic NavigationEngine::fixPositionAtStateTime(const GnssFixMeasurement& fix) const {
@@ -641,17 +660,26 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
       fix.pos_sigma_ned_m * noiseSigmaFactor(NoiseStream::kFixPosition);
   const Eigen::Vector3d vel_sigma_mps =
       fix.vel_sigma_ned_mps * noiseSigmaFactor(NoiseStream::kFixVelocity);
-  const auto p = filter_->update(
-      positionMeasurement(
-          filter_->state(), fixPositionAtStateTime(fix), pos_sigma_m, lever_b,
-          filter_->modelsFixPositionError() ? &filter_->fixPositionError() : nullptr),
-      AidingKind::kPosition);
+  const Eigen::Vector3d fix_vel_ned_mps = fixVelocityAtStateTime(fix);
+  const VectorMeasurement position = positionMeasurement(
+      filter_->state(), fixPositionAtStateTime(fix), pos_sigma_m, lever_b,
+      filter_->modelsFixPositionError() ? &filter_->fixPositionError() : nullptr);
+  // The protection levels' detector sees the epoch as it stood before the updates.
+  const bool monitored = config_.integrity.enabled;
+  if (monitored) {
+    fix_prior_P_ = filter_->covariance();
+    fix_phi_ = filter_->transitionSinceUpdate();
+    fix_velocity_prior_ =
+        velocityMeasurement(filter_->state(), fix_vel_ned_mps, vel_sigma_mps, lever_b, bodyRate());
+  }
+  const auto p = filter_->update(position, AidingKind::kPosition);
   countGated(p.data(), 3);
   adaptNoise(NoiseStream::kFixPosition, p.data(), 3);
-  const auto v = filter_->update(velocityMeasurement(filter_->state(), fixVelocityAtStateTime(fix),
-                                                     vel_sigma_mps, lever_b, bodyRate()),
-                                 AidingKind::kVelocity);
+  const auto v = filter_->update(
+      velocityMeasurement(filter_->state(), fix_vel_ned_mps, vel_sigma_mps, lever_b, bodyRate()),
+      AidingKind::kVelocity);
   countGated(v.data(), 3);
+  if (monitored) monitorFix(fix.time_ns, position, p, v);
   adaptNoise(NoiseStream::kFixVelocity, v.data(), 3);
   std::array<ScalarUpdateResult, 6> rows{};
   std::copy(p.begin(), p.end(), rows.begin());
@@ -664,6 +692,24 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   if (config_.fix_innovation_log != nullptr) logFixInnovations(p, pos_sigma_m, v, vel_sigma_mps);
   ++counters_.fixes_fused;
   if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();
+}
+
+void NavigationEngine::monitorFix(std::int64_t time_ns, const VectorMeasurement& position,
+                                  const std::array<ScalarUpdateResult, 3>& p,
+                                  const std::array<ScalarUpdateResult, 3>& v) {
+  FixEpochInput in;
+  in.position = &position;
+  in.velocity = &fix_velocity_prior_;
+  in.prior_P = &fix_prior_P_;
+  in.phi = &fix_phi_;
+  in.active = filter_->active();
+  in.estimated = filter_->estimated();
+  for (std::size_t i = 0; i < 3; ++i) {
+    in.used[i] = p[i].accepted;
+    in.used[i + 3] = v[i].accepted;
+  }
+  fixEpochDiagnostics(in, fix_gain_, fix_epoch_);
+  integrity_->onEpoch(time_ns, fix_epoch_);
 }
 
 void NavigationEngine::logFixInnovations(const std::array<ScalarUpdateResult, 3>& position,

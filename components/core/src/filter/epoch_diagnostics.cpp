@@ -18,4 +18,34 @@ void AppliedGain::compute(EpochDiagnostics& d, const StateMatrix& prior_P) {
   }
 }
 
+void fixEpochDiagnostics(const FixEpochInput& in, AppliedGain& gain, EpochDiagnostics& d) {
+  constexpr int kRows = 6;
+  d.sv_ids.clear();
+  d.is_rate.clear();
+  d.used.assign(in.used.begin(), in.used.end());
+  d.test_ratio.assign(kRows, 0.0);
+  d.innovation.resize(kRows);
+  d.h.resize(kRows, layout::kSize);
+  Eigen::Matrix<double, kRows, kRows> r = Eigen::Matrix<double, kRows, kRows>::Zero();
+  for (int block = 0; block < 2; ++block) {
+    const VectorMeasurement& m = block == 0 ? *in.position : *in.velocity;
+    d.innovation.segment<3>(3 * block) = m.z;
+    d.h.middleRows<3>(3 * block) = m.h;
+    r.block<3, 3>(3 * block, 3 * block) = m.r;
+    for (int axis = 0; axis < 3; ++axis) {
+      d.sv_ids.push_back(kFixAxisSources[static_cast<std::size_t>(axis)]);
+      d.is_rate.push_back(block == 1);
+    }
+  }
+  for (int j = 0; j < layout::kSize; ++j) {
+    if (!in.active[static_cast<std::size_t>(j)]) d.h.col(j).setZero();
+  }
+  d.innovation_cov = d.h * *in.prior_P * d.h.transpose() + r;
+  d.phi = *in.phi;
+  gain.compute(d, *in.prior_P);
+  for (int j = 0; j < layout::kSize; ++j) {
+    if (!in.estimated[static_cast<std::size_t>(j)]) d.k.row(j).setZero();
+  }
+}
+
 }  // namespace navbus::core

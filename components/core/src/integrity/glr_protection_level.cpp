@@ -83,7 +83,9 @@ void GlrProtectionLevel::reset() {
 void GlrProtectionLevel::onEpoch(std::int64_t time_ns, const EpochDiagnostics& epoch) {
   if (!monitor_) return;
   toGlrEpoch(time_ns, epoch, epoch_);
-  if (!monitor_->update(epoch_).valid) return;  // refused: counted by the monitor
+  const GlrResult& result = monitor_->update(epoch_);
+  if (!result.valid) return;  // refused: counted by the monitor
+  detections_ += result.detected ? 1 : 0;
   monitor_->positionSignatures(signatures_);
   biases_ = FaultBiases{};
   have_biases_ = !signatures_.empty();

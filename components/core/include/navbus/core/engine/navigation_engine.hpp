@@ -258,6 +258,8 @@ class NavigationEngine {
   /// Pseudorange epochs the protection levels took, and refused (not finite).
   std::uint64_t protectionLevelEpochs() const;
   std::uint64_t protectionLevelEpochsRefused() const;
+  /// ... and those at which its detector declared a fault (on fixes: the levels unavailable).
+  std::uint64_t protectionLevelDetections() const;
 
  private:
   StateMask baseMask() const;
@@ -297,6 +299,14 @@ class NavigationEngine {
                          const Eigen::Vector3d& pos_sigma_m,
                          const std::array<ScalarUpdateResult, 3>& velocity,
                          const Eigen::Vector3d& vel_sigma_mps);
+  /// A fused fix to the protection levels' detector (loose coupling and the multi-dimensional
+  /// filter): the fix's rows as one epoch (filter/epoch_diagnostics.hpp, kFixAxisSources).
+  void monitorFix(std::int64_t time_ns, const VectorMeasurement& position,
+                  const std::array<ScalarUpdateResult, 3>& p,
+                  const std::array<ScalarUpdateResult, 3>& v);
+  /// The protection levels' detector watches pseudoranges (and the fault manager acts on its
+  /// decisions) rather than fixes.
+  bool integrityOnPseudoranges() const;
   void judgeConsistency(std::int64_t time_ns, double nis, int dof);
   void askReinitialisation();
   /// While re-initialisation is asked: from this epoch's pseudorange solution (false: not
@@ -312,6 +322,13 @@ class NavigationEngine {
   Indirect<StationarityDetector> stationarity_;
   Indirect<StageSelector> stages_;
   ConsistencyMonitor consistency_;
+  /// A fix epoch for the protection levels' detector: the prior covariance, the transition
+  /// since the previous fix and the velocity row at the prior state, kept between the updates.
+  StateMatrix fix_prior_P_{StateMatrix::Zero()};
+  StateMatrix fix_phi_{StateMatrix::Identity()};
+  VectorMeasurement fix_velocity_prior_;
+  EpochDiagnostics fix_epoch_;
+  AppliedGain fix_gain_;
   std::array<NoiseScaleEstimator, kNoiseStreams> noise_scales_;
   /// The stream's sigma factor for this epoch: sqrt of its scale on R.
   double noiseSigmaFactor(NoiseStream s) const;

@@ -4,11 +4,13 @@
 // Shared by the tightly coupled filter and the static receiver filter.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "navbus/core/filter/aiding_measurements.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 
 namespace navbus::core {
@@ -39,5 +41,27 @@ class AppliedGain {
   /// LLT leaves its status unset, which GCC reports when a filter is assigned.
   Eigen::LLT<Eigen::MatrixXd> llt_{Eigen::MatrixXd(0, 0)};
 };
+
+/// The sources a loosely coupled epoch names in EpochDiagnostics::sv_ids: the fix's north,
+/// east and down axes, each with a value row (its position, in the place of a pseudorange) and
+/// a rate row (its velocity, in the place of a pseudorange rate). The GLR of the protection
+/// levels (glr_protection_level.hpp) then tests per axis a position step and ramp and a
+/// velocity step, as it tests a satellite. Not published: the fault manager watches satellites.
+inline constexpr std::array<int, 3> kFixAxisSources{1, 2, 3};
+
+/// One GNSS fix as an epoch for the GLR (rows: position N E D, velocity N E D): the two
+/// measurements as they stood at the prior state, the prior covariance and the transition since
+/// the previous update, and which rows the update accepted. H has no columns on inactive states
+/// and K no rows on states the update does not correct (consider states), as the update did.
+struct FixEpochInput {
+  const VectorMeasurement* position{nullptr};
+  const VectorMeasurement* velocity{nullptr};
+  const StateMatrix* prior_P{nullptr};
+  const StateMatrix* phi{nullptr};
+  StateMask active;
+  StateMask estimated;
+  std::array<bool, 6> used{};
+};
+void fixEpochDiagnostics(const FixEpochInput& in, AppliedGain& gain, EpochDiagnostics& d);
 
 }  // namespace navbus::core

@@ -65,6 +65,7 @@ class ErrorState {
   StateMatrix& P() { return P_; }
   const StateMatrix& P() const { return P_; }
   const StateMask& active() const { return active_; }
+  const StateMask& estimated() const { return estimated_; }
 
  private:
   void removeInactiveCoupling();

@@ -125,6 +125,10 @@ class IntegratedFilter {
   /// walk of the tuning's failed_* density, so the aiding carries that axis.
   void setAxisFailed(bool accelerometer, int axis, bool failed);
   const StateMask& active() const { return central_.active(); }
+  const StateMask& estimated() const { return central_.estimated(); }
+  /// The transition accumulated since the last update of any kind (the GLR's Phi between two
+  /// epochs that no other update separates).
+  StateMatrix transitionSinceUpdate() const { return phi_since_update_t_.transpose(); }
 
   const NavState& state() const { return ins_.state(); }
   /// The covariance of the estimate: the centralized one, or the master's (federated).

@@ -55,8 +55,12 @@ class GlrProtectionLevel {
 
   const IntegrityConfig& config() const { return config_; }
   const FaultBiases& faultBiases() const { return biases_; }
+  /// The detector's latest epoch declared a fault (l >= h).
+  bool detected() const { return monitor_ && monitor_->last().valid && monitor_->last().detected; }
   std::uint64_t epochs() const { return monitor_ ? monitor_->epochs() : 0; }
   std::uint64_t refused() const { return monitor_ ? monitor_->refused() : 0; }
+  /// Epochs at which the detector declared a fault.
+  std::uint64_t detections() const { return detections_; }
 
  private:
   IntegrityConfig config_;
@@ -69,6 +73,7 @@ class GlrProtectionLevel {
   double k_ff_h_{0.0}, k_ff_v_{0.0};  ///< fault-free multipliers of sigma_major and sigma_D
   double k_md_h_{0.0}, k_md_v_{0.0};  ///< the same at the missed-detection probability
   bool have_biases_{false};
+  std::uint64_t detections_{0};
   FaultBiases biases_;  ///< of the latest epoch
 };
 
