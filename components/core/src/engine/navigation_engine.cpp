@@ -665,12 +665,16 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
       filter_->state(), fixPositionAtStateTime(fix), pos_sigma_m, lever_b,
       filter_->modelsFixPositionError() ? &filter_->fixPositionError() : nullptr);
   // The protection levels' detector sees the epoch as it stood before the updates.
-  const bool monitored = config_.integrity.enabled;
-  if (monitored) {
-    fix_prior_P_ = filter_->covariance();
-    fix_phi_ = filter_->transitionSinceUpdate();
-    fix_velocity_prior_ =
+  FixEpochInput epoch;
+  StateMatrix prior_P, phi;
+  VectorMeasurement velocity_prior;
+  if (config_.integrity.enabled) {
+    prior_P = filter_->covariance();
+    phi = filter_->transitionSinceUpdate();
+    velocity_prior =
         velocityMeasurement(filter_->state(), fix_vel_ned_mps, vel_sigma_mps, lever_b, bodyRate());
+    epoch = {&position,         &velocity_prior,      &prior_P, &phi,
+             filter_->active(), filter_->estimated(), {}};
   }
   const auto p = filter_->update(position, AidingKind::kPosition);
   countGated(p.data(), 3);
@@ -679,7 +683,7 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
       velocityMeasurement(filter_->state(), fix_vel_ned_mps, vel_sigma_mps, lever_b, bodyRate()),
       AidingKind::kVelocity);
   countGated(v.data(), 3);
-  if (monitored) monitorFix(fix.time_ns, position, p, v);
+  if (config_.integrity.enabled) monitorFix(fix.time_ns, epoch, p, v);
   adaptNoise(NoiseStream::kFixVelocity, v.data(), 3);
   std::array<ScalarUpdateResult, 6> rows{};
   std::copy(p.begin(), p.end(), rows.begin());
@@ -694,21 +698,14 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();
 }
 
-void NavigationEngine::monitorFix(std::int64_t time_ns, const VectorMeasurement& position,
+void NavigationEngine::monitorFix(std::int64_t time_ns, FixEpochInput& epoch,
                                   const std::array<ScalarUpdateResult, 3>& p,
                                   const std::array<ScalarUpdateResult, 3>& v) {
-  FixEpochInput in;
-  in.position = &position;
-  in.velocity = &fix_velocity_prior_;
-  in.prior_P = &fix_prior_P_;
-  in.phi = &fix_phi_;
-  in.active = filter_->active();
-  in.estimated = filter_->estimated();
   for (std::size_t i = 0; i < 3; ++i) {
-    in.used[i] = p[i].accepted;
-    in.used[i + 3] = v[i].accepted;
+    epoch.used[i] = p[i].accepted;
+    epoch.used[i + 3] = v[i].accepted;
   }
-  fixEpochDiagnostics(in, fix_gain_, fix_epoch_);
+  fixEpochDiagnostics(epoch, fix_gain_, fix_epoch_);
   integrity_->onEpoch(time_ns, fix_epoch_);
 }
 

@@ -301,7 +301,7 @@ class NavigationEngine {
                          const Eigen::Vector3d& vel_sigma_mps);
   /// A fused fix to the protection levels' detector (loose coupling and the multi-dimensional
   /// filter): the fix's rows as one epoch (filter/epoch_diagnostics.hpp, kFixAxisSources).
-  void monitorFix(std::int64_t time_ns, const VectorMeasurement& position,
+  void monitorFix(std::int64_t time_ns, FixEpochInput& epoch,
                   const std::array<ScalarUpdateResult, 3>& p,
                   const std::array<ScalarUpdateResult, 3>& v);
   /// The protection levels' detector watches pseudoranges (and the fault manager acts on its
@@ -322,11 +322,7 @@ class NavigationEngine {
   Indirect<StationarityDetector> stationarity_;
   Indirect<StageSelector> stages_;
   ConsistencyMonitor consistency_;
-  /// A fix epoch for the protection levels' detector: the prior covariance, the transition
-  /// since the previous fix and the velocity row at the prior state, kept between the updates.
-  StateMatrix fix_prior_P_{StateMatrix::Zero()};
-  StateMatrix fix_phi_{StateMatrix::Identity()};
-  VectorMeasurement fix_velocity_prior_;
+  /// A fix as the protection levels' detector sees it (storage reused from fix to fix).
   EpochDiagnostics fix_epoch_;
   AppliedGain fix_gain_;
   std::array<NoiseScaleEstimator, kNoiseStreams> noise_scales_;
