@@ -31,6 +31,11 @@ void injectStep(const ImuStep& step, std::vector<ImuSample>& samples, ImportRepo
   if (samples.empty()) return;
   report.imu_step_onset_gps_ns =
       samples.front().time_gps_ns + std::llround(step.onset_after_start_s * 1e9);
+  if (report.imu_step_onset_gps_ns > samples.back().time_gps_ns)
+    throw bus::ConfigError(fmt::format(
+        "IMU step onset {:g} s after the first sample is beyond the log's last sample ({:.3f} s)",
+        step.onset_after_start_s,
+        1e-9 * static_cast<double>(samples.back().time_gps_ns - samples.front().time_gps_ns)));
   for (ImuSample& s : samples) {
     if (s.time_gps_ns < report.imu_step_onset_gps_ns) continue;
     (step.gyro ? s.rate_s_radps : s.specific_force_s_mps2)[step.axis] += step.step;

@@ -527,6 +527,8 @@ TEST(GlrProtection, AFixEpochCarriesTheGainItsTwoUpdatesApplied) {
   for (std::size_t i = 0; i < 3; ++i) {
     in.used[i] = p[i].accepted;
     in.used[i + 3] = v[i].accepted;
+    in.test_ratio[i] = p[i].test_ratio;
+    in.test_ratio[i + 3] = v[i].test_ratio;
   }
   nc::AppliedGain gain;
   nc::EpochDiagnostics d;
@@ -534,6 +536,7 @@ TEST(GlrProtection, AFixEpochCarriesTheGainItsTwoUpdatesApplied) {
   ASSERT_EQ(d.innovation.size(), 6);
   EXPECT_EQ(d.sv_ids, (std::vector<int>{1, 2, 3, 1, 2, 3}));
   EXPECT_EQ(d.is_rate, (std::vector<bool>{false, false, false, true, true, true}));
+  EXPECT_EQ(d.test_ratio[4], v[1].test_ratio);
   const StateVector batch = d.k * d.innovation;
   EXPECT_LT((batch - es.x()).cwiseAbs().maxCoeff(), 1e-9 * es.x().cwiseAbs().maxCoeff())
       << "batch " << batch.transpose() << "\nsequential " << es.x().transpose();

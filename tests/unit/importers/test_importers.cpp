@@ -10,6 +10,8 @@
 
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include "navbus/bus/config.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/gnss_data/rinex2.hpp"
@@ -437,4 +439,40 @@ TEST(RinexObservations, ErrorsNameTheKeyAndTheFile) {
       error("bad.yaml", "gnss_observations: {obs: " + bad.string() + ", nav: " + nav + "}\n");
   EXPECT_NE(message.find("bad.obs"), std::string::npos) << message;
   EXPECT_NE(message.find("bad.obs:47: field 'second'"), std::string::npos) << message;
+}
+
+TEST(Import, AnImuStepChangesOneAxisFromItsOnsetOn) {
+  // Ten samples at 100 Hz standing still (1 g up on z); a 0.5 m/s^2 step on x from 0.045 s.
+  std::string text;
+  for (int k = 0; k < 10; ++k) text += fmt::format("0,0,9.81,0,0,0,{:.2f}\n", 1.4e9 + 0.01 * k);
+  DatasetDescription d;
+  d.imu = gpsSecondsCsv(writeText("step.csv", text));
+  d.imu->step = ImuStep{false, 0, 0.5, 0.045};
+  const fs::path out = scratch("step_recording");
+  const ImportReport report = importDataset(d, out);
+  EXPECT_EQ(report.imu_samples_injected, 5u);  // 0.05 .. 0.09 s
+  EXPECT_EQ(report.imu_step_onset_gps_ns,
+            readImuCsv(*d.imu).samples.front().time_gps_ns + 45'000'000);
+  EXPECT_NE(report.text.find("an accelerometer step of 0.5 m/s^2 on sensor axis x"),
+            std::string::npos)
+      << report.text;
+  const auto table = records::readCsv(out / "navbus_imu_increment_block.csv");
+  const auto blocks =
+      records::parseMessages<navbus::ImuIncrementBlock>(table, records::messageRowRanges(table));
+  std::vector<double> dv_x;
+  for (const auto& b : blocks)
+    for (const auto& inc : b.increments()) dv_x.push_back(inc.delta_vel_b_mps()[0]);
+  ASSERT_EQ(dv_x.size(), 9u);
+  // Trapezoidal increments: none before the onset, half a step across it, a full one after
+  // (the intervals are 10 ms to the 128 ns a double keeps of a GPS time of 1.4e9 s).
+  EXPECT_EQ(dv_x[3], 0.0);
+  EXPECT_NEAR(dv_x[4], 0.5 * 0.5 * 0.01, 1e-7);
+  EXPECT_NEAR(dv_x[8], 0.5 * 0.01, 1e-7);
+  // The onset must fall inside the log, and the error says where the log ends.
+  d.imu->step->onset_after_start_s = 2.0;
+  const std::string e = errorOf([&] { importDataset(d, scratch("late_step")); });
+  EXPECT_NE(e.find("IMU step onset 2 s after the first sample is beyond the log's last sample "
+                   "(0.090 s)"),
+            std::string::npos)
+      << e;
 }

@@ -683,8 +683,8 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
       velocityMeasurement(filter_->state(), fix_vel_ned_mps, vel_sigma_mps, lever_b, bodyRate()),
       AidingKind::kVelocity);
   countGated(v.data(), 3);
-  if (config_.integrity.enabled) monitorFix(fix.time_ns, epoch, p, v);
   adaptNoise(NoiseStream::kFixVelocity, v.data(), 3);
+  if (config_.integrity.enabled) monitorFix(fix.time_ns, epoch, p, v);
   std::array<ScalarUpdateResult, 6> rows{};
   std::copy(p.begin(), p.end(), rows.begin());
   std::copy(v.begin(), v.end(), rows.begin() + 3);
@@ -704,6 +704,8 @@ void NavigationEngine::monitorFix(std::int64_t time_ns, FixEpochInput& epoch,
   for (std::size_t i = 0; i < 3; ++i) {
     epoch.used[i] = p[i].accepted;
     epoch.used[i + 3] = v[i].accepted;
+    epoch.test_ratio[i] = p[i].test_ratio;
+    epoch.test_ratio[i + 3] = v[i].test_ratio;
   }
   fixEpochDiagnostics(epoch, fix_gain_, fix_epoch_);
   integrity_->onEpoch(time_ns, fix_epoch_);

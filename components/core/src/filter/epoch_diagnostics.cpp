@@ -23,7 +23,7 @@ void fixEpochDiagnostics(const FixEpochInput& in, AppliedGain& gain, EpochDiagno
   d.sv_ids.clear();
   d.is_rate.clear();
   d.used.assign(in.used.begin(), in.used.end());
-  d.test_ratio.assign(kRows, 0.0);
+  d.test_ratio.assign(in.test_ratio.begin(), in.test_ratio.end());
   d.innovation.resize(kRows);
   d.h.resize(kRows, layout::kSize);
   Eigen::Matrix<double, kRows, kRows> r = Eigen::Matrix<double, kRows, kRows>::Zero();

@@ -61,6 +61,7 @@ struct FixEpochInput {
   StateMask active;
   StateMask estimated;
   std::array<bool, 6> used{};
+  std::array<double, 6> test_ratio{};  ///< each row's, as the sequential update gave it
 };
 void fixEpochDiagnostics(const FixEpochInput& in, AppliedGain& gain, EpochDiagnostics& d);
 
