@@ -142,6 +142,7 @@ navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t v
   append(d.h, msg.h());
   append(d.k, msg.k());
   append(d.phi, msg.phi());
+  msg.process_noise_scale(1.0);  // the configured Q, unless the filter's adapts (nav_filter)
   return msg;
 }
 

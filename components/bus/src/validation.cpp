@@ -236,6 +236,10 @@ std::optional<Rejection> validate(const navbus::FilterDiagnostics& s, const Vali
   if (auto r = finiteSeq(s.h(), "h")) return r;
   if (auto r = finiteSeq(s.k(), "k")) return r;
   if (auto r = finiteSeq(s.phi(), "phi")) return r;
+  if (!std::isfinite(s.process_noise_scale()))
+    return Rejection{navbus::REJECT_NOT_FINITE, "process_noise_scale", s.process_noise_scale()};
+  if (s.process_noise_scale() < 0.0)  // 0: a producer that does not report it
+    return Rejection{navbus::REJECT_OUT_OF_RANGE, "process_noise_scale", s.process_noise_scale()};
   for (std::size_t i = 0; i < m; ++i) {
     const auto& row = s.rows()[i];
     const bool ranging =

@@ -115,6 +115,7 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
   if (faults) {
     on_diagnostics = [&](const navbus::FilterDiagnostics& d) {
       result.last_noise_scales = d.noise_scales();
+      result.last_process_noise_scale = d.process_noise_scale();
       faults->onDiagnostics(d);
     };
     on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };

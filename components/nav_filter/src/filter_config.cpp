@@ -191,6 +191,33 @@ void parseAdaptiveNoise(const YAML::Node& node, core::EngineConfig& e) {
         "configuration adaptive_noise.enabled: true with fusion: adaptive (the adaptive "
         "structure estimates R itself; use one or the other)");
 }
+
+/// Bounded adaptive process noise (core/filter/adaptive_process_noise.hpp): the centralized
+/// filter's inertial Q.
+void parseAdaptiveProcessNoise(const YAML::Node& node, core::EngineConfig& e) {
+  core::ProcessNoiseScaleConfig& n = e.adaptive_process_noise;
+  bus::KeyReader r(node, "adaptive_process_noise");
+  r.value("enabled", n.enabled)
+      .number("memory_s", n.memory_s, {1.0, 1e6})
+      .number("prior_rows", n.prior_rows, {1e-3, 1e6})
+      .number("floor", n.floor, {1e-3, 1e6})
+      .number("ceiling", n.ceiling, {1e-3, 1e6})
+      .finish();
+  if (n.ceiling < n.floor)
+    throw bus::ConfigError(fmt::format(
+        "configuration adaptive_process_noise.ceiling: {} is below adaptive_process_noise.floor: "
+        "{}",
+        n.ceiling, n.floor));
+  if (n.enabled && e.fusion != core::FusionStructure::kCentralized)
+    throw bus::ConfigError(fmt::format(
+        "configuration adaptive_process_noise.enabled: true with fusion: {} (the process noise "
+        "adapts in the centralized filter only)",
+        e.fusion == core::FusionStructure::kFederated ? "federated" : "adaptive"));
+  if (n.enabled && e.aiding == core::AidingMode::kInertialOnly)
+    throw bus::ConfigError(
+        "configuration adaptive_process_noise.enabled: true with mode: inertial_only (no "
+        "innovations to adapt from)");
+}
 }  // namespace
 
 namespace {
@@ -517,7 +544,8 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       .value("star_tracker_updates", e.use_star_tracker)
       .nested({"low_latency_output", "recovery", "time_jump", "fault_monitor", "initial_state",
                "inputs", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional",
-               "alignment", "integrity", "consistency", "adaptive_noise", "geometry"})
+               "alignment", "integrity", "consistency", "adaptive_noise", "adaptive_process_noise",
+               "geometry"})
       .finish(bus::kParticipantKeys);
   parseLowLatency(root["low_latency_output"], c);
   parseRecovery(root["recovery"], c);
@@ -534,6 +562,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   parseIntegrity(root["integrity"], e);
   parseConsistency(root["consistency"], e.consistency);
   parseAdaptiveNoise(root["adaptive_noise"], e);
+  parseAdaptiveProcessNoise(root["adaptive_process_noise"], e);
   parseGeometry(root["geometry"], c);
   return c;
 }

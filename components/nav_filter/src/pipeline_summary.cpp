@@ -57,6 +57,17 @@ std::string describeAdaptiveNoise(const core::NavigationEngine& engine) {
   return out;
 }
 
+/// The adaptive process noise: its scale now, the largest applied, the epochs propagated into
+/// with a scale other than 1 and at the ceiling, and the rows' weight in the estimate now.
+std::string describeAdaptiveProcessNoise(const core::NavigationEngine& engine) {
+  const core::ProcessNoiseScaleEstimator& e = engine.processNoiseScale();
+  const core::ProcessNoiseScaleCounters& c = e.counters();
+  return fmt::format(
+      "adaptive process noise (scale on Q now / largest; epochs scaled, at the ceiling, of all; "
+      "information in rows now): {:.2f} / {:.2f}; {}, {}, of {}; {:.1f}",
+      e.scale(), c.max_scale, c.epochs_scaled, c.epochs_at_ceiling, c.epochs, e.informationRows());
+}
+
 void describeOptional(const PipelineView& v, std::ostringstream& out) {
   const PipelineCounters& p = v.counters;
   if (p.stalls > 0) {
@@ -72,6 +83,8 @@ void describeOptional(const PipelineView& v, std::ostringstream& out) {
         << (v.flags.faultMonitorAlive() ? "" : " (still not)");
   }
   if (v.config.engine.adaptive_noise.enabled) out << ", " << describeAdaptiveNoise(v.engine);
+  if (v.config.engine.adaptive_process_noise.enabled)
+    out << ", " << describeAdaptiveProcessNoise(v.engine);
   if (v.config.engine.start == core::StartSource::kAligned)
     out << ", " << describeAlignment(v.engine);
   if (v.config.engine.integrity.enabled) {

@@ -200,6 +200,7 @@ navbus::MeasurementKind toIdl(core::NoiseStream s) {
 
 void appendNoiseScales(const core::NavigationEngine& engine, navbus::FilterDiagnostics& msg) {
   const core::EngineConfig& c = engine.config();
+  msg.process_noise_scale(engine.processNoiseScale().scale());
   if (!c.adaptive_noise.enabled) return;
   for (int i = 0; i < core::kNoiseStreams; ++i) {
     if (!c.adaptive_noise_streams[static_cast<std::size_t>(i)]) continue;

@@ -298,6 +298,39 @@ TEST_F(ConfigKeys, AdaptiveNoiseNamesItsStreamsAndKeepsItsBoundsInOrder) {
       << both;
 }
 
+TEST_F(ConfigKeys, AdaptiveProcessNoiseKeepsItsBoundsInOrderInTheCentralizedFilter) {
+  const auto with = [&](const std::string& name, const std::string& block,
+                        const std::string& fusion = "centralized") {
+    return write(name, "mode: loosely_coupled\nfusion: " + fusion +
+                           "\ninputs: {imu: {id: 1, period_s: 0.01}, gnss_fix: {id: 1, "
+                           "period_s: 0.25}}\nadaptive_process_noise: " +
+                           block + "\n");
+  };
+  const auto c = navbus::bus::parseFile(
+      with("ok.yaml", "{enabled: true, memory_s: 300, prior_rows: 2, floor: 0.5, ceiling: 16}"),
+      filter);
+  const navbus::core::ProcessNoiseScaleConfig& n = c.engine.adaptive_process_noise;
+  EXPECT_TRUE(n.enabled);
+  EXPECT_DOUBLE_EQ(n.memory_s, 300.0);
+  EXPECT_DOUBLE_EQ(n.prior_rows, 2.0);
+  EXPECT_DOUBLE_EQ(n.floor, 0.5);
+  EXPECT_DOUBLE_EQ(n.ceiling, 16.0);
+  const std::string order =
+      errorOf(with("order.yaml", "{enabled: true, floor: 4, ceiling: 2}"), filter);
+  EXPECT_NE(
+      order.find("adaptive_process_noise.ceiling: 2 is below adaptive_process_noise.floor: 4"),
+      std::string::npos)
+      << order;
+  const std::string memory = errorOf(with("memory.yaml", "{enabled: true, memory_s: 0}"), filter);
+  EXPECT_NE(memory.find("memory_s"), std::string::npos) << memory;
+  // The adaptive structure (seed 001) adapts R its own way, in a filter this one does not track.
+  const std::string adaptive =
+      errorOf(with("adaptive.yaml", "{enabled: true}", "adaptive"), filter);
+  EXPECT_NE(adaptive.find("adaptive_process_noise.enabled: true with fusion: adaptive"),
+            std::string::npos)
+      << adaptive;
+}
+
 TEST_F(ConfigKeys, TheFixPositionErrorBelongsToLooseCouplingWithBothSigmas) {
   const auto with = [&](const std::string& name, const std::string& mode, const std::string& ekf) {
     return write(name, "mode: " + mode + "\ninputs: {imu: {id: 1, period_s: 0.01}, " +

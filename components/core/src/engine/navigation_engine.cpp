@@ -43,6 +43,7 @@ NavigationEngine::NavigationEngine(const EngineConfig& config)
     stream.enabled = stream.enabled && config.adaptive_noise_streams[i];
     noise_scales_[i].configure(stream);
   }
+  process_noise_.configure(config.adaptive_process_noise);
   used_.reserve(32);
   reset();
 }
@@ -136,6 +137,7 @@ void NavigationEngine::reset() {
   stages_->restart();
   consistency_.restart();
   for (NoiseScaleEstimator& n : noise_scales_) n.restart();
+  process_noise_.restart();
 }
 
 std::uint64_t NavigationEngine::pseudorangesWithoutErrorState() const {
@@ -270,6 +272,8 @@ void NavigationEngine::start(const NavState& state, double clock_bias_m, double 
   // levels' own on fixes.
   filter_->keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled ||
                                      config_.integrity.enabled);
+  filter_->trackProcessNoise(config_.adaptive_process_noise.enabled);
+  filter_->setProcessNoiseScale(process_noise_.scale());
   integrity_->reset();  // the hypotheses describe the previous run of the filter
   for (int i = 0; i < 6; ++i) {
     if (failed_axes_ & (1u << i)) filter_->setAxisFailed(i < 3, i % 3, true);
@@ -569,6 +573,9 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
     o.pseudorange_sigma_m *= range_factor;
     o.pseudorange_rate_sigma_mps *= rate_factor;
   }
+  // P_Q before the updates (a copy only when the process noise adapts).
+  StateMatrix process_part = StateMatrix::Zero();
+  if (config_.adaptive_process_noise.enabled) process_part = filter_->processNoisePart();
   const std::vector<MeasurementReport>& reports =
       filter_->update(used_, AntennaArm{config_.antenna_lever_arm_b_m, bodyRate()});
   for (const auto& rep : reports) {
@@ -580,6 +587,8 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   }
   noise_scales_[static_cast<std::size_t>(NoiseStream::kPseudorange)].closeEpoch();
   noise_scales_[static_cast<std::size_t>(NoiseStream::kPseudorangeRate)].closeEpoch();
+  if (config_.adaptive_process_noise.enabled)
+    adaptProcessNoise(time_ns, filter_->lastEpoch(), process_part);
   checkConsistency(time_ns, reports);
   ++counters_.gnss_epochs_fused;
   mode_ = aidedMode();
@@ -664,11 +673,15 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   const VectorMeasurement position = positionMeasurement(
       filter_->state(), fixPositionAtStateTime(fix), pos_sigma_m, lever_b,
       filter_->modelsFixPositionError() ? &filter_->fixPositionError() : nullptr);
-  // The protection levels' detector sees the epoch as it stood before the updates.
+  // The protection levels' detector and the adaptive process noise see the epoch as it stood
+  // before the updates.
   FixEpochInput epoch;
   StateMatrix prior_P, phi;
   VectorMeasurement velocity_prior;
-  if (config_.integrity.enabled) {
+  const bool whole_epoch = config_.integrity.enabled || config_.adaptive_process_noise.enabled;
+  StateMatrix process_part = StateMatrix::Zero();
+  if (config_.adaptive_process_noise.enabled) process_part = filter_->processNoisePart();
+  if (whole_epoch) {
     prior_P = filter_->covariance();
     phi = filter_->transitionSinceUpdate();
     velocity_prior =
@@ -684,7 +697,7 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
       AidingKind::kVelocity);
   countGated(v.data(), 3);
   adaptNoise(NoiseStream::kFixVelocity, v.data(), 3);
-  if (config_.integrity.enabled) monitorFix(fix.time_ns, epoch, p, v);
+  if (whole_epoch) fixEpoch(fix.time_ns, epoch, p, v, process_part);
   std::array<ScalarUpdateResult, 6> rows{};
   std::copy(p.begin(), p.end(), rows.begin());
   std::copy(v.begin(), v.end(), rows.begin() + 3);
@@ -698,9 +711,10 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   if (config_.aiding == AidingMode::kLooselyCoupled) mode_ = aidedMode();
 }
 
-void NavigationEngine::monitorFix(std::int64_t time_ns, FixEpochInput& epoch,
-                                  const std::array<ScalarUpdateResult, 3>& p,
-                                  const std::array<ScalarUpdateResult, 3>& v) {
+void NavigationEngine::fixEpoch(std::int64_t time_ns, FixEpochInput& epoch,
+                                const std::array<ScalarUpdateResult, 3>& p,
+                                const std::array<ScalarUpdateResult, 3>& v,
+                                const StateMatrix& process_part) {
   for (std::size_t i = 0; i < 3; ++i) {
     epoch.used[i] = p[i].accepted;
     epoch.used[i + 3] = v[i].accepted;
@@ -708,7 +722,26 @@ void NavigationEngine::monitorFix(std::int64_t time_ns, FixEpochInput& epoch,
     epoch.test_ratio[i + 3] = v[i].test_ratio;
   }
   fixEpochDiagnostics(epoch, fix_gain_, fix_epoch_);
-  integrity_->onEpoch(time_ns, fix_epoch_);
+  if (config_.integrity.enabled) integrity_->onEpoch(time_ns, fix_epoch_);
+  if (config_.adaptive_process_noise.enabled) adaptProcessNoise(time_ns, fix_epoch_, process_part);
+}
+
+void NavigationEngine::adaptProcessNoise(std::int64_t time_ns, const EpochDiagnostics& d,
+                                         const StateMatrix& process_part) {
+  // While the innovations fail the consistency test, what they show is a fault to flag, not
+  // noise to adapt to: the scale holds until they pass again.
+  if (!trustworthy()) {
+    filter_->forgetProcessNoise();
+    return;
+  }
+  for (Eigen::Index i = 0; i < d.h.rows(); ++i) {
+    if (!d.used[static_cast<std::size_t>(i)]) continue;
+    const double p = (d.h.row(i) * process_part).dot(d.h.row(i));
+    process_noise_.addRow({d.innovation[i], d.innovation_cov(i, i), p});
+  }
+  process_noise_.closeEpoch(time_ns);
+  filter_->setProcessNoiseScale(process_noise_.scale());
+  filter_->forgetProcessNoise();  // the next epoch's P_Q: from this epoch on
 }
 
 void NavigationEngine::logFixInnovations(const std::array<ScalarUpdateResult, 3>& position,

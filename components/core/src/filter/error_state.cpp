@@ -28,6 +28,7 @@ StateMask maskOf(std::initializer_list<StateBlock> blocks) {
 void ErrorState::initialize(const StateMatrix& P0, const StateMask& active) {
   x_.setZero();
   P_ = P0;
+  forgetProcessNoise();
   active_ = active;
   estimated_.set();
   removeInactiveCoupling();
@@ -43,6 +44,13 @@ void ErrorState::predict(const StateMatrix& Phi, const StateVector& q_diagonal) 
   const StateVector variance_before = P_.diagonal();
   x_ = phi.times(x_);
   P_ = phi.sandwichBlockTriangular<layout::kCoupledSize>(P_);
+  if (tracked_noise_.any()) {
+    process_noise_ = phi.sandwichBlockTriangular<layout::kCoupledSize>(process_noise_);
+    for (int i = 0; i < layout::kSize; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (active_[k] && tracked_noise_[k]) process_noise_(i, i) += q_diagonal[i];
+    }
+  }
   for (int i = 0; i < layout::kSize; ++i) {
     if (active_[static_cast<std::size_t>(i)]) {
       P_(i, i) += q_diagonal[i];
@@ -53,12 +61,27 @@ void ErrorState::predict(const StateMatrix& Phi, const StateVector& q_diagonal) 
   }
 }
 
+void ErrorState::trackProcessNoise(const StateMask& states) {
+  tracked_noise_ = states;
+  forgetProcessNoise();
+}
+
+void ErrorState::dropFromProcessNoise(int i) {
+  process_noise_.row(i).setZero();
+  process_noise_.col(i).setZero();
+}
+
 void ErrorState::zeroOffDiagonal() {
   P_ = StateMatrix(P_.diagonal().asDiagonal());
+  // P - P_Q was a covariance: its diagonal, and so diag(P) - diag(P_Q), is not negative.
+  process_noise_ = StateMatrix(process_noise_.diagonal().asDiagonal());
 }
 
 void ErrorState::setVariances(const StateBlock& block, double sigma) {
-  for (int i = block.index; i < block.end(); ++i) P_(i, i) = sigma * sigma;
+  for (int i = block.index; i < block.end(); ++i) {
+    P_(i, i) = sigma * sigma;
+    dropFromProcessNoise(i);
+  }
 }
 
 void ErrorState::resetState(int i, double sigma) {
@@ -66,6 +89,7 @@ void ErrorState::resetState(int i, double sigma) {
   P_.col(i).setZero();
   P_(i, i) = sigma * sigma;
   x_[i] = 0.0;
+  dropFromProcessNoise(i);
 }
 
 void ErrorState::setActive(const StateMask& active) {
@@ -82,6 +106,7 @@ void ErrorState::removeInactiveCoupling() {
     P_.col(i).setZero();
     P_(i, i) = v;
     x_[i] = 0.0;
+    dropFromProcessNoise(i);
     pattern_.decouple(i);
   }
 }

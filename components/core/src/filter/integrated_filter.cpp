@@ -120,9 +120,13 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   // Discrete process noise: white specific force / rate noise into velocity / attitude
   // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3),
   // bias random walks (a failed axis's own walk replaces its bias's).
+  // The inertial part (white noises, bias walks) carries the adaptive process-noise scale.
+  const double q_scale = process_noise_scale_;
   StateVector q = StateVector::Zero();
-  q.segment<3>(kVel.index).setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt);
-  q.segment<3>(kAtt.index).setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt);
+  q.segment<3>(kVel.index)
+      .setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt * q_scale);
+  q.segment<3>(kAtt.index)
+      .setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt * q_scale);
   q[kClockBias.index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
   q[kClockDrift.index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
   if (central_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
@@ -166,12 +170,12 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
                                            ? tuning_.failed_accel_bias_rw_mps2_per_sqrts
                                            : tuning_.accel_bias_rw_mps2_per_sqrts,
                                        2) *
-                              dt;
+                              dt * q_scale;
     q[kGyroBias.index + a] = std::pow(axis_failed_[static_cast<std::size_t>(3 + a)]
                                           ? tuning_.failed_gyro_bias_rw_radps_per_sqrts
                                           : tuning_.gyro_bias_rw_radps_per_sqrts,
                                       2) *
-                             dt;
+                             dt * q_scale;
   }
   if (structure_ == FusionStructure::kFederated) {
     for (ErrorState& l : local_) l.predict(Phi, q * tuning_.federated_share);
@@ -226,6 +230,10 @@ void IntegratedFilter::emitSmoothingRecord() {
   smoothing_.starts_run = false;
   smoothing_.last_record_ns = r.time_ns;
   smoothing_.records_kept = static_cast<std::int64_t>(smoothing_log_->records().size());
+}
+
+void IntegratedFilter::trackProcessNoise(bool on) {
+  central_.trackProcessNoise(on ? maskOf({kVel, kAtt, kAccelBias, kGyroBias}) : StateMask());
 }
 
 void IntegratedFilter::beginCovarianceJump() {
@@ -399,9 +407,10 @@ void IntegratedFilter::turnAttitudeCovariance(double dpsi_rad) {
   // gyrocompass's 83 mrad, into the levelled tilts; measured: seed 000 NEES 10 -> 32).
   const Eigen::Matrix3d R_D =
       Eigen::AngleAxisd(dpsi_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  StateMatrix& P = central_.P();
-  P.middleRows<3>(kAtt.index) = (R_D * P.middleRows<3>(kAtt.index)).eval();
-  P.middleCols<3>(kAtt.index) = (P.middleCols<3>(kAtt.index) * R_D.transpose()).eval();
+  for (StateMatrix* P : {&central_.P(), &central_.processNoisePart()}) {
+    P->middleRows<3>(kAtt.index) = (R_D * P->middleRows<3>(kAtt.index)).eval();
+    P->middleCols<3>(kAtt.index) = (P->middleCols<3>(kAtt.index) * R_D.transpose()).eval();
+  }
 }
 
 void IntegratedFilter::feedback(const StateVector& dx) {
@@ -472,6 +481,7 @@ bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, 
   const StateVector k = Ph / (h.dot(Ph) + sigma_rad * sigma_rad);
   P -= k * Ph.transpose();
   P = (0.5 * (P + P.transpose())).eval();
+  carryThroughUpdate<kSize>(central_.processNoisePart(), h.transpose(), k);
   StateVector dx = k * z_rad;
   // The horizontal velocity turns with the heading: v - dx_v = R_D(dx_psi) v.
   const double a = dx[kHeading];

@@ -48,6 +48,8 @@ struct RecordingResult {
   /// With a fault manager: the adaptive noise scales of the last diagnostics the filter
   /// published (empty when its noise does not adapt).
   std::vector<navbus::NoiseScale> last_noise_scales;
+  /// ... and its scale on the process noise (1 when it does not adapt; 0: no diagnostics).
+  double last_process_noise_scale{0.0};
   /// With RecordingSetup::smooth: one epoch per forward record, and what the smoother says.
   std::vector<core::SmoothedEpoch> smoothed;
   std::string smoother_summary;

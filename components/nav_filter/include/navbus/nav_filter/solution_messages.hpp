@@ -28,7 +28,7 @@ navbus::NavigationSolution lowLatencySolution(const navbus::NavigationSolution& 
 std::string describeAlignment(const core::NavigationEngine& engine);
 
 /// Appends the scale of every stream whose noise adapts to a diagnostics message (nothing when
-/// adaptive noise is off).
+/// adaptive noise is off), and sets the scale on the process noise (1 when it does not adapt).
 void appendNoiseScales(const core::NavigationEngine& engine, navbus::FilterDiagnostics& msg);
 navbus::MeasurementKind toIdl(core::NoiseStream s);
 

@@ -182,6 +182,7 @@ IfMessage<M, navbus::FilterDiagnostics> visitFields(M& m, V& v) {
   std::ostringstream scales;
   for (const auto& n : m.noise_scales()) scales << enumName(n.stream()) << ":" << n.scale() << " ";
   v.text("noise_scales", scales.str());
+  v("process_noise_scale", m.process_noise_scale());
 }
 template <class M, class V>
 IfMessage<M, navbus::FaultDecision> visitFields(M& m, V& v) {

@@ -16,6 +16,7 @@
 
 #include "navbus/core/engine/alignment_config.hpp"
 #include "navbus/core/filter/adaptive_noise_scale.hpp"
+#include "navbus/core/filter/adaptive_process_noise.hpp"
 #include "navbus/core/filter/aiding_inputs.hpp"
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 #include "navbus/core/filter/filter_tuning.hpp"
@@ -125,6 +126,9 @@ struct EngineConfig {
   /// on the streams set here (bit i: NoiseStream i; default all).
   NoiseScaleConfig adaptive_noise;
   std::bitset<kNoiseStreams> adaptive_noise_streams{(1u << kNoiseStreams) - 1u};
+  /// Bounded adaptive process noise: one scale on the inertial Q from the GNSS innovations
+  /// (adaptive_process_noise.hpp). Centralized filter only.
+  ProcessNoiseScaleConfig adaptive_process_noise;
   /// The GNSS antenna's offset from the IMU [m, body axes]: fixes and pseudoranges are of the
   /// antenna.
   Eigen::Vector3d antenna_lever_arm_b_m{Eigen::Vector3d::Zero()};
@@ -238,6 +242,8 @@ class NavigationEngine {
   const NoiseScaleEstimator& noiseScale(NoiseStream s) const {
     return noise_scales_[static_cast<std::size_t>(s)];
   }
+  /// The adaptive process noise: its current scale on Q and its counters.
+  const ProcessNoiseScaleEstimator& processNoiseScale() const { return process_noise_; }
   FusionStructure fusion() const;
   const EngineConfig& config() const { return config_; }
   std::uint32_t status() const { return status_; }
@@ -299,11 +305,12 @@ class NavigationEngine {
                          const Eigen::Vector3d& pos_sigma_m,
                          const std::array<ScalarUpdateResult, 3>& velocity,
                          const Eigen::Vector3d& vel_sigma_mps);
-  /// A fused fix to the protection levels' detector (loose coupling and the multi-dimensional
-  /// filter): the fix's rows as one epoch (filter/epoch_diagnostics.hpp, kFixAxisSources).
-  void monitorFix(std::int64_t time_ns, FixEpochInput& epoch,
-                  const std::array<ScalarUpdateResult, 3>& p,
-                  const std::array<ScalarUpdateResult, 3>& v);
+  /// A fused fix as one epoch (filter/epoch_diagnostics.hpp, kFixAxisSources; loose coupling
+  /// and the multi-dimensional filter) to the protection levels' detector and the adaptive
+  /// process noise (`process_part`: P_Q before the updates), as configured.
+  void fixEpoch(std::int64_t time_ns, FixEpochInput& epoch,
+                const std::array<ScalarUpdateResult, 3>& p,
+                const std::array<ScalarUpdateResult, 3>& v, const StateMatrix& process_part);
   /// The protection levels' detector watches pseudoranges (and the fault manager acts on its
   /// decisions) rather than fixes.
   bool integrityOnPseudoranges() const;
@@ -326,6 +333,11 @@ class NavigationEngine {
   EpochDiagnostics fix_epoch_;
   AppliedGain fix_gain_;
   std::array<NoiseScaleEstimator, kNoiseStreams> noise_scales_;
+  ProcessNoiseScaleEstimator process_noise_;
+  /// A GNSS epoch's accepted rows (from the prior, `process_part` the P_Q it was taken with)
+  /// to the process-noise scale, which the filter propagates with from now on.
+  void adaptProcessNoise(std::int64_t time_ns, const EpochDiagnostics& d,
+                         const StateMatrix& process_part);
   /// The stream's sigma factor for this epoch: sqrt of its scale on R.
   double noiseSigmaFactor(NoiseStream s) const;
   /// The epoch's rows fused with that stream's scale: they feed its next estimate.

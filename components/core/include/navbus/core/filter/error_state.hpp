@@ -38,6 +38,17 @@ class ErrorState {
   /// layout::kCoupledSize, which the product exploits (sparse_rows.hpp).
   void predict(const StateMatrix& Phi, const StateVector& q_diagonal);
 
+  /// Keeps, beside P, the part of it that the process noise of `states` added since the last
+  /// forgetProcessNoise() (adaptive_process_noise.hpp): P_Q = Phi P_Q Phi^T + Q_states, carried
+  /// through the updates as P is, without their R (carryThroughUpdate); a reset of P takes the
+  /// reset rows out of it. An empty mask (the default) keeps nothing.
+  void trackProcessNoise(const StateMask& states);
+  /// P_Q (zero when nothing is tracked).
+  const StateMatrix& processNoisePart() const { return process_noise_; }
+  StateMatrix& processNoisePart() { return process_noise_; }
+  /// Starts P_Q again from zero (the engine does it after each GNSS epoch it adapts from).
+  void forgetProcessNoise() { process_noise_.setZero(); }
+
   /// Sequential Joseph-form update, rows decorrelated by the Cholesky factor of R, inactive
   /// columns of H ignored. gate_sigma <= 0 disables gating. Returns one result per row.
   template <int M>
@@ -69,6 +80,8 @@ class ErrorState {
 
  private:
   void removeInactiveCoupling();
+  /// Takes state i's row and column out of P_Q (P's were replaced).
+  void dropFromProcessNoise(int i);
 
   StateVector x_{StateVector::Zero()};
   StateMatrix P_{StateMatrix::Zero()};
@@ -76,6 +89,8 @@ class ErrorState {
   /// transitionPattern() without the inactive states' coupling.
   SparsityPattern<layout::kSize> pattern_{transitionPattern()};
   StateMask estimated_{StateMask().set()};
+  StateMask tracked_noise_;                         ///< the states whose process noise P_Q holds
+  StateMatrix process_noise_{StateMatrix::Zero()};  ///< P_Q since the last update or reset
 };
 
 template <int M>
@@ -89,9 +104,13 @@ std::array<ScalarUpdateResult, M> ErrorState::update(const AidingMeasurement<M>&
     if (!active_[static_cast<std::size_t>(j)]) H.col(j).setZero();
   }
   std::array<ScalarUpdateResult, M> out;
+  const bool carry = tracked_noise_.any();
+  StateVector K = StateVector::Zero();
   for (int i = 0; i < M; ++i) {
-    out[static_cast<std::size_t>(i)] =
-        scalarUpdate<layout::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma, &estimated_);
+    const auto k = static_cast<std::size_t>(i);
+    out[k] = scalarUpdate<layout::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma, &estimated_,
+                                         carry ? &K : nullptr);
+    if (carry && out[k].accepted) carryThroughUpdate<layout::kSize>(process_noise_, H.row(i), K);
   }
   return out;
 }

@@ -159,6 +159,16 @@ class IntegratedFilter {
   /// diagnostics (the GLR's Phi): on for tightly coupled aiding, off otherwise (it costs a third
   /// of the covariance propagation).
   void keepTransitionSinceUpdate(bool on) { keep_transition_ = on; }
+  /// Adaptive process noise (adaptive_process_noise.hpp): the scale on the inertial process
+  /// noise (velocity and attitude white noise, IMU bias random walks) from the next increment on.
+  void setProcessNoiseScale(double scale) { process_noise_scale_ = scale; }
+  double processNoiseScale() const { return process_noise_scale_; }
+  /// Keeps the part of P that the inertial process noise added since forgetProcessNoise() (off
+  /// by default: it costs a second covariance propagation). Centralized structures.
+  void trackProcessNoise(bool on);
+  /// That part (zero unless tracked; ErrorState::processNoisePart), and its restart.
+  const StateMatrix& processNoisePart() const { return central_.processNoisePart(); }
+  void forgetProcessNoise() { central_.forgetProcessNoise(); }
   const EpochDiagnostics& lastEpoch() const { return last_epoch_; }
   void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
   /// Records what a fixed-interval smoother needs into `log` (nullptr: nothing recorded, the
@@ -209,6 +219,7 @@ class IntegratedFilter {
   /// SparseRows::timesTransposedBlockTriangular).
   StateMatrix phi_since_update_t_{StateMatrix::Identity()};
   bool keep_transition_{true};
+  double process_noise_scale_{1.0};  ///< on the inertial process noise (setProcessNoiseScale)
   EpochDiagnostics last_epoch_;
   StateMatrix prior_P_{StateMatrix::Zero()};  ///< P- of the latest GNSS epoch
   AppliedGain applied_gain_;                  ///< the diagnostics' K from the sequential updates

@@ -23,11 +23,13 @@ struct ScalarUpdateResult {
 /// positive definite even with rounding; the result is symmetrized. States outside
 /// `estimated` (when given) are consider states (Schmidt-Kalman): their gain is zero, so they
 /// are not corrected, but their covariance and correlations are updated and keep counting in
-/// the gains of the others.
+/// the gains of the others. `gain` (when given) receives the K applied (unchanged when the row
+/// is not accepted).
 template <int N>
 ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P,
                                 const Eigen::Matrix<double, 1, N>& h, double z, double r,
-                                double gate_sigma, const std::bitset<N>* estimated = nullptr) {
+                                double gate_sigma, const std::bitset<N>* estimated = nullptr,
+                                Eigen::Matrix<double, N, 1>* gain = nullptr) {
   ScalarUpdateResult out;
   const Eigen::Matrix<double, N, 1> Ph = P * h.transpose();
   out.innovation = z - (h * x)(0, 0);
@@ -52,8 +54,24 @@ ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<do
   P.noalias() -= Ph * K.transpose();
   P.noalias() += (out.innovation_var * K) * K.transpose();
   P = 0.5 * (P + P.transpose());
+  if (gain != nullptr) *gain = K;
   out.accepted = true;
   return out;
+}
+
+/// A part S of the covariance (the share of one noise source) through an update of row h with
+/// gain K: the Joseph form without the measurement's own K r K^T, S = (I - K h) S (I - K h)^T,
+/// expanded as in scalarUpdate. P is linear in its sources for given gains, so each source's
+/// share can be carried on its own.
+template <int N>
+void carryThroughUpdate(Eigen::Matrix<double, N, N>& S, const Eigen::Matrix<double, 1, N>& h,
+                        const Eigen::Matrix<double, N, 1>& K) {
+  const Eigen::Matrix<double, N, 1> Sh = S * h.transpose();
+  const double hSh = h.dot(Sh.transpose());
+  S.noalias() -= K * Sh.transpose();
+  S.noalias() -= Sh * K.transpose();
+  S.noalias() += (hSh * K) * K.transpose();
+  S = 0.5 * (S + S.transpose());
 }
 
 }  // namespace navbus::core
