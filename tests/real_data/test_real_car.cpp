@@ -294,7 +294,7 @@ TEST(RealCar, TheProcessNoiseAdaptsUpFromTheDensitiesAtRest) {
   // The noise densities at rest are 4.0x (accelerometers) and 2.4x (gyros) below those in
   // motion. Measured on the 15 s schedule: 93.7 % of the outage epochs inside 3 sigma_h with
   // them, 100.0 % with the process noise adapting from the fixes' innovations (its scale up to
-  // 6.3; 1.4 at the end).
+  // 25, the ceiling; 3.2 at the end).
   const fs::path dir = workDir("real-car-rest-noise");
   const double fixed = outageCoverage(driveConfigWithRestNoise(dir / "fixed", ""), dir / "fixed");
   const double adapted =

@@ -123,7 +123,9 @@ TEST(AdaptiveProcessNoise, TheConfiguredNoiseWeighsAsItsPriorRowsAndOldRowsFade)
   est.closeEpoch(10 * kEpochNs);
   const double fade = std::exp(-1.0);
   const double g = 1.0 / 3.0, y = 0.0 - (1.0 - 1.0);
-  EXPECT_NEAR(est.scale(), (5.0 * fade + g * y + 1.0) / (fade + g * g + 1.0), 1e-12);
+  const double prior = 1.0 / 9.0;  // one row at the scale in use, 3: 1 / 3^2 in nominal units
+  EXPECT_NEAR(est.scale(), (5.0 * fade + g * y + prior) / (fade + g * g + prior), 1e-12);
+  EXPECT_NEAR(est.informationRows(), fade + 1.0, 1e-12);  // (p / V)^2 = 1 for both rows
   EXPECT_EQ(est.counters().epochs, 2u);
   EXPECT_EQ(est.counters().epochs_scaled, 1u);  // the second was propagated into with 3
   est.addRow({1.0, 1.0, 0.0});                  // no process part: it tells nothing of Q

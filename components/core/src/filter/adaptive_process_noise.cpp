@@ -12,7 +12,7 @@ void ProcessNoiseScaleEstimator::configure(const ProcessNoiseScaleConfig& config
 }
 
 void ProcessNoiseScaleEstimator::restart() {
-  num_ = den_ = open_num_ = open_den_ = 0.0;
+  num_ = den_ = info_ = open_num_ = open_den_ = open_info_ = 0.0;
   open_rows_ = 0;
   last_close_ns_ = 0;
   closed_any_ = false;
@@ -31,6 +31,7 @@ void ProcessNoiseScaleEstimator::addRow(const ProcessNoiseRow& row) {
   const double y = row.innovation * row.innovation - (v - row.process_var);
   open_num_ += g * y / (v * v);
   open_den_ += g * g / (v * v);
+  open_info_ += (row.process_var / v) * (row.process_var / v);
   ++open_rows_;
 }
 
@@ -47,14 +48,19 @@ void ProcessNoiseScaleEstimator::closeEpoch(std::int64_t time_ns) {
     const double fade = std::exp(-dt_s / config_.memory_s);
     num_ *= fade;
     den_ *= fade;
+    info_ *= fade;
   }
   num_ += open_num_;
   den_ += open_den_;
-  open_num_ = open_den_ = 0.0;
+  info_ += open_info_;
+  open_num_ = open_den_ = open_info_ = 0.0;
   open_rows_ = 0;
   last_close_ns_ = time_ns;
   closed_any_ = true;
-  scale_ = bounded((num_ + config_.prior_rows) / (den_ + config_.prior_rows));
+  // The prior: n0 rows all process noise at the scale in use (weight n0 / alpha^2 in the
+  // nominal units of the sums), at the configured Q.
+  const double prior = config_.prior_rows / (scale_ * scale_);
+  scale_ = bounded((num_ + prior) / (den_ + prior));
 }
 
 }  // namespace navbus::core

@@ -13,10 +13,11 @@
 // it was fused with, a consistent model has
 //   E[nu^2] = (a - p) + alpha_true g + r,   g = p / alpha (the nominal process part),
 // so y = nu^2 - (V - p), V = a + r, is alpha_true g plus a noise of variance about 2 V^2. The
-// weighted least-squares estimate over the rows seen, with n0 rows' worth of the configured Q
-// as a prior and the older rows fading with the memory tau,
-//   alpha^ = (sum w g y / V^2 + n0) / (sum w g^2 / V^2 + n0),   w = exp(-(t_now - t_row) / tau),
-//   alpha = min(max(alpha^, floor), ceiling),
+// weighted least-squares estimate over the rows seen, older rows fading with the memory tau,
+// and n0 rows' worth of the configured Q as a prior (rows all process noise at the scale in
+// use, alpha, so that the prior weighs as much beside a large scale as beside 1),
+//   alpha^ = (sum w g y / V^2 + n0 / alpha^2) / (sum w g^2 / V^2 + n0 / alpha^2),
+//   w = exp(-(t_now - t_row) / tau),   alpha = min(max(alpha^, floor), ceiling),
 // leans on the rows where the process noise dominates their variance (after an outage, a long
 // interval between fixes) and hardly on the others (where R does). The scale of an epoch comes
 // from the epochs before it. Only accepted rows count. The measurement's own scale (on R) is
@@ -66,16 +67,17 @@ class ProcessNoiseScaleEstimator {
   void closeEpoch(std::int64_t time_ns);
   /// Forgets the rows (the filter restarted): the configured Q until rows come again.
   void restart();
-  /// The rows' weight in the sums now, in rows whose variance is all process noise.
-  double informationRows() const { return den_; }
+  /// The rows' weight in the sums now, sum w (p / V)^2: in rows whose variance is all process
+  /// noise at the scale they were fused with.
+  double informationRows() const { return info_; }
   const ProcessNoiseScaleCounters& counters() const { return counters_; }
 
  private:
   double bounded(double s) const;
 
   ProcessNoiseScaleConfig config_;
-  double num_{0.0}, den_{0.0};            ///< faded sums over the rows closed
-  double open_num_{0.0}, open_den_{0.0};  ///< the epoch being fused
+  double num_{0.0}, den_{0.0}, info_{0.0};                 ///< faded sums over the rows closed
+  double open_num_{0.0}, open_den_{0.0}, open_info_{0.0};  ///< the epoch being fused
   int open_rows_{0};
   std::int64_t last_close_ns_{0};
   bool closed_any_{false};
