@@ -405,6 +405,11 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
               kArcsecond)
       .number("star_tracker_bias_correlation_time_s", t.star_tracker_bias_correlation_time_s,
               {1.0, 1e7})
+      // A land vehicle's residual mounting misalignment, states when its sigma is positive.
+      .number("mounting_misalignment_sigma_deg", t.mounting_misalignment_sigma_rad, {0.0, 30.0},
+              kDegree)
+      .number("mounting_misalignment_rw_deg_per_sqrts", t.mounting_misalignment_rw_rad_per_sqrts,
+              {0.0, 1.0}, kDegree)
       // Each satellite's time-correlated pseudorange error, states when its sigma is positive.
       .number("pseudorange_error_sigma_m", t.pseudorange_error_sigma_m, {0.0, 1000.0})
       .number("pseudorange_error_correlation_time_s", t.pseudorange_error_correlation_time_s,
@@ -436,6 +441,12 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
   if (t.star_tracker_bias_sigma_rad > 0.0 && !e.use_star_tracker) {
     throw bus::ConfigError(
         "configuration ekf.star_tracker_bias_sigma_arcsec needs star_tracker_updates = true");
+  }
+  if (t.mounting_misalignment_sigma_rad > 0.0 && e.aiding != core::AidingMode::kMultiDimensional) {
+    throw bus::ConfigError(fmt::format(
+        "configuration ekf.mounting_misalignment_sigma_deg ({} deg) needs mode: "
+        "multi_dimensional (the non-holonomic constraint that sees it is fused only there)",
+        t.mounting_misalignment_sigma_rad / units::kDeg));
   }
   if (t.pseudorange_error_sigma_m > 0.0 && e.aiding != core::AidingMode::kTightlyCoupled) {
     throw bus::ConfigError("configuration ekf.pseudorange_error_sigma_m (" +
@@ -493,6 +504,7 @@ void parseMultiDimensional(const YAML::Node& node, core::MdfConfig& m) {
       .number("nhc_sigma_mps", m.nhc_sigma_mps, {1e-6, 10.0})
       .number("nhc_velocity_pitch_per_accel_deg_per_mps2",
               m.nhc_velocity_pitch_per_accel_rad_per_mps2, {-10.0, 10.0}, kDegree)
+      .value("nhc_with_gnss", m.nhc_with_gnss)
       .nested({"stationary"})
       .finish({"reset_states"});
   if (node && node["reset_states"])

@@ -331,6 +331,26 @@ TEST_F(ConfigKeys, AdaptiveProcessNoiseKeepsItsBoundsInOrderInTheCentralizedFilt
       << adaptive;
 }
 
+TEST_F(ConfigKeys, MountingMisalignmentStatesBelongToTheMultiDimensionalFilter) {
+  const auto with = [&](const std::string& name, const std::string& mode, const std::string& rest) {
+    return write(name, "mode: " + mode +
+                           "\ninputs: {imu: {id: 1, period_s: 0.01}, gnss_fix: {id: 1, "
+                           "period_s: 0.25}}\nekf: {mounting_misalignment_sigma_deg: 1.5, "
+                           "mounting_misalignment_rw_deg_per_sqrts: 0.001}\n" +
+                           rest);
+  };
+  const auto c = navbus::bus::parseFile(
+      with("ok.yaml", "multi_dimensional", "multi_dimensional: {nhc_with_gnss: true}\n"), filter);
+  EXPECT_NEAR(c.engine.tuning.mounting_misalignment_sigma_rad, 1.5 * M_PI / 180.0, 1e-15);
+  EXPECT_NEAR(c.engine.tuning.mounting_misalignment_rw_rad_per_sqrts, 0.001 * M_PI / 180.0, 1e-18);
+  EXPECT_TRUE(c.engine.mdf.nhc_with_gnss);
+  const std::string loose = errorOf(with("loose.yaml", "loosely_coupled", ""), filter);
+  EXPECT_NE(loose.find("ekf.mounting_misalignment_sigma_deg (1.5 deg) needs mode: "
+                       "multi_dimensional"),
+            std::string::npos)
+      << loose;
+}
+
 TEST_F(ConfigKeys, TheFixPositionErrorBelongsToLooseCouplingWithBothSigmas) {
   const auto with = [&](const std::string& name, const std::string& mode, const std::string& ekf) {
     return write(name, "mode: " + mode + "\ninputs: {imu: {id: 1, period_s: 0.01}, " +

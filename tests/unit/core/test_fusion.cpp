@@ -93,6 +93,45 @@ TEST(AidingMeasurements, TheConstraintExpectsTheVelocityPitchedAsConfigured) {
   EXPECT_GT(nhc.z.norm(), 0.02);
 }
 
+TEST(AidingMeasurements, TheConstraintHoldsInTheVehiclesAxesWithTheMountingStates) {
+  // Given a car driving along its own forward axis, whose body axes (the IMU's, rotated by the
+  // published mounting) are off the vehicle's by a small mounting misalignment mu,
+  const Eigen::Vector3d mu_true(1e-3, 0.01, -0.015);
+  const Eigen::Matrix3d C_b_v = Eigen::Matrix3d::Identity() - core::skew(mu_true);
+  const Eigen::Vector3d v_b = C_b_v.inverse() * Eigen::Vector3d(12.0, 0.0, 0.0);
+  const Eigen::Vector3d rpy(0.02, -0.01, 0.7);
+  const core::NavState truth = movingTruth(rpy, core::dcmFromEuler(rpy) * v_b);
+  // when the constraint is predicted with the true mounting, it holds exactly; without the
+  // mounting states the misalignment shows as a lateral velocity of v mu_z,
+  const auto exact = core::nonHolonomicMeasurement(truth, 0.1, 0.0, &mu_true);
+  EXPECT_LT(exact.z.norm(), 1e-12);
+  EXPECT_NEAR(core::nonHolonomicMeasurement(truth, 0.1).z[0], 12.0 * mu_true.z(), 2e-3);
+  // and with errors in the velocity, the attitude and the mounting estimate (estimate minus
+  // truth), z = H dx to first order; each mounting column is the finite difference.
+  core::StateVector dx = core::StateVector::Zero();
+  dx.segment<3>(layout::kVel.index) << 0.05, -0.04, 0.02;
+  dx.segment<3>(layout::kAtt.index) << 2e-3, -1e-3, 3e-3;
+  dx.segment<3>(layout::kMountingMisalignment.index) << 1e-3, -2e-3, 3e-3;
+  const Eigen::Vector3d mu_est = mu_true + dx.segment<3>(layout::kMountingMisalignment.index);
+  const core::NavState ins = withError(truth, dx);
+  const auto nhc = core::nonHolonomicMeasurement(ins, 0.1, 0.0, &mu_est);
+  EXPECT_LT((nhc.z - nhc.h * dx).norm(), 1e-3 * nhc.z.norm() + 1e-4);
+  EXPECT_GT(nhc.z.norm(), 0.02);
+  const double eps = 1e-6;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d mu_plus = mu_est;
+    mu_plus[i] += eps;
+    const auto plus = core::nonHolonomicMeasurement(ins, 0.1, 0.0, &mu_plus);
+    const Eigen::Vector2d column = (plus.z - nhc.z) / eps;
+    EXPECT_LT((column - nhc.h.col(layout::kMountingMisalignment.index + i)).norm(), 1e-6)
+        << "mounting column " << i;
+  }
+  // The yaw and pitch columns are -v and +v along the (computed) forward axis.
+  const Eigen::Vector3d v_b_ins = ins.q_b_to_n.conjugate() * ins.vel_ned_mps;
+  EXPECT_NEAR(nhc.h(0, layout::kMountingMisalignment.index + 2), -v_b_ins.x(), 1e-9);
+  EXPECT_NEAR(nhc.h(1, layout::kMountingMisalignment.index + 1), v_b_ins.x(), 1e-9);
+}
+
 TEST(IntegratedFilter, EveryUpdateTypeReducesAConstructedError) {
   const Eigen::Vector3d rpy(0.1, -0.05, 2.0);
   const core::NavState truth =

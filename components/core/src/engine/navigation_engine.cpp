@@ -159,6 +159,11 @@ StateMask NavigationEngine::baseMask() const {
   // The star tracker's bias where it is modelled and the tracker used.
   if (config_.use_star_tracker && config_.tuning.star_tracker_bias_sigma_rad > 0.0)
     m |= maskOf({kStarTrackerBias});
+  // A land vehicle's mounting misalignment, where it is modelled (the non-holonomic
+  // constraint's, in the multi-dimensional filter).
+  if (config_.aiding == AidingMode::kMultiDimensional &&
+      config_.tuning.mounting_misalignment_sigma_rad > 0.0)
+    m |= maskOf({kMountingMisalignment});
   // The fix's time-correlated position error, where it is modelled (loose coupling).
   if (config_.tuning.fix_position_error_sigma_h_m > 0.0) m |= maskOf({kFixPositionError});
   return m;
@@ -472,17 +477,18 @@ void NavigationEngine::constraintUpdate() {
     countGated(r.data(), 3);
     adaptNoise(NoiseStream::kZeroVelocity, r.data(), 3);
     ++counters_.zero_velocity_updates;
-  } else if (stage == MdfStage::kF4Constraint &&
-             config_.mdf.policy == MdfPolicy::kMultiDimensional) {
+  } else if (config_.mdf.policy == MdfPolicy::kMultiDimensional &&
+             (stage == MdfStage::kF4Constraint || config_.mdf.nhc_with_gnss)) {
     const double per_accel = config_.mdf.nhc_velocity_pitch_per_accel_rad_per_mps2;
     const double velocity_pitch_b_rad =
         per_accel != 0.0 ? per_accel * longitudinalAcceleration() : 0.0;  // 0: a rigid body
-    const auto r =
-        filter_->update(nonHolonomicMeasurement(filter_->state(),
-                                                config_.mdf.nhc_sigma_mps *
-                                                    noiseSigmaFactor(NoiseStream::kNonHolonomic),
-                                                velocity_pitch_b_rad),
-                        AidingKind::kNonHolonomic);
+    const auto r = filter_->update(
+        nonHolonomicMeasurement(
+            filter_->state(),
+            config_.mdf.nhc_sigma_mps * noiseSigmaFactor(NoiseStream::kNonHolonomic),
+            velocity_pitch_b_rad,
+            filter_->modelsMountingMisalignment() ? &filter_->mountingMisalignment() : nullptr),
+        AidingKind::kNonHolonomic);
     countGated(r.data(), 2);
     adaptNoise(NoiseStream::kNonHolonomic, r.data(), 2);
     ++counters_.nonholonomic_updates;

@@ -73,20 +73,32 @@ VectorMeasurement zeroVelocityMeasurement(const NavState& ins, double sigma_mps)
 }
 
 AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps,
-                                             double velocity_pitch_b_rad) {
+                                             double velocity_pitch_b_rad,
+                                             const Eigen::Vector3d* mounting_rad) {
   AidingMeasurement<2> m;
+  // The vehicle's axes: (I - [mu x]) times the body's (the identity without mounting states).
+  const Eigen::Matrix3d C_b_v =
+      Eigen::Matrix3d::Identity() -
+      (mounting_rad != nullptr ? skew(*mounting_rad) : Eigen::Matrix3d::Zero());
   const Eigen::Matrix3d C_n_b = ins.q_b_to_n.toRotationMatrix().transpose();
   const Eigen::Vector3d v_b = C_n_b * ins.vel_ned_mps;
-  // d(v_b)/d(dV) = C_n_b and d(v_b)/d(phi) = -C_n_b [V x], per body axis (row).
-  const Eigen::Matrix3d dvb_dv = C_n_b;
-  const Eigen::Matrix3d dvb_dphi = -C_n_b * skew(ins.vel_ned_mps);
+  const Eigen::Vector3d v_v = C_b_v * v_b;
+  // d(v_b)/d(dV) = C_n_b and d(v_b)/d(phi) = -C_n_b [V x], per body axis (row), turned into
+  // the vehicle's axes; d(v_v)/d(d mu) = [v_b x].
+  const Eigen::Matrix3d dvv_dv = C_b_v * C_n_b;
+  const Eigen::Matrix3d dvv_dphi = -C_b_v * C_n_b * skew(ins.vel_ned_mps);
+  const Eigen::Matrix3d dvv_dmu = skew(v_b);
   const double tan_pitch = std::tan(velocity_pitch_b_rad);
-  m.z << v_b.y(), v_b.z() + v_b.x() * tan_pitch;
+  m.z << v_v.y(), v_v.z() + v_v.x() * tan_pitch;
   m.h.setZero();
-  m.h.block<2, 3>(0, kVel.index) = dvb_dv.bottomRows<2>();
-  m.h.block<2, 3>(0, kAtt.index) = dvb_dphi.bottomRows<2>();
-  m.h.block<1, 3>(1, kVel.index) += tan_pitch * dvb_dv.row(0);
-  m.h.block<1, 3>(1, kAtt.index) += tan_pitch * dvb_dphi.row(0);
+  m.h.block<2, 3>(0, kVel.index) = dvv_dv.bottomRows<2>();
+  m.h.block<2, 3>(0, kAtt.index) = dvv_dphi.bottomRows<2>();
+  m.h.block<1, 3>(1, kVel.index) += tan_pitch * dvv_dv.row(0);
+  m.h.block<1, 3>(1, kAtt.index) += tan_pitch * dvv_dphi.row(0);
+  if (mounting_rad != nullptr) {
+    m.h.block<2, 3>(0, kMountingMisalignment.index) = dvv_dmu.bottomRows<2>();
+    m.h.block<1, 3>(1, kMountingMisalignment.index) += tan_pitch * dvv_dmu.row(0);
+  }
   m.r = Eigen::Matrix2d::Identity() * sigma_mps * sigma_mps;
   return m;
 }

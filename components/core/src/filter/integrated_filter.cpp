@@ -34,9 +34,12 @@ StateVector IntegratedFilter::initialSigma(const FilterTuning& tuning) {
   sigma.segment<3>(kGyroScale.index)
       .setConstant(tuning.gyro_scale_sigma > 0.0 ? tuning.gyro_scale_sigma : 1.0);
   // Not modelled: inactive states, whose variance only has to keep P invertible.
-  sigma.segment<3>(kStarTrackerBias.index)
-      .setConstant(tuning.star_tracker_bias_sigma_rad > 0.0 ? tuning.star_tracker_bias_sigma_rad
-                                                            : 1.0);
+  // The block is the star tracker's bias or a land vehicle's mounting misalignment.
+  double frame_sigma = 1.0;
+  if (tuning.star_tracker_bias_sigma_rad > 0.0) frame_sigma = tuning.star_tracker_bias_sigma_rad;
+  if (tuning.mounting_misalignment_sigma_rad > 0.0)
+    frame_sigma = tuning.mounting_misalignment_sigma_rad;
+  sigma.segment<3>(kStarTrackerBias.index).setConstant(frame_sigma);
   sigma[kClockBias.index] = tuning.clock_bias_sigma_m;
   sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
   sigma.segment<kPseudorangeError.dof>(kPseudorangeError.index)
@@ -129,7 +132,11 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
       .setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt * q_scale);
   q[kClockBias.index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
   q[kClockDrift.index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
-  if (central_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
+  if (modelsMountingMisalignment()) {
+    // Random constants with a random walk (layout::kMountingMisalignment).
+    q.segment<3>(kMountingMisalignment.index)
+        .setConstant(std::pow(tuning_.mounting_misalignment_rw_rad_per_sqrts, 2) * dt);
+  } else if (central_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
     // First-order Gauss-Markov: decay exp(-dt / tau), driving noise that keeps the variance
     // at sigma^2 (exact discretization). The estimate is the process's expected value and
     // decays with it; held constant, its error would gain the unmodelled (1 - decay) b_est.
@@ -348,6 +355,11 @@ bool IntegratedFilter::modelsFixPositionError() const {
          tuning_.fix_position_error_sigma_h_m > 0.0 && !(tuning_.pseudorange_error_sigma_m > 0.0);
 }
 
+bool IntegratedFilter::modelsMountingMisalignment() const {
+  return central_.active()[static_cast<std::size_t>(kMountingMisalignment.index)] &&
+         tuning_.mounting_misalignment_sigma_rad > 0.0;
+}
+
 bool IntegratedFilter::modelsPseudorangeErrors() const {
   return central_.active()[static_cast<std::size_t>(kPseudorangeError.index)] &&
          tuning_.pseudorange_error_sigma_m > 0.0;
@@ -424,7 +436,7 @@ void IntegratedFilter::feedback(const StateVector& dx) {
   gyro_bias_ -= dx.segment<3>(kGyroBias.index);
   accel_scale_ -= dx.segment<3>(kAccelScale.index);
   gyro_scale_ -= dx.segment<3>(kGyroScale.index);
-  star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);
+  star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);  // or the mounting's (same block)
   clock_bias_m_ -= dx[kClockBias.index];
   clock_drift_mps_ -= dx[kClockDrift.index];
   if (modelsFixPositionError()) {

@@ -66,7 +66,13 @@ VectorMeasurement zeroVelocityMeasurement(const NavState& ins, double sigma_mps)
 /// that far above the forward axis (the body pitched against the track, as a car's under
 /// acceleration): z_D = v_b,z + v_b,x tan(velocity_pitch_b_rad), H's vertical row gaining
 /// tan() times the forward row.
+///
+/// With `mounting_rad` (the estimated residual mounting misalignment mu, nullptr: not
+/// modelled) the constraint holds in the vehicle's axes, v_v = (I - [mu x]) v_b; the error of
+/// v_v gains [v_b x] d(mu) (estimate minus truth), the columns of layout::kMountingMisalignment,
+/// and the velocity and attitude columns turn by (I - [mu x]).
 AidingMeasurement<2> nonHolonomicMeasurement(const NavState& ins, double sigma_mps,
-                                             double velocity_pitch_b_rad = 0.0);
+                                             double velocity_pitch_b_rad = 0.0,
+                                             const Eigen::Vector3d* mounting_rad = nullptr);
 
 }  // namespace navbus::core

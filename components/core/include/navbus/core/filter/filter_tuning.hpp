@@ -40,6 +40,11 @@ struct FilterTuning {
   // modelled, the states stay inactive).
   double star_tracker_bias_sigma_rad{0.0};             ///< stationary 1 sigma per axis [rad]
   double star_tracker_bias_correlation_time_s{300.0};  ///< [s]
+  // Residual mounting misalignment of a land vehicle (layout::kMountingMisalignment): random
+  // constants with this 1 sigma per body axis when positive (0: not modelled), plus a random
+  // walk (a body that settles on its suspension).
+  double mounting_misalignment_sigma_rad{0.0};         ///< 1 sigma per axis [rad]
+  double mounting_misalignment_rw_rad_per_sqrts{0.0};  ///< [rad/sqrt(s)]
   // Time-correlated pseudorange errors (tight coupling): a first-order Gauss-Markov state per
   // tracked satellite (layout::kPseudorangeError, pseudorange_error_slots.hpp) when the sigma
   // is positive (0: not modelled, pseudoranges fused with their white sigma only).

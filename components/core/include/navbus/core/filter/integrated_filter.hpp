@@ -146,6 +146,12 @@ class IntegratedFilter {
   /// The star tracker's estimated bias [rad, star-tracker axes], subtracted from its
   /// measurements (attitudeMeasurement()); 0 while the bias is not modelled.
   const Eigen::Vector3d& starTrackerBias() const { return star_tracker_bias_; }
+  /// The estimated residual mounting misalignment [rad, body; layout::kMountingMisalignment]
+  /// while it is modelled (zero otherwise): the block's estimate, which a star tracker's bias
+  /// shares when there is one.
+  const Eigen::Vector3d& mountingMisalignment() const { return star_tracker_bias_; }
+  /// The mounting misalignment is a state (tuning sigma positive, block active).
+  bool modelsMountingMisalignment() const;
   /// Estimated error of the GNSS fix's position [m, NED] (zero when not modelled).
   const Eigen::Vector3d& fixPositionError() const { return fix_position_error_ned_m_; }
   /// The fix's position error is a state (tuning sigma positive, block active, no pseudorange
@@ -230,6 +236,7 @@ class IntegratedFilter {
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d accel_scale_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_scale_{Eigen::Vector3d::Zero()};
+  /// The star tracker's bias, or a land vehicle's mounting misalignment (the block's estimate).
   Eigen::Vector3d star_tracker_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d fix_position_error_ned_m_{Eigen::Vector3d::Zero()};
   double clock_bias_m_{0.0};

@@ -74,6 +74,9 @@ struct MdfConfig {
   /// m/s^2]: a car's body pitches against its track as it speeds up or brakes (navbus
   /// calibrate mounting measures it); the constraint's vertical row expects it. 0: a rigid body.
   double nhc_velocity_pitch_per_accel_rad_per_mps2{0.0};
+  /// The non-holonomic constraint also while GNSS is available (stages F2 and F3), beside the
+  /// fixes: what makes the mounting misalignment observable (false: seed 004's F4 only).
+  bool nhc_with_gnss{false};
 };
 
 }  // namespace navbus::core

@@ -44,6 +44,13 @@ inline constexpr int kSize = 38;
 /// truth]. The aiding mode says which meaning the block has; the two are never active together
 /// (the configuration refuses each error model outside its mode).
 inline constexpr StateBlock kFixPositionError{kPseudorangeError.index, 3};
+/// A land vehicle has no star tracker: there the star tracker's block holds the residual
+/// mounting misalignment between the body axes the IMU is rotated into and the vehicle's own
+/// [rad, body axes: the vehicle's axes are (I - [mu x]) times the body's; random constants,
+/// estimate minus truth], which the non-holonomic constraint needs. The multi-dimensional
+/// filter (the only one with that constraint) takes no star-tracker updates, so the two are
+/// never active together.
+inline constexpr StateBlock kMountingMisalignment{kStarTrackerBias.index, 3};
 /// The leading states the error dynamics couple (position, velocity, attitude). No navigation
 /// error drives the trailing ones (biases, clock, pseudorange errors, scale factors), so every
 /// transition matrix is block upper triangular at this size (ins_error_model.hpp, tested).
