@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "navbus/core/math/units.hpp"
 #include "navbus/nav_filter/solution_messages.hpp"
 
 namespace navbus::nav_filter {
@@ -68,6 +69,20 @@ std::string describeAdaptiveProcessNoise(const core::NavigationEngine& engine) {
       e.scale(), c.max_scale, c.epochs_scaled, c.epochs_at_ceiling, c.epochs, e.informationRows());
 }
 
+/// The mounting misalignment the filter estimated, with its 1 sigma, roll / pitch / yaw.
+std::string describeMounting(const core::NavigationEngine& engine) {
+  const Eigen::Vector3d mu_deg = engine.mountingMisalignment() / units::kDeg;
+  const Eigen::Vector3d sigma_deg = engine.covariance()
+                                        .diagonal()
+                                        .segment<3>(core::layout::kMountingMisalignment.index)
+                                        .cwiseSqrt() /
+                                    units::kDeg;
+  return fmt::format(
+      "mounting misalignment (roll, pitch, yaw) {:.3f} / {:.3f} / {:.3f} deg (1 sigma {:.3f} / "
+      "{:.3f} / {:.3f})",
+      mu_deg.x(), mu_deg.y(), mu_deg.z(), sigma_deg.x(), sigma_deg.y(), sigma_deg.z());
+}
+
 void describeOptional(const PipelineView& v, std::ostringstream& out) {
   const PipelineCounters& p = v.counters;
   if (p.stalls > 0) {
@@ -87,6 +102,8 @@ void describeOptional(const PipelineView& v, std::ostringstream& out) {
     out << ", " << describeAdaptiveProcessNoise(v.engine);
   if (v.config.engine.start == core::StartSource::kAligned)
     out << ", " << describeAlignment(v.engine);
+  if (v.engine.initialized() && v.engine.modelsMountingMisalignment())
+    out << ", " << describeMounting(v.engine);
   if (v.config.engine.integrity.enabled) {
     out << ", protection-level epochs " << v.engine.protectionLevelEpochs() << " refused "
         << v.engine.protectionLevelEpochsRefused() << " with a fault declared "

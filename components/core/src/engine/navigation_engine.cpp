@@ -81,6 +81,12 @@ ImuCorrection NavigationEngine::imuCorrection() const {
 Eigen::Vector3d NavigationEngine::starTrackerBias() const {
   return filter_->starTrackerBias();
 }
+Eigen::Vector3d NavigationEngine::mountingMisalignment() const {
+  return filter_->mountingMisalignment();
+}
+bool NavigationEngine::modelsMountingMisalignment() const {
+  return filter_->modelsMountingMisalignment();
+}
 double NavigationEngine::clockBias() const {
   return filter_->clockBias();
 }
@@ -405,6 +411,9 @@ void NavigationEngine::applyStage(const StageDecision& d) {
     // The stages that estimate every bias estimate the scale factors too, where modelled.
     if (m[static_cast<std::size_t>(kAccelBias.index)])
       m |= baseMask() & maskOf({kAccelScale, kGyroScale});
+    // Every stage estimates the mounting misalignment, where modelled (the constraint's rows
+    // observe it; the fixes through its correlations).
+    m |= baseMask() & maskOf({kMountingMisalignment});
     if (config_.mdf.unestimated != ReducedStates::kDropped)
       filter_->setEstimated(m);
     else

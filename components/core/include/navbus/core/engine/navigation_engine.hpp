@@ -227,6 +227,10 @@ class NavigationEngine {
   ImuCorrection imuCorrection() const;
   /// Estimated star-tracker bias [rad, star-tracker body axes] (zero when not modelled).
   Eigen::Vector3d starTrackerBias() const;
+  /// The estimated residual mounting misalignment [rad, body] and whether it is modelled
+  /// (IntegratedFilter::mountingMisalignment; its sigmas: covariance(), kMountingMisalignment).
+  Eigen::Vector3d mountingMisalignment() const;
+  bool modelsMountingMisalignment() const;
   double clockBias() const;   ///< receiver clock bias c*b [m]
   double clockDrift() const;  ///< receiver clock drift c*f [m/s]
   EngineMode mode() const {
