@@ -491,12 +491,12 @@ void NavigationEngine::constraintUpdate() {
     const double per_accel = config_.mdf.nhc_velocity_pitch_per_accel_rad_per_mps2;
     const double velocity_pitch_b_rad =
         per_accel != 0.0 ? per_accel * longitudinalAcceleration() : 0.0;  // 0: a rigid body
+    const Eigen::Vector3d mounting_rad = filter_->mountingMisalignment();
     const auto r = filter_->update(
         nonHolonomicMeasurement(
             filter_->state(),
             config_.mdf.nhc_sigma_mps * noiseSigmaFactor(NoiseStream::kNonHolonomic),
-            velocity_pitch_b_rad,
-            filter_->modelsMountingMisalignment() ? &filter_->mountingMisalignment() : nullptr),
+            velocity_pitch_b_rad, filter_->modelsMountingMisalignment() ? &mounting_rad : nullptr),
         AidingKind::kNonHolonomic);
     countGated(r.data(), 2);
     adaptNoise(NoiseStream::kNonHolonomic, r.data(), 2);

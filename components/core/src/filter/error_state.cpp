@@ -44,11 +44,12 @@ void ErrorState::predict(const StateMatrix& Phi, const StateVector& q_diagonal) 
   const StateVector variance_before = P_.diagonal();
   x_ = phi.times(x_);
   P_ = phi.sandwichBlockTriangular<layout::kCoupledSize>(P_);
-  if (tracked_noise_.any()) {
-    process_noise_ = phi.sandwichBlockTriangular<layout::kCoupledSize>(process_noise_);
+  if (tracksProcessNoise()) {
+    Eigen::Map<StateMatrix> pq = processNoiseMap();
+    pq = phi.sandwichBlockTriangular<layout::kCoupledSize>(StateMatrix(pq));
     for (int i = 0; i < layout::kSize; ++i) {
       const auto k = static_cast<std::size_t>(i);
-      if (active_[k] && tracked_noise_[k]) process_noise_(i, i) += q_diagonal[i];
+      if (active_[k] && tracked_noise_[k]) pq(i, i) += q_diagonal[i];
     }
   }
   for (int i = 0; i < layout::kSize; ++i) {
@@ -63,10 +64,38 @@ void ErrorState::predict(const StateMatrix& Phi, const StateVector& q_diagonal) 
 
 void ErrorState::trackProcessNoise(const StateMask& states) {
   tracked_noise_ = states;
-  forgetProcessNoise();
+  if (tracksProcessNoise())
+    process_noise_.setZero(layout::kSize, layout::kSize);
+  else
+    process_noise_.resize(0, 0);
+}
+
+StateMatrix ErrorState::processNoisePart() const {
+  if (!tracksProcessNoise()) return StateMatrix::Zero();
+  return Eigen::Map<const StateMatrix>(process_noise_.data());
+}
+
+void ErrorState::forgetProcessNoise() {
+  if (tracksProcessNoise()) process_noise_.setZero();
+}
+
+void ErrorState::carryProcessNoise(const Eigen::Matrix<double, 1, layout::kSize>& h,
+                                   const StateVector& K) {
+  if (!tracksProcessNoise()) return;
+  StateMatrix pq = processNoiseMap();
+  carryThroughUpdate<layout::kSize>(pq, h, K);
+  processNoiseMap() = pq;
+}
+
+void ErrorState::turnProcessNoise(const StateBlock& block, const Eigen::Matrix3d& R) {
+  if (!tracksProcessNoise()) return;
+  Eigen::Map<StateMatrix> pq = processNoiseMap();
+  pq.middleRows<3>(block.index) = (R * pq.middleRows<3>(block.index)).eval();
+  pq.middleCols<3>(block.index) = (pq.middleCols<3>(block.index) * R.transpose()).eval();
 }
 
 void ErrorState::dropFromProcessNoise(int i) {
+  if (!tracksProcessNoise()) return;
   process_noise_.row(i).setZero();
   process_noise_.col(i).setZero();
 }
@@ -74,7 +103,10 @@ void ErrorState::dropFromProcessNoise(int i) {
 void ErrorState::zeroOffDiagonal() {
   P_ = StateMatrix(P_.diagonal().asDiagonal());
   // P - P_Q was a covariance: its diagonal, and so diag(P) - diag(P_Q), is not negative.
-  process_noise_ = StateMatrix(process_noise_.diagonal().asDiagonal());
+  if (tracksProcessNoise()) {
+    const Eigen::VectorXd d = process_noise_.diagonal();
+    process_noise_ = d.asDiagonal();
+  }
 }
 
 void ErrorState::setVariances(const StateBlock& block, double sigma) {

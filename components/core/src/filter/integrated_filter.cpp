@@ -419,10 +419,10 @@ void IntegratedFilter::turnAttitudeCovariance(double dpsi_rad) {
   // gyrocompass's 83 mrad, into the levelled tilts; measured: seed 000 NEES 10 -> 32).
   const Eigen::Matrix3d R_D =
       Eigen::AngleAxisd(dpsi_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  for (StateMatrix* P : {&central_.P(), &central_.processNoisePart()}) {
-    P->middleRows<3>(kAtt.index) = (R_D * P->middleRows<3>(kAtt.index)).eval();
-    P->middleCols<3>(kAtt.index) = (P->middleCols<3>(kAtt.index) * R_D.transpose()).eval();
-  }
+  StateMatrix& P = central_.P();
+  P.middleRows<3>(kAtt.index) = (R_D * P.middleRows<3>(kAtt.index)).eval();
+  P.middleCols<3>(kAtt.index) = (P.middleCols<3>(kAtt.index) * R_D.transpose()).eval();
+  central_.turnProcessNoise(kAtt, R_D);
 }
 
 void IntegratedFilter::feedback(const StateVector& dx) {
@@ -493,7 +493,7 @@ bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, 
   const StateVector k = Ph / (h.dot(Ph) + sigma_rad * sigma_rad);
   P -= k * Ph.transpose();
   P = (0.5 * (P + P.transpose())).eval();
-  carryThroughUpdate<kSize>(central_.processNoisePart(), h.transpose(), k);
+  central_.carryProcessNoise(h.transpose(), k);
   StateVector dx = k * z_rad;
   // The horizontal velocity turns with the heading: v - dx_v = R_D(dx_psi) v.
   const double a = dx[kHeading];

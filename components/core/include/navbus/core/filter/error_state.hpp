@@ -43,11 +43,16 @@ class ErrorState {
   /// through the updates as P is, without their R (carryThroughUpdate); a reset of P takes the
   /// reset rows out of it. An empty mask (the default) keeps nothing.
   void trackProcessNoise(const StateMask& states);
+  bool tracksProcessNoise() const { return tracked_noise_.any(); }
   /// P_Q (zero when nothing is tracked).
-  const StateMatrix& processNoisePart() const { return process_noise_; }
-  StateMatrix& processNoisePart() { return process_noise_; }
+  StateMatrix processNoisePart() const;
   /// Starts P_Q again from zero (the engine does it after each GNSS epoch it adapts from).
-  void forgetProcessNoise() { process_noise_.setZero(); }
+  void forgetProcessNoise();
+  /// P_Q through an update that P took outside update(): row h with gain K.
+  void carryProcessNoise(const Eigen::Matrix<double, 1, layout::kSize>& h, const StateVector& K);
+  /// P_Q through the turn of one 3-state block (P's rows and columns turned by R, as the
+  /// heading reset does).
+  void turnProcessNoise(const StateBlock& block, const Eigen::Matrix3d& R);
 
   /// Sequential Joseph-form update, rows decorrelated by the Cholesky factor of R, inactive
   /// columns of H ignored. gate_sigma <= 0 disables gating. Returns one result per row.
@@ -89,8 +94,13 @@ class ErrorState {
   /// transitionPattern() without the inactive states' coupling.
   SparsityPattern<layout::kSize> pattern_{transitionPattern()};
   StateMask estimated_{StateMask().set()};
-  StateMask tracked_noise_;                         ///< the states whose process noise P_Q holds
-  StateMatrix process_noise_{StateMatrix::Zero()};  ///< P_Q since the last update or reset
+  StateMask tracked_noise_;  ///< the states whose process noise P_Q holds
+  /// P_Q (kSize x kSize while tracked, empty otherwise: a filter that does not track it, and
+  /// each snapshot of one, carries no storage for it).
+  Eigen::MatrixXd process_noise_;
+  Eigen::Map<StateMatrix> processNoiseMap() {
+    return Eigen::Map<StateMatrix>(process_noise_.data());
+  }
 };
 
 template <int M>
@@ -104,13 +114,13 @@ std::array<ScalarUpdateResult, M> ErrorState::update(const AidingMeasurement<M>&
     if (!active_[static_cast<std::size_t>(j)]) H.col(j).setZero();
   }
   std::array<ScalarUpdateResult, M> out;
-  const bool carry = tracked_noise_.any();
+  const bool carry = tracksProcessNoise();
   StateVector K = StateVector::Zero();
   for (int i = 0; i < M; ++i) {
     const auto k = static_cast<std::size_t>(i);
     out[k] = scalarUpdate<layout::kSize>(x_, P_, H.row(i), z[i], 1.0, gate_sigma, &estimated_,
                                          carry ? &K : nullptr);
-    if (carry && out[k].accepted) carryThroughUpdate<layout::kSize>(process_noise_, H.row(i), K);
+    if (carry && out[k].accepted) carryProcessNoise(H.row(i), K);
   }
   return out;
 }

@@ -149,7 +149,9 @@ class IntegratedFilter {
   /// The estimated residual mounting misalignment [rad, body; layout::kMountingMisalignment]
   /// while it is modelled (zero otherwise): the block's estimate, which a star tracker's bias
   /// shares when there is one.
-  const Eigen::Vector3d& mountingMisalignment() const { return star_tracker_bias_; }
+  Eigen::Vector3d mountingMisalignment() const {
+    return modelsMountingMisalignment() ? star_tracker_bias_ : Eigen::Vector3d::Zero();
+  }
   /// The mounting misalignment is a state (tuning sigma positive, block active).
   bool modelsMountingMisalignment() const;
   /// Estimated error of the GNSS fix's position [m, NED] (zero when not modelled).
@@ -173,7 +175,7 @@ class IntegratedFilter {
   /// by default: it costs a second covariance propagation). Centralized structures.
   void trackProcessNoise(bool on);
   /// That part (zero unless tracked; ErrorState::processNoisePart), and its restart.
-  const StateMatrix& processNoisePart() const { return central_.processNoisePart(); }
+  StateMatrix processNoisePart() const { return central_.processNoisePart(); }
   void forgetProcessNoise() { central_.forgetProcessNoise(); }
   const EpochDiagnostics& lastEpoch() const { return last_epoch_; }
   void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
