@@ -187,6 +187,31 @@ TEST(Validation, StarTrackerQuaternionMustBeUnit) {
   EXPECT_FALSE(validate(s, ValidationLimits{}));
 }
 
+TEST(Validation, DiagnosticsProcessNoiseScaleIsFiniteAndNotNegative) {
+  // One pseudorange row of an epoch, as the filter publishes it: the scale on Q defaults to 1.
+  navbus::core::EpochDiagnostics d;
+  d.sv_ids = {5};
+  d.is_rate = {false};
+  d.used = {true};
+  d.test_ratio = {0.1};
+  d.innovation = Eigen::VectorXd::Constant(1, 0.5);
+  d.innovation_cov = Eigen::MatrixXd::Constant(1, 1, 4.0);
+  d.h = Eigen::MatrixXd::Zero(1, navbus::core::layout::kSize);
+  d.k = Eigen::MatrixXd::Zero(navbus::core::layout::kSize, 1);
+  navbus::FilterDiagnostics m = navbus::bus::toIdl(d, 1, 1, 1'400'000'000'000'000'000);
+  EXPECT_DOUBLE_EQ(m.process_noise_scale(), 1.0);
+  EXPECT_FALSE(validate(m, ValidationLimits{}));
+  m.process_noise_scale(0.0);  // a producer that does not report it
+  EXPECT_FALSE(validate(m, ValidationLimits{}));
+  m.process_noise_scale(std::numeric_limits<double>::quiet_NaN());
+  ASSERT_TRUE(validate(m, ValidationLimits{}));
+  EXPECT_EQ(validate(m, ValidationLimits{})->reason, navbus::REJECT_NOT_FINITE);
+  EXPECT_EQ(validate(m, ValidationLimits{})->field, "process_noise_scale");
+  m.process_noise_scale(-2.0);
+  EXPECT_EQ(validate(m, ValidationLimits{})->reason, navbus::REJECT_OUT_OF_RANGE);
+  EXPECT_EQ(validate(m, ValidationLimits{})->field, "process_noise_scale");
+}
+
 TEST(Validation, GnssFixRanges) {
   navbus::GnssFix f;
   f.valid(false);

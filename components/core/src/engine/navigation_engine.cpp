@@ -588,9 +588,8 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
     o.pseudorange_sigma_m *= range_factor;
     o.pseudorange_rate_sigma_mps *= rate_factor;
   }
-  // P_Q before the updates (a copy only when the process noise adapts).
-  StateMatrix process_part = StateMatrix::Zero();
-  if (config_.adaptive_process_noise.enabled) process_part = filter_->processNoisePart();
+  // P_Q before the updates (zero when the process noise does not adapt).
+  const StateMatrix process_part = filter_->processNoisePart();
   const std::vector<MeasurementReport>& reports =
       filter_->update(used_, AntennaArm{config_.antenna_lever_arm_b_m, bodyRate()});
   for (const auto& rep : reports) {
@@ -694,8 +693,7 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
   StateMatrix prior_P, phi;
   VectorMeasurement velocity_prior;
   const bool whole_epoch = config_.integrity.enabled || config_.adaptive_process_noise.enabled;
-  StateMatrix process_part = StateMatrix::Zero();
-  if (config_.adaptive_process_noise.enabled) process_part = filter_->processNoisePart();
+  const StateMatrix process_part = filter_->processNoisePart();
   if (whole_epoch) {
     prior_P = filter_->covariance();
     phi = filter_->transitionSinceUpdate();

@@ -82,9 +82,8 @@ void ErrorState::forgetProcessNoise() {
 void ErrorState::carryProcessNoise(const Eigen::Matrix<double, 1, layout::kSize>& h,
                                    const StateVector& K) {
   if (!tracksProcessNoise()) return;
-  StateMatrix pq = processNoiseMap();
+  Eigen::Map<StateMatrix> pq = processNoiseMap();
   carryThroughUpdate<layout::kSize>(pq, h, K);
-  processNoiseMap() = pq;
 }
 
 void ErrorState::turnProcessNoise(const StateBlock& block, const Eigen::Matrix3d& R) {

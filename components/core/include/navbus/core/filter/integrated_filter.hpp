@@ -170,7 +170,6 @@ class IntegratedFilter {
   /// Adaptive process noise (adaptive_process_noise.hpp): the scale on the inertial process
   /// noise (velocity and attitude white noise, IMU bias random walks) from the next increment on.
   void setProcessNoiseScale(double scale) { process_noise_scale_ = scale; }
-  double processNoiseScale() const { return process_noise_scale_; }
   /// Keeps the part of P that the inertial process noise added since forgetProcessNoise() (off
   /// by default: it costs a second covariance propagation). Centralized structures.
   void trackProcessNoise(bool on);

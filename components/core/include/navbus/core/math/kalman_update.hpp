@@ -63,15 +63,16 @@ ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<do
 /// gain K: the Joseph form without the measurement's own K r K^T, S = (I - K h) S (I - K h)^T,
 /// expanded as in scalarUpdate. P is linear in its sources for given gains, so each source's
 /// share can be carried on its own.
-template <int N>
-void carryThroughUpdate(Eigen::Matrix<double, N, N>& S, const Eigen::Matrix<double, 1, N>& h,
+/// S: an N x N matrix or a map of one.
+template <int N, typename Square>
+void carryThroughUpdate(Eigen::MatrixBase<Square>& S, const Eigen::Matrix<double, 1, N>& h,
                         const Eigen::Matrix<double, N, 1>& K) {
   const Eigen::Matrix<double, N, 1> Sh = S * h.transpose();
   const double hSh = h.dot(Sh.transpose());
   S.noalias() -= K * Sh.transpose();
   S.noalias() -= Sh * K.transpose();
   S.noalias() += (hSh * K) * K.transpose();
-  S = 0.5 * (S + S.transpose());
+  S = (0.5 * (S + S.transpose())).eval();
 }
 
 }  // namespace navbus::core
