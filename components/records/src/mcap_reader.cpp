@@ -20,22 +20,34 @@ class McapParser {
 
   McapContents parse() {
     const std::size_t magic = sizeof(mcap::kMagic);
-    if (bytes_.size() < 2 * magic || std::memcmp(bytes_.data(), mcap::kMagic, magic) != 0) {
+    if (bytes_.size() < magic || std::memcmp(bytes_.data(), mcap::kMagic, magic) != 0) {
       fail(0, "file", "does not start with the MCAP magic (0x89 MCAP0 \\r\\n)");
     }
-    if (std::memcmp(bytes_.data() + bytes_.size() - magic, mcap::kMagic, magic) != 0) {
-      fail(bytes_.size() - magic, "file",
-           "does not end with the MCAP magic: the recording was cut short (not closed)");
-    }
+    // A closed file ends with the magic, and its records end before it; a file cut short ends
+    // anywhere, and its last complete record marks what can be read.
+    const bool closed = bytes_.size() >= 2 * magic &&
+                        std::memcmp(bytes_.data() + bytes_.size() - magic, mcap::kMagic, magic) == 0;
+    const std::size_t end = closed ? bytes_.size() - magic : bytes_.size();
     std::size_t at = magic;
-    bool header = false, data_end = false;
-    while (!data_end) {
-      if (at + 9 > bytes_.size() - magic) fail(at, "file", "ends before the Data End record");
+    std::uint8_t last_opcode = 0;
+    bool header = false;
+    for (;;) {
+      if (end - at < 9) {
+        if (closed) fail(at, "file", "ends before the Data End record");
+        return cutAt(at, last_opcode, at == end ? "" : "record's opcode and length");
+      }
+      if (bytes_[at] == 0) {  // opcode 0 is reserved: a tail the system allocated, never written
+        if (closed) fail(at, "record opcode", "0 is reserved");
+        return cutAt(at, last_opcode, "zero bytes, never written");
+      }
       const std::uint8_t opcode = bytes_[at];
       std::uint64_t length = 0;
       for (int i = 0; i < 8; ++i) length |= std::uint64_t{bytes_[at + 1 + i]} << (8 * i);
-      if (length > bytes_.size() - magic - at - 9) {
-        fail(at, "record length", std::to_string(length) + " bytes run past the file's end");
+      if (length > end - at - 9) {
+        if (closed) {
+          fail(at, "record length", std::to_string(length) + " bytes run past the file's end");
+        }
+        return cutAt(at, last_opcode, mcap::recordName(opcode));
       }
       const std::uint8_t* content = bytes_.data() + at + 9;
       if (!header && opcode != mcap::kHeader) fail(at, "Header", "is not the first record");
@@ -44,13 +56,13 @@ class McapParser {
         readHeader(at, content, length);
       } else if (opcode == mcap::kDataEnd) {
         checkDataEnd(at, content, length);
-        data_end = true;
+        return std::move(contents_);
       } else {
         dataRecord(at, opcode, content, length, false);
       }
       at += 9 + static_cast<std::size_t>(length);
+      last_opcode = opcode;
     }
-    return std::move(contents_);
   }
 
  private:
@@ -65,6 +77,21 @@ class McapParser {
                               fail(offset, std::string(record) + " field '" + field + "'",
                                    "runs past the record's end");
                             });
+  }
+
+  /// The file ends at byte `at` without Data End; `lost` says what the bytes after it are ("":
+  /// none).
+  McapContents cutAt(std::uint64_t at, std::uint8_t last, std::string lost) {
+    McapCut cut;
+    cut.file_bytes = bytes_.size();
+    cut.complete_bytes = at;
+    cut.last_record = mcap::recordName(last);
+    cut.lost_record = std::move(lost);
+    for (const McapMessage& m : contents_.messages) {
+      cut.last_log_time_ns = std::max(cut.last_log_time_ns.value_or(0), m.log_time_ns);
+    }
+    contents_.cut = std::move(cut);
+    return std::move(contents_);
   }
 
   void readHeader(std::uint64_t at, const std::uint8_t* content, std::uint64_t length) {
@@ -130,12 +157,20 @@ class McapParser {
         contents_.messages.push_back(std::move(m));
         break;
       }
+      case mcap::kMetadata: {
+        auto r = reader(at, "Metadata", content, length);
+        McapMetadata m;
+        m.name = r.str("name");
+        m.entries = r.stringMap("metadata");
+        contents_.metadata.push_back(std::move(m));
+        break;
+      }
       case mcap::kChunk:
         if (in_chunk) fail(at, "Chunk", "inside a chunk");
         readChunk(at, content, length);
         break;
       default:
-        // Message Index, Attachment, Metadata, and records this reader does not know (the spec
+        // Message Index, Attachment, and records this reader does not know (the spec
         // lets files carry private records and readers ignore them).
         break;
     }

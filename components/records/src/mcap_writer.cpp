@@ -1,5 +1,9 @@
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <zstd.h>
 
 #include "mcap_bytes.hpp"
@@ -43,8 +47,10 @@ std::vector<std::uint8_t> zstdCompress(const std::vector<std::uint8_t>& in) {
 }  // namespace
 
 McapWriter::McapWriter(const std::filesystem::path& file, McapWriterOptions options)
-    : path_(file), out_(file, std::ios::binary | std::ios::trunc), options_(std::move(options)) {
-  if (!out_) throw std::runtime_error("cannot write " + file.string());
+    : path_(file),
+      fd_(::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644)),
+      options_(std::move(options)) {
+  if (fd_ < 0) failWrite("cannot create");
   writeBytes({std::begin(mcap::kMagic), std::end(mcap::kMagic)});
   mcap::ByteWriter header;
   header.str(options_.profile).str(options_.library);
@@ -56,12 +62,20 @@ McapWriter::~McapWriter() {
     close();
   } catch (...) {  // a destructor must not throw; close() explicitly to see the error
   }
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void McapWriter::failWrite(const char* what) const {
+  throw std::runtime_error(std::string(what) + " " + path_.string() + ": " + std::strerror(errno));
 }
 
 void McapWriter::writeBytes(const std::vector<std::uint8_t>& bytes) {
-  out_.write(reinterpret_cast<const char*>(bytes.data()),
-             static_cast<std::streamsize>(bytes.size()));
-  if (!out_) throw std::runtime_error("cannot write " + path_.string());
+  for (std::size_t done = 0; done < bytes.size();) {
+    const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) failWrite("cannot write");
+    done += static_cast<std::size_t>(n);
+  }
   running_crc_ = mcap::crc32Of(running_crc_, bytes.data(), bytes.size());
   offset_ += bytes.size();
 }
@@ -127,7 +141,15 @@ void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns,
   const auto rec = record(mcap::kMessage, content.bytes());
   chunk_.insert(chunk_.end(), rec.begin(), rec.end());
   ++message_count_;
+  ++pending_messages_;
   if (chunk_.size() >= options_.chunk_size_bytes) flushChunk();
+}
+
+void McapWriter::flush() {
+  if (closed_ || pending_messages_ == 0) return;
+  flushChunk();
+  if (::fdatasync(fd_) != 0) failWrite("cannot write to the disk");
+  pending_messages_ = 0;
 }
 
 void McapWriter::flushChunk() {
@@ -180,8 +202,14 @@ void McapWriter::close() {
   data_end.u32(running_crc_);
   writeRecord(mcap::kDataEnd, data_end.bytes());
   writeSummary();
-  out_.close();
-  if (!out_) throw std::runtime_error("cannot write " + path_.string());
+  const int fd = fd_;
+  fd_ = -1;
+  const bool synced = ::fdatasync(fd) == 0;
+  const int sync_errno = errno;
+  if (::close(fd) != 0 || !synced) {
+    if (!synced) errno = sync_errno;
+    failWrite("cannot close");
+  }
 }
 
 void McapWriter::writeSummary() {

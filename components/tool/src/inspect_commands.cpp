@@ -217,6 +217,11 @@ class RecordCommand final : public Subcommand {
                      "first (0: never)")
         ->check(CLI::Range(0.0, 3600.0));
     cli_->add_option("--duration", duration_s, "stop after this many seconds (0: until SIGINT)");
+    cli_->add_option("--flush-s", flush_s,
+                     "put what was recorded on the disk at least this often (mcap: the open "
+                     "chunk closed and the file synced; csv: every file flushed), so that a "
+                     "killed recorder loses at most this much; navbus recover closes such a file")
+        ->check(CLI::Range(0.05, 3600.0));
   }
   bool inspectsBus() const override { return true; }
   int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
@@ -243,8 +248,14 @@ class RecordCommand final : public Subcommand {
       sink.open(*entries.back());
       matches.add(t, entries.back()->subscribe(p, sink));
     }
+    auto last_flush = std::chrono::steady_clock::now();
     auto all_counted = [&] {
       matches.update();
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_flush >= std::chrono::duration<double>(flush_s)) {
+        sink.flush();
+        last_flush = now;
+      }
       if (idle_s > 0.0 && sink.idleSeconds() >= idle_s) return true;
       if (count == 0) return false;
       for (const auto* e : entries)
@@ -269,6 +280,37 @@ class RecordCommand final : public Subcommand {
   double idle_s{0.0};
   std::uint64_t count{0};
   double duration_s{0.0};
+  double flush_s{1.0};
+};
+
+/// `navbus recover IN -o OUT`: an MCAP recording cut short (a killed recorder) rewritten whole.
+class RecoverCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = app.add_subcommand(
+        "recover",
+        "rewrite an MCAP recording that was cut short (a killed recorder, a power cut, a full "
+        "disk) with every complete message, its summary and indexes, as the mcap tool's recover "
+        "does; a complete file is copied message by message");
+    cli_->add_option("in", in, "the MCAP file to read")->required()->check(CLI::ExistingFile);
+    cli_->add_option("-o,--out", out, "the recovered MCAP file (created)")->required();
+  }
+  bool usesBus() const override { return false; }
+  int run(bus::Participant::Options&, bus::ShutdownSignal&) override {
+    const records::McapRecovery r = records::recoverMcap(in, out);
+    if (r.contents.cut) {
+      std::printf("%s\n", records::describeCut(in, *r.contents.cut).c_str());
+    } else {
+      std::printf("%s was closed (complete)\n", in.c_str());
+    }
+    std::printf("%s: %llu messages on %zu channels in %u chunks, closed with its summary\n",
+                out.c_str(), static_cast<unsigned long long>(r.messages_written),
+                r.contents.channels.size(), r.contents.chunk_count);
+    return nb::bus::kExitOk;
+  }
+
+ private:
+  std::string in, out;
 };
 
 }  // namespace
@@ -277,6 +319,7 @@ void addInspectionSubcommands(Subcommands& out) {
   out.push_back(std::make_unique<TopicsCommand>());
   out.push_back(std::make_unique<EchoCommand>());
   out.push_back(std::make_unique<RecordCommand>());
+  out.push_back(std::make_unique<RecoverCommand>());
 }
 
 }  // namespace navbus::tool::cli

@@ -53,8 +53,15 @@ void CsvRecordSink::onSample(const std::string& topic, const SampleTimes& times,
   }
 }
 
+void CsvRecordSink::flush() {
+  for (auto& [name, f] : files_) {
+    f->flush();
+    if (!*f) throw std::runtime_error("cannot write " + (dir_ / recordFileName(name)).string());
+  }
+}
+
 void CsvRecordSink::finish() {
-  for (auto& [name, f] : files_) f->flush();
+  flush();
 }
 
 McapRecordSink::McapRecordSink(const std::filesystem::path& file, bool ros2)
@@ -89,6 +96,10 @@ void McapRecordSink::onSample(const std::string& topic, const SampleTimes& times
   counted(topic);
   writer_.write(channel_of_topic_.at(topic), nonNegative(times.reception_ns),
                 nonNegative(times.source_ns), sample.cdr());
+}
+
+void McapRecordSink::flush() {
+  writer_.flush();
 }
 
 void McapRecordSink::finish() {

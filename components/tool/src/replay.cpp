@@ -210,6 +210,10 @@ std::vector<std::unique_ptr<Stream>> loadCsvStreams(const ReplayOptions& o) {
 
 std::vector<std::unique_ptr<Stream>> loadMcapStreams(const ReplayOptions& o) {
   const records::McapContents contents = records::readMcap(o.recording);
+  if (contents.cut) {
+    spdlog::warn("{}; replaying the {} messages read (navbus recover closes the file)",
+                 records::describeCut(o.recording, *contents.cut), contents.messages.size());
+  }
   std::map<std::string, std::uint16_t> channel_of_topic;
   for (const auto& [id, channel] : contents.channels) {
     channel_of_topic[navbusTopic(channel.topic)] = id;

@@ -35,7 +35,7 @@ class Subcommand {
 
 using Subcommands = std::vector<std::unique_ptr<Subcommand>>;
 
-/// topics, echo, record (inspect_commands.cpp).
+/// topics, echo, record, recover (inspect_commands.cpp).
 void addInspectionSubcommands(Subcommands& out);
 /// replay, health, command, latency (bus_commands.cpp).
 void addBusSubcommands(Subcommands& out);

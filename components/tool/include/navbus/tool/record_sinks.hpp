@@ -22,6 +22,9 @@ class RecordSink : public SampleSink {
  public:
   /// Prepares the topic's file or channel (before it is subscribed to).
   virtual void open(const TopicEntry& topic) = 0;
+  /// Puts what was recorded since the last flush on the disk (a crash then loses nothing
+  /// before it).
+  virtual void flush() = 0;
   /// Writes what is buffered and closes the recording.
   virtual void finish() = 0;
   std::uint64_t samples(const std::string& topic) const;
@@ -43,6 +46,9 @@ class CsvRecordSink final : public RecordSink {
   void open(const TopicEntry& topic) override;
   void onSample(const std::string& topic, const SampleTimes& times,
                 const SampleViews& sample) override;
+  /// Hands every file's buffered rows to the system (not synced: a crash of the recorder loses
+  /// nothing flushed, a crash of the machine may).
+  void flush() override;
   void finish() override;
 
  private:
@@ -58,6 +64,8 @@ class McapRecordSink final : public RecordSink {
   void open(const TopicEntry& topic) override;
   void onSample(const std::string& topic, const SampleTimes& times,
                 const SampleViews& sample) override;
+  /// Closes the open chunk and syncs the file (records::McapWriter::flush).
+  void flush() override;
   void finish() override;
 
  private:
