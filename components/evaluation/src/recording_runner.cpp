@@ -6,6 +6,9 @@
 #include <variant>
 
 #include <fmt/format.h>
+#include <navbus_idl/GnssPubSubTypes.h>
+#include <navbus_idl/ImuPubSubTypes.h>
+#include <navbus_idl/StarTrackerPubSubTypes.h>
 
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
@@ -18,6 +21,8 @@
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/records/csv_messages.hpp"
 #include "navbus/records/formatters.hpp"
+#include "navbus/records/mcap.hpp"
+#include "navbus/records/mcap_samples.hpp"
 #include "navbus/tool/topic_registry.hpp"
 
 namespace navbus::evaluation {
@@ -46,16 +51,47 @@ std::int64_t dataTimeNs(const T& m) {
   return static_cast<std::int64_t>(m.time_gps_ns());
 }
 
-template <class T>
-void load(const std::filesystem::path& dir, const char* topic, int rank, std::vector<Event>& out,
-          std::string& inputs) {
-  const std::filesystem::path file = dir / tool::recordFileName(topic);
-  if (!std::filesystem::exists(file)) return;
-  const records::CsvTable table = records::readCsv(file);
-  const auto messages = records::parseMessages<T>(table, records::messageRowRanges(table));
-  for (const T& m : messages) out.push_back({dataTimeNs(m), rank, out.size(), m});
-  inputs += fmt::format("{}: {} samples\n", file.string(), messages.size());
-}
+/// A recording's sensor samples: a directory of CSV files, or one MCAP file (read once; a file
+/// cut short is read up to its last complete record, and `inputs` says what was lost).
+class RecordedSamples {
+ public:
+  RecordedSamples(const std::filesystem::path& path, std::string& inputs)
+      : path_(path), inputs_(inputs) {
+    if (!std::filesystem::is_regular_file(path)) return;
+    if (!records::isMcapFile(path)) {
+      throw bus::ConfigError(path.string() +
+                             ": neither a directory of CSV files nor an MCAP file (no MCAP magic)");
+    }
+    mcap_ = records::readMcap(path);
+    if (mcap_->cut) inputs_ += records::describeCut(path, *mcap_->cut) + "\n";
+  }
+
+  template <class PubSubType>
+  void load(const char* topic, int rank, std::vector<Event>& out) {
+    using T = typename PubSubType::type;
+    std::vector<T> messages;
+    std::string from;
+    if (mcap_) {
+      const records::McapChannel* channel = records::channelOfTopic(*mcap_, topic);
+      if (channel == nullptr) return;
+      messages = records::decodeChannel<PubSubType>(path_.string(), *mcap_, *channel);
+      from = fmt::format("{} channel {}", path_.string(), channel->topic);
+    } else {
+      const std::filesystem::path file = path_ / tool::recordFileName(topic);
+      if (!std::filesystem::exists(file)) return;
+      const records::CsvTable table = records::readCsv(file);
+      messages = records::parseMessages<T>(table, records::messageRowRanges(table));
+      from = file.string();
+    }
+    for (const T& m : messages) out.push_back({dataTimeNs(m), rank, out.size(), m});
+    inputs_ += fmt::format("{}: {} samples\n", from, messages.size());
+  }
+
+ private:
+  std::filesystem::path path_;
+  std::string& inputs_;
+  std::optional<records::McapContents> mcap_;
+};
 
 }  // namespace
 
@@ -72,13 +108,12 @@ ImportedRun importForRun(const std::string& dataset_yaml, const std::string& fil
 RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolutionHook& hook) {
   RecordingResult result;
   std::vector<Event> events;
-  load<navbus::ImuIncrement>(setup.dir, bus::topic::kImuIncrement, 0, events, result.inputs);
-  load<navbus::ImuIncrementBlock>(setup.dir, bus::topic::kImuIncrementBlock, 0, events,
-                                  result.inputs);
-  load<navbus::GnssObservationEpoch>(setup.dir, bus::topic::kGnssObservations, 1, events,
-                                     result.inputs);
-  load<navbus::GnssFix>(setup.dir, bus::topic::kGnssFix, 2, events, result.inputs);
-  load<navbus::StarTrackerAttitude>(setup.dir, bus::topic::kStarTracker, 3, events, result.inputs);
+  RecordedSamples recorded(setup.dir, result.inputs);
+  recorded.load<navbus::ImuIncrementPubSubType>(bus::topic::kImuIncrement, 0, events);
+  recorded.load<navbus::ImuIncrementBlockPubSubType>(bus::topic::kImuIncrementBlock, 0, events);
+  recorded.load<navbus::GnssObservationEpochPubSubType>(bus::topic::kGnssObservations, 1, events);
+  recorded.load<navbus::GnssFixPubSubType>(bus::topic::kGnssFix, 2, events);
+  recorded.load<navbus::StarTrackerAttitudePubSubType>(bus::topic::kStarTracker, 3, events);
   if (events.empty())
     throw bus::ConfigError(
         "no recording of a sensor topic in '" + setup.dir.string() +

@@ -36,23 +36,40 @@ enum Opcode : std::uint8_t {
 /// A record's name as the specification gives it ("" for opcode 0: no record).
 inline const char* recordName(std::uint8_t opcode) {
   switch (opcode) {
-    case 0: return "";
-    case kHeader: return "Header";
-    case kFooter: return "Footer";
-    case kSchema: return "Schema";
-    case kChannel: return "Channel";
-    case kMessage: return "Message";
-    case kChunk: return "Chunk";
-    case kMessageIndex: return "Message Index";
-    case kChunkIndex: return "Chunk Index";
-    case kAttachment: return "Attachment";
-    case kAttachmentIndex: return "Attachment Index";
-    case kStatistics: return "Statistics";
-    case kMetadata: return "Metadata";
-    case kMetadataIndex: return "Metadata Index";
-    case kSummaryOffset: return "Summary Offset";
-    case kDataEnd: return "Data End";
-    default: return "private or unknown record";
+    case 0:
+      return "";
+    case kHeader:
+      return "Header";
+    case kFooter:
+      return "Footer";
+    case kSchema:
+      return "Schema";
+    case kChannel:
+      return "Channel";
+    case kMessage:
+      return "Message";
+    case kChunk:
+      return "Chunk";
+    case kMessageIndex:
+      return "Message Index";
+    case kChunkIndex:
+      return "Chunk Index";
+    case kAttachment:
+      return "Attachment";
+    case kAttachmentIndex:
+      return "Attachment Index";
+    case kStatistics:
+      return "Statistics";
+    case kMetadata:
+      return "Metadata";
+    case kMetadataIndex:
+      return "Metadata Index";
+    case kSummaryOffset:
+      return "Summary Offset";
+    case kDataEnd:
+      return "Data End";
+    default:
+      return "private or unknown record";
   }
 }
 

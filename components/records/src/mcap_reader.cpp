@@ -25,8 +25,9 @@ class McapParser {
     }
     // A closed file ends with the magic, and its records end before it; a file cut short ends
     // anywhere, and its last complete record marks what can be read.
-    const bool closed = bytes_.size() >= 2 * magic &&
-                        std::memcmp(bytes_.data() + bytes_.size() - magic, mcap::kMagic, magic) == 0;
+    const bool closed =
+        bytes_.size() >= 2 * magic &&
+        std::memcmp(bytes_.data() + bytes_.size() - magic, mcap::kMagic, magic) == 0;
     const std::size_t end = closed ? bytes_.size() - magic : bytes_.size();
     std::size_t at = magic;
     std::uint8_t last_opcode = 0;

@@ -31,10 +31,9 @@ std::string describeCut(const std::filesystem::path& file, const McapCut& cut) {
               ? std::string("no bytes lost after it; ")
               : fmt::format("the last {} bytes ({}) are lost; ", cut.lostBytes(),
                             cut.lost_record.empty() ? "an incomplete record" : cut.lost_record);
-  text += cut.last_log_time_ns
-              ? fmt::format("the last complete message was logged at {} ({} ns)",
-                            utcText(*cut.last_log_time_ns), *cut.last_log_time_ns)
-              : std::string("no complete message");
+  text += cut.last_log_time_ns ? fmt::format("the last complete message was logged at {} ({} ns)",
+                                             utcText(*cut.last_log_time_ns), *cut.last_log_time_ns)
+                               : std::string("no complete message");
   return text;
 }
 
@@ -52,7 +51,8 @@ McapRecovery recoverMcap(const std::filesystem::path& in, const std::filesystem:
   // The writer numbers schemas from 1 and channels from 0 in the order added; the file's own
   // ids may differ (or have gaps), so messages are mapped through the new ids.
   std::map<std::uint16_t, std::uint16_t> schema_id, channel_id;
-  for (const auto& [id, s] : c.schemas) schema_id[id] = writer.addSchema(s.name, s.encoding, s.data);
+  for (const auto& [id, s] : c.schemas)
+    schema_id[id] = writer.addSchema(s.name, s.encoding, s.data);
   for (const auto& [id, ch] : c.channels) {
     if (ch.schema_id == 0) {
       throw bus::ConfigError(in.string() + ": channel '" + ch.topic +

@@ -27,10 +27,12 @@ class OfflineCommand final : public Subcommand {
             ->check(CLI::ExistingFile);
     auto* recording =
         cli_->add_option("--recording", recording_.recording,
-                         "a recording directory instead of a scenario (navbus import, navbus "
-                         "record): its sensor topics in data-time order, as navbus replay sends "
-                         "them; --start, --seed and --duration do not apply")
-            ->check(CLI::ExistingDirectory);
+                         "a recording instead of a scenario: a directory of CSV files (navbus "
+                         "import, navbus record) or an MCAP file (navbus record --format mcap; one "
+                         "cut short is read up to its last complete record): its sensor topics in "
+                         "data-time order, as navbus replay sends them; --start, --seed and "
+                         "--duration do not apply")
+            ->check(CLI::ExistingPath);
     scenario->excludes(recording);
     cli_->add_flag("--innovations", recording_.innovations,
                    "with --recording: also write innovations.csv, every fused GNSS fix's "

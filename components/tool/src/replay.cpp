@@ -14,6 +14,7 @@
 #include "navbus/bus/streams.hpp"
 #include "navbus/records/csv_messages.hpp"
 #include "navbus/records/mcap.hpp"
+#include "navbus/records/mcap_samples.hpp"
 #include "navbus/tool/spin.hpp"
 #include "navbus/tool/topic_registry.hpp"
 
@@ -145,42 +146,18 @@ std::unique_ptr<Stream> loadCsvStream(const std::string& topic, const std::files
 
 /// A recorded channel's messages decoded with the topic's type.
 std::unique_ptr<Stream> loadMcapStream(const std::string& file, const std::string& topic,
-                                       const records::McapChannel& channel,
-                                       const std::vector<const records::McapMessage*>& messages) {
-  if (channel.message_encoding != "cdr") {
-    throw bus::ConfigError(file + ": channel '" + channel.topic + "' has message encoding '" +
-                           channel.message_encoding + "', not cdr");
-  }
+                                       const records::McapContents& contents,
+                                       const records::McapChannel& channel) {
   std::unique_ptr<Stream> stream;
   forSensorTopic(topic, [&](auto traits) {
     using Traits = decltype(traits);
     using PubSubType = typename Traits::PubSubType;
-    using T = typename PubSubType::type;
-    PubSubType type;
-    std::vector<T> decoded(messages.size());
     std::vector<std::int64_t> source_ns;
-    for (std::size_t i = 0; i < messages.size(); ++i) {
-      const auto& m = *messages[i];
-      eprosima::fastrtps::rtps::SerializedPayload_t payload(
-          static_cast<std::uint32_t>(m.data.size()));
-      std::copy(m.data.begin(), m.data.end(), payload.data);
-      payload.length = static_cast<std::uint32_t>(m.data.size());
-      if (!type.deserialize(&payload, &decoded[i])) {
-        throw bus::ConfigError(file + ": channel '" + channel.topic + "' message " +
-                               std::to_string(i + 1) + " (sequence " + std::to_string(m.sequence) +
-                               ") is not a valid " + type.getName());
-      }
-      source_ns.push_back(static_cast<std::int64_t>(m.publish_time_ns));
-    }
+    auto decoded = records::decodeChannel<PubSubType>(file, contents, channel, &source_ns);
     stream = std::make_unique<TypedStream<PubSubType>>(topic, Traits::kTopic.writer_profile,
                                                        std::move(decoded), std::move(source_ns));
   });
   return stream;
-}
-
-/// The navbus topic a recorded channel carries: its name, or under ROS 2 naming "/" + name.
-std::string navbusTopic(const std::string& channel_topic) {
-  return channel_topic.rfind('/', 0) == 0 ? channel_topic.substr(1) : channel_topic;
 }
 
 void checkReplayable(const ReplayOptions& o) {
@@ -214,23 +191,16 @@ std::vector<std::unique_ptr<Stream>> loadMcapStreams(const ReplayOptions& o) {
     spdlog::warn("{}; replaying the {} messages read (navbus recover closes the file)",
                  records::describeCut(o.recording, *contents.cut), contents.messages.size());
   }
-  std::map<std::string, std::uint16_t> channel_of_topic;
-  for (const auto& [id, channel] : contents.channels) {
-    channel_of_topic[navbusTopic(channel.topic)] = id;
-  }
-  std::map<std::uint16_t, std::vector<const records::McapMessage*>> by_channel;
-  for (const auto& m : contents.messages) by_channel[m.channel_id].push_back(&m);
   std::vector<std::unique_ptr<Stream>> streams;
   for (const auto& topic : o.topics.empty() ? replayableTopics() : o.topics) {
-    const auto channel = channel_of_topic.find(topic);
-    if (channel == channel_of_topic.end()) {
+    const records::McapChannel* channel = records::channelOfTopic(contents, topic);
+    if (channel == nullptr) {
       if (!o.topics.empty()) {
         throw bus::ConfigError(o.recording + ": no channel of topic '" + topic + "'");
       }
       continue;
     }
-    streams.push_back(loadMcapStream(o.recording, topic, contents.channels.at(channel->second),
-                                     by_channel[channel->second]));
+    streams.push_back(loadMcapStream(o.recording, topic, contents, *channel));
     spdlog::info("{}: {} samples of {}", o.recording, streams.back()->size(), topic);
   }
   return streams;
