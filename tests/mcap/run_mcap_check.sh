@@ -15,34 +15,9 @@
 set -euo pipefail
 build=$(cd "$1" && pwd) src=$(cd "$2" && pwd)
 bin=$build/bin
-work=$(mktemp -d /tmp/navbus-mcap.XXXXXX)
-[ -z "${KEEP_WORK:-}" ] || echo "scratch directory (kept): $work"
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -KILL "$p" 2> /dev/null || true; done
-  [ -n "${KEEP_WORK:-}" ] || rm -rf "$work"
-  rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2> /dev/null || true
-}
-trap cleanup EXIT
-fail() {
-  echo "FAIL: $*"
-  for f in "$work"/*.log; do echo "--- $f"; tail -15 "$f"; done
-  echo "FAIL: $*"  # again, last: what a truncated log shows
-  exit 1
-}
-
-# --- Foxglove's readers, in the test's own folder --------------------------------------------
-node_dir=$build/mcap-node
-command -v node > /dev/null && command -v npm > /dev/null || {
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends nodejs npm > /dev/null
-}
-mkdir -p "$node_dir"
-if ! cmp -s "$src/tests/mcap/package-lock.json" "$node_dir/package-lock.json" ||
-  [ ! -d "$node_dir/node_modules" ]; then
-  cp "$src/tests/mcap/package.json" "$src/tests/mcap/package-lock.json" "$node_dir/"
-  (cd "$node_dir" && npm ci --no-audit --no-fund --loglevel=error) || fail "npm ci"
-fi
-cp "$src/tests/mcap/check_mcap.mjs" "$node_dir/"
+MCAP_TEST_NAME=mcap
+source "$src/tests/mcap/common.sh"
+install_node_readers check_mcap.mjs
 
 # Stops the given pids with SIGTERM and checks each exited 0.
 stop() {
@@ -139,13 +114,6 @@ replay_into() {  # RECORDING OUT_DIR
   wait $rec_pid || fail "the replay's recorder"
   pids=()
 }
-# The recorded message columns of a CSV file, without the time stamps of reception.
-content() { python3 -c '
-import csv, sys
-rows = list(csv.reader(open(sys.argv[1])))
-drop = {i for i, c in enumerate(rows[0]) if c in ("source_timestamp_ns", "reception_timestamp_ns")}
-for r in rows:
-    print(",".join(c for i, c in enumerate(r) if i not in drop))' "$1"; }
 replay_into "$work/run.mcap" "$work/from_mcap"
 replay_into "$work/csv" "$work/from_csv"
 for topic in navbus_imu_increment_block navbus_imu_raw navbus_gnss_observations navbus_gnss_fix; do

@@ -14,35 +14,11 @@
 set -euo pipefail
 build=$(cd "$1" && pwd) src=$(cd "$2" && pwd)
 bin=$build/bin
-work=$(mktemp -d /tmp/navbus-mcap-crash.XXXXXX)
-[ -z "${KEEP_WORK:-}" ] || echo "scratch directory (kept): $work"
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -KILL "$p" 2> /dev/null || true; done
-  [ -n "${KEEP_WORK:-}" ] || rm -rf "$work"
-  rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2> /dev/null || true
-}
-trap cleanup EXIT
-fail() {
-  echo "FAIL: $*"
-  for f in "$work"/*.log; do echo "--- $f"; tail -15 "$f"; done
-  echo "FAIL: $*"
-  exit 1
-}
+MCAP_TEST_NAME=mcap-crash
+source "$src/tests/mcap/common.sh"
+install_node_readers check_mcap.mjs check_crash.mjs
 flush_s=1
 kill_after_s=12.5  # half a flush interval after the recorders flush (they start together)
-
-node_dir=$build/mcap-node
-command -v node > /dev/null && command -v npm > /dev/null || {
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends nodejs npm > /dev/null
-}
-mkdir -p "$node_dir"
-if ! cmp -s "$src/tests/mcap/package-lock.json" "$node_dir/package-lock.json" ||
-  [ ! -d "$node_dir/node_modules" ]; then
-  cp "$src/tests/mcap/package.json" "$src/tests/mcap/package-lock.json" "$node_dir/"
-  (cd "$node_dir" && npm ci --no-audit --no-fund --loglevel=error) || fail "npm ci"
-fi
-cp "$src/tests/mcap/check_mcap.mjs" "$src/tests/mcap/check_crash.mjs" "$node_dir/"
 
 # --- 1. the demo's loop in real time, the MCAP recorder killed ------------------------------
 domain=111
@@ -118,12 +94,6 @@ replay_into "$work/run.mcap" "$work/from_cut"
 grep -q "cut short" "$work/replay.log" || fail "navbus replay did not say the file was cut"
 grep -o "cut short.*" "$work/replay.log" | head -1
 replay_into "$work/recovered.mcap" "$work/from_recovered"
-content() { python3 -c '
-import csv, sys
-rows = list(csv.reader(open(sys.argv[1])))
-drop = {i for i, c in enumerate(rows[0]) if c in ("source_timestamp_ns", "reception_timestamp_ns")}
-for r in rows:
-    print(",".join(c for i, c in enumerate(r) if i not in drop))' "$1"; }
 for topic in navbus_imu_increment navbus_imu_raw navbus_gnss_observations navbus_gnss_fix; do
   [ "$(content "$work/from_cut/$topic.csv" | md5sum)" = \
     "$(content "$work/from_recovered/$topic.csv" | md5sum)" ] ||
