@@ -3,14 +3,15 @@
 # configured with -DNAVBUS_BUILD_FUZZERS=ON) for a given number of executions each:
 #   navbus_fuzz_topics  CDR deserialization of every topic type + the input validators
 #   navbus_fuzz_config  the configuration parsers (participant, simulator, filter, fault manager)
+#   navbus_fuzz_foxglove  the Foxglove bridge's handling of client messages
 # Seeds: a valid sample of each topic type and the shipped configurations; the corpus grows in
 # the work directory and is reused by the next run. A crash, leak, undefined behaviour or
 # violated property fails the script and leaves the input under <work>/artifacts.
 # --parallel runs the two targets side by side (one core each) instead of one after the other;
-# --only topics|config runs one of them.
+# --only topics|config|foxglove runs one of them.
 #
 #   bash scripts/fuzz.sh [--bin build-san/bin] [--runs 10000000] [--work build-san/fuzz]
-#                        [--parallel] [--only topics|config]
+#                        [--parallel] [--only topics|config|foxglove]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=$root/build-san/bin
@@ -30,20 +31,25 @@ while [ $# -gt 0 ]; do
 done
 work=${work:-$bin/../fuzz}
 case "$only" in
-  ""|topics|config) ;;
-  *) echo "fuzz.sh: --only '$only': expected topics or config" >&2; exit 2 ;;
+  ""|topics|config|foxglove) ;;
+  *) echo "fuzz.sh: --only '$only': expected topics, config or foxglove" >&2; exit 2 ;;
 esac
-for t in navbus_fuzz_topics navbus_fuzz_config navbus_fuzz_seeds; do
+for t in navbus_fuzz_topics navbus_fuzz_config navbus_fuzz_foxglove navbus_fuzz_seeds; do
   [ -x "$bin/$t" ] || { echo "fuzz.sh: $bin/$t missing: build with scripts/sanitize.sh first" >&2; exit 2; }
 done
-mkdir -p "$work/corpus/topics" "$work/corpus/config" "$work/artifacts"
+mkdir -p "$work/corpus/topics" "$work/corpus/config" "$work/corpus/foxglove" "$work/artifacts"
 seeds=()
 for f in "$root"/config/filter*.yaml; do seeds+=("filter:$f"); done
 for f in "$root"/config/fault_manager*.yaml; do seeds+=("fault:$f"); done
 for f in "$root"/sim/scenarios/*.yaml; do seeds+=("sim:$f"); done
 seeds+=("participant:$root/config/filter.yaml")
-mkdir -p "$work/seeds/topics" "$work/seeds/config"
+mkdir -p "$work/seeds/topics" "$work/seeds/config" "$work/seeds/foxglove"
 "$bin/navbus_fuzz_seeds" "$work/seeds" "${seeds[@]}"
+# The bridge's clients: what Foxglove sends, and one of each refusal, 0x00 between messages.
+printf '{"op":"subscribe","subscriptions":[{"id":0,"channelId":1},{"id":1,"channelId":2}]}\0{"op":"unsubscribe","subscriptionIds":[0]}' \
+  > "$work/seeds/foxglove/subscribe"
+printf '{"op":"subscribe","subscriptions":[{"id":4294967296,"channelId":1}]}\0{"op":1}\0[]\0\001abc\0{' \
+  > "$work/seeds/foxglove/refusals"
 
 # LeakSanitizer on; the first finding stops the target. malloc_context_size=0: ASan keeps every
 # distinct allocation stack for the life of the process, and the parsers' recursion makes new ones
@@ -74,14 +80,17 @@ if [ -n "$only" ]; then
   case "$only" in
     topics) run navbus_fuzz_topics topics 65536 || status=1 ;;
     config) run navbus_fuzz_config config 8192 || status=1 ;;
+    foxglove) run navbus_fuzz_foxglove foxglove 1024 || status=1 ;;
   esac
 elif [ "$parallel" = 1 ]; then
   run navbus_fuzz_topics topics 65536 & topics=$!
   run navbus_fuzz_config config 8192 & config=$!
   wait "$topics" || status=1
   wait "$config" || status=1
+  run navbus_fuzz_foxglove foxglove 1024 || status=1
 else
   run navbus_fuzz_topics topics 65536 || status=1
   run navbus_fuzz_config config 8192 || status=1
+  run navbus_fuzz_foxglove foxglove 1024 || status=1
 fi
 exit $status

@@ -7,10 +7,11 @@ packages=(
   build-essential cmake pkg-config git ccache              # ccache: a rebuild of the same sources is quick
   libfastrtps-dev libfastcdr-dev fastddsgen                # Fast DDS 2.9, Fast-CDR, code generator
   python3                                                  # IDL schemas for MCAP recordings (idl/idl_schemas.py)
-  libeigen3-dev libfftw3-dev libboost-dev                  # math (Boost.Math: noncentral chi-square)
+  libeigen3-dev libfftw3-dev libboost-dev                  # math (Boost.Math: noncentral chi-square); Boost.Beast (navbus foxglove)
   libyaml-cpp-dev libcli11-dev libspdlog-dev               # configuration, command line, logging
   libcsv-dev libtinyxml2-dev                               # CSV recordings (navbus replay), QoS files
   zlib1g-dev libzstd-dev                                   # MCAP recordings: CRC-32, zstd chunks
+  nlohmann-json3-dev                                       # JSON of the Foxglove WebSocket bridge (navbus foxglove)
 )
 if [ "${1:-}" != --package ]; then
   packages+=(

@@ -17,6 +17,7 @@ import { parse as parseRosMsg } from "@foxglove/rosmsg";
 import { MessageReader as Ros2Reader } from "@foxglove/rosmsg2-serialization";
 import { decompress as zstdDecompress } from "fzstd";
 import { parse as parseCsv } from "csv-parse/sync";
+import { compareRows, constants } from "./csv_compare.mjs";
 
 const [file, csvDir, ...flags] = process.argv.slice(2);
 const ros2 = flags.includes("--ros2");
@@ -79,7 +80,7 @@ if (indexed.header.profile !== (ros2 ? "ros2" : "")) fail(`profile '${indexed.he
 
 // 3 and 4. Decode every channel and compare with the CSV recording.
 let topicsCompared = 0;
-let summarized = 0; // CSV cells that summarize structs as text, left uncompared
+const counts = { summarized: 0 }; // CSV cells that summarize structs as text, left uncompared
 const recordFileName = (topic) => `${topic.replace(/^\//, "").replaceAll("/", "_")}.csv`;
 for (const channel of indexed.channelsById.values()) {
   const schema = indexed.schemasById.get(channel.schemaId);
@@ -120,7 +121,7 @@ for (const channel of indexed.channelsById.values()) {
     const group = csvBySource.get(m.publishTime.toString());
     if (!group) continue;
     compared += 1;
-    cells += compareRows(channel.topic, value, group, enums);
+    cells += compareRows(channel.topic, value, group, enums, fail, counts);
   }
   console.log(
     `${channel.topic}: ${schema.name} (${schema.encoding}), ${messages.length} messages decoded, ` +
@@ -138,7 +139,7 @@ for (const channel of indexed.channelsById.values()) {
   if (compared > 0) topicsCompared += 1;
 }
 if (topicsCompared === 0) fail("no topic was compared");
-console.log(`${summarized} CSV cells summarize structs as text and were not compared`);
+console.log(`${counts.summarized} CSV cells summarize structs as text and were not compared`);
 console.log(`${topicsCompared} topics decoded and equal to the CSV recording`);
 if (failures > 0) {
   console.log(`${failures} failures`);
@@ -146,101 +147,3 @@ if (failures > 0) {
 }
 console.log("mcap check: ok");
 
-// Every constant of a schema (OMG IDL enumerators and consts; ROS 2 msg constants, which carry
-// the IDL enumerators): [name, value] pairs.
-function constants(definitions) {
-  const all = [];
-  for (const d of definitions) {
-    for (const c of d.definitions ?? []) if (c.isConstant) all.push([c.name, c.value]);
-  }
-  return all;
-}
-
-// Compares one decoded message with its CSV rows; returns the number of cells compared.
-// CSV columns (records/formatters.hpp): "name", "name[i]" for arrays, "seq.field" (a row per
-// element) for the sequence of structs, "a;b;c" for a sequence of numbers, enums by name,
-// booleans as 0/1, a nested struct's fields as "<struct>_<field>". Fields the CSV summarizes as text (diagnostics, decision candidates) are
-// not compared.
-function compareRows(topic, value, rows, enums) {
-  let cells = 0;
-  const columns = Object.keys(rows[0]).filter(
-    (c) => c !== "source_timestamp_ns" && c !== "reception_timestamp_ns",
-  );
-  rows.forEach((row, r) => {
-    for (const column of columns) {
-      const m = /^([a-z_0-9]+)(?:\[(\d+)\])?(?:\.([a-z_0-9]+)(?:\[(\d+)\])?)?$/.exec(column);
-      if (!m) {
-        fail(`${topic}: column '${column}' is not a field path`);
-        continue;
-      }
-      let v = field(value, m[1]);
-      if (m[3] !== undefined) {
-        if (row[column] === "" && (v?.length ?? 0) === 0) continue; // no element: empty cells
-        v = v?.[r]?.[m[3]];
-        if (m[4] !== undefined) v = v?.[Number(m[4])];
-      } else if (m[2] !== undefined) {
-        v = v?.[Number(m[2])];
-      } else if (r > 0) {
-        continue; // a message's own fields are repeated on each of its rows
-      }
-      if (v === undefined) {
-        fail(`${topic}: column '${column}' has no decoded field`);
-        continue;
-      }
-      // A struct, or a sequence of structs, that the CSV summarizes as one text cell: not
-      // compared, and not counted as equal.
-      const structs = Array.isArray(v) && v.length > 0 && typeof v[0] === "object";
-      if (structs || (typeof v === "object" && !ArrayBuffer.isView(v) && !Array.isArray(v))) {
-        summarized += 1;
-        continue;
-      }
-      if (!equalCell(row[column], v, enums)) {
-        fail(`${topic}: '${column}' CSV '${row[column]}' decoded '${format(v)}'`);
-        continue;
-      }
-      cells += 1;
-    }
-  });
-  return cells;
-}
-
-// A message's field by its CSV name; a nested struct's fields are named "<struct>_<field>"
-// (FaultDecision.dither.peak_frequency_hz as dither_peak_frequency_hz).
-function field(value, name) {
-  if (name in value) return value[name];
-  for (let i = name.indexOf("_"); i > 0; i = name.indexOf("_", i + 1)) {
-    const outer = value[name.slice(0, i)];
-    if (outer && typeof outer === "object" && !ArrayBuffer.isView(outer) && !Array.isArray(outer)) {
-      const inner = field(outer, name.slice(i + 1));
-      if (inner !== undefined) return inner;
-    }
-  }
-  return undefined;
-}
-
-function format(v) {
-  return ArrayBuffer.isView(v) || Array.isArray(v) ? Array.from(v).join(";") : String(v);
-}
-
-function equalCell(cell, v, enums) {
-  if (typeof v === "bigint") return /^-?\d+$/.test(cell) && BigInt(cell) === v;
-  if (typeof v === "boolean") return cell === (v ? "1" : "0");
-  if (typeof v === "string") return cell === v;
-  if (ArrayBuffer.isView(v) || Array.isArray(v)) {
-    // A sequence of numbers as one cell.
-    const parts = cell === "" ? [] : cell.split(";");
-    return parts.length === v.length && parts.every((p, i) => Number(p) === Number(v[i]));
-  }
-  if (typeof v === "number") {
-    // An enumerator by name: the CSV writes it without the enum's prefix (MODE_INERTIAL_ONLY
-    // as INERTIAL_ONLY, records/message_fields.hpp's enumName).
-    if (/^[A-Za-z][A-Za-z0-9_]*$/.test(cell)) {
-      const upper = cell.toUpperCase();
-      return enums.some(
-        ([name, value]) => (name === upper || name.endsWith(`_${upper}`)) && value === v,
-      );
-    }
-    return Number(cell) === v;
-  }
-  return false;
-}

@@ -17,7 +17,7 @@ build=$(cd "$1" && pwd) src=$(cd "$2" && pwd)
 bin=$build/bin
 MCAP_TEST_NAME=mcap
 source "$src/tests/mcap/common.sh"
-install_node_readers check_mcap.mjs
+install_node_readers check_mcap.mjs csv_compare.mjs
 
 # Stops the given pids with SIGTERM and checks each exited 0.
 stop() {

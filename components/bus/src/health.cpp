@@ -119,6 +119,8 @@ const char* rejectReasonName(navbus::RejectReason reason) {
       return "not_applicable";
     case navbus::REJECT_MALFORMED:
       return "malformed";
+    case navbus::REJECT_CLIENT_BEHIND:
+      return "client_behind";
   }
   return "unknown";
 }

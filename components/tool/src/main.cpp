@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   nb::tool::cli::addBusSubcommands(subcommands);
   nb::tool::cli::addEvaluationSubcommands(subcommands);
   nb::tool::cli::addRealDataSubcommands(subcommands);
+  nb::tool::cli::addFoxgloveSubcommand(subcommands);
   for (const auto& s : subcommands) s->add(app);
 
   return nb::bus::runMain(app, argc, argv, common, [&](const YAML::Node& yaml) -> int {
@@ -37,7 +38,8 @@ int main(int argc, char** argv) {
       }
       auto options = nb::bus::participantOptions(common, yaml, "navbus");
       options.publish_health =
-          publish_health;  // an inspection tool is not part of what it inspects
+          publish_health;  // an inspection tool is not part of what it inspects (a subcommand
+                           // that serves the bus, foxglove, turns it on)
       options.dds.discovery_super_client = s->inspectsBus();
       return s->run(options, shutdown);
     }

@@ -1,7 +1,5 @@
 #include "navbus/tool/record_sinks.hpp"
 
-#include <navbus_idl/IdlSchemas.h>
-
 #include <stdexcept>
 
 #include "navbus/bus/config.hpp"
@@ -70,25 +68,10 @@ McapRecordSink::McapRecordSink(const std::filesystem::path& file, bool ros2)
                                                ros2 ? "ros2" : "", "navbus record"}) {}
 
 void McapRecordSink::open(const TopicEntry& e) {
-  const idl_schemas::TypeSchema* schema = idl_schemas::find(e.type_name);
-  if (schema == nullptr) {
-    throw bus::ConfigError("record --format mcap: no schema for type '" + e.type_name + "' of " +
-                           e.name);
-  }
+  const TopicSchema t = topicSchema(e, ros2_);
   auto [it, added] = schema_of_type_.try_emplace(e.type_name, 0);
-  if (added) {
-    it->second = ros2_ ? writer_.addSchema(std::string(schema->ros2_name), "ros2msg",
-                                           std::string(schema->ros2msg))
-                       : writer_.addSchema(std::string(schema->type_name), "omgidl",
-                                           std::string(schema->omgidl));
-  }
-  // The DDS names beside the channel's own, for tools that go back to the bus.
-  const std::map<std::string, std::string> metadata{
-      {"dds_topic", ros2_ ? bus::ros2TopicName(e.name) : e.name},
-      {"dds_type", ros2_ ? bus::ros2TypeName(e.type_name) : e.type_name},
-      {"reader_profile", e.reader_profile}};
-  channel_of_topic_[e.name] =
-      writer_.addChannel(it->second, ros2_ ? "/" + e.name : e.name, kCdr, metadata);
+  if (added) it->second = writer_.addSchema(t.schema_name, t.schema_encoding, t.schema);
+  channel_of_topic_[e.name] = writer_.addChannel(it->second, t.channel_topic, kCdr, t.metadata);
 }
 
 void McapRecordSink::onSample(const std::string& topic, const SampleTimes& times,

@@ -43,5 +43,7 @@ void addBusSubcommands(Subcommands& out);
 void addEvaluationSubcommands(Subcommands& out);
 /// import, allan, benchmark real-car (real_data_commands.cpp).
 void addRealDataSubcommands(Subcommands& out);
+/// foxglove: the bus served to Foxglove (foxglove_command.cpp).
+void addFoxgloveSubcommand(Subcommands& out);
 
 }  // namespace navbus::tool::cli

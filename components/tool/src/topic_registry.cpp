@@ -2,8 +2,11 @@
 
 #include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/HealthPubSubTypes.h>
+#include <navbus_idl/IdlSchemas.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
+#include "navbus/bus/config.hpp"
+#include "navbus/bus/dds_context.hpp"
 #include "navbus/bus/streams.hpp"
 #include "navbus/records/formatters.hpp"
 
@@ -70,6 +73,22 @@ std::vector<TopicEntry> makeRegistry() {
 const std::vector<TopicEntry>& topicRegistry() {
   static const std::vector<TopicEntry> registry = makeRegistry();
   return registry;
+}
+
+TopicSchema topicSchema(const TopicEntry& e, bool ros2) {
+  const idl_schemas::TypeSchema* schema = idl_schemas::find(e.type_name);
+  if (schema == nullptr) {
+    throw bus::ConfigError("no schema for type '" + e.type_name + "' of " + e.name);
+  }
+  TopicSchema t;
+  t.channel_topic = ros2 ? "/" + e.name : e.name;
+  t.schema_name = ros2 ? std::string(schema->ros2_name) : std::string(schema->type_name);
+  t.schema_encoding = ros2 ? "ros2msg" : "omgidl";
+  t.schema = ros2 ? std::string(schema->ros2msg) : std::string(schema->omgidl);
+  t.metadata = {{"dds_topic", ros2 ? bus::ros2TopicName(e.name) : e.name},
+                {"dds_type", ros2 ? bus::ros2TypeName(e.type_name) : e.type_name},
+                {"reader_profile", e.reader_profile}};
+  return t;
 }
 
 std::string recordFileName(const std::string& topic) {

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,19 @@ struct TopicEntry {
 const std::vector<TopicEntry>& topicRegistry();
 /// nullptr if the topic is not a navbus topic.
 const TopicEntry* findTopic(const std::string& name);
+/// How a topic is described outside DDS (an MCAP channel, a Foxglove bridge channel): its name
+/// ("/" + name under ROS 2 naming), its type's self-contained schema (OMG IDL, or a ROS 2
+/// message definition under ROS 2 naming) and the DDS names, for tools that go back to the bus.
+struct TopicSchema {
+  std::string channel_topic;
+  std::string schema_name;
+  std::string schema_encoding;  ///< omgidl or ros2msg
+  std::string schema;
+  std::map<std::string, std::string> metadata;  ///< dds_topic, dds_type, reader_profile
+};
+/// Throws bus::ConfigError if the type has no schema.
+TopicSchema topicSchema(const TopicEntry& entry, bool ros2);
+
 /// The file `navbus record` writes a topic to (and `navbus replay` reads): "/" as "_", ".csv".
 std::string recordFileName(const std::string& topic);
 

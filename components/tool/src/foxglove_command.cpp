@@ -1,0 +1,150 @@
+// `navbus foxglove`: the bus live in Foxglove. A participant that subscribes to every navbus
+// topic and serves it over the Foxglove WebSocket protocol (components/foxglove): a channel per
+// topic with the type's schema (OMG IDL, or ROS 2 msg under ROS 2 naming) and the samples' CDR
+// bytes, advertised while the topic has a writer. It never back-pressures the bus: each client
+// has a bounded queue per channel; what a slow client misses is counted in this participant's
+// health (navbus-foxglove, REJECT_CLIENT_BEHIND per topic).
+#include <chrono>
+#include <memory>
+
+#include <spdlog/spdlog.h>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+
+#include "navbus/bus/app.hpp"
+#include "navbus/bus/config.hpp"
+#include "navbus/foxglove/ws_server.hpp"
+#include "navbus/tool/topic_registry.hpp"
+#include "subcommand.hpp"
+
+namespace navbus::tool::cli {
+
+namespace {
+
+constexpr const char* kCdr = "cdr";
+
+/// The bus side of the bridge: samples in, channels and frames out.
+class BusBridge final : public SampleSink {
+ public:
+  BusBridge(foxglove::WsServer& server, bus::HealthCounters& health, bool ros2)
+      : server_(server), health_(health), ros2_(ros2) {}
+
+  /// Subscribes to a topic; its channel id is its place in the registry.
+  void add(bus::Participant& p, const TopicEntry& e) {
+    Bridged b;
+    b.channel.id = static_cast<std::uint32_t>(bridged_.size());
+    const TopicSchema t = topicSchema(e, ros2_);
+    b.channel.topic = t.channel_topic;
+    b.channel.encoding = kCdr;
+    b.channel.schema_name = t.schema_name;
+    b.channel.schema = t.schema;
+    b.channel.schema_encoding = t.schema_encoding;
+    b.name = e.name;
+    index_[e.name] = bridged_.size();
+    bridged_.push_back(b);
+    bridged_.back().reader = e.subscribe(p, *this);
+  }
+
+  void onSample(const std::string& topic, const SampleTimes& times,
+                const SampleViews& sample) override {
+    Bridged& b = bridged_[index_.at(topic)];
+    if (!b.advertised) return;  // a sample before its writer matched: no channel yet
+    ++health_.stream(topic).accepted;
+    server_.publish(b.channel.id,
+                    times.reception_ns < 0 ? 0 : static_cast<std::uint64_t>(times.reception_ns),
+                    std::make_shared<const std::vector<std::uint8_t>>(sample.cdr()));
+  }
+
+  /// Advertises the topics that gained a writer, withdraws those that lost their last one, and
+  /// puts the clients' drops into the health counters.
+  void update() {
+    for (Bridged& b : bridged_) {
+      eprosima::fastdds::dds::SubscriptionMatchedStatus status;
+      b.reader->get_subscription_matched_status(status);
+      const bool has_writer = status.current_count > 0;
+      if (has_writer == b.advertised) continue;
+      b.advertised = has_writer;
+      if (has_writer) {
+        server_.advertise(b.channel);
+      } else {
+        server_.unadvertise(b.channel.id);
+      }
+      spdlog::info("{}: {} ({} writer(s))", b.channel.topic,
+                   has_writer ? "advertised" : "withdrawn", status.current_count);
+    }
+    const foxglove::ServerCounters c = server_.counters();
+    for (const auto& [channel, dropped] : c.dropped_by_channel) {
+      health_.stream(bridged_.at(channel).name).rejected[navbus::REJECT_CLIENT_BEHIND] = dropped;
+    }
+  }
+
+ private:
+  struct Bridged {
+    foxglove::Channel channel;
+    std::string name;
+    eprosima::fastdds::dds::DataReader* reader{nullptr};
+    bool advertised{false};
+  };
+  foxglove::WsServer& server_;
+  bus::HealthCounters& health_;
+  bool ros2_;
+  std::vector<Bridged> bridged_;
+  std::map<std::string, std::size_t> index_;
+};
+
+class FoxgloveCommand final : public Subcommand {
+ public:
+  void add(CLI::App& app) override {
+    cli_ = app.add_subcommand(
+        "foxglove",
+        "serve the bus live to Foxglove over its WebSocket protocol (foxglove.websocket.v1): "
+        "open ws://HOST:PORT in Foxglove's 'Foxglove WebSocket' connection");
+    cli_->add_option("--port", options_.port, "TCP port (Foxglove's default 8765; 0: any free)")
+        ->check(CLI::Range(0, 65535));
+    cli_->add_option("--bind", options_.bind,
+                     "address to listen on (default this machine only; 0.0.0.0: every interface)");
+    cli_->add_option("--queue", options_.frames_per_subscription,
+                     "frames waiting per client and channel; beyond it the oldest is dropped and "
+                     "counted")
+        ->check(CLI::Range(1, 100000));
+    cli_->add_option("--duration", duration_s_, "stop after this many seconds (0: until SIGINT)")
+        ->check(CLI::Range(0.0, 1e7));
+  }
+
+  int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
+    options.dds.name = "navbus-foxglove";
+    options.publish_health = true;  // a service on the bus: its drops are reported
+    foxglove::WsServer server(options_);
+    spdlog::info("Foxglove WebSocket server on ws://{}:{} ({})", options_.bind, server.port(),
+                 foxglove::kSubprotocol);
+    bus::Participant p(options, shutdown);
+    BusBridge bridge(server, p.health(), options.dds.ros2_names);
+    for (const auto& e : topicRegistry()) bridge.add(p, e);
+    p.setState(navbus::STATE_RUNNING);
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s_);
+    while (!p.stopping() && (duration_s_ <= 0.0 || std::chrono::steady_clock::now() < end)) {
+      p.spinOnce(std::chrono::milliseconds(50));
+      bridge.update();
+    }
+    p.finish();
+    const foxglove::ServerCounters c = server.counters();
+    spdlog::info(
+        "foxglove bridge: clients accepted {} (now {}, ended by an error or an unread control "
+        "queue {}), handshakes refused {}, frames sent {}, dropped for clients behind {}, "
+        "requests refused {}",
+        c.clients_accepted, c.clients_now, c.clients_dropped, c.handshakes_refused, c.frames_sent,
+        c.frames_dropped, c.requests_refused);
+    return bus::kExitOk;
+  }
+
+ private:
+  foxglove::ServerOptions options_;
+  double duration_s_{0.0};
+};
+
+}  // namespace
+
+void addFoxgloveSubcommand(Subcommands& out) {
+  out.push_back(std::make_unique<FoxgloveCommand>());
+}
+
+}  // namespace navbus::tool::cli
