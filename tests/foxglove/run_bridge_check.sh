@@ -4,7 +4,9 @@
 #      the fault manager, a CSV recorder and the bridge on a free port of 127.0.0.1;
 #   2. check_bridge.mjs (@foxglove/ws-protocol) subscribes to every channel as it is advertised,
 #      parses every schema, decodes every message, compares the middle message of each channel
-#      with the CSV recording and prints the bridge hop on the low-latency solution;
+#      with the CSV recording and prints the bridge hop on the low-latency solution; the
+#      LocationFix track and the Log lines equal the recorded solutions and the operator's
+#      commands and the filter's answers (one applied, one refused) sent mid-run;
 #   3. hostile_clients.mjs, at the same time: malformed JSON, an unknown op, a subscription to an
 #      unknown channel, a binary message, an oversized message, a client that stops reading and
 #      one that disconnects mid-frame; each gets its error and the checked client sees nothing
@@ -16,7 +18,7 @@ build=$(cd "$1" && pwd) src=$(cd "$2" && pwd)
 bin=$build/bin
 MCAP_TEST_NAME=foxglove
 source "$src/tests/mcap/common.sh"
-install_node_readers csv_compare.mjs
+install_node_readers csv_compare.mjs foxglove_derived.mjs
 cp "$src/tests/foxglove/check_bridge.mjs" "$src/tests/foxglove/hostile_clients.mjs" "$node_dir/"
 
 domain=113
@@ -59,7 +61,26 @@ until grep -q "^connected" "$work/check.log"; do
   [ $SECONDS -lt $deadline ] || fail "the checking client did not connect"
   sleep 0.1
 done
-timeout 120 "$bin/navbus-sensor-sim" -c "$work/sim.yaml" > "$work/sim.log" 2>&1 || fail "simulator"
+"$bin/navbus-sensor-sim" -c "$work/sim.yaml" > "$work/sim.log" 2>&1 &
+sim=$!
+pids+=($sim)
+# An operator's commands in the middle of the run (the scenario's faults come after 15 s): one
+# the filter applies and one it refuses (an issuer it does not obey), for the Log channel.
+until grep -q "publishing" "$work/sim.log"; do
+  [ $SECONDS -lt $deadline ] || fail "the simulator did not start publishing"
+  sleep 0.1
+done
+sleep 5
+# Three readers of the commands: the filter, the bridge and the CSV recorder.
+"$bin/navbus" -d $domain command EXCLUDE_SATELLITE --sv 5 --issuer operator --min-readers 3 \
+  > "$work/command1.log" 2>&1 || fail "command: $(cat "$work/command1.log")"
+grep -q "vehicle 1: APPLIED" "$work/command1.log" || fail "not applied: $(cat "$work/command1.log")"
+! "$bin/navbus" -d $domain command READMIT_SATELLITE --sv 5 --issuer stranger --min-readers 3 \
+  > "$work/command2.log" 2>&1 || fail "the stranger's command exited 0"
+grep -q "vehicle 1: REFUSED (unauthorized)" "$work/command2.log" ||
+  fail "the stranger's command was not refused: $(cat "$work/command2.log")"
+timeout 120 tail --pid=$sim -f /dev/null || fail "the simulator did not end"
+wait $sim || fail "simulator"
 sleep 1
 for p in $filter $fm; do kill -TERM $p; done
 for p in $filter $fm; do wait $p || fail "process $p exited $?"; done

@@ -1,6 +1,7 @@
 // `navbus command`: an operator's FilterCommand reaches a running navbus-filter, which applies
-// it or refuses it (an issuer not in its command_issuers); bad options exit 2 naming the option
-// and the value; with no filter on the domain the tool says so and exits 1. Domain 67.
+// it or refuses it (an issuer not in its command_issuers), and the tool prints the filter's
+// answer (exit 0 applied, 1 refused); bad options exit 2 naming the option and the value; with
+// no filter on the domain the tool says so and exits 1. Domain 67.
 #include <gtest/gtest.h>
 
 #include "harness.hpp"
@@ -40,8 +41,13 @@ TEST(CommandTool, AppliedRefusedAndBadOptions) {
       runTool(dir, "ok.log", {"EXCLUDE_STREAM", "--sensor", "GNSS_FIX_STREAM", "--sensor-id", "1"}),
       0)
       << test::readFile(dir / "ok.log");
-  EXPECT_NE(test::readFile(dir / "ok.log").find("acknowledged by 1 reader"), std::string::npos);
-  EXPECT_EQ(runTool(dir, "intruder.log", {"CMD_RESET", "--issuer", "intruder"}), 0);
+  EXPECT_NE(test::readFile(dir / "ok.log").find("vehicle 1: APPLIED"), std::string::npos)
+      << test::readFile(dir / "ok.log");
+  EXPECT_EQ(runTool(dir, "intruder.log", {"CMD_RESET", "--issuer", "intruder"}), 1);
+  EXPECT_NE(test::readFile(dir / "intruder.log")
+                .find("vehicle 1: REFUSED (unauthorized): issuer 'intruder' not in command_issuers"),
+            std::string::npos)
+      << test::readFile(dir / "intruder.log");
 
   EXPECT_EQ(runTool(dir, "bad.log", {"SELECT_FUSION", "--fusion", "BOGUS"}), 2);
   EXPECT_NE(test::readFile(dir / "bad.log")

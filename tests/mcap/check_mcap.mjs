@@ -7,8 +7,10 @@
 //      ROS 2 msg: @foxglove/rosmsg) and every message decoded from its CDR bytes
 //      (@foxglove/omgidl-serialization, @foxglove/rosmsg2-serialization);
 //   4. the decoded fields equal the CSV recording of the same run (navbus record --format csv),
-//      message by message, matched by their DDS source time stamps.
-// Usage: node check_mcap.mjs FILE.mcap CSV_DIR [--ros2]. Exits 1 naming the first difference.
+//      message by message, matched by their DDS source time stamps;
+//   5. with --foxglove, the channels in Foxglove's schemas (LocationFix, Log) are valid under
+//      Foxglove's published schemas and equal the recorded solutions and decisions, every one.
+// Usage: node check_mcap.mjs FILE.mcap CSV_DIR [--ros2] [--foxglove]. Exits 1 naming the first difference.
 import { readFileSync, existsSync } from "node:fs";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import { parseIDL } from "@foxglove/omgidl-parser";
@@ -18,9 +20,11 @@ import { MessageReader as Ros2Reader } from "@foxglove/rosmsg2-serialization";
 import { decompress as zstdDecompress } from "fzstd";
 import { parse as parseCsv } from "csv-parse/sync";
 import { compareRows, constants } from "./csv_compare.mjs";
+import { checkDerived, isDerivedChannel } from "./foxglove_derived.mjs";
 
 const [file, csvDir, ...flags] = process.argv.slice(2);
 const ros2 = flags.includes("--ros2");
+const expectDerived = flags.includes("--foxglove"); // recorded with navbus record --foxglove
 const bytes = new Uint8Array(readFileSync(file));
 const decompressHandlers = {
   zstd: (data, size) => {
@@ -80,11 +84,22 @@ if (indexed.header.profile !== (ros2 ? "ros2" : "")) fail(`profile '${indexed.he
 
 // 3 and 4. Decode every channel and compare with the CSV recording.
 let topicsCompared = 0;
+let derivedChecked = 0; // channels in Foxglove's schemas (navbus record --foxglove)
 const counts = { summarized: 0 }; // CSV cells that summarize structs as text, left uncompared
 const recordFileName = (topic) => `${topic.replace(/^\//, "").replaceAll("/", "_")}.csv`;
 for (const channel of indexed.channelsById.values()) {
   const schema = indexed.schemasById.get(channel.schemaId);
   const messages = viaIndex.filter((m) => m.channelId === channel.id);
+  if (isDerivedChannel(channel.messageEncoding)) {
+    const schemaText = new TextDecoder().decode(schema.data);
+    const bytes = messages.map((m) => m.data);
+    console.log(
+      checkDerived({ topic: channel.topic, schemaName: schema.name, schemaText, messages: bytes,
+                     csvDir, complete: true, fail }),
+    );
+    derivedChecked += 1;
+    continue;
+  }
   const expectedEncoding = ros2 ? "ros2msg" : "omgidl";
   if (schema.encoding !== expectedEncoding || channel.messageEncoding !== "cdr") {
     fail(`${channel.topic}: schema ${schema.encoding}, messages ${channel.messageEncoding}`);
@@ -139,6 +154,7 @@ for (const channel of indexed.channelsById.values()) {
   if (compared > 0) topicsCompared += 1;
 }
 if (topicsCompared === 0) fail("no topic was compared");
+if (expectDerived && derivedChecked !== 2) fail(`${derivedChecked} of 2 channels in Foxglove's schemas`);
 console.log(`${counts.summarized} CSV cells summarize structs as text and were not compared`);
 console.log(`${topicsCompared} topics decoded and equal to the CSV recording`);
 if (failures > 0) {

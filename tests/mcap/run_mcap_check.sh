@@ -4,7 +4,9 @@
 #      once with `navbus record --all`: as CSV and as one MCAP file;
 #   2. Foxglove's libraries (check_mcap.mjs: @mcap/core, @foxglove/omgidl-parser and
 #      -serialization) validate the file, its index and summary, decode every message of every
-#      topic and compare it with the CSV recording;
+#      topic and compare it with the CSV recording; the channels in Foxglove's schemas that
+#      `record --foxglove` adds are valid under Foxglove's published schemas and equal the
+#      recorded solutions, decisions, commands and outcomes;
 #   3. `navbus replay` of the MCAP file and of the CSV directory, each into a CSV recorder on
 #      domain 107: both replays must equal the original recording, bit for bit;
 #   4. a ROS 2 named run (--ros2, domain 108) recorded as MCAP with ros2msg schemas, decoded by
@@ -17,7 +19,7 @@ build=$(cd "$1" && pwd) src=$(cd "$2" && pwd)
 bin=$build/bin
 MCAP_TEST_NAME=mcap
 source "$src/tests/mcap/common.sh"
-install_node_readers check_mcap.mjs csv_compare.mjs
+install_node_readers check_mcap.mjs csv_compare.mjs foxglove_derived.mjs
 
 # Stops the given pids with SIGTERM and checks each exited 0.
 stop() {
@@ -68,7 +70,7 @@ fm=$!
 # however far behind (a SIGTERM would cut a slow one short).
 "$bin/navbus" -d $domain record --all -o "$work/csv" --idle 3 > "$work/record_csv.log" 2>&1 &
 rec_csv=$!
-"$bin/navbus" -d $domain record --all --format mcap -o "$work/run.mcap" --idle 3 \
+"$bin/navbus" -d $domain record --all --format mcap --foxglove -o "$work/run.mcap" --idle 3 \
   > "$work/record_mcap.log" 2>&1 &
 rec_mcap=$!
 pids=($filter $fm $rec_csv $rec_mcap)
@@ -100,7 +102,7 @@ ls -l "$work/run.mcap" | awk '{print "MCAP file: " $5 " bytes"}'
 du -sb "$work/csv" | awk '{print "CSV recording: " $1 " bytes"}'
 
 # --- 2. Foxglove's readers -------------------------------------------------------------------
-(cd "$node_dir" && node check_mcap.mjs "$work/run.mcap" "$work/csv") || fail "Foxglove's readers"
+(cd "$node_dir" && node check_mcap.mjs "$work/run.mcap" "$work/csv" --foxglove) || fail "Foxglove's readers"
 
 # --- 3. replay from MCAP = replay from CSV = the recording -----------------------------------
 replay_into() {  # RECORDING OUT_DIR

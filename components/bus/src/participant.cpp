@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "navbus/bus/gps_time.hpp"
 #include "navbus/bus/shared_memory.hpp"
 #include "navbus/bus/topics.hpp"
 
@@ -237,10 +238,7 @@ std::uint64_t wallTimeNowNs() {
 }
 
 std::uint64_t gpsTimeNowNs() {
-  // GPS epoch 1980-01-06 is 315964800 s after the Unix epoch; GPS is ahead of UTC by 18 s.
-  constexpr std::uint64_t kGpsEpochUnixNs = 315'964'800ULL * 1'000'000'000ULL;
-  constexpr std::uint64_t kLeapNs = 18ULL * 1'000'000'000ULL;
-  return wallTimeNowNs() - kGpsEpochUnixNs + kLeapNs;
+  return unixToGpsNs(wallTimeNowNs());
 }
 
 }  // namespace navbus::bus

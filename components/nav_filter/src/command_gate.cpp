@@ -39,7 +39,8 @@ void CommandGate::report(const navbus::FilterCommand& c, bool applied, navbus::R
   o.outcome(!applied ? navbus::OUTCOME_REFUSED
                      : (clamped ? navbus::OUTCOME_CLAMPED : navbus::OUTCOME_APPLIED));
   o.reason(applied ? navbus::REJECT_NOT_APPLICABLE : reason);
-  o.detail((clamped ? clamped_detail_ : detail).substr(0, 160));
+  // The IDL: the field and value refused or clamped; empty when applied as sent.
+  o.detail((clamped ? clamped_detail_ : (applied ? std::string() : detail)).substr(0, 160));
   outcome_sink_(o);
 }
 

@@ -100,8 +100,12 @@ class CommandCommand final : public Subcommand {
     cli_->add_option("--command-id", command.command_id,
                      "unique per issuer, increasing (default: this run's start time [ns])");
     cli_->add_option("--match-timeout", command.match_timeout_s,
-                     "seconds to wait for the filter's reader and its acknowledgment")
+                     "seconds to wait for the filter's reader, then for its answer")
         ->check(CLI::Range(0.1, 600.0));
+    cli_->add_option("--min-readers", command.min_readers,
+                     "write once this many readers of navbus/filter/command matched (the filter "
+                     "and the recorders that must have the command)")
+        ->check(CLI::Range(1, 1000));
   }
   int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
     options.dds.name = "navbus-command";

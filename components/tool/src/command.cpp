@@ -1,6 +1,8 @@
 #include "navbus/tool/command.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <optional>
 
 #include <navbus_idl/FaultPubSubTypes.h>
 #include <spdlog/spdlog.h>
@@ -54,6 +56,26 @@ navbus::FilterCommand buildCommand(const CommandOptions& o, std::uint64_t run_id
   return c;
 }
 
+namespace {
+
+/// The filter's answer to `c`, as the operator reads it.
+std::string outcomeText(const navbus::FilterCommandOutcome& o) {
+  std::string text =
+      "vehicle " + std::to_string(o.vehicle_id()) + ": " + records::enumName(o.outcome());
+  if (o.outcome() == navbus::OUTCOME_REFUSED) {
+    text += std::string(" (") + records::enumName(o.reason()) + ")";
+  }
+  if (o.detail().size() > 0) text += ": " + o.detail().to_string();
+  return text;
+}
+
+bool answers(const navbus::FilterCommandOutcome& o, const navbus::FilterCommand& c) {
+  return o.vehicle_id() == c.vehicle_id() && o.command_id() == c.command_id() &&
+         o.issuer() == c.issuer() && o.run_id() == c.run_id();
+}
+
+}  // namespace
+
 int runCommandCommand(const bus::Participant::Options& participant, const CommandOptions& o,
                       bus::ShutdownSignal& shutdown) {
   const auto run_id =
@@ -62,11 +84,21 @@ int runCommandCommand(const bus::Participant::Options& participant, const Comman
                                      .count());
   const navbus::FilterCommand command = buildCommand(o, run_id);
   bus::Participant p(participant, shutdown);
+  std::optional<navbus::FilterCommandOutcome> outcome;
+  p.subscribe<navbus::FilterCommandOutcomePubSubType>(
+      bus::topic::kCommandOutcome, bus::profile::kDecisionReader,
+      [&](const navbus::FilterCommandOutcome& m, const auto&) {
+        if (!outcome && answers(m, command)) outcome = m;
+      });
   auto writer = p.createWriter<navbus::FilterCommandPubSubType>(bus::topic::kFilterCommand,
                                                                 bus::profile::kDecisionWriter);
-  if (!spinUntil(p, o.match_timeout_s, [&] { return writer.matchedReaders() > 0; })) {
-    spdlog::error("no reader of {} (is navbus-filter running on this domain?) within {} s",
-                  bus::topic::kFilterCommand, o.match_timeout_s);
+  if (!spinUntil(p, o.match_timeout_s, [&] {
+        return writer.matchedReaders() >= std::max<std::uint32_t>(1, o.min_readers);
+      })) {
+    spdlog::error(
+        "no reader of {} (is navbus-filter running on this domain?) within {} s ({} of {} "
+        "matched)",
+        bus::topic::kFilterCommand, o.match_timeout_s, writer.matchedReaders(), o.min_readers);
     p.finish();
     return bus::kExitRuntimeError;
   }
@@ -74,20 +106,19 @@ int runCommandCommand(const bus::Participant::Options& participant, const Comman
     p.finish();
     return bus::kExitRuntimeError;
   }
-  const auto timeout = eprosima::fastrtps::Duration_t(o.match_timeout_s);
-  const bool acknowledged =
-      writer.raw()->wait_for_acknowledgments(timeout) == ReturnCode_t::RETCODE_OK;
   std::printf("%s", records::textOf(command).c_str());
-  if (acknowledged) {
-    std::printf(
-        "acknowledged by %zu reader(s); the filter's log and summary say whether it was "
-        "applied or refused\n",
-        writer.matchedReaders());
-  } else {
-    spdlog::error("the command was not acknowledged within {} s", o.match_timeout_s);
-  }
+  // The command is durable: a filter whose reader matches later still gets it while this waits.
+  const bool answered = spinUntil(p, o.match_timeout_s, [&] { return outcome.has_value(); });
   p.finish();
-  return acknowledged ? bus::kExitOk : bus::kExitRuntimeError;
+  if (!answered) {
+    spdlog::error(
+        "no answer from the filter of vehicle {} on {} within {} s (read by {} reader(s))",
+        command.vehicle_id(), bus::topic::kCommandOutcome, o.match_timeout_s,
+        writer.matchedReaders());
+    return bus::kExitRuntimeError;
+  }
+  std::printf("%s\n", outcomeText(*outcome).c_str());
+  return outcome->outcome() == navbus::OUTCOME_REFUSED ? bus::kExitRuntimeError : bus::kExitOk;
 }
 
 }  // namespace navbus::tool

@@ -1,18 +1,25 @@
 // `navbus foxglove`: the bus live in Foxglove. A participant that subscribes to every navbus
 // topic and serves it over the Foxglove WebSocket protocol (components/foxglove): a channel per
 // topic with the type's schema (OMG IDL, or ROS 2 msg under ROS 2 naming) and the samples' CDR
-// bytes, advertised while the topic has a writer. It never back-pressures the bus: each client
-// has a bounded queue per channel; what a slow client misses is counted in this participant's
-// health (navbus-foxglove, REJECT_CLIENT_BEHIND per topic).
+// bytes, advertised while the topic has a writer; and the channels in Foxglove's own schemas
+// derived from them (foxglove_channels.hpp: LocationFix for the Map panel, Log lines). It never
+// back-pressures the bus: each client has a bounded queue per channel; what a slow client misses is
+// counted in this participant's health (navbus-foxglove, REJECT_CLIENT_BEHIND per topic).
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <memory>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/config.hpp"
+#include "navbus/bus/topics.hpp"
+#include "navbus/foxglove/schemas.hpp"
 #include "navbus/foxglove/ws_server.hpp"
+#include "navbus/tool/foxglove_channels.hpp"
 #include "navbus/tool/topic_registry.hpp"
 #include "subcommand.hpp"
 
@@ -22,13 +29,96 @@ namespace {
 
 constexpr const char* kCdr = "cdr";
 
+/// A channel in Foxglove's schemas, advertised while one of its source topics is.
+struct DerivedBridged {
+  foxglove::Channel channel;
+  std::vector<std::string> sources;
+  bool advertised{false};
+};
+
+/// The topics each derived channel is made from (foxglove_channels.hpp).
+std::vector<std::string> derivedSources(DerivedChannel c) {
+  if (c == DerivedChannel::kLocationFix) return {bus::topic::kNavSolution};
+  return {bus::topic::kFaultDecision, bus::topic::kFilterCommand, bus::topic::kCommandOutcome};
+}
+
 /// The bus side of the bridge: samples in, channels and frames out.
 class BusBridge final : public SampleSink {
  public:
   BusBridge(foxglove::WsServer& server, bus::HealthCounters& health, bool ros2)
       : server_(server), health_(health), ros2_(ros2) {}
 
-  /// Subscribes to a topic; its channel id is its place in the registry.
+  /// Subscribes to every navbus topic (channel id: its place in the registry), then adds the
+  /// derived channels (ids after them).
+  void start(bus::Participant& p) {
+    for (const auto& e : topicRegistry()) add(p, e);
+    const auto schemas = derivedChannelSchemas(ros2_);
+    for (std::size_t i = 0; i < kDerivedChannelCount; ++i) {
+      DerivedBridged d;
+      d.channel.id = static_cast<std::uint32_t>(bridged_.size() + i);
+      d.channel.topic = schemas[i].topic;
+      d.channel.encoding = foxglove::kJsonEncoding;
+      d.channel.schema_name = schemas[i].schema_name;
+      d.channel.schema = schemas[i].schema;
+      d.channel.schema_encoding = foxglove::kJsonSchemaEncoding;
+      d.sources = derivedSources(static_cast<DerivedChannel>(i));
+      for (const auto& source : d.sources) bridged_[index_.at(source)].derives = true;
+      derived_[i] = d;
+    }
+  }
+
+  void onSample(const std::string& topic, const SampleTimes& times,
+                const SampleViews& sample) override {
+    Bridged& b = bridged_[index_.at(topic)];
+    if (!b.advertised) return;  // a sample before its writer matched: no channel yet
+    ++health_.stream(topic).accepted;
+    const std::uint64_t receive_ns =
+        times.reception_ns < 0 ? 0 : static_cast<std::uint64_t>(times.reception_ns);
+    server_.publish(b.channel.id, receive_ns,
+                    std::make_shared<const std::vector<std::uint8_t>>(sample.cdr()));
+    if (!b.derives) return;
+    std::optional<DerivedMessage> m = sample.derived();
+    if (!m) return;
+    const DerivedBridged& d = derived_[static_cast<std::size_t>(m->channel)];
+    ++health_.stream(d.channel.topic).accepted;
+    server_.publish(d.channel.id, receive_ns,
+                    std::make_shared<const std::vector<std::uint8_t>>(std::move(m->json)));
+  }
+
+  /// Advertises the channels whose topics gained a writer, withdraws those that lost their last
+  /// one, and puts the clients' drops into the health counters.
+  void update() {
+    for (Bridged& b : bridged_) {
+      eprosima::fastdds::dds::SubscriptionMatchedStatus status;
+      b.reader->get_subscription_matched_status(status);
+      const bool has_writer = status.current_count > 0;
+      if (has_writer == b.advertised) continue;
+      b.advertised = has_writer;
+      advertised(b.channel, has_writer, status.current_count);
+    }
+    for (DerivedBridged& d : derived_) {
+      const bool any = std::any_of(d.sources.begin(), d.sources.end(), [this](const auto& s) {
+        return bridged_[index_.at(s)].advertised;
+      });
+      if (any == d.advertised) continue;
+      d.advertised = any;
+      advertised(d.channel, any, -1);
+    }
+    const foxglove::ServerCounters c = server_.counters();
+    for (const auto& [channel, dropped] : c.dropped_by_channel) {
+      health_.stream(topicOfChannel(channel)).rejected[navbus::REJECT_CLIENT_BEHIND] = dropped;
+    }
+  }
+
+ private:
+  struct Bridged {
+    foxglove::Channel channel;
+    std::string name;
+    eprosima::fastdds::dds::DataReader* reader{nullptr};
+    bool advertised{false};
+    bool derives{false};  ///< a source of a derived channel
+  };
+
   void add(bus::Participant& p, const TopicEntry& e) {
     Bridged b;
     b.channel.id = static_cast<std::uint32_t>(bridged_.size());
@@ -44,50 +134,30 @@ class BusBridge final : public SampleSink {
     bridged_.back().reader = e.subscribe(p, *this);
   }
 
-  void onSample(const std::string& topic, const SampleTimes& times,
-                const SampleViews& sample) override {
-    Bridged& b = bridged_[index_.at(topic)];
-    if (!b.advertised) return;  // a sample before its writer matched: no channel yet
-    ++health_.stream(topic).accepted;
-    server_.publish(b.channel.id,
-                    times.reception_ns < 0 ? 0 : static_cast<std::uint64_t>(times.reception_ns),
-                    std::make_shared<const std::vector<std::uint8_t>>(sample.cdr()));
-  }
-
-  /// Advertises the topics that gained a writer, withdraws those that lost their last one, and
-  /// puts the clients' drops into the health counters.
-  void update() {
-    for (Bridged& b : bridged_) {
-      eprosima::fastdds::dds::SubscriptionMatchedStatus status;
-      b.reader->get_subscription_matched_status(status);
-      const bool has_writer = status.current_count > 0;
-      if (has_writer == b.advertised) continue;
-      b.advertised = has_writer;
-      if (has_writer) {
-        server_.advertise(b.channel);
-      } else {
-        server_.unadvertise(b.channel.id);
-      }
-      spdlog::info("{}: {} ({} writer(s))", b.channel.topic,
-                   has_writer ? "advertised" : "withdrawn", status.current_count);
+  void advertised(const foxglove::Channel& channel, bool on, int writers) {
+    if (on) {
+      server_.advertise(channel);
+    } else {
+      server_.unadvertise(channel.id);
     }
-    const foxglove::ServerCounters c = server_.counters();
-    for (const auto& [channel, dropped] : c.dropped_by_channel) {
-      health_.stream(bridged_.at(channel).name).rejected[navbus::REJECT_CLIENT_BEHIND] = dropped;
+    if (writers < 0) {
+      spdlog::info("{}: {} (derived)", channel.topic, on ? "advertised" : "withdrawn");
+    } else {
+      spdlog::info("{}: {} ({} writer(s))", channel.topic, on ? "advertised" : "withdrawn",
+                   writers);
     }
   }
 
- private:
-  struct Bridged {
-    foxglove::Channel channel;
-    std::string name;
-    eprosima::fastdds::dds::DataReader* reader{nullptr};
-    bool advertised{false};
-  };
+  const std::string& topicOfChannel(std::uint32_t channel) const {
+    return channel < bridged_.size() ? bridged_[channel].name
+                                     : derived_.at(channel - bridged_.size()).channel.topic;
+  }
+
   foxglove::WsServer& server_;
   bus::HealthCounters& health_;
   bool ros2_;
   std::vector<Bridged> bridged_;
+  std::array<DerivedBridged, kDerivedChannelCount> derived_;
   std::map<std::string, std::size_t> index_;
 };
 
@@ -118,7 +188,7 @@ class FoxgloveCommand final : public Subcommand {
                  foxglove::kSubprotocol);
     bus::Participant p(options, shutdown);
     BusBridge bridge(server, p.health(), options.dds.ros2_names);
-    for (const auto& e : topicRegistry()) bridge.add(p, e);
+    bridge.start(p);
     p.setState(navbus::STATE_RUNNING);
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s_);
     while (!p.stopping() && (duration_s_ <= 0.0 || std::chrono::steady_clock::now() < end)) {

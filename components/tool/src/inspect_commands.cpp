@@ -222,6 +222,10 @@ class RecordCommand final : public Subcommand {
                      "chunk closed and the file synced; csv: every file flushed), so that a "
                      "killed recorder loses at most this much; navbus recover closes such a file")
         ->check(CLI::Range(0.05, 3600.0));
+    cli_->add_flag("--foxglove", foxglove,
+                   "mcap: add the channels in Foxglove's schemas derived from the recorded "
+                   "topics (navbus/foxglove/location_fix from the solution for the Map panel, "
+                   "navbus/foxglove/log from decisions, commands and their outcomes)");
   }
   bool inspectsBus() const override { return true; }
   int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
@@ -229,7 +233,10 @@ class RecordCommand final : public Subcommand {
     if (format == "mcap") {
       const auto parent = std::filesystem::path(out).parent_path();
       if (!parent.empty()) std::filesystem::create_directories(parent);
-      sink_owner = std::make_unique<McapRecordSink>(out, options.dds.ros2_names);
+      sink_owner = std::make_unique<McapRecordSink>(out, options.dds.ros2_names, foxglove);
+    } else if (foxglove) {
+      throw nb::bus::ConfigError("record: --foxglove needs --format mcap (format is '" + format +
+                                 "')");
     } else {
       sink_owner = std::make_unique<CsvRecordSink>(out);
     }
@@ -277,6 +284,7 @@ class RecordCommand final : public Subcommand {
   std::string out;
   std::string format{"csv"};
   bool record_all{false};
+  bool foxglove{false};
   double idle_s{0.0};
   std::uint64_t count{0};
   double duration_s{0.0};

@@ -4,6 +4,8 @@
 
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/dds_context.hpp"
+#include "navbus/foxglove/schemas.hpp"
+#include "navbus/tool/foxglove_channels.hpp"
 
 namespace navbus::tool {
 
@@ -62,10 +64,17 @@ void CsvRecordSink::finish() {
   flush();
 }
 
-McapRecordSink::McapRecordSink(const std::filesystem::path& file, bool ros2)
+McapRecordSink::McapRecordSink(const std::filesystem::path& file, bool ros2, bool foxglove)
     : ros2_(ros2),
       writer_(file, records::McapWriterOptions{1u << 20, records::McapCompression::kZstd,
-                                               ros2 ? "ros2" : "", "navbus record"}) {}
+                                               ros2 ? "ros2" : "", "navbus record"}) {
+  if (!foxglove) return;
+  for (const DerivedChannelSchema& d : derivedChannelSchemas(ros2)) {
+    const std::uint16_t schema =
+        writer_.addSchema(d.schema_name, foxglove::kJsonSchemaEncoding, d.schema);
+    derived_channels_.push_back(writer_.addChannel(schema, d.topic, foxglove::kJsonEncoding, {}));
+  }
+}
 
 void McapRecordSink::open(const TopicEntry& e) {
   const TopicSchema t = topicSchema(e, ros2_);
@@ -79,6 +88,11 @@ void McapRecordSink::onSample(const std::string& topic, const SampleTimes& times
   counted(topic);
   writer_.write(channel_of_topic_.at(topic), nonNegative(times.reception_ns),
                 nonNegative(times.source_ns), sample.cdr());
+  if (derived_channels_.empty()) return;
+  if (std::optional<DerivedMessage> m = sample.derived()) {
+    writer_.write(derived_channels_.at(static_cast<std::size_t>(m->channel)),
+                  nonNegative(times.reception_ns), nonNegative(times.source_ns), m->json);
+  }
 }
 
 void McapRecordSink::flush() {

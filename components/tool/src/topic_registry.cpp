@@ -1,5 +1,7 @@
 #include "navbus/tool/topic_registry.hpp"
 
+#include <algorithm>
+
 #include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/HealthPubSubTypes.h>
 #include <navbus_idl/IdlSchemas.h>
@@ -38,7 +40,12 @@ TopicEntry entry(const char* topic, const char* profile) {
           sink.onSample(
               topic, times,
               SampleViews{[&m] { return records::textOf(m); }, [&m] { return records::csvRows(m); },
-                          [&m] { return serialized<PubSubType>(m); }});
+                          [&m] { return serialized<PubSubType>(m); },
+                          [&m, &times] {
+                            return derivedMessage(
+                                m, static_cast<std::uint64_t>(
+                                       std::max<std::int64_t>(times.reception_ns, 0)));
+                          }});
         });
       }};
 }

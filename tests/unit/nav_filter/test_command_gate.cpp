@@ -110,7 +110,8 @@ TEST(CommandGate, AnswersEachCommandsIssuerAppliedClampedOrRefusedWithTheFieldAn
   nb::FilterCommand applied = relearn(2e-4);
   applied.command_id(8);
   gate.relearnSigma(applied);
-  gate.report(applied, true);
+  // The pipeline prepares the refusal's words before it knows: an applied command drops them.
+  gate.report(applied, true, nb::REJECT_NOT_APPLICABLE, "not available in the configured mode");
   nb::FilterCommand stale = relearn(2e-4);
   stale.command_id(9);
   stale.time_gps_ns(1'000);

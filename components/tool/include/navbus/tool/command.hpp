@@ -1,7 +1,7 @@
 // `navbus command KIND ...`: sends one FilterCommand (any kind, any field) to navbus-filter, as
-// an operator would, and waits until the filter's reader has acknowledged it. The filter
-// range-checks it and obeys or refuses it (its log, summary and health say which); commands
-// are obeyed only from the issuers in its configuration (`operator` by default).
+// an operator would, and waits for the filter's answer on navbus/nav/command_outcome: the filter
+// range-checks it and applies, clamps or refuses it (its log, summary and health say so too);
+// commands are obeyed only from the issuers in its configuration (`operator` by default).
 #pragma once
 
 #include <cstdint>
@@ -32,14 +32,18 @@ struct CommandOptions {
   std::uint32_t decision_id{0};
   std::string issuer{"operator"};
   std::uint64_t command_id{0};   ///< 0: this run's start time [ns] (increasing across runs)
-  double match_timeout_s{10.0};  ///< wait this long for the filter's reader
+  double match_timeout_s{10.0};  ///< wait this long for the filter's reader, then its answer
+  /// Write once this many readers matched (the filter, and recorders that must have it: a
+  /// reader that matches after this tool ended never gets the command).
+  std::uint32_t min_readers{1};
 };
 
 /// Builds the command; throws bus::ConfigError naming the option and the value.
 navbus::FilterCommand buildCommand(const CommandOptions& options, std::uint64_t run_id_ns);
 
-/// Returns an exit code: 0 once a reader acknowledged the command, runtime error if none
-/// matched or acknowledged within the timeout.
+/// Returns an exit code: 0 once the addressed filter applied the command (or clamped a value of
+/// it), runtime error if it refused it, or if no reader matched or no answer came within the
+/// timeout.
 int runCommandCommand(const bus::Participant::Options& participant, const CommandOptions& options,
                       bus::ShutdownSignal& shutdown);
 

@@ -58,9 +58,11 @@ class CsvRecordSink final : public RecordSink {
 
 /// One MCAP file; `ros2`: the bus runs under ROS 2 naming, so the channels carry the ROS 2
 /// topic names ("/navbus/imu/increment") and ros2msg schemas ("navbus/msg/ImuIncrement").
+/// `foxglove`: the channels in Foxglove's schemas derived from the recorded topics are written
+/// too (foxglove_channels.hpp; JSON messages, with the sample's times).
 class McapRecordSink final : public RecordSink {
  public:
-  McapRecordSink(const std::filesystem::path& file, bool ros2);
+  McapRecordSink(const std::filesystem::path& file, bool ros2, bool foxglove);
   void open(const TopicEntry& topic) override;
   void onSample(const std::string& topic, const SampleTimes& times,
                 const SampleViews& sample) override;
@@ -72,6 +74,8 @@ class McapRecordSink final : public RecordSink {
   bool ros2_;
   records::McapWriter writer_;
   std::map<std::string, std::uint16_t> schema_of_type_, channel_of_topic_;
+  /// The derived channels' ids (foxglove), in DerivedChannel order.
+  std::vector<std::uint16_t> derived_channels_;
 };
 
 }  // namespace navbus::tool

@@ -4,10 +4,12 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "navbus/bus/participant.hpp"
+#include "navbus/tool/foxglove_channels.hpp"
 
 namespace navbus::tool {
 
@@ -26,6 +28,8 @@ struct SampleViews {
   /// encapsulation header, the bytes a navbus writer puts on the wire (DDS hands readers the
   /// deserialized sample, so this is its re-serialization).
   std::function<std::vector<std::uint8_t>()> cdr;
+  /// Its message on a channel in Foxglove's schemas (foxglove_channels.hpp), if its type has one.
+  std::function<std::optional<DerivedMessage>()> derived;
 };
 
 /// Receives samples.
