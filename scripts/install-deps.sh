@@ -22,6 +22,7 @@ if [ "${1:-}" != --package ]; then
     time                                                   # GNU time: peak RSS in scripts/bench.sh
     rtklib                                                 # rnx2rtkp: independent GPS fixes for the real-data test
     python3-matplotlib python3-yaml python3-numpy          # demo summary, figures, pseudorange errors (scripts/*.py)
+    chromium                                               # a real browser opens the Foxglove bridge (tests/foxglove)
   )
 fi
 if [ "${1:-}" = --sanitizers ]; then

@@ -4,7 +4,9 @@
 // serialization); after the run, the middle message of each channel equals the CSV recording of
 // the same run, field by field; the bridge hop (the frame's receive time, the bridge's DDS
 // reception, to this client's reception) on the low-latency solution channel.
-// Usage: node check_bridge.mjs ws://HOST:PORT CSV_DIR SECONDS [LATENCY_TOPIC]
+// The repository's Foxglove layout names only advertised topics and plots only numbers
+// (layout_check.mjs).
+// Usage: node check_bridge.mjs ws://HOST:PORT CSV_DIR SECONDS LAYOUT.json [LATENCY_TOPIC]
 // Listens SECONDS seconds, then compares once CSV_DIR.done exists (the CSV recorder finished).
 // Exits 1 naming the first differences.
 import { readFileSync, existsSync } from "node:fs";
@@ -16,11 +18,13 @@ import { MessageReader } from "@foxglove/omgidl-serialization";
 import { parse as parseCsv } from "csv-parse/sync";
 import { compareRows, constants } from "./csv_compare.mjs";
 import { checkDerived, isDerivedChannel } from "./foxglove_derived.mjs";
+import { checkLayout } from "./layout_check.mjs";
 
 const { FoxgloveClient } = wsProtocol;
 
-const [url, csvDir, seconds, latencyTopic = "navbus/nav/solution_low_latency"] =
+const [url, csvDir, seconds, layoutFile, latencyTopic = "navbus/nav/solution_low_latency"] =
   process.argv.slice(2);
+const advertised = new Map(); // topic -> its middle message decoded (null: none or not decoded)
 let failures = 0;
 const fail = (what) => {
   failures += 1;
@@ -98,6 +102,7 @@ let derivedChecked = 0;
 const percentile = (sorted, p) => sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];
 for (const c of channels.values()) {
   const { channel, reader, enums, messages, hops } = c;
+  if (!advertised.has(channel.topic)) advertised.set(channel.topic, null);
   if (messages.length === 0) {
     console.log(`${channel.topic}: advertised, no message`);
     continue;
@@ -129,6 +134,7 @@ for (const c of channels.values()) {
     groups.get(row.source_timestamp_ns).push(row);
   }
   const middle = decoded[Math.floor(decoded.length / 2)];
+  advertised.set(channel.topic, middle);
   let match = null;
   for (const group of groups.values()) {
     const misses = [];
@@ -157,6 +163,7 @@ for (const c of channels.values()) {
   }
 }
 if (compared === 0) fail("no channel compared");
+console.log(checkLayout(JSON.parse(readFileSync(layoutFile)), advertised, fail));
 if (derivedChecked !== 2) fail(`${derivedChecked} of the 2 channels in Foxglove's schemas carried messages`);
 if (statuses > 0) fail(`${statuses} status messages`);
 console.log(`${channels.size} channels advertised, ${compared} compared with the CSV recording`);

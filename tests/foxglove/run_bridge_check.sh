@@ -6,7 +6,8 @@
 #      parses every schema, decodes every message, compares the middle message of each channel
 #      with the CSV recording and prints the bridge hop on the low-latency solution; the
 #      LocationFix track and the Log lines equal the recorded solutions and the operator's
-#      commands and the filter's answers (one applied, one refused) sent mid-run;
+#      commands and the filter's answers (one applied, one refused) sent mid-run; the
+#      repository's Foxglove layout names only advertised topics and plots only numbers;
 #   3. hostile_clients.mjs, at the same time: malformed JSON, an unknown op, a subscription to an
 #      unknown channel, a binary message, an oversized message, a client that stops reading and
 #      one that disconnects mid-frame; each gets its error and the checked client sees nothing
@@ -19,7 +20,8 @@ bin=$build/bin
 MCAP_TEST_NAME=foxglove
 source "$src/tests/mcap/common.sh"
 install_node_readers csv_compare.mjs foxglove_derived.mjs
-cp "$src/tests/foxglove/check_bridge.mjs" "$src/tests/foxglove/hostile_clients.mjs" "$node_dir/"
+cp "$src/tests/foxglove/check_bridge.mjs" "$src/tests/foxglove/hostile_clients.mjs" \
+  "$src/tests/foxglove/layout_check.mjs" "$node_dir/"
 
 domain=113
 cat > "$work/sim.yaml" << YAML
@@ -51,7 +53,8 @@ until grep -q "navbus/nav/solution: [1-9][0-9]* writer(s) matched" "$work/record
   [ $SECONDS -lt $deadline ] || fail "the filter's writers did not match within 60 s"
   sleep 0.1
 done
-(cd "$node_dir" && node check_bridge.mjs "ws://127.0.0.1:$port" "$work/csv" 24) \
+(cd "$node_dir" && node check_bridge.mjs "ws://127.0.0.1:$port" "$work/csv" 24 \
+  "$src/config/foxglove/navbus_layout.json") \
   > "$work/check.log" 2>&1 &
 check=$!
 (cd "$node_dir" && node hostile_clients.mjs "ws://127.0.0.1:$port") > "$work/hostile.log" 2>&1 &
