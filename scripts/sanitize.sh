@@ -43,7 +43,9 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # unit_evaluation tests here) and mcap_foxglove (two recorders of one fast-paced run compared
 # message by message: under ASan only 1 of the 1,200 IMU blocks and 400 of the 1,200 solutions
 # of the MCAP file matched a row of the CSV recording by source time stamp, not yet explained;
-# unit_records runs the MCAP writer and reader here).
+# unit_records runs the MCAP writer and reader here), and foxglove_load (three fast-paced runs
+# to compare the simulator's throughput with and without the bridge: a timing measurement;
+# foxglove_bridge runs the bridge here).
 (cd build-san && ctest --output-on-failure -j2 --timeout 600 \
-  -E "^(cpu_load|fault_loop_load|figures|mcap_foxglove)$")
+  -E "^(cpu_load|fault_loop_load|figures|mcap_foxglove|foxglove_load)$")
 echo "sanitizers: tests $((SECONDS - t0)) s"

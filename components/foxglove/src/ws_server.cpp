@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -113,7 +114,8 @@ class WsServer::Impl {
   mutable std::mutex mutex_;  // channels_, connections_, totals_
   std::map<std::uint32_t, Channel> channels_;
   std::set<std::shared_ptr<Connection>> connections_;
-  ServerCounters totals_;  ///< of connections that ended, and server-wide events
+  ServerCounters totals_;           ///< of connections that ended, and server-wide events
+  std::deque<ClientReport> ended_;  ///< the last kEndedClientReports clients that ended
 };
 
 class WsServer::Impl::Connection : public std::enable_shared_from_this<Connection> {
@@ -121,7 +123,11 @@ class WsServer::Impl::Connection : public std::enable_shared_from_this<Connectio
   Connection(tcp::socket socket, Impl& server)
       : ws_(std::move(socket)),
         server_(server),
-        session_(server.options().frames_per_subscription, server.options().max_texts) {}
+        session_(server.options().frames_per_subscription, server.options().max_texts) {
+    beast::error_code ec;
+    const tcp::endpoint peer = ws_.next_layer().socket().remote_endpoint(ec);
+    if (!ec) peer_ = peer.address().to_string() + ":" + std::to_string(peer.port());
+  }
 
   void run() {
     http::async_read(
@@ -154,6 +160,13 @@ class WsServer::Impl::Connection : public std::enable_shared_from_this<Connectio
     return session_.counters();
   }
   std::uint64_t sent() const { return sent_.load(); }
+  void setNumber(std::uint64_t n) { number_ = n; }
+  /// Its account now; `open` false and `dropped` as given once it ended.
+  ClientReport report(bool open, bool dropped) const {
+    const SessionCounters s = sessionCounters();
+    return ClientReport{number_,           peer_, open, dropped, sent(), s.frames_dropped,
+                        s.requests_refused};
+  }
   /// Ends the connection (the server stops): pending operations complete with errors.
   void shutdown() {
     net::post(ws_.get_executor(), [self = shared_from_this()] { self->end(false); });
@@ -313,6 +326,8 @@ class WsServer::Impl::Connection : public std::enable_shared_from_this<Connectio
   bool writing_{false};  // I/O thread only
   Outgoing current_;     // the message being written (its buffers must outlive the write)
   std::atomic<std::uint64_t> sent_{0};
+  std::uint64_t number_{0};  // set once, under the server's mutex, before any report
+  std::string peer_{"unknown peer"};
 };
 
 void WsServer::Impl::stop() {
@@ -347,6 +362,7 @@ void WsServer::Impl::opened(const std::shared_ptr<Connection>& c) {
     std::lock_guard<std::mutex> lock(mutex_);
     connections_.insert(c);
     ++totals_.clients_accepted;
+    c->setNumber(totals_.clients_accepted);
     for (const auto& [id, channel] : channels_) offered.push_back(channel);
   }
   c->text(advertiseJson(offered));
@@ -354,11 +370,14 @@ void WsServer::Impl::opened(const std::shared_ptr<Connection>& c) {
 
 void WsServer::Impl::closed(const std::shared_ptr<Connection>& c, bool dropped) {
   const SessionCounters s = c->sessionCounters();
+  const ClientReport report = c->report(false, dropped);
   std::lock_guard<std::mutex> lock(mutex_);
   if (connections_.erase(c) == 0) return;
   totals_.frames_sent += c->sent();
   addSession(totals_, s);
   if (dropped) ++totals_.clients_dropped;
+  ended_.push_back(report);
+  if (ended_.size() > kEndedClientReports) ended_.pop_front();
 }
 
 void WsServer::Impl::advertise(const Channel& channel) {
@@ -403,12 +422,16 @@ ServerCounters WsServer::Impl::counters() const {
     std::lock_guard<std::mutex> lock(mutex_);
     clients = connections_;
     out = totals_;
+    out.clients.assign(ended_.begin(), ended_.end());
   }
   out.clients_now = clients.size();
   for (const auto& c : clients) {
     out.frames_sent += c->sent();
     addSession(out, c->sessionCounters());
+    out.clients.push_back(c->report(true, false));
   }
+  std::sort(out.clients.begin(), out.clients.end(),
+            [](const ClientReport& a, const ClientReport& b) { return a.number < b.number; });
   return out;
 }
 

@@ -85,10 +85,19 @@ class BusBridge final : public SampleSink {
                     std::make_shared<const std::vector<std::uint8_t>>(std::move(m->json)));
   }
 
+  /// Samples the bridge's own readers missed, over every topic.
+  std::uint64_t samplesLost() const { return lost_total_; }
+
   /// Advertises the channels whose topics gained a writer, withdraws those that lost their last
   /// one, and puts the clients' drops into the health counters.
   void update() {
     for (Bridged& b : bridged_) {
+      eprosima::fastdds::dds::SampleLostStatus lost;
+      b.reader->get_sample_lost_status(lost);
+      const auto lost_now = static_cast<std::uint64_t>(lost.total_count);
+      health_.stream(b.name).sequence_gaps += lost_now - b.lost;
+      lost_total_ += lost_now - b.lost;
+      b.lost = lost_now;
       eprosima::fastdds::dds::SubscriptionMatchedStatus status;
       b.reader->get_subscription_matched_status(status);
       const bool has_writer = status.current_count > 0;
@@ -108,6 +117,21 @@ class BusBridge final : public SampleSink {
     for (const auto& [channel, dropped] : c.dropped_by_channel) {
       health_.stream(topicOfChannel(channel)).rejected[navbus::REJECT_CLIENT_BEHIND] = dropped;
     }
+    for (const foxglove::ClientReport& r : c.clients) {
+      if (r.open || r.number <= last_ended_logged_) continue;
+      logClient(r);
+      last_ended_logged_ = r.number;
+    }
+  }
+
+  /// What one client was sent and missed.
+  static void logClient(const foxglove::ClientReport& r) {
+    spdlog::info(
+        "client {} ({}) {}: frames sent {}, dropped for being behind {}, requests refused {}",
+        r.number, r.peer,
+        r.open ? "connected"
+               : (r.dropped ? "ended by an error or an unread control queue" : "ended"),
+        r.frames_sent, r.frames_dropped, r.requests_refused);
   }
 
  private:
@@ -116,7 +140,8 @@ class BusBridge final : public SampleSink {
     std::string name;
     eprosima::fastdds::dds::DataReader* reader{nullptr};
     bool advertised{false};
-    bool derives{false};  ///< a source of a derived channel
+    bool derives{false};    ///< a source of a derived channel
+    std::uint64_t lost{0};  ///< samples its best-effort reader missed (DDS sample-lost status)
   };
 
   void add(bus::Participant& p, const TopicEntry& e) {
@@ -131,7 +156,15 @@ class BusBridge final : public SampleSink {
     b.name = e.name;
     index_[e.name] = bridged_.size();
     bridged_.push_back(b);
-    bridged_.back().reader = e.subscribe(p, *this);
+    bridged_.back().reader = e.subscribe_with(p, *this, bridgeReaderProfile(e));
+  }
+
+  /// Decisions, commands and outcomes are read as their own durable reliable readers read them
+  /// (rare; the Log channel wants each one); every other stream best effort, so that a bridge
+  /// short of CPU never holds back a reliable writer.
+  static std::string bridgeReaderProfile(const TopicEntry& e) {
+    return e.reader_profile == bus::profile::kDecisionReader ? e.reader_profile
+                                                             : bus::profile::kFoxgloveReader;
   }
 
   void advertised(const foxglove::Channel& channel, bool on, int writers) {
@@ -158,6 +191,8 @@ class BusBridge final : public SampleSink {
   bool ros2_;
   std::vector<Bridged> bridged_;
   std::array<DerivedBridged, kDerivedChannelCount> derived_;
+  std::uint64_t lost_total_{0};
+  std::uint64_t last_ended_logged_{0};
   std::map<std::string, std::size_t> index_;
 };
 
@@ -195,14 +230,18 @@ class FoxgloveCommand final : public Subcommand {
       p.spinOnce(std::chrono::milliseconds(50));
       bridge.update();
     }
+    bridge.update();
     p.finish();
     const foxglove::ServerCounters c = server.counters();
+    for (const foxglove::ClientReport& r : c.clients) {
+      if (r.open) BusBridge::logClient(r);
+    }
     spdlog::info(
         "foxglove bridge: clients accepted {} (now {}, ended by an error or an unread control "
         "queue {}), handshakes refused {}, frames sent {}, dropped for clients behind {}, "
-        "requests refused {}",
+        "requests refused {}; samples the bridge's best-effort readers missed {}",
         c.clients_accepted, c.clients_now, c.clients_dropped, c.handshakes_refused, c.frames_sent,
-        c.frames_dropped, c.requests_refused);
+        c.frames_dropped, c.requests_refused, bridge.samplesLost());
     return bus::kExitOk;
   }
 

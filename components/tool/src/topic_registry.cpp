@@ -33,9 +33,9 @@ TopicEntry entry(const char* topic, const char* profile) {
   PubSubType type;
   return TopicEntry{
       topic, type.getName(), profile, records::csvHeader<T>(),
-      [topic, profile](bus::Participant& p, SampleSink& sink) {
+      [topic](bus::Participant& p, SampleSink& sink, const std::string& reader_profile) {
         return p.subscribe<
-            PubSubType>(topic, profile, [topic, &sink](const T& m, const auto& info) {
+            PubSubType>(topic, reader_profile, [topic, &sink](const T& m, const auto& info) {
           const SampleTimes times{info.source_timestamp.to_ns(), info.reception_timestamp.to_ns()};
           sink.onSample(
               topic, times,

@@ -52,6 +52,7 @@ inline constexpr const char* kDiagnosticsWriter = "navbus_diagnostics_writer";
 inline constexpr const char* kDiagnosticsReader = "navbus_diagnostics_reader";
 inline constexpr const char* kHealthWriter = "navbus_health_writer";
 inline constexpr const char* kHealthReader = "navbus_health_reader";
+inline constexpr const char* kFoxgloveReader = "navbus_foxglove_reader";
 }  // namespace profile
 
 }  // namespace navbus::bus

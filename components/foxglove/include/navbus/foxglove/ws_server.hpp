@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "navbus/foxglove/client_session.hpp"
 #include "navbus/foxglove/protocol.hpp"
@@ -28,6 +29,17 @@ struct ServerOptions {
   int socket_send_buffer_bytes{128 * 1024};
 };
 
+/// One client's account: what it was sent and what it missed.
+struct ClientReport {
+  std::uint64_t number{0};  ///< 1, 2, ... in the order the clients connected
+  std::string peer;         ///< its address and port
+  bool open{true};          ///< still connected
+  bool dropped{false};      ///< ended by an error, or for control messages not read
+  std::uint64_t frames_sent{0};
+  std::uint64_t frames_dropped{0};  ///< the oldest of a full subscription queue
+  std::uint64_t requests_refused{0};
+};
+
 struct ServerCounters {
   std::uint64_t clients_accepted{0};
   std::uint64_t clients_now{0};
@@ -37,7 +49,10 @@ struct ServerCounters {
   std::uint64_t frames_dropped{0};
   std::map<std::uint32_t, std::uint64_t> dropped_by_channel;
   std::uint64_t requests_refused{0};
+  /// The clients connected now, after the last kEndedClientReports that ended, by number.
+  std::vector<ClientReport> clients;
 };
+inline constexpr std::size_t kEndedClientReports = 256;
 
 class WsServer {
  public:

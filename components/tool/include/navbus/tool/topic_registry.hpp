@@ -44,8 +44,15 @@ struct TopicEntry {
   std::string type_name;
   std::string reader_profile;
   std::string csv_header;
-  /// Subscribes the sink to the topic; returns the reader (owned by the participant).
-  std::function<eprosima::fastdds::dds::DataReader*(bus::Participant&, SampleSink&)> subscribe;
+  /// Subscribes the sink to the topic with the given reader profile; returns the reader (owned
+  /// by the participant).
+  std::function<eprosima::fastdds::dds::DataReader*(bus::Participant&, SampleSink&,
+                                                    const std::string& reader_profile)>
+      subscribe_with;
+  /// Subscribes with the topic's own reader profile.
+  eprosima::fastdds::dds::DataReader* subscribe(bus::Participant& p, SampleSink& sink) const {
+    return subscribe_with(p, sink, reader_profile);
+  }
 };
 
 const std::vector<TopicEntry>& topicRegistry();
