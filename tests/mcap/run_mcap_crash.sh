@@ -16,7 +16,7 @@ build=$(cd "$1" && pwd) src=$(cd "$2" && pwd)
 bin=$build/bin
 MCAP_TEST_NAME=mcap-crash
 source "$src/tests/mcap/common.sh"
-install_node_readers check_mcap.mjs csv_compare.mjs check_crash.mjs
+install_node_readers check_mcap.mjs csv_compare.mjs check_crash.mjs foxglove_derived.mjs
 flush_s=1
 kill_after_s=12.5  # half a flush interval after the recorders flush (they start together)
 

@@ -3,6 +3,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/bus/realtime.hpp"
 #include "navbus/bus/topics.hpp"
 
 namespace navbus::bus {
@@ -54,6 +55,7 @@ Participant::Options participantOptions(const CommonOptions& o, const YAML::Node
   const double health_s =
       checkRange(get<double>(cfg, "", "health_period_s", 1.0), 0.05, 60.0, "health_period_s");
   p.health_period = std::chrono::milliseconds(static_cast<long>(health_s * 1000.0));
+  p.realtime = readRealtime(cfg);
   return p;
 }
 

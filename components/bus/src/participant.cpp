@@ -15,9 +15,18 @@ namespace dds = eprosima::fastdds::dds;
 
 Participant::Participant(const Options& options, ShutdownSignal& shutdown)
     : shutdown_(shutdown),
+      realtime_(applyRealtime(options.realtime)),
       dds_(options.dds),
       health_(options.dds.name),
       publish_health_(options.publish_health) {
+  if (options.realtime.requested()) {
+    const int processing = raiseProcessingThread(options.realtime);
+    spdlog::info("real-time: granted {}{}", realtime_.text(),
+                 processing > 0 ? fmt::format("; this processing thread at priority {}, the DDS "
+                                              "threads at {}",
+                                              processing, realtime_.priority)
+                                : "");
+  }
   waitset_.attach_condition(shutdown_.condition());
   if (publish_health_) {
     health_writer_ = createWriter<navbus::HealthPubSubType>(topic::kHealth, profile::kHealthWriter);

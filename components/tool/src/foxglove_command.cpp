@@ -5,9 +5,13 @@
 // derived from them (foxglove_channels.hpp: LocationFix for the Map panel, Log lines). It never
 // back-pressures the bus: each client has a bounded queue per channel; what a slow client misses is
 // counted in this participant's health (navbus-foxglove, REJECT_CLIENT_BEHIND per topic).
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <memory>
 #include <optional>
 
@@ -28,6 +32,8 @@ namespace navbus::tool::cli {
 namespace {
 
 constexpr const char* kCdr = "cdr";
+/// The bridge's default niceness: below the navigation participants (0) for the CPU.
+constexpr int kBridgeNiceness = 10;
 
 /// A channel in Foxglove's schemas, advertised while one of its source topics is.
 struct DerivedBridged {
@@ -213,9 +219,17 @@ class FoxgloveCommand final : public Subcommand {
         ->check(CLI::Range(1, 100000));
     cli_->add_option("--duration", duration_s_, "stop after this many seconds (0: until SIGINT)")
         ->check(CLI::Range(0.0, 1e7));
+    cli_->add_option("--nice", nice_,
+                     "the bridge's CPU niceness (0-19): a live view yields the CPU to the "
+                     "navigation participants")
+        ->check(CLI::Range(0, 19));
   }
 
   int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
+    // Before any thread exists: Linux keeps a niceness per thread, and new threads inherit it.
+    if (setpriority(PRIO_PROCESS, 0, nice_) != 0) {
+      spdlog::warn("--nice {}: {}", nice_, std::strerror(errno));
+    }
     options.dds.name = "navbus-foxglove";
     options.publish_health = true;  // a service on the bus: its drops are reported
     foxglove::WsServer server(options_);
@@ -248,6 +262,7 @@ class FoxgloveCommand final : public Subcommand {
  private:
   foxglove::ServerOptions options_;
   double duration_s_{0.0};
+  int nice_{kBridgeNiceness};
 };
 
 }  // namespace

@@ -34,8 +34,8 @@ struct CommonOptions {
 void addCommonOptions(CLI::App& app, CommonOptions& options, bool config_required);
 
 /// Participant options: command line first, then the configuration's keys domain_id,
-/// qos_file, participant_profile, security_identity, discovery_server and health_period_s,
-/// then defaults.
+/// qos_file, participant_profile, security_identity, discovery_server, health_period_s and the
+/// realtime block, then defaults.
 Participant::Options participantOptions(const CommonOptions& options, const YAML::Node& config,
                                         const std::string& name);
 

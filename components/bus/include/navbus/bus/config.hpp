@@ -49,7 +49,7 @@ void checkKeys(const YAML::Node& node, const std::string& where,
 /// The top-level keys every participant's configuration may carry (participantOptions()).
 inline constexpr std::initializer_list<const char*> kParticipantKeys = {
     "domain_id",       "qos_file",         "participant_profile", "security_identity",
-    "health_period_s", "discovery_server", "ros2_names"};
+    "health_period_s", "discovery_server", "ros2_names",          "realtime"};
 
 /// The file of `path`'s extends chain that spells `key_path` (the most derived one; `path`
 /// itself when none does).

@@ -21,6 +21,7 @@
 
 #include "navbus/bus/dds_context.hpp"
 #include "navbus/bus/health.hpp"
+#include "navbus/bus/realtime.hpp"
 #include "navbus/bus/shutdown.hpp"
 #include "navbus/bus/stream_end.hpp"
 
@@ -105,6 +106,9 @@ class Participant {
     /// False: no health reports on the bus (an inspection tool that must not show up in what
     /// it inspects); the counters are still kept.
     bool publish_health{true};
+    /// Scheduling class, priority, CPU affinity and locked memory (realtime.hpp), applied
+    /// before the DDS participant is created so that its threads inherit them.
+    RealtimeOptions realtime;
   };
 
   Participant(const Options& options, ShutdownSignal& shutdown);
@@ -241,6 +245,7 @@ class Participant {
   };
 
   ShutdownSignal& shutdown_;
+  RealtimeGrant realtime_;  ///< before dds_: applied before the DDS participant exists
   ShmReclaimAtExit shm_reclaim_at_exit_;
   DdsContext dds_;
   HealthCounters health_;
