@@ -20,6 +20,11 @@ Participant::Participant(const Options& options, ShutdownSignal& shutdown)
       health_(options.dds.name),
       publish_health_(options.publish_health) {
   if (options.realtime.requested()) {
+    if (options.realtime.lock_memory && !realtime_.memory_locked) {
+      spdlog::warn(
+          "realtime.lock_memory: mlockall succeeded but nothing is locked (VmLck 0 kB): a build "
+          "with AddressSanitizer ignores mlockall");
+    }
     const int processing = raiseProcessingThread(options.realtime);
     spdlog::info("real-time: granted {}{}", realtime_.text(),
                  processing > 0 ? fmt::format("; this processing thread at priority {}, the DDS "

@@ -91,8 +91,8 @@ bus::SensorReaders::Events FaultManagerNode::streamEvents() {
 template <class Message>
 void FaultManagerNode::watch(const char* profile) {
   using Traits = bus::SensorMessage<Message>;
-  const StreamKind kind = Traits::kTopic.kind;
-  auto* reader = sensors_.subscribe<Message>(profile, [this, kind](const Message& m) {
+  static constexpr StreamKind kind = Traits::kTopic.kind;  // no capture needed
+  auto* reader = sensors_.subscribe<Message>(profile, [this](const Message& m) {
     if constexpr (std::is_same_v<Message, navbus::ImuIncrementBlock>) {
       // The block is counted under its topic; each element is received (and watched) as
       // one increment, under the increment topic, as the filter counts them.

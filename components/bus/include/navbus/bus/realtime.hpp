@@ -46,7 +46,7 @@ struct RealtimeGrant {
   SchedulingPolicy policy{SchedulingPolicy::kOther};
   int priority{0};
   std::vector<int> cpus;  ///< the thread's affinity
-  bool memory_locked{false};
+  bool memory_locked{false};  ///< read back: the process has locked memory (VmLck > 0)
   std::string text() const;
 };
 
