@@ -23,7 +23,12 @@ function resolve(value, steps) {
   return steps.reduce((v, step) => (v === undefined || v === null ? undefined : v[step]), value);
 }
 
-export function checkLayout(layout, advertised, fail) {
+export function checkLayout(layout, advertised, report) {
+  let failures = 0;
+  const fail = (what) => {
+    failures += 1;
+    report(what);
+  };
   const placed = leaves(layout.layout);
   const configured = Object.keys(layout.configById);
   for (const id of placed) if (!layout.configById[id]) fail(`layout: panel ${id} has no configuration`);
@@ -55,6 +60,6 @@ export function checkLayout(layout, advertised, fail) {
     }
     resolved += 1;
   }
-  return `layout: ${placed.length} panels, ${paths.length} topics and paths named, all advertised; ` +
-    `${resolved} plotted paths resolve to numbers`;
+  return `layout: ${placed.length} panels, ${paths.length} topics and paths named, ` +
+    `${resolved} plotted paths resolve to numbers, ${failures} problems`;
 }

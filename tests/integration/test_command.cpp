@@ -44,9 +44,10 @@ TEST(CommandTool, AppliedRefusedAndBadOptions) {
   EXPECT_NE(test::readFile(dir / "ok.log").find("vehicle 1: APPLIED"), std::string::npos)
       << test::readFile(dir / "ok.log");
   EXPECT_EQ(runTool(dir, "intruder.log", {"CMD_RESET", "--issuer", "intruder"}), 1);
-  EXPECT_NE(test::readFile(dir / "intruder.log")
-                .find("vehicle 1: REFUSED (unauthorized): issuer 'intruder' not in command_issuers"),
-            std::string::npos)
+  EXPECT_NE(
+      test::readFile(dir / "intruder.log")
+          .find("vehicle 1: REFUSED (unauthorized): issuer 'intruder' not in command_issuers"),
+      std::string::npos)
       << test::readFile(dir / "intruder.log");
 
   EXPECT_EQ(runTool(dir, "bad.log", {"SELECT_FUSION", "--fusion", "BOGUS"}), 2);

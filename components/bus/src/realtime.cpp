@@ -192,7 +192,7 @@ RealtimeGrant applyRealtime(const RealtimeOptions& o) {
   checkOptions(o);
   if (!o.cpus.empty()) setAffinity(o.cpus);
   if (o.policy != SchedulingPolicy::kOther) setScheduling(o.policy, o.priority, "realtime.policy");
-  applyToOtherThreads(o);
+  if (o.policy != SchedulingPolicy::kOther || !o.cpus.empty()) applyToOtherThreads(o);
   if (o.lock_memory) lockMemory();
   RealtimeGrant g;
   int policy = SCHED_OTHER;

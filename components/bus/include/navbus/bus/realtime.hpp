@@ -5,11 +5,12 @@
 //
 // applied to the process's main thread before the DDS participant is created, so that the
 // threads Fast DDS creates (Fast DDS 2.9 has no per-thread settings) inherit the scheduling
-// class, priority and CPU affinity (the threads that exist already are given them too); the main thread, which takes the samples and runs the
-// pipeline, is then raised one priority above them. Memory is locked as it is touched
-// (mlockall with MCL_ONFAULT: locking every thread's whole stack would cost megabytes), and the
-// main thread's stack is touched ahead. What the kernel granted is read back and reported; a
-// refusal is a ConfigError naming the key, the value and the system's reason.
+// class, priority and CPU affinity (the threads that exist already are given them too); the main
+// thread, which takes the samples and runs the pipeline, is then raised one priority above them.
+// Memory is locked as it is touched (mlockall with MCL_ONFAULT: locking every thread's whole stack
+// would cost megabytes), and the main thread's stack is touched ahead. What the kernel granted is
+// read back and reported; a refusal is a ConfigError naming the key, the value and the system's
+// reason.
 #pragma once
 
 #include <string>
@@ -45,7 +46,7 @@ RealtimeOptions readRealtime(const YAML::Node& config);
 struct RealtimeGrant {
   SchedulingPolicy policy{SchedulingPolicy::kOther};
   int priority{0};
-  std::vector<int> cpus;  ///< the thread's affinity
+  std::vector<int> cpus;      ///< the thread's affinity
   bool memory_locked{false};  ///< read back: the process has locked memory (VmLck > 0)
   std::string text() const;
 };
