@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The sanitizer stage: builds navbus with clang, AddressSanitizer and UndefinedBehaviorSanitizer
 # (any undefined behaviour aborts) into ./build-san, with the libFuzzer targets; runs the unit
-# and integration tests under them and a bounded slice of each fuzz target (ctest fuzz_smoke:
-# scripts/fuzz.sh, 200000 executions each). Benchmarks and the CPU-load timing tests are left to
+# and integration tests under them and a bounded slice of each fuzz target (ctest fuzz_smoke_*:
+# scripts/fuzz.sh, 100000 executions each). Benchmarks and the CPU-load timing tests are left to
 # the normal build: the sanitizers change the timing they measure.
 set -euo pipefail
 cd "$(dirname "$0")/.."

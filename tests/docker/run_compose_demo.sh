@@ -26,8 +26,8 @@ t0=$SECONDS
 say() { echo "[compose-demo $((SECONDS - t0)) s] $*"; }
 
 # --- the engine ---------------------------------------------------------------------------
-# Debian's client (/usr/bin/docker, with BuildKit) before any other docker on PATH.
-export PATH=/usr/bin:$PATH DOCKER_BUILDKIT=1 COMPOSE_DOCKER_CLI_BUILD=1
+# The demo itself goes through scripts/compose.sh, the README's command, which picks a docker
+# client with BuildKit on whatever PATH this test inherits.
 start_engine() {
   if ! command -v dockerd > /dev/null || ! command -v docker-compose > /dev/null; then
     say "installing docker.io and docker-compose (Debian 12)"
@@ -56,20 +56,19 @@ else
   [ "$(id -u)" = 0 ] || { echo "SKIP: no Docker engine runs, and starting one needs root"; exit 77; }
   start_engine
 fi
-if docker compose version > /dev/null 2>&1; then
-  compose=(docker compose)
-else
-  command -v docker-compose > /dev/null ||
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends docker-compose
-  compose=(docker-compose)
+if ! docker compose version > /dev/null 2>&1 && ! command -v docker-compose > /dev/null; then
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends docker-compose
 fi
+compose=(bash "$src/scripts/compose.sh")
+# The images' own user (as before the wrapper, which defaults to the caller's ids), and no
+# ./navbus-out in the checkout: each run below mounts its own output directory.
+export NAVBUS_UID=10001 NAVBUS_GID=10001 NAVBUS_OUT_DIR=$work
 
 project=navbus-test-$$
-files=(-f "$src/docker/docker-compose.yml")
 cleanup() {
   local mode
   for mode in plain secure; do
-    "${compose[@]}" -p "$project-$mode" "${files[@]}" -f "$src/docker/docker-compose.secure.yml" \
+    "${compose[@]}" --secure -p "$project-$mode" \
       down --volumes --remove-orphans > /dev/null 2>&1 || true
   done
   docker rmi "navbus:$NAVBUS_TAG" "navbus-report:$NAVBUS_TAG" > /dev/null 2>&1 || true
@@ -107,12 +106,12 @@ run_demo() {  # MODE
     cp -r "$build/security" "$work/security"
     chown -R 10001:10001 "$work/security"
     export NAVBUS_SECURITY_DIR=$work/security
-    extra=(-f "$src/docker/docker-compose.secure.yml")
+    extra=(--secure)
   fi
   say "$mode: ${compose[*]} up --build (NAVBUS_PACKAGE=$NAVBUS_PACKAGE)"
   local t=$SECONDS rc=0
-  NAVBUS_OUT_DIR=$out timeout 600 "${compose[@]}" -p "$project-$mode" "${files[@]}" \
-    "${extra[@]}" up --build > "$work/compose.log" 2>&1 || rc=$?
+  NAVBUS_OUT_DIR=$out timeout 600 "${compose[@]}" "${extra[@]}" -p "$project-$mode" \
+    up --build > "$work/compose.log" 2>&1 || rc=$?
   say "$mode: up returned $rc after $((SECONDS - t)) s"
   [ $rc -eq 0 ] || fail "$mode: compose up exited $rc"
   # Every container of the project, with its exit code.
@@ -134,7 +133,7 @@ run_demo() {  # MODE
   grep -q "end of data: 0 stream-lost decisions" "$summary" || fail "$mode: a stream was called lost"
   grep -E "^ *decision [0-9]* at|^fault [0-9]|^end of data" "$summary"
   say "$mode: ok ($(ls "$out/figures/"*.png | wc -l) figures)"
-  "${compose[@]}" -p "$project-$mode" "${files[@]}" "${extra[@]}" down --volumes > /dev/null 2>&1
+  "${compose[@]}" "${extra[@]}" -p "$project-$mode" down --volumes > /dev/null 2>&1
 }
 for mode in "${modes[@]}"; do
   case $mode in

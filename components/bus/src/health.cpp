@@ -1,6 +1,7 @@
 #include "navbus/bus/health.hpp"
 
 #include <sstream>
+#include <vector>
 
 namespace navbus::bus {
 
@@ -31,36 +32,48 @@ const StreamCounters* HealthCounters::find(const std::string& topic) const {
   return nullptr;
 }
 
-navbus::Health HealthCounters::report(navbus::ParticipantState state, std::uint64_t wall_time_ns) {
-  navbus::Health h;
+namespace {
+
+/// Copies `counts` into `into`, reusing its elements (no allocation once it had as many).
+template <class Counts>
+void fillRejectCounts(const Counts& counts, std::vector<navbus::RejectCount>& into) {
+  into.resize(counts.size());
+  std::size_t i = 0;
+  for (const auto& [reason, count] : counts) {
+    into[i].reason(reason);
+    into[i].count(count);
+    ++i;
+  }
+}
+
+}  // namespace
+
+void HealthCounters::report(navbus::ParticipantState state, std::uint64_t wall_time_ns,
+                            navbus::Health& h) {
   h.participant(participant_);
   h.seq(++seq_);
   h.wall_time_ns(wall_time_ns);
   h.state(state);
   h.samples_published(published_);
   h.resume_ns(resume_ns_);
+  h.inputs().resize(streams_.size());
+  std::size_t i = 0;
   for (const auto& [name, c] : streams_) {
-    navbus::StreamHealth s;
-    s.topic(name);
+    navbus::StreamHealth& s = h.inputs()[i++];
+    s.topic(name);  // assigned: the string keeps its storage
     s.received(c.received);
     s.accepted(c.accepted);
     s.sequence_gaps(c.sequence_gaps);
     s.deadline_misses(c.deadline_misses);
     s.source_restarts(c.source_restarts);
-    for (const auto& [reason, count] : c.rejected) {
-      navbus::RejectCount rc;
-      rc.reason(reason);
-      rc.count(count);
-      s.rejected().push_back(rc);
-    }
-    for (const auto& [reason, count] : c.elements_rejected) {
-      navbus::RejectCount rc;
-      rc.reason(reason);
-      rc.count(count);
-      s.elements_rejected().push_back(rc);
-    }
-    h.inputs().push_back(s);
+    fillRejectCounts(c.rejected, s.rejected());
+    fillRejectCounts(c.elements_rejected, s.elements_rejected());
   }
+}
+
+navbus::Health HealthCounters::report(navbus::ParticipantState state, std::uint64_t wall_time_ns) {
+  navbus::Health h;
+  report(state, wall_time_ns, h);
   return h;
 }
 

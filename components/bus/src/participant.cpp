@@ -242,7 +242,8 @@ void Participant::finish() {
 
 void Participant::publishHealth() {
   if (!publish_health_) return;
-  health_writer_.write(health_.report(state_, wallTimeNowNs()));
+  health_.report(state_, wallTimeNowNs(), health_message_);
+  health_writer_.write(health_message_);
 }
 
 std::uint64_t wallTimeNowNs() {

@@ -33,13 +33,31 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   return s;
 }
 
+/// The inputs the recovery history holds over its span: one per period of each configured
+/// stream (a stream without a period counted at the IMU's), and a quarter more for jitter and
+/// commands.
+std::size_t historyItems(const FilterConfig& c) {
+  if (c.recovery_history_ns <= 0) return 1;
+  double per_ns = 0.0;
+  const auto add = [&](const std::optional<InputConfig>& in) {
+    const std::int64_t period_ns = in && in->period_ns > 0 ? in->period_ns : c.imu.period_ns;
+    if (in && period_ns > 0) per_ns += 1.0 / static_cast<double>(period_ns);
+  };
+  add(c.imu);
+  add(c.gnss_observations);
+  add(c.gnss_fix);
+  add(c.star_tracker);
+  return static_cast<std::size_t>(1.25 * per_ns * static_cast<double>(c.recovery_history_ns)) + 16;
+}
+
 }  // namespace
 
 FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks)
     : config_(config),
       sinks_(std::move(sinks)),
       sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
-      history_(config.recovery_history_ns, config.recovery_snapshot_period_ns),
+      history_(config.recovery_history_ns, config.recovery_snapshot_period_ns,
+               historyItems(config)),
       engine_(config.engine),
       predictor_(config.engine.tuning.gravity, config.low_latency_max_buffered),
       imu_gate_(bus::topic::kImuIncrement, health.stream(bus::topic::kImuIncrement),

@@ -127,10 +127,11 @@ class LatencyCommand final : public Subcommand {
         "passively on a running bus (IMU source time stamp -> outputs received), or `flood` "
         "against "
         "a `sink` process: saturation throughput with zero loss checked (same domain, --profile, "
-        "--qos)");
-    cli_->add_option("role", latency.role, "ping, pong, imu, observe, flood or sink")
+        "--qos); `table` runs ping/pong and navbus-filter + imu itself, idle and beside CPU-bound "
+        "processes, with and without the real-time option, and prints the tail of each");
+    cli_->add_option("role", latency.role, "ping, pong, imu, observe, flood, sink or table")
         ->required()
-        ->check(CLI::IsMember({"ping", "pong", "imu", "observe", "flood", "sink"}));
+        ->check(CLI::IsMember({"ping", "pong", "imu", "observe", "flood", "sink", "table"}));
     cli_->add_option("--samples", latency.samples, "pings (flood: samples) timed after the warm-up")
         ->check(CLI::Range(1, 10'000'000));
     cli_->add_option("--warmup", latency.warmup, "pings sent first, not timed")
@@ -153,14 +154,47 @@ class LatencyCommand final : public Subcommand {
     cli_->add_option("--csv", latency.csv,
                      "ping: every round trip [ns]; imu: every increment's latencies [ns] "
                      "(-1: not received); observe: every output's latency [ns]");
+    addTableOptions();
   }
   int run(bus::Participant::Options& options, bus::ShutdownSignal& shutdown) override {
     options.dds.name = "navbus-latency-" + latency.role;
+    if (latency.role == "table") return runTable(options);
     return runLatencyCommand(options, latency, shutdown);
   }
 
  private:
+  void addTableOptions() {
+    cli_->add_option("--rounds", table.rounds, "table: the whole table this many times (pooled)")
+        ->check(CLI::Range(1, 100));
+    cli_->add_option("--hogs", table.cpu_hogs, "table: CPU-bound processes beside the loaded rows")
+        ->check(CLI::Range(0, 64));
+    cli_->add_option("--filter-config", table.filter_config,
+                     "table: navbus-filter's configuration (IMU sensor 1 at --rate, the "
+                     "low-latency output on)")
+        ->capture_default_str();
+    cli_->add_option("--policy", table.policy, "table: the real-time rows' realtime.policy")
+        ->check(CLI::IsMember({"fifo", "rr"}))
+        ->capture_default_str();
+    cli_->add_option("--priority", table.priority, "table: the real-time rows' realtime.priority")
+        ->check(CLI::Range(1, 98))
+        ->capture_default_str();
+    cli_->add_flag("--keep", table.keep, "table: keep its work directory (CSV files, logs)");
+  }
+  int runTable(const bus::Participant::Options& options) {
+    // --samples, --warmup and --rate given: they apply to every row (else the table's defaults).
+    if (cli_->count("--samples") > 0) table.samples = latency.samples;
+    if (cli_->count("--warmup") > 0) table.warmup = latency.warmup;
+    if (cli_->count("--rate") > 0) table.rate_hz = latency.rate_hz;
+    try {
+      return runLatencyTable(options, table);
+    } catch (const std::runtime_error& e) {
+      spdlog::error("latency table: {}", e.what());
+      return bus::kExitRuntimeError;
+    }
+  }
+
   LatencyOptions latency;
+  LatencyTableOptions table;
 };
 
 }  // namespace

@@ -404,6 +404,7 @@ LatencyStats latencyStats(std::vector<std::int64_t> v) {
   s.p90_ns = rank(0.9);
   s.p99_ns = rank(0.99);
   s.p999_ns = rank(0.999);
+  s.p9999_ns = rank(0.9999);
   s.max_ns = static_cast<double>(v.back());
   return s;
 }

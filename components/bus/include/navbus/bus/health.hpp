@@ -40,6 +40,9 @@ class HealthCounters {
 
   /// Builds the next report (sequence incremented on each call).
   navbus::Health report(navbus::ParticipantState state, std::uint64_t wall_time_ns);
+  /// The same into `into`, whose vectors and strings are reused: a participant that keeps one
+  /// message allocates nothing for its reports once the set of streams and reasons is stable.
+  void report(navbus::ParticipantState state, std::uint64_t wall_time_ns, navbus::Health& into);
 
   /// One line per stream, for the end-of-run summary.
   std::string summary() const;

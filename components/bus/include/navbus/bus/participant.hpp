@@ -249,6 +249,7 @@ class Participant {
   ShmReclaimAtExit shm_reclaim_at_exit_;
   DdsContext dds_;
   HealthCounters health_;
+  navbus::Health health_message_;  ///< reused by every report (no allocation once filled)
   bool publish_health_{true};
   navbus::ParticipantState state_{navbus::STATE_STARTING};
   bool state_managed_{false};

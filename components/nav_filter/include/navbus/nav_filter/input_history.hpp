@@ -27,8 +27,14 @@ class InputHistory {
  public:
   using Item = Input;
 
-  InputHistory(std::int64_t span_ns, std::int64_t snapshot_period_ns)
-      : span_ns_(span_ns), snapshot_period_ns_(snapshot_period_ns) {}
+  /// `expected_items`: the inputs the span holds (FilterPipeline counts them from the
+  /// configured periods); the item buffer is made that large at once, so that it does not
+  /// allocate while it fills (it still grows if more come).
+  InputHistory(std::int64_t span_ns, std::int64_t snapshot_period_ns,
+               std::size_t expected_items = 16)
+      : span_ns_(span_ns),
+        snapshot_period_ns_(snapshot_period_ns),
+        items_(span_ns > 0 ? expected_items : 1) {}
 
   bool enabled() const { return span_ns_ > 0; }
 

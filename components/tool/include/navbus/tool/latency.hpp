@@ -43,9 +43,27 @@ struct SinkCount {
 /// Nearest-rank statistics of round-trip times [ns].
 struct LatencyStats {
   std::size_t count{0};
-  double median_ns{0}, p90_ns{0}, p99_ns{0}, p999_ns{0}, max_ns{0};
+  double median_ns{0}, p90_ns{0}, p99_ns{0}, p999_ns{0}, p9999_ns{0}, max_ns{0};
 };
 LatencyStats latencyStats(std::vector<std::int64_t> round_trips_ns);
+
+/// `navbus latency table`: what it runs (latency_table.cpp).
+struct LatencyTableOptions {
+  int samples{4000};  ///< timed per row and round (after the warm-up)
+  int warmup{200};    ///< sent first and not timed
+  double rate_hz{200.0};
+  int rounds{1};    ///< the whole table this many times, samples pooled per row
+  int cpu_hogs{2};  ///< CPU-bound processes beside the loaded rows
+  std::string filter_config{"config/filter_latency.yaml"};
+  std::string policy{"fifo"};  ///< the real-time rows' `realtime.policy`
+  int priority{20};            ///< and `realtime.priority` (lock_memory: true)
+  bool keep{false};            ///< keep the work directory (CSV files, logs)
+};
+
+/// Runs the table: child processes on domains from `participant.dds.domain_id` (six of them,
+/// per round), with its profile and QoS file. Exit 0 when every row received all its samples
+/// (the targets are printed, not enforced); throws std::runtime_error when a child fails.
+int runLatencyTable(const bus::Participant::Options& participant, const LatencyTableOptions& o);
 
 /// Runs one side; returns an exit code (runtime error if the other side never matched or a
 /// ping was not echoed).
