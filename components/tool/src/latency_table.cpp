@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -53,6 +54,7 @@ class Child {
     }
   }
   ~Child() { stop(SIGKILL, 0.0); }
+  pid_t pid() const { return pid_; }
   Child(const Child&) = delete;
   Child& operator=(const Child&) = delete;
 
@@ -150,11 +152,21 @@ struct Row {
   std::vector<std::int64_t> samples;  ///< [ns]
   LatencyStats stats;
   std::size_t expected{0};
+  long filter_peak_kib{-1};  ///< navbus-filter's VmHWM at the end of the row (-1: raw row)
 };
+
+/// A process's peak resident memory (VmHWM) [KiB], -1 if unknown.
+long peakResidentKib(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
 
 Row makeRow(const std::string& state, const std::string& path, std::vector<std::int64_t> samples,
             std::size_t expected) {
-  Row r{state, path, std::move(samples), {}, expected};
+  Row r{state, path, std::move(samples), {}, expected, -1};
   r.stats = latencyStats(r.samples);
   return r;
 }
@@ -215,9 +227,12 @@ class TableRun {
     Child filter(filter_args, filter_log);
     Child imu(toolArgs(d, realtime, sampleArgs("imu", csv)), work_ / ("imu_" + tag + ".log"));
     expectExit(imu, "imu", tag, work_ / ("imu_" + tag + ".log"));
+    const long filter_peak_kib = peakResidentKib(filter.pid());
     filter.stop(SIGTERM, 5.0);
-    return makeRow(state, realtime ? "navbus, real-time option" : "navbus", readColumn(csv, 1),
-                   static_cast<std::size_t>(o_.samples));
+    Row row = makeRow(state, realtime ? "navbus, real-time option" : "navbus",
+                      readColumn(csv, 1), static_cast<std::size_t>(o_.samples));
+    row.filter_peak_kib = filter_peak_kib;
+    return row;
   }
 
  private:
@@ -283,7 +298,11 @@ std::vector<double> quantiles(const LatencyStats& s) {
 void printRow(const Row& r) {
   std::printf("%-7s %-26s", r.state.c_str(), r.path.c_str());
   for (const double ns : quantiles(r.stats)) std::printf(" %9.1f", ns / 1000.0);
-  std::printf("  %zu of %zu\n", r.stats.count, r.expected);
+  std::printf("  %zu of %zu", r.stats.count, r.expected);
+  if (r.filter_peak_kib > 0) {
+    std::printf("  (navbus-filter VmHWM %.1f MiB)", static_cast<double>(r.filter_peak_kib) / 1024.0);
+  }
+  std::printf("\n");
 }
 
 void printRatios(const Row& r, const Row& raw) {
@@ -311,6 +330,7 @@ struct Pool {
     for (const Row& r : rows) {
       all.insert(all.end(), r.samples.begin(), r.samples.end());
       out.expected += r.expected;
+      out.filter_peak_kib = std::max(out.filter_peak_kib, r.filter_peak_kib);
     }
     out.stats = latencyStats(all);
     return out;

@@ -180,11 +180,16 @@ void GlrMonitor::configure(const GlrConfig& config) {
   r_sat_.resize(kSatDirections * kSatDirections * kMaxSatellites, config_.window);
   const int columns = kMaxPropagated * config_.window;
   mu_.resize(kStates, columns);
-  mu_next_.resize(kStates, columns);
-  ms_.resize(kSupport, columns);
-  z_.resize(kSupport, columns);
+  sizeWorkingBuffers();
   spacing_s_.resize(config_.window);
   reset();
+}
+
+void GlrMonitor::sizeWorkingBuffers() {
+  const int columns = kMaxPropagated * config_.window;
+  if (mu_next_->cols() != columns) mu_next_->resize(kStates, columns);
+  if (ms_->cols() != columns) ms_->resize(kSupport, columns);
+  if (z_->cols() != columns) z_->resize(kSupport, columns);
 }
 
 void GlrMonitor::reset() {
@@ -338,7 +343,7 @@ void GlrMonitor::propagate() {
   // every onset and column in one product.
   const int columns = propagatedColumns() * config_.window;
   const auto in = mu_.leftCols(columns);
-  auto out = mu_next_.leftCols(columns);
+  auto out = mu_next_->leftCols(columns);
   if (biasAndClockRowsSparse()) {
     // Bias and receiver rows: B = [0 I 0] + B(:, support): support-wide per column, not n-wide.
     constexpr int kNav = layout::kAtt.end();  // position, velocity, attitude rows
@@ -356,7 +361,7 @@ void GlrMonitor::propagate() {
   } else {
     out.noalias() = b_ * in;
   }
-  mu_.swap(mu_next_);
+  mu_.swap(*mu_next_);
   const bool range = config_.range_steps || config_.range_ramps;
   for (int s = 0; s < slots_used_; ++s) {
     const Slot& slot = slots_[static_cast<std::size_t>(s)];
@@ -400,11 +405,11 @@ void GlrMonitor::accumulate() {
   // (one block of `window` columns per direction); the direct inputs d enter in
   // accumulateSatellite.
   const int columns = propagatedColumns() * config_.window;
-  ms_.topLeftCorner<kSupportHead.dof, Eigen::Dynamic>(kSupportHead.dof, columns) =
+  ms_->topLeftCorner<kSupportHead.dof, Eigen::Dynamic>(kSupportHead.dof, columns) =
       mu_.block(kSupportHead.index, 0, kSupportHead.dof, columns);
-  ms_.bottomLeftCorner<kSupportTail.dof, Eigen::Dynamic>(kSupportTail.dof, columns) =
+  ms_->bottomLeftCorner<kSupportTail.dof, Eigen::Dynamic>(kSupportTail.dof, columns) =
       mu_.block(kSupportTail.index, 0, kSupportTail.dof, columns);
-  z_.leftCols(columns).noalias() = s_ * ms_.leftCols(columns);
+  z_->leftCols(columns).noalias() = s_ * ms_->leftCols(columns);
   if (config_.imu_steps) accumulateImu();
   for (int s = 0; s < slots_used_; ++s) accumulateSatellite(s);
 }
@@ -414,11 +419,11 @@ void GlrMonitor::accumulate() {
 void GlrMonitor::accumulateImu() {
   const int window = config_.window;
   for (int c = 0; c < kImuDirections; ++c) {
-    const auto mu_c = ms_.middleCols(firstColumn(c), window);
+    const auto mu_c = ms_->middleCols(firstColumn(c), window);
     f_.row(c).noalias() += a_.transpose() * mu_c;
     for (int d = c; d < kImuDirections; ++d) {
       const OnsetArray r =
-          mu_c.cwiseProduct(z_.middleCols(firstColumn(d), window)).colwise().sum().array();
+          mu_c.cwiseProduct(z_->middleCols(firstColumn(d), window)).colwise().sum().array();
       r_imu_.row(c + kImuDirections * d) += r.matrix();
       if (d != c) r_imu_.row(d + kImuDirections * c) += r.matrix();
     }
@@ -454,10 +459,10 @@ void GlrMonitor::accumulateSatellite(int s) {
   double ramp_d = 0.0;
   int ring = (onset_head_ + onset_count_ - 1) % window;
   for (int age = 0; age < onset_count_; ++age, ring = ring == 0 ? window - 1 : ring - 1) {
-    const ConstColumn mu_step(ms_.col(step_first + ring).data());
-    const ConstColumn z_step(z_.col(step_first + ring).data());
-    const ConstColumn mu_rate(ms_.col(rate_first + ring).data());
-    const ConstColumn z_rate(z_.col(rate_first + ring).data());
+    const ConstColumn mu_step(ms_->col(step_first + ring).data());
+    const ConstColumn z_step(z_->col(step_first + ring).data());
+    const ConstColumn mu_rate(ms_->col(rate_first + ring).data());
+    const ConstColumn z_rate(z_->col(rate_first + ring).data());
     const double c = spacing_s_[ring];
     ramp_mu += c * mu_step;
     ramp_z += c * z_step;
@@ -501,6 +506,7 @@ const GlrResult& GlrMonitor::update(const GlrEpoch& e) {
     result_ = GlrResult{};
     return result_;
   }
+  sizeWorkingBuffers();
   llt_.compute(e.innovation_cov);  // used again for V^-1 in prepareEpoch
   if (llt_.info() != Eigen::Success) {
     ++refused_;
@@ -578,7 +584,7 @@ void GlrMonitor::positionSignatures(std::vector<PositionSignature>& out) const {
       prev_k_.middleRows<3>(kPos);
   const Eigen::Matrix<double, 3, kSupport> kh = k_pos * prev_h_support_;
   const auto after = [&](int column, double d, int row) {
-    Eigen::Vector3d p = mu_.block<3, 1>(kPos, column) - kh * ms_.col(column);
+    Eigen::Vector3d p = mu_.block<3, 1>(kPos, column) - kh * ms_->col(column);
     if (row >= 0) p -= d * k_pos.col(row);
     return p;
   };

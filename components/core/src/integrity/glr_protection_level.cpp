@@ -60,7 +60,7 @@ void GlrProtectionLevel::configure(const IntegrityConfig& config) {
     return;
   }
   monitor_.emplace(config.detector);
-  signatures_.reserve(static_cast<std::size_t>(glr::kMaxDirections * monitor_->config().window));
+  reserveSignatures();
   // The group statistics have as many degrees of freedom as the rank of their directions (up
   // to 6 for the IMU, 3 per satellite), and against the one threshold h a lower rank needs the
   // larger noncentrality: rank 1, the largest, bounds every group (within 2.2 % of rank 6 at
@@ -74,6 +74,11 @@ void GlrProtectionLevel::configure(const IntegrityConfig& config) {
   reset();
 }
 
+void GlrProtectionLevel::reserveSignatures() {
+  const auto n = static_cast<std::size_t>(glr::kMaxDirections * monitor_->config().window);
+  if (signatures_->capacity() < n) signatures_->reserve(n);
+}
+
 void GlrProtectionLevel::reset() {
   if (monitor_) monitor_->reset();
   have_biases_ = false;
@@ -82,14 +87,15 @@ void GlrProtectionLevel::reset() {
 
 void GlrProtectionLevel::onEpoch(std::int64_t time_ns, const EpochDiagnostics& epoch) {
   if (!monitor_) return;
-  toGlrEpoch(time_ns, epoch, epoch_);
-  const GlrResult& result = monitor_->update(epoch_);
+  toGlrEpoch(time_ns, epoch, *epoch_);
+  const GlrResult& result = monitor_->update(*epoch_);
   if (!result.valid) return;  // refused: counted by the monitor
   detections_ += result.detected ? 1 : 0;
-  monitor_->positionSignatures(signatures_);
+  reserveSignatures();
+  monitor_->positionSignatures(*signatures_);
   biases_ = FaultBiases{};
-  have_biases_ = !signatures_.empty();
-  for (const auto& s : signatures_) {
+  have_biases_ = !signatures_->empty();
+  for (const auto& s : *signatures_) {
     // Minimum detectable magnitude nu = sqrt(lambda / R*) (doc eq. PL2) and the position
     // error it leaves after this epoch's update, nu mu+ (eq. PL3).
     if (!(s.information > 0.0)) continue;  // the data cannot see it: reported by the monitor

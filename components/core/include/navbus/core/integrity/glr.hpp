@@ -21,7 +21,8 @@
 // diagonal and drops directions whose information is within `rank_tolerance` of dependent,
 // and isolation reports such directions as ambiguous instead of picking one.
 //
-// Fixed-capacity storage, allocated once in configure(): update() allocates nothing.
+// Fixed-capacity storage, allocated once in configure(): update() allocates nothing (but the
+// first update of a copy, which sizes its working buffers: math/scratch.hpp).
 #pragma once
 
 #include <array>
@@ -34,6 +35,7 @@
 #include "navbus/core/gnss/gnss_measurement.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/ins/state_layout.hpp"
+#include "navbus/core/math/scratch.hpp"
 
 namespace navbus::core {
 
@@ -257,6 +259,8 @@ class GlrMonitor {
   void isolate(const OnsetView& o, int onset_age, GlrResult& r) const;
   double onsetStatistic(const OnsetView& o) const;
   int propagatedColumns() const { return glr::kImuDirections + 2 * slots_used_; }
+  /// Sizes the working buffers for the configured window (a no-op once sized).
+  void sizeWorkingBuffers();
 
   GlrConfig config_;
   std::vector<Onset> onsets_;  ///< ring buffer, capacity window
@@ -268,10 +272,14 @@ class GlrMonitor {
 
   // Signatures of every onset in one matrix, so that one product propagates them all: column
   // c (an IMU step or a satellite's range or rate step, see muColumn) of the onset at ring
-  // position i is column c * window + i. Sized once in configure(), swapped after each product.
-  Eigen::Matrix<double, glr::kStates, Eigen::Dynamic> mu_, mu_next_;
-  /// mu_ on H's support (ms_) and S ms_ (z_), same column order.
-  Eigen::Matrix<double, glr::kSupport, Eigen::Dynamic> ms_, z_;
+  // position i is column c * window + i. Sized once in configure(); the product goes into the
+  // working buffer mu_next_, then the two are swapped.
+  using SignatureMatrix = Eigen::Matrix<double, glr::kStates, Eigen::Dynamic>;
+  SignatureMatrix mu_;
+  /// Working buffers, overwritten by every update before they are read (not in copies:
+  /// scratch.hpp): the next mu_, mu_ on H's support (ms_) and S ms_ (z_), same column order.
+  Scratch<SignatureMatrix> mu_next_;
+  Scratch<Eigen::Matrix<double, glr::kSupport, Eigen::Dynamic>> ms_, z_;
   OnsetArray spacing_s_;  ///< t_theta - t_{theta-1} of each ring position [s]
   // Sums of eqs. 9-10, one column per ring position: f per direction, the IMU group's R (6 x 6,
   // column-major) and each satellite slot's R (3 x 3, column-major, slot after slot).

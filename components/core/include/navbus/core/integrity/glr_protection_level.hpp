@@ -20,6 +20,7 @@
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 #include "navbus/core/integrity/glr.hpp"
 #include "navbus/core/integrity/protection_level_config.hpp"
+#include "navbus/core/math/scratch.hpp"
 
 namespace navbus::core {
 
@@ -67,8 +68,10 @@ class GlrProtectionLevel {
   /// Only with integrity enabled: its windows are about 0.5 MB, copied with every snapshot of
   /// the engine the filter's recovery history takes.
   std::optional<GlrMonitor> monitor_;
-  GlrEpoch epoch_;
-  std::vector<GlrMonitor::PositionSignature> signatures_;
+  /// Working buffers of onEpoch, rebuilt every epoch (not in copies: math/scratch.hpp).
+  Scratch<GlrEpoch> epoch_;
+  Scratch<std::vector<GlrMonitor::PositionSignature>> signatures_;
+  void reserveSignatures();
   double detectable_sigmas_{0.0};     ///< sqrt(lambda_md) of a one-direction group
   double k_ff_h_{0.0}, k_ff_v_{0.0};  ///< fault-free multipliers of sigma_major and sigma_D
   double k_md_h_{0.0}, k_md_v_{0.0};  ///< the same at the missed-detection probability
