@@ -6,10 +6,11 @@
 //
 // The processing thread is this test's main thread, which runs a FilterNode exactly as
 // navbus-filter's main() does (config/filter_latency.yaml: the IMU alone at 200 Hz, the
-// low-latency output on; with a recovery history of 40 s); a second thread is the IMU (its own participant, writer and readers of
-// both solution topics). malloc, calloc, realloc and the aligned allocators are replaced in this
-// executable (every library's calls come here: Fast DDS's, Eigen's, the standard library's);
-// they count the calls made on the main thread while counting is on, by call stack. Domain 119.
+// low-latency output on; with a recovery history of 40 s); a second thread is the IMU (its own
+// participant, writer and readers of both solution topics). malloc, calloc, realloc and the
+// aligned allocators are replaced in this executable (every library's calls come here: Fast
+// DDS's, Eigen's, the standard library's); they count the calls made on the main thread while
+// counting is on, by call stack. Domain 119.
 #include <dlfcn.h>
 #include <execinfo.h>
 #include <gtest/gtest.h>

@@ -229,8 +229,8 @@ class TableRun {
     expectExit(imu, "imu", tag, work_ / ("imu_" + tag + ".log"));
     const long filter_peak_kib = peakResidentKib(filter.pid());
     filter.stop(SIGTERM, 5.0);
-    Row row = makeRow(state, realtime ? "navbus, real-time option" : "navbus",
-                      readColumn(csv, 1), static_cast<std::size_t>(o_.samples));
+    Row row = makeRow(state, realtime ? "navbus, real-time option" : "navbus", readColumn(csv, 1),
+                      static_cast<std::size_t>(o_.samples));
     row.filter_peak_kib = filter_peak_kib;
     return row;
   }
@@ -300,7 +300,8 @@ void printRow(const Row& r) {
   for (const double ns : quantiles(r.stats)) std::printf(" %9.1f", ns / 1000.0);
   std::printf("  %zu of %zu", r.stats.count, r.expected);
   if (r.filter_peak_kib > 0) {
-    std::printf("  (navbus-filter VmHWM %.1f MiB)", static_cast<double>(r.filter_peak_kib) / 1024.0);
+    std::printf("  (navbus-filter VmHWM %.1f MiB)",
+                static_cast<double>(r.filter_peak_kib) / 1024.0);
   }
   std::printf("\n");
 }
