@@ -187,7 +187,7 @@ class LatencyCommand final : public Subcommand {
     if (cli_->count("--rate") > 0) table.rate_hz = latency.rate_hz;
     try {
       return runLatencyTable(options, table);
-    } catch (const std::runtime_error& e) {
+    } catch (const std::exception& e) {  // a child that failed, a file it did not write
       spdlog::error("latency table: {}", e.what());
       return bus::kExitRuntimeError;
     }

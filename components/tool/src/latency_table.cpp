@@ -17,9 +17,11 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -121,17 +123,30 @@ class CpuHogs {
   std::vector<pid_t> pids_;
 };
 
+/// The non-negative values of one column of a CSV file a child wrote (a header line first);
+/// throws naming the file and line when a cell is not an integer.
 std::vector<std::int64_t> readColumn(const fs::path& csv, int column) {
   std::ifstream in(csv);
+  if (!in) throw std::runtime_error("cannot read " + csv.string());
   std::vector<std::int64_t> out;
   std::string line;
   std::getline(in, line);  // header
-  while (std::getline(in, line)) {
+  for (int number = 2; std::getline(in, line); ++number) {
     std::stringstream row(line);
     std::string cell;
     for (int c = 0; c <= column && std::getline(row, cell, ','); ++c) {
     }
-    const std::int64_t v = std::stoll(cell);
+    std::size_t used = 0;
+    std::int64_t v = -1;
+    try {
+      v = std::stoll(cell, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != cell.size()) {
+      throw std::runtime_error(csv.string() + " line " + std::to_string(number) + ": '" + cell +
+                               "' is not an integer");
+    }
     if (v >= 0) out.push_back(v);
   }
   return out;

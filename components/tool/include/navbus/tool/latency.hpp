@@ -62,7 +62,8 @@ struct LatencyTableOptions {
 
 /// Runs the table: child processes on domains from `participant.dds.domain_id` (six of them,
 /// per round), with its profile and QoS file. Exit 0 when every row received all its samples
-/// (the targets are printed, not enforced); throws std::runtime_error when a child fails.
+/// (the targets are printed, not enforced); throws when a child fails (the message ends with
+/// its log) or wrote a CSV file that is not what it should be (naming the file and line).
 int runLatencyTable(const bus::Participant::Options& participant, const LatencyTableOptions& o);
 
 /// Runs one side; returns an exit code (runtime error if the other side never matched or a
