@@ -357,7 +357,8 @@ struct Pool {
 
 int runLatencyTable(const bus::Participant::Options& participant, const LatencyTableOptions& o) {
   TableRun run(participant, o);
-  const char* states[] = {"idle", "loaded"};
+  // The second state is "idle again" when no CPU-bound process was asked for.
+  const char* states[] = {"idle", o.cpu_hogs > 0 ? "loaded" : "idle-2"};
   std::vector<Pool> pools(6);
   const auto started = std::chrono::steady_clock::now();
   for (int round = 0; round < o.rounds; ++round) {
