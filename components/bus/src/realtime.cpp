@@ -8,14 +8,13 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/key_reader.hpp"
+#include "navbus/bus/proc_status.hpp"
 
 namespace navbus::bus {
 
@@ -148,17 +147,6 @@ void lockMemory() {
   prefaultStack();
 }
 
-/// VmLck of this process [kB] (/proc/self/status): what mlockall really locked. A build with
-/// AddressSanitizer ignores mlockall (it succeeds and locks nothing); 0 then.
-long lockedKilobytes() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmLck:", 0) == 0) return std::strtol(line.c_str() + 6, nullptr, 10);
-  }
-  return 0;
-}
-
 }  // namespace
 
 const char* policyName(SchedulingPolicy policy) {
@@ -208,7 +196,8 @@ RealtimeGrant applyRealtime(const RealtimeOptions& o) {
       if (CPU_ISSET(cpu, &set)) g.cpus.push_back(cpu);
     }
   }
-  g.memory_locked = o.lock_memory && lockedKilobytes() > 0;
+  // Read back: a build with AddressSanitizer ignores mlockall (it succeeds and locks nothing).
+  g.memory_locked = o.lock_memory && procStatusKilobytes("self", "VmLck") > 0;
   return g;
 }
 

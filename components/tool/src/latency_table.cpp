@@ -5,8 +5,9 @@
 // Every measurement is a pair of child processes this command starts: `navbus latency pong` +
 // `navbus latency ping` (raw), or navbus-filter + `navbus latency imu` (navbus), each pair on a
 // domain of its own, each writing its samples to a CSV file that is read back here. The
-// CPU-bound processes are children forked before anything else runs (no thread in this process:
-// it never creates a DDS participant), each spinning until killed at the end of the loaded rows.
+// CPU-bound processes are children forked by this process (which creates no DDS participant;
+// its only other thread waits for SIGINT/SIGTERM), each spinning, touching nothing shared,
+// until it is killed at the end of the loaded rows.
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -27,6 +28,7 @@
 #include <vector>
 
 #include "navbus/bus/app.hpp"
+#include "navbus/bus/proc_status.hpp"
 #include "navbus/tool/latency.hpp"
 
 extern char** environ;
@@ -170,15 +172,6 @@ struct Row {
   long filter_peak_kib{-1};  ///< navbus-filter's VmHWM at the end of the row (-1: raw row)
 };
 
-/// A process's peak resident memory (VmHWM) [KiB], -1 if unknown.
-long peakResidentKib(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  for (std::string line; std::getline(status, line);) {
-    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
-
 Row makeRow(const std::string& state, const std::string& path, std::vector<std::int64_t> samples,
             std::size_t expected) {
   Row r{state, path, std::move(samples), {}, expected, -1};
@@ -242,7 +235,7 @@ class TableRun {
     Child filter(filter_args, filter_log);
     Child imu(toolArgs(d, realtime, sampleArgs("imu", csv)), work_ / ("imu_" + tag + ".log"));
     expectExit(imu, "imu", tag, work_ / ("imu_" + tag + ".log"));
-    const long filter_peak_kib = peakResidentKib(filter.pid());
+    const long filter_peak_kib = bus::procStatusKilobytes(std::to_string(filter.pid()), "VmHWM");
     filter.stop(SIGTERM, 5.0);
     Row row = makeRow(state, realtime ? "navbus, real-time option" : "navbus", readColumn(csv, 1),
                       static_cast<std::size_t>(o_.samples));
