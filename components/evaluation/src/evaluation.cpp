@@ -400,20 +400,25 @@ int runOfflineCommand(const OfflineOptions& o) {
   return bus::kExitOk;
 }
 
-int runMonteCarloCommand(const MonteCarloOptions& o) {
-  struct Variant {
-    std::string label;
-    YAML::Node yaml;
-    std::string path;
-  };
+namespace {
+
+/// One row of the tables: a filter file with its overrides (fusion, policy).
+struct Variant {
+  std::string label;
+  YAML::Node yaml;
+  std::string path;
+};
+
+/// Set-up: every filter file times every --fusion and --policy override.
+std::vector<Variant> monteCarloVariants(const MonteCarloOptions& o) {
   std::vector<Variant> variants;
+  const auto orEmpty = [](const std::vector<std::string>& v) {
+    return v.empty() ? std::vector<std::string>{""} : v;
+  };
   for (const std::string& file : o.filters) {
     const std::string stem = std::filesystem::path(file).stem().string();
-    std::vector<std::string> fusions = o.fusions.empty() ? std::vector<std::string>{""} : o.fusions;
-    std::vector<std::string> policies =
-        o.policies.empty() ? std::vector<std::string>{""} : o.policies;
-    for (const auto& fu : fusions) {
-      for (const auto& po : policies) {
+    for (const auto& fu : orEmpty(o.fusions)) {
+      for (const auto& po : orEmpty(o.policies)) {
         YAML::Node y = filterYaml(file, o.align);
         std::string label = stem;
         if (!fu.empty()) {
@@ -428,95 +433,97 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
       }
     }
   }
-  std::printf(
-      "Monte Carlo: scenario %s, %d runs per configuration (seeds %llu..%llu)%s\n",
-      o.scenario.c_str(), o.runs, static_cast<unsigned long long>(o.first_seed),
-      static_cast<unsigned long long>(o.first_seed + static_cast<std::uint64_t>(o.runs) - 1),
-      o.align             ? ", every filter aligned from its inputs"
-      : o.perturb_initial ? ", initial state drawn from the filter's initial sigmas (filters "
-                            "without an initial_state align)"
-                          : "");
-  struct Row {
-    std::string label;
-    Stats st;
-    std::vector<AlignmentOutcome> alignments;  ///< one per run, filters that aligned
-    IntegrityTally integrity;                  ///< protection levels against the errors
-    HonestyTally honesty;                      ///< the filter's own claims
-  };
-  std::vector<Row> rows;
-  struct FaultTable {
-    std::string label;
-    std::optional<sim::Fault> fault;
-    std::vector<FaultRunOutcome> runs;
-    double hours;
-  };
-  std::vector<FaultTable> fault_tables;
-  for (const Variant& v : variants) {
-    Row row{v.label, {}, {}, {}, {}};
-    // Runs in parallel (one per core unless --threads), gathered in seed order.
-    std::vector<OfflineResult> results(static_cast<std::size_t>(o.runs));
-    std::vector<OfflineSetup> setups(static_cast<std::size_t>(o.runs));
-    for (int i = 0; i < o.runs; ++i) {
-      const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
-      OfflineSetup& setup = setups[static_cast<std::size_t>(i)];
-      setup = loadSetup(o.scenario, v.yaml, v.path, seed, o.duration_s, o.fault_manager);
-      if (setup.filter.engine.start == core::StartSource::kAligned) continue;
-      const core::NavState truth0 = initialTruth(setup.sim.scenario);
-      setup.filter.engine.initial_state =
-          o.perturb_initial
-              ? perturbedInitialState(truth0, setup.filter.engine.tuning, seed * 1000003ull + 17ull)
-              : truth0;
-    }
-    std::atomic<int> next{0}, done{0};
-    std::mutex progress;
-    auto worker = [&] {
-      for (int i = next++; i < o.runs; i = next++) {
-        results[static_cast<std::size_t>(i)] = runOffline(setups[static_cast<std::size_t>(i)]);
-        const std::lock_guard<std::mutex> lock(progress);
-        std::fprintf(stderr, "\r[%s] run %d/%d", v.label.c_str(), ++done, o.runs);
-        std::fflush(stderr);
-      }
-    };
-    const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-    const int threads = std::min(o.runs, o.threads > 0 ? o.threads : static_cast<int>(hw));
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
-    std::vector<FaultRunOutcome> outcomes;
-    std::optional<sim::Fault> fault;
-    for (int i = 0; i < o.runs; ++i) {
-      const OfflineSetup& setup = setups[static_cast<std::size_t>(i)];
-      const OfflineResult& r = results[static_cast<std::size_t>(i)];
-      const std::int64_t start = setup.sim.scenario.start_time_ns;
-      accumulate(row.st, r, start + static_cast<std::int64_t>(std::llround(o.from_s * 1e9)), o,
-                 start);
-      row.integrity.add(r, o.first_seed + static_cast<std::uint64_t>(i));
-      row.honesty.add(r, setup.filter.engine.consistency.false_alarm_probability);
-      if (setup.filter.engine.start == core::StartSource::kAligned)
-        row.alignments.push_back(
-            {r.aligned, r.aligned_start, r.aligned_start_error,
-             1e-9 * static_cast<double>(r.aligned_start.state.time_ns - start)});
-      if (setup.fault_manager) {
-        fault = detectableFault(setup.sim.scenario.faults);
-        outcomes.push_back(
-            evaluateRun(r, fault, start, o.first_seed + static_cast<std::uint64_t>(i)));
-      }
-    }
-    if (!outcomes.empty())
-      fault_tables.push_back({v.label, fault, outcomes, setups[0].duration_s / 3600.0});
-    std::fprintf(stderr, "\n");
-    rows.push_back(std::move(row));
+  return variants;
+}
+
+/// Set-up: one offline run per seed, the initial state drawn (or the truth) unless it aligns.
+std::vector<OfflineSetup> monteCarloSetups(const MonteCarloOptions& o, const Variant& v) {
+  std::vector<OfflineSetup> setups(static_cast<std::size_t>(o.runs));
+  for (int i = 0; i < o.runs; ++i) {
+    const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
+    OfflineSetup& setup = setups[static_cast<std::size_t>(i)];
+    setup = loadSetup(o.scenario, v.yaml, v.path, seed, o.duration_s, o.fault_manager);
+    if (setup.filter.engine.start == core::StartSource::kAligned) continue;
+    const core::NavState truth0 = initialTruth(setup.sim.scenario);
+    setup.filter.engine.initial_state =
+        o.perturb_initial
+            ? perturbedInitialState(truth0, setup.filter.engine.tuning, seed * 1000003ull + 17ull)
+            : truth0;
   }
+  return setups;
+}
+
+/// Runs: in parallel (one per core unless --threads), results in seed order.
+std::vector<OfflineResult> runAll(const std::vector<OfflineSetup>& setups, int threads_wanted,
+                                  const std::string& label) {
+  const int runs = static_cast<int>(setups.size());
+  std::vector<OfflineResult> results(setups.size());
+  std::atomic<int> next{0}, done{0};
+  std::mutex progress;
+  auto worker = [&] {
+    for (int i = next++; i < runs; i = next++) {
+      results[static_cast<std::size_t>(i)] = runOffline(setups[static_cast<std::size_t>(i)]);
+      const std::lock_guard<std::mutex> lock(progress);
+      std::fprintf(stderr, "\r[%s] run %d/%d", label.c_str(), ++done, runs);
+      std::fflush(stderr);
+    }
+  };
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const int threads = std::min(runs, threads_wanted > 0 ? threads_wanted : static_cast<int>(hw));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  std::fprintf(stderr, "\n");
+  return results;
+}
+
+/// Tallies of one configuration over its runs: each tally takes every run (add), the report
+/// prints them. A new tally (a lane's, say) is a member here and a line in add().
+struct Tallies {
+  std::string label;
+  Stats st;
+  std::vector<AlignmentOutcome> alignments;  ///< one per run, filters that aligned
+  IntegrityTally integrity;                  ///< protection levels against the errors
+  HonestyTally honesty;                      ///< the filter's own claims
+  std::optional<sim::Fault> fault;           ///< the detectable fault, with a fault manager
+  std::vector<FaultRunOutcome> fault_runs;   ///< one per run, with a fault manager
+  double hours{0.0};                         ///< of data per run
+
+  void add(const MonteCarloOptions& o, const OfflineSetup& setup, const OfflineResult& r,
+           std::uint64_t seed) {
+    const std::int64_t start = setup.sim.scenario.start_time_ns;
+    accumulate(st, r, start + static_cast<std::int64_t>(std::llround(o.from_s * 1e9)), o, start);
+    integrity.add(r, seed);
+    honesty.add(r, setup.filter.engine.consistency.false_alarm_probability);
+    if (setup.filter.engine.start == core::StartSource::kAligned)
+      alignments.push_back({r.aligned, r.aligned_start, r.aligned_start_error,
+                            1e-9 * static_cast<double>(r.aligned_start.state.time_ns - start)});
+    if (setup.fault_manager) {
+      fault = detectableFault(setup.sim.scenario.faults);
+      fault_runs.push_back(evaluateRun(r, fault, start, seed));
+    }
+    hours = setup.duration_s / 3600.0;
+  }
+};
+
+/// The average NEES's 95 % band for `runs` runs of 9 degrees of freedom.
+struct NeesBand {
+  double lo, hi;
+};
+NeesBand neesBand(int runs) {
   const double dof = 9.0;
-  const double lo = chiSquareQuantile(0.025, dof * o.runs) / o.runs;
-  const double hi = chiSquareQuantile(0.975, dof * o.runs) / o.runs;
+  return {chiSquareQuantile(0.025, dof * runs) / runs, chiSquareQuantile(0.975, dof * runs) / runs};
+}
+
+void printErrorTable(const std::vector<Tallies>& rows, const MonteCarloOptions& o) {
+  const NeesBand band = neesBand(o.runs);
   std::printf("\nerrors from %.0f s; RMS and max of the 3-D error norms over all epochs and runs\n",
               o.from_s);
   std::printf("%-34s %9s %9s %10s %10s %10s %10s %8s %16s %8s\n", "configuration", "pos RMS m",
               "pos max m", "vel RMS m/s", "vel max", "att RMS \"", "att max \"", "NEES(9)",
               "95% band", "in band");
-  for (const Row& r : rows) {
+  for (const Tallies& r : rows) {
     const Stats& s = r.st;
     const double n = static_cast<double>(s.n > 0 ? s.n : 1);
     double nees_mean = 0;
@@ -525,73 +532,115 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
       if (s.nees_runs[k] != o.runs) continue;  // epochs every run reached
       const double avg = s.nees_sum[k] / o.runs;
       nees_mean += avg;
-      in_band += (avg >= lo && avg <= hi) ? 1 : 0;
+      in_band += (avg >= band.lo && avg <= band.hi) ? 1 : 0;
       ++epochs;
     }
     nees_mean /= std::max(epochs, 1);
     std::printf("%-34s %9.3f %9.3f %10.4f %10.4f %10.2f %10.2f %8.2f [%6.2f,%6.2f] %7.1f%%\n",
                 r.label.c_str(), std::sqrt(s.sum_pos2 / n), s.max_pos, std::sqrt(s.sum_vel2 / n),
                 s.max_vel, std::sqrt(s.sum_att2 / n) * kArcsecPerRad, s.max_att * kArcsecPerRad,
-                nees_mean, lo, hi, 100.0 * in_band / std::max(epochs, 1));
+                nees_mean, band.lo, band.hi, 100.0 * in_band / std::max(epochs, 1));
   }
+}
+
+void writeMonteCarloCsvs(const std::vector<Tallies>& rows, const MonteCarloOptions& o) {
+  const NeesBand band = neesBand(o.runs);
+  std::filesystem::create_directories(o.csv_dir);
+  std::ofstream nees(o.csv_dir + "/nees.csv");
+  nees << "configuration,time_s,nees9_mean,band_low,band_high,runs\n";
+  for (const Tallies& r : rows) writeNeesCsv(nees, r.label, r.st, o.runs, band.lo, band.hi);
+  std::string written = o.csv_dir + "/nees.csv";
+  bool ok = static_cast<bool>(nees);
+  const bool faults_run =
+      std::any_of(rows.begin(), rows.end(), [](const Tallies& r) { return !r.fault_runs.empty(); });
+  if (faults_run) {
+    std::ofstream faults(o.csv_dir + "/faults.csv");
+    faults << "configuration,seed,fault_s,detected,detection_s,delay_s,onset_s,class_correct,"
+              "source_correct,ambiguous,false_alarms,recovery_s,decided,decisions\n";
+    for (const Tallies& r : rows) {
+      if (!r.fault_runs.empty()) writeFaultRunsCsv(faults, r.label, r.fault, r.fault_runs);
+    }
+    ok = ok && static_cast<bool>(faults);
+    written += ", faults.csv";
+  }
+  if (!ok) throw bus::ConfigError("cannot write the CSV files into --csv " + o.csv_dir);
+  std::printf("\nwrote %s\n", written.c_str());
+}
+
+void printRecoveryTable(const std::vector<Tallies>& rows, const MonteCarloOptions& o) {
+  std::printf(
+      "\nconvergence after each instant: median over runs of the time until the "
+      "horizontal position error stays below %.2f m for %.0f s; runs that do not converge "
+      "within the window (count in brackets) count as slowest\n",
+      o.recovery_threshold_m, o.recovery_window_s);
+  std::printf("%-34s", "configuration");
+  for (double t : o.recovery_after_s) std::printf("   after %5.1f s", t);
+  std::printf("\n");
+  for (const Tallies& r : rows) {
+    std::printf("%-34s", r.label.c_str());
+    const std::size_t m = o.recovery_after_s.size();
+    for (std::size_t j = 0; j < m; ++j) {
+      std::vector<double> v;
+      int missing = 0;
+      for (std::size_t i = j; i < r.st.recovery_s.size(); i += m) {
+        v.push_back(r.st.recovery_s[i]);
+        missing += std::isnan(r.st.recovery_s[i]) ? 1 : 0;
+      }
+      const double med = median(v);
+      if (std::isinf(med)) {
+        std::printf("   %6s%4.0f s (%d)", ">", o.recovery_window_s, missing);
+      } else {
+        std::printf("   %8.2f s (%d)", med, missing);
+      }
+    }
+    std::printf("\n");
+  }
+}
+
+/// Report: every table of the tallies, then the CSV files.
+void report(const std::vector<Tallies>& rows, const MonteCarloOptions& o) {
+  printErrorTable(rows, o);
   printBlockNees(rows, o.runs);
-  for (const Row& r : rows) {
+  for (const Tallies& r : rows) {
     if (!r.alignments.empty()) printAlignment(r.label, r.alignments);
   }
-  for (const FaultTable& t : fault_tables) printFaultTable(t.label, t.fault, t.runs, t.hours);
+  for (const Tallies& r : rows) {
+    if (!r.fault_runs.empty()) printFaultTable(r.label, r.fault, r.fault_runs, r.hours);
+  }
   std::vector<std::pair<std::string, IntegrityTally>> integrity;
-  for (const Row& r : rows) integrity.emplace_back(r.label, r.integrity);
-  printIntegrityTable(integrity);
   std::vector<std::pair<std::string, HonestyTally>> honesty;
-  for (const Row& r : rows) honesty.emplace_back(r.label, r.honesty);
+  for (const Tallies& r : rows) {
+    integrity.emplace_back(r.label, r.integrity);
+    honesty.emplace_back(r.label, r.honesty);
+  }
+  printIntegrityTable(integrity);
   printHonestyTable(honesty);
-  if (!o.csv_dir.empty()) {
-    std::filesystem::create_directories(o.csv_dir);
-    std::ofstream nees(o.csv_dir + "/nees.csv");
-    nees << "configuration,time_s,nees9_mean,band_low,band_high,runs\n";
-    for (const Row& r : rows) writeNeesCsv(nees, r.label, r.st, o.runs, lo, hi);
-    std::string written = o.csv_dir + "/nees.csv";
-    bool ok = static_cast<bool>(nees);
-    if (!fault_tables.empty()) {
-      std::ofstream faults(o.csv_dir + "/faults.csv");
-      faults << "configuration,seed,fault_s,detected,detection_s,delay_s,onset_s,class_correct,"
-                "source_correct,ambiguous,false_alarms,recovery_s,decided,decisions\n";
-      for (const FaultTable& t : fault_tables) writeFaultRunsCsv(faults, t.label, t.fault, t.runs);
-      ok = ok && static_cast<bool>(faults);
-      written += ", faults.csv";
-    }
-    if (!ok) throw bus::ConfigError("cannot write the CSV files into --csv " + o.csv_dir);
-    std::printf("\nwrote %s\n", written.c_str());
+  if (!o.csv_dir.empty()) writeMonteCarloCsvs(rows, o);
+  if (!o.recovery_after_s.empty()) printRecoveryTable(rows, o);
+}
+
+}  // namespace
+
+int runMonteCarloCommand(const MonteCarloOptions& o) {
+  const std::vector<Variant> variants = monteCarloVariants(o);
+  std::printf(
+      "Monte Carlo: scenario %s, %d runs per configuration (seeds %llu..%llu)%s\n",
+      o.scenario.c_str(), o.runs, static_cast<unsigned long long>(o.first_seed),
+      static_cast<unsigned long long>(o.first_seed + static_cast<std::uint64_t>(o.runs) - 1),
+      o.align             ? ", every filter aligned from its inputs"
+      : o.perturb_initial ? ", initial state drawn from the filter's initial sigmas (filters "
+                            "without an initial_state align)"
+                          : "");
+  std::vector<Tallies> rows;
+  for (const Variant& v : variants) {
+    const std::vector<OfflineSetup> setups = monteCarloSetups(o, v);
+    const std::vector<OfflineResult> results = runAll(setups, o.threads, v.label);
+    Tallies& row = rows.emplace_back();
+    row.label = v.label;
+    for (std::size_t i = 0; i < setups.size(); ++i)
+      row.add(o, setups[i], results[i], o.first_seed + i);
   }
-  if (!o.recovery_after_s.empty()) {
-    std::printf(
-        "\nconvergence after each instant: median over runs of the time until the "
-        "horizontal position error stays below %.2f m for %.0f s; runs that do not converge "
-        "within the window (count in brackets) count as slowest\n",
-        o.recovery_threshold_m, o.recovery_window_s);
-    std::printf("%-34s", "configuration");
-    for (double t : o.recovery_after_s) std::printf("   after %5.1f s", t);
-    std::printf("\n");
-    for (const Row& r : rows) {
-      std::printf("%-34s", r.label.c_str());
-      const std::size_t m = o.recovery_after_s.size();
-      for (std::size_t j = 0; j < m; ++j) {
-        std::vector<double> v;
-        int missing = 0;
-        for (std::size_t i = j; i < r.st.recovery_s.size(); i += m) {
-          v.push_back(r.st.recovery_s[i]);
-          missing += std::isnan(r.st.recovery_s[i]) ? 1 : 0;
-        }
-        const double med = median(v);
-        if (std::isinf(med)) {
-          std::printf("   %6s%4.0f s (%d)", ">", o.recovery_window_s, missing);
-        } else {
-          std::printf("   %8.2f s (%d)", med, missing);
-        }
-      }
-      std::printf("\n");
-    }
-  }
+  report(rows, o);
   return bus::kExitOk;
 }
 

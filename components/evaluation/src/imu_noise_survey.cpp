@@ -11,7 +11,7 @@
 #include "navbus/core/math/allan.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/records/csv_messages.hpp"
-#include "navbus/tool/topic_registry.hpp"
+#include "navbus/records/recording_layout.hpp"
 
 namespace navbus::evaluation {
 
@@ -19,8 +19,8 @@ namespace {
 
 std::vector<navbus::ImuIncrement> recordedIncrements(const std::filesystem::path& dir) {
   std::vector<navbus::ImuIncrement> out;
-  const auto blocks = dir / tool::recordFileName(bus::topic::kImuIncrementBlock);
-  const auto singles = dir / tool::recordFileName(bus::topic::kImuIncrement);
+  const auto blocks = dir / records::recordFileName(bus::topic::kImuIncrementBlock);
+  const auto singles = dir / records::recordFileName(bus::topic::kImuIncrement);
   if (std::filesystem::exists(blocks)) {
     const records::CsvTable t = records::readCsv(blocks);
     for (const auto& b :

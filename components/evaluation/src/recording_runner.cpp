@@ -23,7 +23,7 @@
 #include "navbus/records/formatters.hpp"
 #include "navbus/records/mcap.hpp"
 #include "navbus/records/mcap_samples.hpp"
-#include "navbus/tool/topic_registry.hpp"
+#include "navbus/records/recording_layout.hpp"
 
 namespace navbus::evaluation {
 
@@ -77,7 +77,7 @@ class RecordedSamples {
       messages = records::decodeChannel<PubSubType>(path_.string(), *mcap_, *channel);
       from = fmt::format("{} channel {}", path_.string(), channel->topic);
     } else {
-      const std::filesystem::path file = path_ / tool::recordFileName(topic);
+      const std::filesystem::path file = path_ / records::recordFileName(topic);
       if (!std::filesystem::exists(file)) return;
       const records::CsvTable table = records::readCsv(file);
       messages = records::parseMessages<T>(table, records::messageRowRanges(table));

@@ -11,7 +11,7 @@
 #include "navbus/importers/imu_increments.hpp"
 #include "navbus/importers/rtklib_pos.hpp"
 #include "navbus/records/formatters.hpp"
-#include "navbus/tool/topic_registry.hpp"
+#include "navbus/records/recording_layout.hpp"
 
 namespace navbus::importers {
 
@@ -20,7 +20,7 @@ namespace {
 template <class T>
 void write(const std::filesystem::path& dir, const char* topic, const std::vector<T>& messages,
            std::string& text) {
-  const std::filesystem::path path = dir / tool::recordFileName(topic);
+  const std::filesystem::path path = dir / records::recordFileName(topic);
   if (!records::writeCsvFile(path.string(), messages))
     throw bus::ConfigError(path.string() + ": cannot be written");
   text += fmt::format("wrote {} samples of {} to {}\n", messages.size(), topic, path.string());

@@ -5,6 +5,7 @@
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/dds_context.hpp"
 #include "navbus/foxglove/schemas.hpp"
+#include "navbus/records/recording_layout.hpp"
 #include "navbus/tool/foxglove_channels.hpp"
 
 namespace navbus::tool {
@@ -37,7 +38,7 @@ CsvRecordSink::CsvRecordSink(std::filesystem::path dir) : dir_(std::move(dir)) {
 }
 
 void CsvRecordSink::open(const TopicEntry& e) {
-  const std::filesystem::path path = dir_ / recordFileName(e.name);
+  const std::filesystem::path path = dir_ / records::recordFileName(e.name);
   auto file = std::make_unique<std::ofstream>(path);
   if (!*file) throw std::runtime_error("cannot write " + path.string());
   *file << e.csv_header << ",source_timestamp_ns,reception_timestamp_ns\n";
@@ -56,7 +57,8 @@ void CsvRecordSink::onSample(const std::string& topic, const SampleTimes& times,
 void CsvRecordSink::flush() {
   for (auto& [name, f] : files_) {
     f->flush();
-    if (!*f) throw std::runtime_error("cannot write " + (dir_ / recordFileName(name)).string());
+    if (!*f)
+      throw std::runtime_error("cannot write " + (dir_ / records::recordFileName(name)).string());
   }
 }
 

@@ -15,6 +15,7 @@
 #include "navbus/records/csv_messages.hpp"
 #include "navbus/records/mcap.hpp"
 #include "navbus/records/mcap_samples.hpp"
+#include "navbus/records/recording_layout.hpp"
 #include "navbus/tool/spin.hpp"
 #include "navbus/tool/topic_registry.hpp"
 
@@ -174,7 +175,8 @@ void checkReplayable(const ReplayOptions& o) {
 std::vector<std::unique_ptr<Stream>> loadCsvStreams(const ReplayOptions& o) {
   std::vector<std::unique_ptr<Stream>> streams;
   for (const auto& topic : o.topics.empty() ? replayableTopics() : o.topics) {
-    const std::filesystem::path file = std::filesystem::path(o.recording) / recordFileName(topic);
+    const std::filesystem::path file =
+        std::filesystem::path(o.recording) / records::recordFileName(topic);
     if (!std::filesystem::exists(file)) {
       if (!o.topics.empty()) throw bus::ConfigError(file.string() + ": no such file");
       continue;

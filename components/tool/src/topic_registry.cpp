@@ -98,14 +98,6 @@ TopicSchema topicSchema(const TopicEntry& e, bool ros2) {
   return t;
 }
 
-std::string recordFileName(const std::string& topic) {
-  std::string file = topic;
-  for (char& c : file) {
-    if (c == '/') c = '_';
-  }
-  return file + ".csv";
-}
-
 const TopicEntry* findTopic(const std::string& name) {
   for (const auto& e : topicRegistry()) {
     if (e.name == name) return &e;

@@ -39,7 +39,7 @@ class RecordSink : public SampleSink {
   std::optional<std::chrono::steady_clock::time_point> last_sample_;
 };
 
-/// One CSV file per topic in a directory (recordFileName()).
+/// One CSV file per topic in a directory (records::recordFileName()).
 class CsvRecordSink final : public RecordSink {
  public:
   explicit CsvRecordSink(std::filesystem::path dir);

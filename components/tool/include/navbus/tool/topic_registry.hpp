@@ -71,7 +71,4 @@ struct TopicSchema {
 /// Throws bus::ConfigError if the type has no schema.
 TopicSchema topicSchema(const TopicEntry& entry, bool ros2);
 
-/// The file `navbus record` writes a topic to (and `navbus replay` reads): "/" as "_", ".csv".
-std::string recordFileName(const std::string& topic);
-
 }  // namespace navbus::tool
