@@ -165,6 +165,16 @@ if glr:
     row("GLR per epoch, 12 satellites, M = 20", f"{float(glr.group(3)):.1f} us",
         f"{float(glr.group(3)) / float(glr.group(2)):.2f} x the TC update; target <= 50 us",
         "met" if float(glr.group(3)) <= 50 else "NOT met")
+arm = re.search(r"seed 001 LEO: 12 sats, arm\s+12.0\s+20\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)",
+                open(f"{d}/glr.txt").read())
+if arm:
+    ratio = float(arm.group(3)) / float(arm.group(2))
+    row("GLR per epoch with a lever arm, 12 satellites, M = 20", f"{float(arm.group(3)):.1f} us",
+        f"{ratio:.2f} x the TC update; target <= 1x", "met" if ratio <= 1.0 else "NOT met")
+parity = re.search(r"two per IMU epoch \(gyros, accelerometers\): ([0-9.]+) us", open(f"{d}/glr.txt").read())
+if parity:
+    row("parity detector, 3 triads, per IMU epoch", f"{parity.group(1)} us", "target <= 5 us",
+        "met" if float(parity.group(1)) <= 5 else "NOT met")
 dither = re.search(r"monitor\s+([0-9.]+) s\s+=\s+([0-9.]+) % of one core", open(f"{d}/dither.txt").read())
 if dither:
     row("dither monitor, share of one core", f"{dither.group(2)} %", "target < 1 %",

@@ -35,9 +35,21 @@ const int kSvIds[kSats] = {3, 6, 9, 13};
 
 /// A linear system with the filter's state layout: random but fixed Phi (biases and clock as random
 /// constants / random walk), pseudorange-like and rate-like rows, a Kalman filter's gains.
+/// Variations of the loop that change which states the signatures reach.
+struct LoopShape {
+  /// Pseudorange rows see the attitude (an antenna's lever arm) and their satellite's
+  /// pseudorange-error state, a consider state (propagated, never corrected: K's row is 0).
+  bool lever_arm{false};
+  /// From this epoch on the velocity is driven by the accelerometer's scale factor, the first
+  /// pseudorange-error state by the clock and the second by the first: states the signatures
+  /// had not reached, the first two through the gains, the third (a consider state driven by a
+  /// consider state) through Phi only; -1: never.
+  int couple_scale_from{-1};
+};
+
 class ClosedLoop {
  public:
-  explicit ClosedLoop(std::uint64_t seed) : rng_(seed) {
+  explicit ClosedLoop(std::uint64_t seed, LoopShape shape = {}) : rng_(seed), shape_(shape) {
     std::normal_distribution<double> n(0.0, 1.0);
     phi_ = StateMatrix::Identity();
     // Position <- velocity, velocity <- attitude and accelerometer bias, attitude <- gyro
@@ -65,10 +77,19 @@ class ClosedLoop {
 
   /// One epoch: propagate the covariance, compute H, V, K for this epoch.
   void nextEpoch() {
+    if (epoch_++ == shape_.couple_scale_from) {
+      for (int i = 0; i < 3; ++i) phi_(3 + i, nc::layout::kAccelScale.index + i) = 0.5;
+      phi_(nc::layout::kPseudorangeError.index, kClock) = 0.1;
+      phi_(nc::layout::kPseudorangeError.index + 1, nc::layout::kPseudorangeError.index) = 0.5;
+    }
     p_ = phi_ * p_ * phi_.transpose() + q_;
     h_.setZero(kRows, nc::layout::kSize);
     for (int s = 0; s < kSats; ++s) {
       h_.block<1, 3>(2 * s, 0) = -los_[s].transpose();
+      if (shape_.lever_arm) {
+        h_.block<1, 3>(2 * s, 6) = 0.8 * los_[s].cross(Eigen::Vector3d::UnitZ());
+        h_(2 * s, nc::layout::kPseudorangeError.index + s) = 1.0;
+      }
       h_(2 * s, kClock) = 1.0;
       h_.block<1, 3>(2 * s + 1, 3) = -los_[s].transpose();
       h_(2 * s + 1, kDrift) = 1.0;
@@ -77,6 +98,7 @@ class ClosedLoop {
     for (int s = 0; s < kSats; ++s) r_(2 * s + 1, 2 * s + 1) = 0.01;
     v_ = h_ * p_ * h_.transpose() + r_;
     k_ = p_ * h_.transpose() * v_.inverse();
+    if (shape_.lever_arm) k_.middleRows<kSats>(nc::layout::kPseudorangeError.index).setZero();
     const StateMatrix a = StateMatrix::Identity() - k_ * h_;
     p_ = a * p_ * a.transpose() + k_ * r_ * k_.transpose();
     // Slowly rotating geometry, so that the gains change from epoch to epoch.
@@ -93,6 +115,8 @@ class ClosedLoop {
 
  private:
   std::mt19937_64 rng_;
+  LoopShape shape_;
+  int epoch_{0};
   StateMatrix phi_, q_, p_;
   Eigen::MatrixXd h_, k_, v_, r_;
   Eigen::Vector3d los_[kSats];
@@ -126,8 +150,9 @@ int rowOf(const GlrHypothesis& h) {
 /// Simulates `epochs` epochs of the closed loop: truth error dx (estimate minus truth),
 /// innovations eps = H dx + v - (measurement fault), correction dx -= K eps. With `noise` false
 /// the run is the deterministic response to the fault alone: its innovations are the signature.
-LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& faults, bool noise) {
-  ClosedLoop loop(seed);
+LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& faults, bool noise,
+                 LoopShape shape = {}) {
+  ClosedLoop loop(seed, shape);
   std::mt19937_64 rng(seed * 7 + 1);
   std::normal_distribution<double> n(0.0, noise ? 1.0 : 0.0);
   StateVector dx = StateVector::Zero();
@@ -180,8 +205,9 @@ LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& fault
 /// Brute force: f and R of one direction for onset `onset` at epoch `k`, from the explicit
 /// signature (noise-free faulty run with unit magnitude).
 nc::GlrMonitor::DirectionSums bruteForce(std::uint64_t seed, const LoopRun& data,
-                                         const GlrHypothesis& h, int onset, int k) {
-  const LoopRun sig = simulate(seed, k + 1, {{h, onset, 1.0}}, false);
+                                         const GlrHypothesis& h, int onset, int k,
+                                         LoopShape shape = {}) {
+  const LoopRun sig = simulate(seed, k + 1, {{h, onset, 1.0}}, false, shape);
   nc::GlrMonitor::DirectionSums out;
   for (int i = onset; i <= k; ++i) {
     const Eigen::MatrixXd v_inv = data.epochs[static_cast<std::size_t>(i)].innovation_cov.inverse();
@@ -232,6 +258,46 @@ TEST(Glr, SignatureSumsEqualTheExplicitRegression) {
           << nc::glrFaultName(h.fault) << " axis " << h.axis << " sv " << h.sv_id << " age " << age;
       EXPECT_NEAR(got.f, want.f, 1e-7 * std::max(1.0, std::abs(want.f)))
           << nc::glrFaultName(h.fault) << " axis " << h.axis << " sv " << h.sv_id << " age " << age;
+    }
+  }
+}
+
+TEST(Glr, SignatureSumsHoldWhenTheLoopReachesANewStateAndTheAttitude) {
+  // Given a loop whose pseudoranges see the attitude (a lever arm) and whose velocity starts,
+  // at epoch 18, to be driven by the accelerometer's scale factor (a state no signature had
+  // reached: the monitor keeps only the states reached so far), when the monitor processes it
+  // with and without the IMU directions (without them, only the measurement inputs reach the
+  // states at first), then f and R still equal the brute-force regression for every direction
+  // and onset.
+  const std::uint64_t seed = 23;
+  const LoopShape shape{true, 18};
+  const std::vector<Fault> faults = {{{GlrFault::kAccelStep, 1, 0}, 14, 0.05},
+                                     {{GlrFault::kRangeStep, 0, 6}, 20, 3.0}};
+  const LoopRun run = simulate(seed, 30, faults, true, shape);
+  for (const bool imu_steps : {true, false}) {
+    nc::GlrConfig cfg;
+    cfg.window = 10;
+    cfg.imu_steps = imu_steps;
+    nc::GlrMonitor glr(cfg);
+    for (const auto& e : run.epochs) ASSERT_TRUE(glr.update(e).valid);
+    const int k = 29;
+    const GlrHypothesis hyps[] = {{GlrFault::kAccelStep, 1, 0},
+                                  {GlrFault::kGyroStep, 2, 0},
+                                  {GlrFault::kRangeStep, 0, 6},
+                                  {GlrFault::kRangeRamp, 0, 13},
+                                  {GlrFault::kRateStep, 0, 3}};
+    for (int age = 0; age < glr.onsetCount(); ++age) {
+      for (const auto& h : hyps) {
+        if (h.isImu() && !imu_steps) continue;
+        const auto got = glr.directionSums(age, h);
+        const auto want = bruteForce(seed, run, h, k - age, k, shape);
+        EXPECT_NEAR(got.r, want.r, 1e-7 * std::max(1.0, std::abs(want.r)))
+            << nc::glrFaultName(h.fault) << " axis " << h.axis << " sv " << h.sv_id << " age "
+            << age;
+        EXPECT_NEAR(got.f, want.f, 1e-7 * std::max(1.0, std::abs(want.f)))
+            << nc::glrFaultName(h.fault) << " axis " << h.axis << " sv " << h.sv_id << " age "
+            << age;
+      }
     }
   }
 }

@@ -1,0 +1,185 @@
+// The GLR's window of signature sums (seed 000 eqs. 9-10): for every hypothesised onset theta in
+// a sliding window of M measurement epochs, the signature of every direction (an IMU bias step,
+// a satellite's pseudorange step, ramp and rate step) through navbus's closed-loop filter, and
+// the sums f (eq. 9) and R (eq. 10) of the regression of the innovations on them. The
+// recursions are derived in doc/glr_closed_loop.md; the statistics and decisions built on the
+// sums are in glr_group_fit.hpp, glr_isolation.hpp and glr.hpp.
+//
+// Fixed-capacity storage, allocated once in configure(): update() allocates nothing (but the
+// first update of a copy, which sizes its working buffers: math/scratch.hpp).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "navbus/core/integrity/glr_types.hpp"
+#include "navbus/core/math/scratch.hpp"
+
+namespace navbus::core {
+
+class GlrWindow {
+ public:
+  /// f (eq. 9) and R (eq. 10) of one onset, read from the per-onset columns.
+  struct OnsetView {
+    std::int64_t ramp_start_ns;  ///< epoch theta - 1: the fault began after it
+    Eigen::Map<const Eigen::Matrix<double, glr::kMaxDirections, 1>> f;
+    Eigen::Map<const Eigen::Matrix<double, glr::kImuDirections, glr::kImuDirections>> r_imu;
+    const double* r_sat;
+    Eigen::Map<const Eigen::Matrix3d> rSat(int slot) const {
+      return Eigen::Map<const Eigen::Matrix3d>(r_sat +
+                                               glr::kSatDirections * glr::kSatDirections * slot);
+    }
+  };
+  /// A satellite's place in f, R and the signatures.
+  struct Slot {
+    int sv_id{0};
+    std::uint64_t last_seen{0};
+    int range_row{-1}, rate_row{-1};            ///< rows this epoch, -1 if absent
+    int prev_range_row{-1}, prev_rate_row{-1};  ///< rows at the previous epoch
+    bool quarantined{false};
+  };
+  /// What a fault of unit magnitude along one direction, begun at one onset in the window,
+  /// does to the position after the latest epoch's update, with what the test knows of it.
+  struct PositionSignature {
+    GlrHypothesis hypothesis;
+    int onset_age{0};
+    /// mu+ = mu - K rho (doc eqs. C1, C3) on the position error states [m per unit of the
+    /// fault's magnitude, N E D]
+    Eigen::Vector3d position_ned{Eigen::Vector3d::Zero()};
+    /// R* = T^T R T (eqs. 10, 14): under this fault of magnitude nu, 2 l of its group is
+    /// noncentral chi-square with noncentrality nu^2 R*.
+    double information{0.0};
+  };
+
+  /// Sizes the window (config.window onsets, clamped to 1..kMaxWindow) and forgets everything.
+  void configure(const GlrConfig& config);
+  /// Forgets every onset and the previous epoch; quarantines stay.
+  void reset();
+  /// Whether the epoch can be processed: sizes, satellites 1..32, H on the support, finite
+  /// values, and a time after the previous epoch's.
+  bool accepts(const GlrEpoch& e) const;
+  /// Processes an epoch that accepts() took: propagates every signature, starts the onset at
+  /// this epoch and adds this epoch's terms to f and R. Returns false (nothing changed) when
+  /// the innovation covariance is not positive definite.
+  bool update(const GlrEpoch& e);
+
+  int window() const { return config_.window; }
+  /// Onsets currently in the window (age 0 = the latest epoch, count - 1 = the oldest).
+  int onsetCount() const { return onset_count_; }
+  OnsetView onset(int age) const;
+  int slotsUsed() const { return slots_used_; }
+  const Slot& slot(int s) const { return slots_[static_cast<std::size_t>(s)]; }
+  /// The slot of a satellite, -1 if it has none.
+  int slotOf(int sv_id) const;
+
+  /// A quarantined satellite keeps its slot (its sums go on) across resets.
+  void setQuarantined(int sv_id, bool quarantined);
+  bool quarantined(int sv_id) const;
+
+  /// Every enabled direction at every onset, after update(); `out` is cleared and refilled
+  /// (no allocation once its capacity suffices: kMaxDirections * window). Quarantined
+  /// satellites are left out (they cannot raise a detection).
+  void positionSignatures(std::vector<PositionSignature>& out) const;
+
+ private:
+  /// The times of an onset; its signatures and sums live in mu_, f_, r_imu_ and r_sat_.
+  struct Onset {
+    std::int64_t time_ns{0};        ///< epoch theta
+    std::int64_t ramp_start_ns{0};  ///< epoch theta - 1: where the hypothesised ramp is 0
+  };
+  /// Per-onset values of one quantity, indexed by ring position (not age).
+  using OnsetArray = Eigen::Array<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, glr::kMaxWindow>;
+  /// A block of mu_ / z_: one signature column c for every ring position.
+  int firstColumn(int c) const { return c * config_.window; }
+  int onsetIndex(int age) const;
+  int propagatedColumns() const { return glr::kImuDirections + 2 * slots_used_; }
+
+  void assignSlots(const GlrEpoch& e);
+  void claimSlot(int slot, int sv_id);
+  void prepareEpoch(const GlrEpoch& e);
+  /// Adds to the live rows every state this epoch's recursion can make nonzero (see live_).
+  void growLive(const GlrEpoch& e);
+  void addLive(int state);
+  void propagate();
+  /// - G D for one signature column c (every onset): the input entered `row` last epoch.
+  void subtractInput(int column, int row);
+  void startOnset(const GlrEpoch& e);
+  /// H, V^-1 H, S and a on this epoch's support: the live states H measures.
+  void prepareSupport(const GlrEpoch& e);
+  /// Puts the live states `first[0..count)` in the leading rows of mu, the others after them.
+  void reorderLive(const std::array<int, glr::kStates>& first, int count);
+  double vInv(int i, int j) const;  ///< (V^-1)_ij of this epoch, from l_inv_
+  void accumulate();
+  void accumulateImu();
+  template <int N>  ///< N: the support's size, or Eigen::Dynamic
+  void accumulateSatellite(int slot);
+  /// Sizes the working buffers for the configured window (a no-op once sized).
+  void sizeWorkingBuffers();
+
+  GlrConfig config_;
+  std::uint64_t epochs_{0};    ///< epochs processed (a slot's age is counted in them)
+  std::vector<Onset> onsets_;  ///< ring buffer, capacity window
+  int onset_head_{0};          ///< index of the oldest onset
+  int onset_count_{0};
+  std::array<Slot, glr::kMaxSatellites> slots_{};
+  int slots_used_{0};
+  std::array<int, 33> slot_of_sv_{};  ///< PRN 1..32 -> slot + 1 (0: none)
+
+  // Signatures of every onset in one matrix, so that one product propagates them all: column
+  // c (an IMU step or a satellite's range or rate step, see muColumn) of the onset at ring
+  // position i is column c * window + i. Sized once in configure(); the product goes into the
+  // working buffer mu_next_, then the two are swapped. Only the live rows are kept (row r is
+  // state live_[r]): a state that no signature has reached is zero in every column, and stays
+  // so as long as B, G and the IMU inputs do not reach it from a live one (growLive checks it
+  // every epoch), so the recursion runs on the live states only (the active ones of the filter
+  // watched: 17 of 38 for seed 001 tightly coupled).
+  using SignatureMatrix = Eigen::Matrix<double, glr::kStates, Eigen::Dynamic>;
+  SignatureMatrix mu_;
+  std::array<int, glr::kStates> live_{};    ///< state of each live row
+  std::array<int, glr::kStates> row_of_{};  ///< live row of each state, -1 if not live
+  int live_count_{0};
+  /// This epoch's support (the live states H measures): the leading support_count_ live rows.
+  int support_count_{0};
+  /// Working buffers, overwritten by every update before they are read (not in copies:
+  /// scratch.hpp): the next mu_ and S times mu_'s support rows (z_), same column order.
+  Scratch<SignatureMatrix> mu_next_;
+  Scratch<Eigen::Matrix<double, glr::kSupport, Eigen::Dynamic>> z_;
+  OnsetArray spacing_s_;  ///< t_theta - t_{theta-1} of each ring position [s]
+  // Sums of eqs. 9-10, one column per ring position: f per direction, the IMU group's R (6 x 6,
+  // column-major) and each satellite slot's R (3 x 3, column-major, slot after slot).
+  Eigen::Matrix<double, glr::kMaxDirections, Eigen::Dynamic> f_;
+  Eigen::Matrix<double, glr::kImuDirections * glr::kImuDirections, Eigen::Dynamic> r_imu_;
+  Eigen::Matrix<double, glr::kSatDirections * glr::kSatDirections * glr::kMaxSatellites,
+                Eigen::Dynamic>
+      r_sat_;
+
+  // Per-epoch quantities (current epoch k) and what the recursion keeps of epoch k-1.
+  bool have_previous_{false};
+  std::int64_t time_ns_{0}, prev_time_ns_{0};
+  Eigen::LLT<glr::RowMatrix> llt_;  ///< Cholesky factor of this epoch's V
+  glr::KMatrix prev_k_;
+  glr::RowMatrix l_inv_;  ///< L^-1 of this epoch's V = L L^T (lower triangular)
+  glr::RowVector w_;      ///< V^-1 eps
+  using SupportVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, glr::kSupport, 1>;
+  using SupportMatrix =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kSupport, glr::kSupport>;
+  using HSupport =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kMaxRows, glr::kSupport>;
+  HSupport h_support_, u_;  ///< H and V^-1 H on this epoch's support (live row order)
+  /// The previous epoch's H on the fixed support (kSupportHead, then kSupportTail)
+  Eigen::Matrix<double, Eigen::Dynamic, glr::kSupport, 0, glr::kMaxRows, glr::kSupport>
+      prev_h_fixed_;
+  SupportMatrix s_;  ///< H^T V^-1 H on the support
+  SupportVector a_;  ///< H^T V^-1 eps on the support
+  StateMatrix b_;    ///< Phi_k (I - K_{k-1} H_{k-1})
+  glr::KMatrix g_;   ///< Phi_k K_{k-1}
+  /// B on the live states (the propagation's matrix) and a G column on them
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kStates, glr::kStates> b_live_;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, glr::kStates, 1> g_live_;
+};
+
+}  // namespace navbus::core

@@ -1,0 +1,522 @@
+#include "navbus/core/integrity/glr_window.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace navbus::core {
+
+using namespace glr;
+
+namespace {
+
+/// D of a measurement step per unit magnitude: innovations are predicted minus measured, so a
+/// measurement reading long by nu lowers them (doc: inputs table).
+constexpr double kStepInput = -1.0;
+
+/// Column of a slot's propagated signature in mu: the pseudorange step and the rate step. A
+/// ramp is not propagated: it is the sum of steps begun at each later epoch, weighted by the
+/// epoch spacing (doc: ramps), formed from the step columns of the newer onsets.
+constexpr int muColumn(int slot, int direction) {
+  return kImuDirections + 2 * slot + (direction == kRateStep ? 1 : 0);
+}
+
+/// The bias state a column-j IMU direction steps: accelerometer x y z, gyro x y z.
+constexpr int imuState(int j) {
+  return j < 3 ? layout::kAccelBias.index + j : layout::kGyroBias.index + (j - 3);
+}
+
+}  // namespace
+
+void GlrWindow::configure(const GlrConfig& config) {
+  config_ = config;
+  config_.window = std::clamp(config.window, 1, kMaxWindow);
+  onsets_.assign(static_cast<std::size_t>(config_.window), Onset{});
+  f_.resize(kMaxDirections, config_.window);
+  r_imu_.resize(kImuDirections * kImuDirections, config_.window);
+  r_sat_.resize(kSatDirections * kSatDirections * kMaxSatellites, config_.window);
+  const int columns = kMaxPropagated * config_.window;
+  mu_.resize(kStates, columns);
+  sizeWorkingBuffers();
+  spacing_s_.resize(config_.window);
+  reset();
+}
+
+void GlrWindow::sizeWorkingBuffers() {
+  const int columns = kMaxPropagated * config_.window;
+  if (mu_next_->cols() != columns) mu_next_->resize(kStates, columns);
+  if (z_->cols() != columns) z_->resize(kSupport, columns);
+}
+
+void GlrWindow::reset() {
+  onset_head_ = 0;
+  onset_count_ = 0;
+  have_previous_ = false;
+  // Quarantine is a decision of the fault manager: it survives a reset of the statistics.
+  std::array<int, 33> quarantined{};
+  for (int s = 0; s < slots_used_; ++s) {
+    const Slot& slot = slots_[static_cast<std::size_t>(s)];
+    if (slot.quarantined) quarantined[static_cast<std::size_t>(slot.sv_id)] = 1;
+  }
+  slots_ = {};
+  slots_used_ = 0;
+  slot_of_sv_ = {};
+  mu_.setZero();
+  live_count_ = 0;
+  row_of_.fill(-1);
+  support_count_ = 0;
+  spacing_s_.setZero();
+  for (int sv = 1; sv <= 32; ++sv) {
+    if (quarantined[static_cast<std::size_t>(sv)]) setQuarantined(sv, true);
+  }
+}
+
+void GlrWindow::claimSlot(int slot, int sv_id) {
+  slots_[static_cast<std::size_t>(slot)] = Slot{};
+  slots_[static_cast<std::size_t>(slot)].sv_id = sv_id;
+  slots_[static_cast<std::size_t>(slot)].last_seen = epochs_;
+  slot_of_sv_[static_cast<std::size_t>(sv_id)] = slot + 1;
+  // A new satellite has no signature yet at any onset (its two propagated columns are
+  // adjacent, so their blocks are too).
+  mu_.middleCols(firstColumn(muColumn(slot, 0)), 2 * config_.window).setZero();
+  f_.middleRows<kSatDirections>(satColumn(slot, 0)).setZero();
+  r_sat_.middleRows<kSatDirections * kSatDirections>(kSatDirections * kSatDirections * slot)
+      .setZero();
+}
+
+void GlrWindow::setQuarantined(int sv_id, bool quarantined) {
+  if (sv_id < 1 || sv_id > 32) return;
+  int slot = slot_of_sv_[static_cast<std::size_t>(sv_id)] - 1;
+  if (slot < 0) {
+    if (!quarantined || slots_used_ >= kMaxSatellites) return;
+    slot = slots_used_++;
+    claimSlot(slot, sv_id);
+  }
+  slots_[static_cast<std::size_t>(slot)].quarantined = quarantined;
+}
+
+bool GlrWindow::quarantined(int sv_id) const {
+  if (sv_id < 1 || sv_id > 32) return false;
+  const int slot = slot_of_sv_[static_cast<std::size_t>(sv_id)] - 1;
+  return slot >= 0 && slots_[static_cast<std::size_t>(slot)].quarantined;
+}
+
+bool GlrWindow::accepts(const GlrEpoch& e) const {
+  if (e.rows < 1 || e.rows > kMaxRows || e.innovation.size() != e.rows ||
+      e.innovation_cov.rows() != e.rows || e.innovation_cov.cols() != e.rows ||
+      e.h.rows() != e.rows || e.k.cols() != e.rows)
+    return false;
+  for (int r = 0; r < e.rows; ++r) {
+    const int sv = e.sv_id[static_cast<std::size_t>(r)];
+    if (sv < 1 || sv > 32) return false;
+  }
+  // H must stay on the support (the pseudorange and rate model of the layout).
+  if (!e.h.middleCols<kSupportTail.index - kSupportHead.end()>(kSupportHead.end()).isZero(0.0))
+    return false;
+  return e.innovation.allFinite() && e.innovation_cov.allFinite() && e.h.allFinite() &&
+         e.k.allFinite() && e.phi.allFinite() && (!have_previous_ || e.time_ns > time_ns_);
+}
+
+bool GlrWindow::update(const GlrEpoch& e) {
+  sizeWorkingBuffers();
+  llt_.compute(e.innovation_cov);  // used again for V^-1 in prepareEpoch
+  if (llt_.info() != Eigen::Success) return false;
+  ++epochs_;
+  assignSlots(e);
+  const bool had_previous = have_previous_;
+  prepareEpoch(e);
+  if (had_previous) {
+    growLive(e);
+    propagate();
+    startOnset(e);
+  }
+  prepareSupport(e);
+  accumulate();
+  prev_h_fixed_.resize(e.rows, kSupport);
+  prev_h_fixed_.leftCols<kSupportHead.dof>() = e.h.middleCols<kSupportHead.dof>(kSupportHead.index);
+  prev_h_fixed_.rightCols<kSupportTail.dof>() =
+      e.h.middleCols<kSupportTail.dof>(kSupportTail.index);
+  prev_k_ = e.k;
+  have_previous_ = true;
+  return true;
+}
+
+int GlrWindow::slotOf(int sv_id) const {
+  if (sv_id < 1 || sv_id > 32) return -1;
+  return slot_of_sv_[static_cast<std::size_t>(sv_id)] - 1;
+}
+
+void GlrWindow::assignSlots(const GlrEpoch& e) {
+  for (int s = 0; s < slots_used_; ++s) {
+    Slot& slot = slots_[static_cast<std::size_t>(s)];
+    slot.prev_range_row = slot.range_row;
+    slot.prev_rate_row = slot.rate_row;
+    slot.range_row = slot.rate_row = -1;
+  }
+  for (int r = 0; r < e.rows; ++r) {
+    const int sv = e.sv_id[static_cast<std::size_t>(r)];
+    int slot = slot_of_sv_[static_cast<std::size_t>(sv)] - 1;
+    if (slot < 0) {
+      // A slot whose satellite has not been seen for a whole window carries no signature
+      // any more (every onset that saw it has left the window): reuse it.
+      for (int s = 0; s < slots_used_ && slot < 0; ++s) {
+        const Slot& old = slots_[static_cast<std::size_t>(s)];
+        if (!old.quarantined &&
+            epochs_ - old.last_seen > static_cast<std::uint64_t>(config_.window))
+          slot = s;
+      }
+      if (slot < 0) {
+        if (slots_used_ >= kMaxSatellites) continue;  // cannot happen with <= 24 per epoch
+        slot = slots_used_++;
+      } else {
+        slot_of_sv_[static_cast<std::size_t>(slots_[static_cast<std::size_t>(slot)].sv_id)] = 0;
+      }
+      claimSlot(slot, sv);
+    }
+    Slot& s = slots_[static_cast<std::size_t>(slot)];
+    s.last_seen = epochs_;
+    (e.is_rate[static_cast<std::size_t>(r)] ? s.rate_row : s.range_row) = r;
+  }
+}
+
+void GlrWindow::prepareEpoch(const GlrEpoch& e) {
+  const int m = e.rows;
+  if (have_previous_) {
+    // Closed-loop transition from the previous epoch's prior to this one's (doc eq. C3).
+    g_.resize(kStates, prev_k_.cols());
+    g_.noalias() = e.phi * prev_k_;
+    // H is zero outside the support (validate), so G H only touches the support's columns.
+    b_ = e.phi;
+    b_.middleCols<kSupportHead.dof>(kSupportHead.index).noalias() -=
+        g_ * prev_h_fixed_.leftCols<kSupportHead.dof>();
+    b_.middleCols<kSupportTail.dof>(kSupportTail.index).noalias() -=
+        g_ * prev_h_fixed_.rightCols<kSupportTail.dof>();
+  }
+  prev_time_ns_ = time_ns_;
+  time_ns_ = e.time_ns;
+  // V = L L^T: V^-1 eps and V^-1 H by two triangular solves; the few entries of V^-1 the
+  // direct inputs need (vInv) from the columns of L^-1.
+  l_inv_.setIdentity(m, m);
+  llt_.matrixL().solveInPlace(l_inv_);
+  w_ = llt_.solve(e.innovation);
+}
+
+void GlrWindow::addLive(int state) {
+  if (row_of_[static_cast<std::size_t>(state)] >= 0) return;
+  row_of_[static_cast<std::size_t>(state)] = live_count_;
+  live_[static_cast<std::size_t>(live_count_)] = state;
+  mu_.row(live_count_++).setZero();  // no signature has reached it (the row may be stale)
+}
+
+void GlrWindow::growLive(const GlrEpoch& e) {
+  // What the recursion below can make nonzero: B's rows that read a live state, G's rows (the
+  // measurement inputs, doc eq. C3) and the IMU steps' inputs Phi(:, bias) (doc eq. C4). A row
+  // added now is zero, so its own column of B does not matter this epoch.
+  const int live_before = live_count_;
+  for (int i = 0; i < kStates; ++i) {
+    if (row_of_[static_cast<std::size_t>(i)] >= 0) continue;
+    bool reached = !g_.row(i).isZero(0.0);
+    for (int r = 0; r < live_before && !reached; ++r)
+      reached = b_(i, live_[static_cast<std::size_t>(r)]) != 0.0;
+    for (int j = 0; j < kImuDirections && !reached && config_.imu_steps; ++j)
+      reached = e.phi(i, imuState(j)) != 0.0;
+    if (reached) addLive(i);
+  }
+}
+
+void GlrWindow::reorderLive(const std::array<int, kStates>& first, int count) {
+  // The new order: `first`, then the other live states as they were; mu's rows follow (through
+  // the working buffer). Runs when the support changes, not every epoch.
+  std::array<int, kStates> order = first;
+  int n = count;
+  for (int r = 0; r < live_count_; ++r) {
+    const int state = live_[static_cast<std::size_t>(r)];
+    if (std::find(first.begin(), first.begin() + count, state) == first.begin() + count)
+      order[static_cast<std::size_t>(n++)] = state;
+  }
+  const int columns = static_cast<int>(mu_.cols());
+  for (int r = 0; r < n; ++r) {
+    const int state = order[static_cast<std::size_t>(r)];
+    mu_next_->row(r) = mu_.row(row_of_[static_cast<std::size_t>(state)]).head(columns);
+  }
+  mu_.swap(*mu_next_);
+  for (int r = 0; r < n; ++r) {
+    live_[static_cast<std::size_t>(r)] = order[static_cast<std::size_t>(r)];
+    row_of_[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])] = r;
+  }
+}
+
+double GlrWindow::vInv(int i, int j) const {
+  // (V^-1)_ij = sum_k (L^-1)_ki (L^-1)_kj, over the rows where both columns can be nonzero.
+  const int first = std::max(i, j);
+  const int n = static_cast<int>(l_inv_.rows()) - first;
+  return l_inv_.col(i).tail(n).dot(l_inv_.col(j).tail(n));
+}
+
+void GlrWindow::propagate() {
+  // mu_k = Phi_k (mu_{k-1} - K_{k-1} rho_{k-1}) = B mu_{k-1} - G D_{k-1}  (doc eq. C3), for
+  // every onset and column in one product, on the live rows. (Splitting off B's identity on
+  // the random-constant biases saves a quarter of the multiplications and costs more than that
+  // in a second product and pass on this size, measured.)
+  const int n = live_count_;
+  b_live_.resize(n, n);
+  for (int c = 0; c < n; ++c) {
+    for (int r = 0; r < n; ++r)
+      b_live_(r, c) = b_(live_[static_cast<std::size_t>(r)], live_[static_cast<std::size_t>(c)]);
+  }
+  const int columns = propagatedColumns() * config_.window;
+  mu_next_->topLeftCorner(n, columns).noalias() = b_live_ * mu_.topLeftCorner(n, columns);
+  mu_.swap(*mu_next_);
+  const bool range = config_.range_steps || config_.range_ramps;
+  for (int s = 0; s < slots_used_; ++s) {
+    const Slot& slot = slots_[static_cast<std::size_t>(s)];
+    if (slot.prev_range_row >= 0 && range)
+      subtractInput(muColumn(s, kRangeStep), slot.prev_range_row);
+    if (slot.prev_rate_row >= 0 && config_.rate_steps)
+      subtractInput(muColumn(s, kRateStep), slot.prev_rate_row);
+  }
+}
+
+void GlrWindow::subtractInput(int column, int row) {
+  // - G D: the direct input d = kStepInput entered row `row` of the previous epoch.
+  const int n = live_count_;
+  g_live_.resize(n);
+  for (int r = 0; r < n; ++r) g_live_[r] = g_(live_[static_cast<std::size_t>(r)], row);
+  mu_.block(0, firstColumn(column), n, config_.window).colwise() -= g_live_ * kStepInput;
+}
+
+void GlrWindow::startOnset(const GlrEpoch& e) {
+  if (onset_count_ == config_.window) {
+    onset_head_ = (onset_head_ + 1) % config_.window;  // the oldest onset leaves the window
+    --onset_count_;
+  }
+  const int ring = (onset_head_ + onset_count_) % config_.window;
+  Onset& o = onsets_[static_cast<std::size_t>(ring)];
+  ++onset_count_;
+  f_.col(ring).setZero();
+  r_imu_.col(ring).setZero();
+  r_sat_.col(ring).setZero();
+  o.time_ns = e.time_ns;
+  o.ramp_start_ns = prev_time_ns_;
+  spacing_s_[ring] = 1e-9 * static_cast<double>(o.time_ns - o.ramp_start_ns);
+  for (int c = 0; c < propagatedColumns(); ++c)
+    mu_.col(firstColumn(c) + ring).head(live_count_).setZero();
+  if (config_.imu_steps) {
+    // A bias step at the start of the interval: the bias error (estimate minus truth) drops by
+    // the step, and Phi_k carries it to this epoch (doc eq. C4); growLive made its rows live.
+    for (int j = 0; j < kImuDirections; ++j) {
+      for (int r = 0; r < live_count_; ++r)
+        mu_(r, firstColumn(j) + ring) = -e.phi(live_[static_cast<std::size_t>(r)], imuState(j));
+    }
+  }
+}
+
+void GlrWindow::prepareSupport(const GlrEpoch& e) {
+  // The statistics see the state only through H: everything below lives on H's support, the
+  // live states with a nonzero column in H (position, velocity, the clock, and attitude only
+  // with a lever arm), which makes S mu an 8 x 8 product instead of n x n. The support is kept
+  // as the leading live rows, so that mu's first rows are what f and R read.
+  const int m = e.rows;
+  std::array<int, kStates> order{};
+  int count = 0;
+  for (int i = 0; i < kStates; ++i) {
+    if (row_of_[static_cast<std::size_t>(i)] >= 0 && !e.h.col(i).isZero(0.0))
+      order[static_cast<std::size_t>(count++)] = i;
+  }
+  bool leading = true;
+  for (int k = 0; k < count && leading; ++k)
+    leading = row_of_[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] < count;
+  if (!leading || count != support_count_) reorderLive(order, count);
+  support_count_ = count;
+  h_support_.resize(m, count);
+  for (int c = 0; c < count; ++c) h_support_.col(c) = e.h.col(live_[static_cast<std::size_t>(c)]);
+  u_.resize(m, count);
+  u_ = llt_.solve(h_support_);
+  s_.resize(count, count);
+  s_.noalias() = h_support_.transpose() * u_;
+  a_.resize(count);
+  a_.noalias() = h_support_.transpose() * w_;
+}
+
+void GlrWindow::accumulate() {
+  // rho_c = H mu_c + d_c e_{row_c}; f_c += rho_c^T V^-1 eps; R_cd += rho_c^T V^-1 rho_d
+  // (eqs. 9-10), on H's support: mu's leading rows and z_ = S mu there for every onset at once
+  // (one block of `window` columns per direction); the direct inputs d enter in
+  // accumulateSatellite.
+  const int columns = propagatedColumns() * config_.window;
+  const int n = support_count_;
+  z_->topLeftCorner(n, columns).noalias() = s_ * mu_.topLeftCorner(n, columns);
+  if (config_.imu_steps) accumulateImu();
+  // The satellites' sums are support-wide dot products, many per onset: with the support's size
+  // known at compile time for the usual cases (position, velocity and clock; with a lever arm,
+  // the attitude too) they are a third of the cost.
+  for (int s = 0; s < slots_used_; ++s) {
+    if (n == 8) {
+      accumulateSatellite<8>(s);
+    } else if (n == 11) {
+      accumulateSatellite<11>(s);
+    } else {
+      accumulateSatellite<Eigen::Dynamic>(s);
+    }
+  }
+}
+
+// The sums are added to every ring position, active or not: a position that is not (yet) an
+// onset is cleared when it becomes one (startOnset), and only active ones are read.
+void GlrWindow::accumulateImu() {
+  const int window = config_.window;
+  for (int c = 0; c < kImuDirections; ++c) {
+    const auto mu_c = mu_.block(0, firstColumn(c), support_count_, window);
+    f_.row(c).noalias() += a_.transpose() * mu_c;
+    for (int d = c; d < kImuDirections; ++d) {
+      const OnsetArray r = mu_c.cwiseProduct(z_->block(0, firstColumn(d), support_count_, window))
+                               .colwise()
+                               .sum()
+                               .array();
+      r_imu_.row(c + kImuDirections * d) += r.matrix();
+      if (d != c) r_imu_.row(d + kImuDirections * c) += r.matrix();
+    }
+  }
+}
+
+template <int N>
+void GlrWindow::accumulateSatellite(int s) {
+  const Slot& slot = slots_[static_cast<std::size_t>(s)];
+  using Vector = Eigen::Matrix<double, N, 1, 0, N == Eigen::Dynamic ? kSupport : N, 1>;
+  using ConstColumn = Eigen::Map<const Vector>;
+  const int window = config_.window;
+  const int n = support_count_;
+  // Direct inputs d (doc: inputs table) and the rows they enter; an absent row has d = 0.
+  const int rr = slot.range_row, tr = slot.rate_row;
+  const double d_step = rr >= 0 ? kStepInput : 0.0;
+  const double d_rate = tr >= 0 && config_.rate_steps ? kStepInput : 0.0;
+  const Vector u_range = rr >= 0 ? Vector(u_.row(rr).transpose()) : Vector::Zero(n);
+  const Vector u_rate = tr >= 0 ? Vector(u_.row(tr).transpose()) : Vector::Zero(n);
+  const double w_range = rr >= 0 ? w_[rr] : 0.0, w_rate = tr >= 0 ? w_[tr] : 0.0;
+  const double v_rr = rr >= 0 ? vInv(rr, rr) : 0.0;
+  const double v_rt = rr >= 0 && tr >= 0 ? vInv(rr, tr) : 0.0;
+  const double v_tt = tr >= 0 ? vInv(tr, tr) : 0.0;
+  // Disabled hypotheses add nothing (their columns may still carry a ramp's steps).
+  const double on_step = config_.range_steps ? 1.0 : 0.0;
+  const double on_ramp = config_.range_ramps ? 1.0 : 0.0;
+  const double on_rate = config_.rate_steps ? 1.0 : 0.0;
+  const int step_first = firstColumn(muColumn(s, kRangeStep));
+  const int rate_first = firstColumn(muColumn(s, kRateStep));
+  const int r_first = kSatDirections * kSatDirections * s;
+  // Newest onset to oldest: a ramp from onset theta is the sum of the steps from the onsets
+  // theta and newer, each weighted by its epoch spacing (doc: ramps from steps).
+  Vector ramp_mu = Vector::Zero(n), ramp_z = Vector::Zero(n);
+  double ramp_d = 0.0;
+  int ring = (onset_head_ + onset_count_ - 1) % window;
+  for (int age = 0; age < onset_count_; ++age, ring = ring == 0 ? window - 1 : ring - 1) {
+    const ConstColumn mu_step(mu_.col(step_first + ring).data(), n);
+    const ConstColumn z_step(z_->col(step_first + ring).data(), n);
+    const ConstColumn mu_rate(mu_.col(rate_first + ring).data(), n);
+    const ConstColumn z_rate(z_->col(rate_first + ring).data(), n);
+    const double c = spacing_s_[ring];
+    ramp_mu += c * mu_step;
+    ramp_z += c * z_step;
+    ramp_d += c * d_step;
+    // f_c = mu_c^T a + d_c w(r_c)
+    double* f = f_.col(ring).data() + satColumn(s, 0);
+    f[kRangeStep] += on_step * (mu_step.dot(a_) + d_step * w_range);
+    f[kRangeRamp] += on_ramp * (ramp_mu.dot(a_) + ramp_d * w_range);
+    f[kRateStep] += on_rate * (mu_rate.dot(a_) + d_rate * w_rate);
+    // R_ij = mu_i^T S mu_j + d_j U(r_j,:) mu_i + d_i U(r_i,:) mu_j + d_i d_j V^-1(r_i, r_j);
+    // the range step and ramp enter the range row, the rate step the rate row.
+    const double ur_step = u_range.dot(mu_step), ur_ramp = u_range.dot(ramp_mu);
+    const double ur_rate = u_range.dot(mu_rate);
+    const double ut_step = u_rate.dot(mu_step), ut_ramp = u_rate.dot(ramp_mu);
+    const double ut_rate = u_rate.dot(mu_rate);
+    const double ss = mu_step.dot(z_step) + 2.0 * d_step * ur_step + d_step * d_step * v_rr;
+    const double pp = ramp_mu.dot(ramp_z) + 2.0 * ramp_d * ur_ramp + ramp_d * ramp_d * v_rr;
+    const double tt = mu_rate.dot(z_rate) + 2.0 * d_rate * ut_rate + d_rate * d_rate * v_tt;
+    const double sp =
+        mu_step.dot(ramp_z) + ramp_d * ur_step + d_step * ur_ramp + d_step * ramp_d * v_rr;
+    const double st =
+        mu_step.dot(z_rate) + d_rate * ut_step + d_step * ur_rate + d_step * d_rate * v_rt;
+    const double pt =
+        ramp_mu.dot(z_rate) + d_rate * ut_ramp + ramp_d * ur_rate + ramp_d * d_rate * v_rt;
+    Eigen::Map<Eigen::Matrix3d> R(r_sat_.col(ring).data() + r_first);
+    R(kRangeStep, kRangeStep) += on_step * ss;
+    R(kRangeRamp, kRangeRamp) += on_ramp * pp;
+    R(kRateStep, kRateStep) += on_rate * tt;
+    R(kRangeStep, kRangeRamp) += on_step * on_ramp * sp;
+    R(kRangeStep, kRateStep) += on_step * on_rate * st;
+    R(kRangeRamp, kRateStep) += on_ramp * on_rate * pt;
+    R(kRangeRamp, kRangeStep) = R(kRangeStep, kRangeRamp);
+    R(kRateStep, kRangeStep) = R(kRangeStep, kRateStep);
+    R(kRateStep, kRangeRamp) = R(kRangeRamp, kRateStep);
+  }
+}
+
+int GlrWindow::onsetIndex(int age) const {
+  const int i = onset_count_ - 1 - std::clamp(age, 0, std::max(onset_count_ - 1, 0));
+  return (onset_head_ + i) % config_.window;
+}
+
+GlrWindow::OnsetView GlrWindow::onset(int age) const {
+  const int ring = onsetIndex(age);
+  return {onsets_[static_cast<std::size_t>(ring)].ramp_start_ns,
+          Eigen::Map<const Eigen::Matrix<double, kMaxDirections, 1>>(f_.col(ring).data()),
+          Eigen::Map<const Eigen::Matrix<double, kImuDirections, kImuDirections>>(
+              r_imu_.col(ring).data()),
+          r_sat_.col(ring).data()};
+}
+
+void GlrWindow::positionSignatures(std::vector<PositionSignature>& out) const {
+  out.clear();
+  if (!have_previous_ || onset_count_ == 0) return;
+  // mu+ = mu - K (H mu + D) on the position rows (doc eqs. C1, C3), with this epoch's K and H.
+  constexpr int kPos = layout::kPos.index;
+  const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxRows> k_pos =
+      prev_k_.middleRows<3>(kPos);
+  const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kSupport> kh = k_pos * h_support_;
+  const auto after = [&](int column, double d, int row) {
+    Eigen::Vector3d p = -kh * mu_.col(column).head(support_count_);
+    for (int i = 0; i < 3; ++i) {
+      const int live_row = row_of_[static_cast<std::size_t>(kPos + i)];
+      if (live_row >= 0) p[i] += mu_(live_row, column);
+    }
+    if (row >= 0) p -= d * k_pos.col(row);
+    return p;
+  };
+  if (config_.imu_steps) {
+    for (int age = 0; age < onset_count_; ++age) {
+      const int ring = onsetIndex(age);
+      const OnsetView o = onset(age);
+      for (int j = 0; j < kImuDirections; ++j) {
+        const GlrHypothesis h{j < 3 ? GlrFault::kAccelStep : GlrFault::kGyroStep, j % 3, 0};
+        out.push_back({h, age, after(firstColumn(j) + ring, 0.0, -1), o.r_imu(j, j)});
+      }
+    }
+  }
+  for (int s = 0; s < slots_used_; ++s) {
+    const Slot& slot = slots_[static_cast<std::size_t>(s)];
+    if (slot.quarantined) continue;
+    const int step_first = firstColumn(muColumn(s, kRangeStep));
+    const int rate_first = firstColumn(muColumn(s, kRateStep));
+    // Newest onset to oldest: a ramp is the spacing-weighted sum of the newer steps (doc: ramps
+    // from steps), and so is its effect, the map from signature to effect being linear.
+    Eigen::Vector3d ramp = Eigen::Vector3d::Zero();
+    for (int age = 0; age < onset_count_; ++age) {
+      const int ring = onsetIndex(age);
+      const OnsetView o = onset(age);
+      const Eigen::Matrix3d r = o.rSat(s);
+      const Eigen::Vector3d step = after(step_first + ring, kStepInput, slot.range_row);
+      ramp += spacing_s_[ring] * step;
+      if (config_.range_steps)
+        out.push_back(
+            {{GlrFault::kRangeStep, 0, slot.sv_id}, age, step, r(kRangeStep, kRangeStep)});
+      if (config_.range_ramps)
+        out.push_back(
+            {{GlrFault::kRangeRamp, 0, slot.sv_id}, age, ramp, r(kRangeRamp, kRangeRamp)});
+      if (config_.rate_steps)
+        out.push_back({{GlrFault::kRateStep, 0, slot.sv_id},
+                       age,
+                       after(rate_first + ring, kStepInput, slot.rate_row),
+                       r(kRateStep, kRateStep)});
+    }
+  }
+}
+
+}  // namespace navbus::core
