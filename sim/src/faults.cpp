@@ -5,18 +5,24 @@
 
 namespace navbus::sim {
 
-Eigen::Vector3d FaultSchedule::imuBias(double t, SensorKind sensor) const {
+Eigen::Vector3d FaultSchedule::imuBias(double t, SensorKind sensor, int unit) const {
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   for (const auto& f : faults_) {
-    if (f.kind == FaultKind::kImuBiasStep && f.sensor == sensor && active(f, t))
-      b[f.axis] += f.magnitude;
+    if (f.sensor != sensor || f.unit != unit || !active(f, t)) continue;
+    if (f.kind == FaultKind::kImuBiasStep) b[f.axis] += f.magnitude;
+    if (f.kind == FaultKind::kImuBiasRamp) {
+      const double ramp = f.slope * (t - f.start_s);
+      b[f.axis] += f.saturation > 0.0 ? std::clamp(ramp, -f.saturation, f.saturation) : ramp;
+    }
   }
   return b;
 }
 
-std::optional<double> FaultSchedule::stuckSince(SensorKind sensor, int axis, double t) const {
+std::optional<double> FaultSchedule::stuckSince(SensorKind sensor, int axis, double t,
+                                                int unit) const {
   for (const auto& f : faults_) {
-    if (f.kind == FaultKind::kSensorStuck && f.sensor == sensor && f.axis == axis && active(f, t))
+    if (f.kind == FaultKind::kSensorStuck && f.sensor == sensor && f.axis == axis &&
+        f.unit == unit && active(f, t))
       return f.start_s;
   }
   return std::nullopt;
@@ -58,6 +64,8 @@ const char* faultKindName(FaultKind kind) {
   switch (kind) {
     case FaultKind::kImuBiasStep:
       return "imu_bias_step";
+    case FaultKind::kImuBiasRamp:
+      return "imu_bias_ramp";
     case FaultKind::kPseudorangeRamp:
       return "pseudorange_ramp";
     case FaultKind::kGnssPositionPulse:

@@ -1,6 +1,7 @@
 #include "navbus/sim/scenario_source.hpp"
 
 #include <cmath>
+#include <tuple>
 
 #include "navbus/core/math/rotation.hpp"
 
@@ -35,31 +36,79 @@ ScenarioSource::ScenarioSource(const ScenarioConfig& c)
       constellation_(c.constellation),
       receiver_(c.gnss, constellation_),
       star_(c.star_tracker, c.seed * 4 + 3),
-      rng_(c.seed * 4) {}
+      rng_(c.seed * 4) {
+  // Each further unit's noise from a stream of its own (a step of the golden-ratio constant
+  // apart from the others'), derived from the one scenario seed.
+  for (std::size_t k = 0; k < c.extra_imus.size(); ++k)
+    extra_.push_back(
+        {ImuErrorModel(c.extra_imus[k].imu, c.seed * 4 + 1 + 0x9E3779B97F4A7C15ull * (k + 1)),
+         {},
+         Eigen::Vector3d::Constant(std::nan(""))});
+}
 
-Eigen::Vector3d ScenarioSource::frozen(SensorKind sensor, const Eigen::Vector3d& rate, double t) {
+Eigen::Vector3d ScenarioSource::frozen(UnitOutputs& unit, int unit_index, SensorKind sensor,
+                                       const Eigen::Vector3d& rate, double t) {
   Eigen::Vector3d out = rate;
-  Eigen::Vector3d& stuck = sensor == SensorKind::kAccelerometer ? stuck_accel_ : stuck_gyro_;
-  const Eigen::Vector3d& last = sensor == SensorKind::kAccelerometer ? last_accel_ : last_gyro_;
+  const bool accel = sensor == SensorKind::kAccelerometer;
+  Eigen::Vector3d& stuck = accel ? unit.stuck_accel : unit.stuck_gyro;
+  const Eigen::Vector3d& last = accel ? unit.last_accel : unit.last_gyro;
   for (int i = 0; i < 3; ++i) {
-    if (config_.faults.stuckSince(sensor, i, t)) {
+    if (config_.faults.stuckSince(sensor, i, t, unit_index)) {
       if (std::isnan(stuck[i])) stuck[i] = last[i];  // frozen at the last output before onset
       out[i] = stuck[i];
     } else {
       stuck[i] = std::nan("");
     }
   }
+  (accel ? unit.last_accel : unit.last_gyro) = out;
   return out;
 }
 
+void ScenarioSource::senseExtraUnit(int k, const PerfectIncrement& perfect,
+                                    const Eigen::Vector3d& f_b,
+                                    const Eigen::Vector3d& vibration_f_b,
+                                    const Eigen::Vector3d& vibration_w_b, double t, double dt,
+                                    SensorFrame& f) {
+  ExtraUnit& u = extra_[static_cast<std::size_t>(k)];
+  const ImuUnit& spec = config_.extra_imus[static_cast<std::size_t>(k)];
+  const int unit = k + 1;
+  // A rigid body: at the lever arm r the specific force gains dw/dt x r + w x (w x r), with w the
+  // sample's mean rate and dw/dt from the previous sample's (first order over the sample).
+  const Eigen::Vector3d w = perfect.delta_angle_b_rad / dt;
+  const Eigen::Vector3d w_dot = std::isnan(u.previous_rate_b.x())
+                                    ? Eigen::Vector3d::Zero()
+                                    : Eigen::Vector3d((w - u.previous_rate_b) / dt);
+  u.previous_rate_b = w;
+  const Eigen::Vector3d& r = spec.lever_arm_b_m;
+  const Eigen::Vector3d arm_f = w_dot.cross(r) + w.cross(w.cross(r));
+  PerfectIncrement at_unit;
+  at_unit.delta_angle_b_rad = spec.c_u_b * perfect.delta_angle_b_rad;
+  at_unit.delta_vel_b_mps = spec.c_u_b * (perfect.delta_vel_b_mps + arm_f * dt);
+  PerfectIncrement sensed = u.model.apply(at_unit, spec.c_u_b * (f_b + arm_f), dt);
+  sensed.delta_vel_b_mps += config_.faults.accelBias(t, unit) * dt;
+  sensed.delta_angle_b_rad += config_.faults.gyroBias(t, unit) * dt;
+  sensed.delta_vel_b_mps += spec.c_u_b * vibration_f_b * dt;
+  sensed.delta_angle_b_rad += spec.c_u_b * vibration_w_b * dt;
+  const Eigen::Vector3d accel =
+      frozen(u.outputs, unit, SensorKind::kAccelerometer, sensed.delta_vel_b_mps / dt, t);
+  const Eigen::Vector3d gyro =
+      frozen(u.outputs, unit, SensorKind::kGyro, sensed.delta_angle_b_rad / dt, t);
+  core::ImuIncrement& inc = f.extra_imus[static_cast<std::size_t>(k)].increment;
+  inc.delta_vel_b_mps += accel * dt;
+  inc.delta_angle_b_rad += gyro * dt;
+}
+
 namespace {
-/// A default frame that keeps the capacity of its raw-sample buffer (one per IMU frame; a GNSS
-/// epoch's satellites come as a new vector from the receiver model, 10 Hz at most).
-void clearKeepingRawBuffer(SensorFrame& f) {
+/// A default frame that keeps the capacity of its raw-sample and unit buffers (one per IMU
+/// frame; a GNSS epoch's satellites come as a new vector from the receiver model, 10 Hz at most).
+void clearKeepingBuffers(SensorFrame& f) {
   std::vector<RawImuSample> raw = std::move(f.raw.samples);
+  std::vector<UnitImuIncrement> units = std::move(f.extra_imus);
   f = SensorFrame{};
   raw.clear();
+  units.clear();
   f.raw.samples = std::move(raw);
+  f.extra_imus = std::move(units);
 }
 }  // namespace
 
@@ -71,7 +120,7 @@ SensorFrame ScenarioSource::next() {
 
 void ScenarioSource::next(SensorFrame& f) {
   ++index_;
-  clearKeepingRawBuffer(f);
+  clearKeepingBuffers(f);
   const std::int64_t t_end = config_.start_time_ns + index_ * config_.imu_period_ns;
   const std::int64_t t_begin = t_end - config_.imu_period_ns;
   f.time_ns = t_end;
@@ -85,25 +134,32 @@ void ScenarioSource::next(SensorFrame& f) {
   f.raw.samples.resize(static_cast<std::size_t>(n));
   f.increment.time_ns = t_end;
   f.increment.interval_s = T;
+  f.extra_imus.resize(extra_.size());
+  for (UnitImuIncrement& u : f.extra_imus) {
+    u.increment.time_ns = t_end;
+    u.increment.interval_s = T;
+  }
   for (int i = 0; i < n; ++i) {
     const double t = t0 + (i + 1) * dt;  // the raw sample is the mean over (t - dt, t]
     const PerfectIncrement perfect = trajectory_->advance(dt);
-    PerfectIncrement sensed = imu_.apply(perfect, trajectory_->specificForceBody(), dt);
+    const Eigen::Vector3d f_b = trajectory_->specificForceBody();
+    PerfectIncrement sensed = imu_.apply(perfect, f_b, dt);
     sensed.delta_vel_b_mps += config_.faults.accelBias(t) * dt;
     sensed.delta_angle_b_rad += config_.faults.gyroBias(t) * dt;
+    Eigen::Vector3d f_vib = Eigen::Vector3d::Zero(), w_vib = Eigen::Vector3d::Zero();
     if (config_.vibration.enabled) {
-      const auto [f_vib, w_vib] =
-          vibration_.next(trajectory_->state().vel_ned_mps.head<2>().norm());
+      std::tie(f_vib, w_vib) = vibration_.next(trajectory_->state().vel_ned_mps.head<2>().norm());
       sensed.delta_vel_b_mps += f_vib * dt;
       sensed.delta_angle_b_rad += w_vib * dt;
     }
+    for (int k = 0; k < static_cast<int>(extra_.size()); ++k)
+      senseExtraUnit(k, perfect, f_b, f_vib, w_vib, t, dt, f);
     // Mean rates over the sample; a stuck axis outputs its frozen value (no dither either:
     // the loss of the dither is how seed 003 detects it).
     const Eigen::Vector3d accel =
-        frozen(SensorKind::kAccelerometer, sensed.delta_vel_b_mps / dt, t);
-    const Eigen::Vector3d gyro = frozen(SensorKind::kGyro, sensed.delta_angle_b_rad / dt, t);
-    last_accel_ = accel;
-    last_gyro_ = gyro;
+        frozen(outputs_, 0, SensorKind::kAccelerometer, sensed.delta_vel_b_mps / dt, t);
+    const Eigen::Vector3d gyro =
+        frozen(outputs_, 0, SensorKind::kGyro, sensed.delta_angle_b_rad / dt, t);
     auto& raw = f.raw.samples[static_cast<std::size_t>(i)];
     raw.specific_force_b_mps2 = accel;
     raw.angular_rate_b_radps = gyro;
@@ -124,6 +180,13 @@ void ScenarioSource::next(SensorFrame& f) {
   f.truth.time_ns = t_end;
   f.truth_accel_bias_b_mps2 = imu_.accelBias() + config_.faults.accelBias(t0 + T);
   f.truth_gyro_bias_b_radps = imu_.gyroBias() + config_.faults.gyroBias(t0 + T);
+  for (std::size_t k = 0; k < extra_.size(); ++k) {
+    const int unit = static_cast<int>(k) + 1;
+    f.extra_imus[k].truth_accel_bias_u_mps2 =
+        extra_[k].model.accelBias() + config_.faults.accelBias(t0 + T, unit);
+    f.extra_imus[k].truth_gyro_bias_u_radps =
+        extra_[k].model.gyroBias() + config_.faults.gyroBias(t0 + T, unit);
+  }
 
   const double t_s = t0 + T;
   if (config_.gnss_every_n_increments > 0 && index_ % config_.gnss_every_n_increments == 0 &&

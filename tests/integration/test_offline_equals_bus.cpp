@@ -28,6 +28,7 @@ struct Case {
   std::string filter_extra;
   int seed;
   double duration_s;
+  std::vector<std::string> filter_log_says{};  ///< lines the filter's log must contain
 };
 
 void runCase(const Case& c) {
@@ -104,6 +105,8 @@ void runCase(const Case& c) {
   EXPECT_NE(log.find("navbus/imu/increment id 1 ended (its writer disposed it)"), std::string::npos)
       << log;
   EXPECT_NE(log.find("sequencer timeouts 0,"), std::string::npos) << log;
+  for (const std::string& line : c.filter_log_says)
+    EXPECT_NE(log.find(line), std::string::npos) << line;
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }
@@ -116,6 +119,20 @@ TEST(OfflineEqualsBus, LandVehicleMultiDimensionalFilter) {
 
 TEST(OfflineEqualsBus, LeoFederatedGnssAndStarTracker) {
   runCase({87, "seed001_leo.yaml", "filter_seed001_lc.yaml", "fusion: federated\n", 3, 40.0});
+}
+
+// A triplex installation (sensor 1 and units 2 and 3) into a filter configured for sensor 1: the
+// units' increments go over the bus in blocks of their own instances, the filter refuses them
+// as unexpected sources, and its solutions stay those of the offline run.
+TEST(OfflineEqualsBus, TriplexUnitsBesideAOneImuFilter) {
+  runCase({92,
+           "seed000_triplex_gyro_step.yaml",
+           "filter_seed000_tc.yaml",
+           "",
+           2,
+           120.0,
+           {"rejected sample of sensor 2 (unexpected_source: sensor_id = 2",
+            "rejected sample of sensor 3 (unexpected_source: sensor_id = 3"}});
 }
 
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->

@@ -9,6 +9,7 @@
 
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/health.hpp"
+#include "navbus/bus/topics.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/evaluation/frame_prefetcher.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
@@ -195,6 +196,8 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   // End of data: whatever waits for a stream that will not speak again is released.
   pipeline.flush(sim.scenario.start_time_ns + total * period_ns);
   result.summary = pipeline.summary();
+  if (const bus::StreamCounters* imu = health.find(bus::topic::kImuIncrement))
+    result.imu_rejected = imu->rejected;
   result.consistency = pipeline.engine().consistency().counters();
   if (faults) {
     result.fault_summary = faults->summary();

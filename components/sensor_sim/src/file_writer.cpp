@@ -55,13 +55,18 @@ FileWriter::FileWriter(const std::filesystem::path& dir, const sim::ScenarioConf
   std::ofstream faults =
       open("faults.csv",
            "kind,start_s,end_s,sensor,axis,sv_id,magnitude,slope_mps,saturation_m,vector_x,"
-           "vector_y,vector_z");
+           "vector_y,vector_z,unit,bias_slope_per_s,bias_saturation");
   for (const auto& f : scenario.faults.faults()) {
+    // Slopes and saturations: a pseudorange ramp's in slope_mps and saturation_m, an IMU bias
+    // ramp's in bias_slope_per_s [m/s^2 or rad/s per s] and bias_saturation [m/s^2 or rad/s].
+    const bool imu_ramp = f.kind == sim::FaultKind::kImuBiasRamp;
     faults << sim::faultKindName(f.kind) << "," << num(f.start_s) << ","
            << (f.end_s > 1e299 ? std::string("inf") : num(f.end_s)) << ","
            << (f.sensor == sim::SensorKind::kGyro ? "gyro" : "accelerometer") << "," << f.axis
-           << "," << f.sv_id << "," << num(f.magnitude) << "," << num(f.slope) << ","
-           << num(f.saturation) << "," << vec(f.vector) << "\n";
+           << "," << f.sv_id << "," << num(f.magnitude) << "," << num(imu_ramp ? 0.0 : f.slope)
+           << "," << num(imu_ramp ? 0.0 : f.saturation) << "," << vec(f.vector) << "," << f.unit
+           << "," << num(imu_ramp ? f.slope : 0.0) << "," << num(imu_ramp ? f.saturation : 0.0)
+           << "\n";
   }
 }
 

@@ -89,6 +89,8 @@ FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& c
       increments_per_block_(sensor_sim::incrementsPerBlock(config)) {
   if (increments_per_block_ > 0) {
     batcher_.emplace(increments_per_block_);
+    unit_batchers_.assign(config.extra_imu_sensor_ids.size(),
+                          ImuBlockBatcher(increments_per_block_));
     imu_blocks_ = createWriter<navbus::ImuIncrementBlock>();
   } else {
     imu_ = createWriter<navbus::ImuIncrement>();
@@ -116,9 +118,17 @@ bool FramePublisher::writeReliably(bus::Writer<Sample>& writer, const Sample& sa
       sample, [this] { return participant_.stopping(); }, write_retries_);
 }
 
+ImuBlockBatcher& FramePublisher::batcherOf(std::uint32_t sensor_id) {
+  const auto& ids = config_.extra_imu_sensor_ids;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (ids[k] == sensor_id) return unit_batchers_[k];
+  }
+  return *batcher_;
+}
+
 bool FramePublisher::writeIncrement(const navbus::ImuIncrement& increment) {
   if (batcher_) {
-    batcher_->addIncrement(increment);  // written by writeBlocks when full
+    batcherOf(increment.sensor_id()).addIncrement(increment);  // written by writeBlocks
     return true;
   }
   if (!writeReliably(imu_, increment)) return false;
@@ -142,12 +152,20 @@ bool FramePublisher::batchRaw(const navbus::ImuRawBlock& raw) {
   return writeRaw(raw);  // longer than any block: as it is
 }
 
+bool FramePublisher::writeIncrementBlock(ImuBlockBatcher& batcher) {
+  if (!batcher.hasIncrements()) return true;
+  const navbus::ImuIncrementBlock block = batcher.takeIncrements();
+  if (!writeReliably(imu_blocks_, block)) return false;
+  written_.increments += block.increments().size();
+  ++written_.increment_samples;
+  return true;
+}
+
 bool FramePublisher::writeBlocks() {
-  if (batcher_->hasIncrements()) {
-    const navbus::ImuIncrementBlock block = batcher_->takeIncrements();
-    if (!writeReliably(imu_blocks_, block)) return false;
-    written_.increments += block.increments().size();
-    ++written_.increment_samples;
+  // The units' blocks cover the same frames as the scenario IMU's (filled in lockstep).
+  if (!writeIncrementBlock(*batcher_)) return false;
+  for (ImuBlockBatcher& b : unit_batchers_) {
+    if (!writeIncrementBlock(b)) return false;
   }
   return !batcher_->hasRaw() || writeRaw(batcher_->takeRaw());
 }
@@ -216,12 +234,18 @@ void disposeIfPublished(bus::Writer<Sample>& writer, std::uint64_t published, co
 
 void FramePublisher::endStreams() {
   if (batcher_ && !writeBlocks()) return;  // stopped meanwhile
-  navbus::ImuIncrement imu;
-  imu.sensor_id(config_.imu_sensor_id);
-  disposeIfPublished(imu_, batcher_ ? 0 : written_.increment_samples, imu);
-  navbus::ImuIncrementBlock imu_block;
-  imu_block.sensor_id(config_.imu_sensor_id);
-  disposeIfPublished(imu_blocks_, batcher_ ? written_.increment_samples : 0, imu_block);
+  // Every IMU's instance: the scenario's and each further unit's.
+  std::vector<std::uint32_t> imu_ids{config_.imu_sensor_id};
+  imu_ids.insert(imu_ids.end(), config_.extra_imu_sensor_ids.begin(),
+                 config_.extra_imu_sensor_ids.end());
+  for (const std::uint32_t id : imu_ids) {
+    navbus::ImuIncrement imu;
+    imu.sensor_id(id);
+    disposeIfPublished(imu_, batcher_ ? 0 : written_.increment_samples, imu);
+    navbus::ImuIncrementBlock imu_block;
+    imu_block.sensor_id(id);
+    disposeIfPublished(imu_blocks_, batcher_ ? written_.increment_samples : 0, imu_block);
+  }
   navbus::ImuRawBlock raw;
   raw.sensor_id(config_.imu_sensor_id);
   disposeIfPublished(raw_, written_.raw_blocks, raw);

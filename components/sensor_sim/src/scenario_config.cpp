@@ -1,9 +1,11 @@
 #include "navbus/sensor_sim/scenario_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/key_reader.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
 
 namespace navbus::sensor_sim {
@@ -123,9 +125,9 @@ std::vector<sim::Segment> parseSegments(const YAML::Node& list) {
   return out;
 }
 
-void checkImuKeys(const YAML::Node& imu) {
+void checkImuKeys(const YAML::Node& imu, const std::string& where) {
   checkKeys(
-      imu, "imu",
+      imu, where,
       {"accel_bias_ug", "accel_bias_sigma_ug", "accel_bias_instability_ug",
        "accel_noise_ug_per_sqrthz", "accel_vrw_ug_per_sqrth", "accel_scale_factor_ppm",
        "accel_misalignment_urad", "accel_quantum_mps", "gyro_bias_deg_per_h",
@@ -137,27 +139,34 @@ void checkImuKeys(const YAML::Node& imu) {
 /// The keys every fault has.
 constexpr std::initializer_list<const char*> kFaultCommonKeys = {"type", "start_s", "end_s",
                                                                  "duration_s"};
+/// The keys every IMU fault has: the common ones and the unit it is addressed to.
+constexpr std::initializer_list<const char*> kImuFaultKeys = {"type", "start_s", "end_s",
+                                                              "duration_s", "sensor_id"};
 
 /// The keys of one fault: the common ones and those of its type.
 void checkFaultKeys(const YAML::Node& n, const std::string& where, const std::string& type) {
   if (type == "imu_bias_step")
-    checkKeys(n, where, {"sensor", "axis", "magnitude_mg", "magnitude_deg_per_h"},
-              kFaultCommonKeys);
+    checkKeys(n, where, {"sensor", "axis", "magnitude_mg", "magnitude_deg_per_h"}, kImuFaultKeys);
+  else if (type == "imu_bias_ramp")
+    checkKeys(n, where,
+              {"sensor", "axis", "slope_mg_per_s", "slope_deg_per_h_per_s", "saturation_mg",
+               "saturation_deg_per_h"},
+              kImuFaultKeys);
   else if (type == "pseudorange_ramp")
     checkKeys(n, where, {"sv_id", "slope_mps", "saturation_m"}, kFaultCommonKeys);
   else if (type == "gnss_position_pulse")
     checkKeys(n, where, {"north_m", "east_m", "down_m"}, kFaultCommonKeys);
   else if (type == "sensor_stuck")
-    checkKeys(n, where, {"sensor", "axis"}, kFaultCommonKeys);
+    checkKeys(n, where, {"sensor", "axis"}, kImuFaultKeys);
   else if (type == "star_tracker_bias")
     checkKeys(n, where, {"bias_arcsec"}, kFaultCommonKeys);
   else
     checkKeys(n, where, kFaultCommonKeys);
 }
 
-void parseTriad(const YAML::Node& imu, const std::string& prefix, double bias_unit, double bi_unit,
-                double rw_unit, const std::string& rw_key, sim::TriadErrors& t) {
-  const std::string w = "imu";
+void parseTriad(const YAML::Node& imu, const std::string& w, const std::string& prefix,
+                double bias_unit, double bi_unit, double rw_unit, const std::string& rw_key,
+                sim::TriadErrors& t) {
   t.bias = bus::getVector3(imu, w, prefix + "bias" + (prefix == "accel_" ? "_ug" : "_deg_per_h"),
                            bias_unit);
   // Random-constant biases (seeds 000, 004): drawn by the IMU model from the scenario seed, so
@@ -169,18 +178,33 @@ void parseTriad(const YAML::Node& imu, const std::string& prefix, double bias_un
                   0.0) *
       bi_unit;
   t.bias_correlation_time_s = checkRange(get<double>(imu, w, "bias_correlation_time_s", 100.0),
-                                         1e-3, 1e7, "imu.bias_correlation_time_s");
+                                         1e-3, 1e7, w + ".bias_correlation_time_s");
   t.random_walk = get<double>(imu, w, rw_key, 0.0) * rw_unit;
   t.scale_factor = bus::getVector3(imu, w, prefix + "scale_factor_ppm", units::kPpm);
   const auto mis =
       get<std::vector<double>>(imu, w, prefix + "misalignment_urad", {0, 0, 0, 0, 0, 0});
   if (mis.size() != 6)
-    throw ConfigError("configuration imu." + prefix +
+    throw ConfigError("configuration " + w + "." + prefix +
                       "misalignment_urad must have 6 elements (xy xz yx yz zx zy)");
   for (int i = 0; i < 6; ++i) t.misalignment[i] = mis[static_cast<std::size_t>(i)] * 1e-6;
 }
 
-sim::FaultSchedule parseFaults(const YAML::Node& list) {
+/// The unit an IMU fault's `sensor_id` names (absent: the scenario's IMU, unit 0), among
+/// `imu_ids` (unit k's sensor id at k).
+int faultUnit(const YAML::Node& n, const std::string& where,
+              const std::vector<std::uint32_t>& imu_ids) {
+  if (!n["sensor_id"]) return 0;
+  const auto id = bus::require<std::uint32_t>(n, where, "sensor_id");
+  for (std::size_t k = 0; k < imu_ids.size(); ++k) {
+    if (imu_ids[k] == id) return static_cast<int>(k);
+  }
+  std::string known;
+  for (const std::uint32_t i : imu_ids) known += (known.empty() ? "" : ", ") + std::to_string(i);
+  throw ConfigError("configuration " + where + ".sensor_id = " + std::to_string(id) +
+                    " is not an IMU of the scenario (ids.imu and imu_units: " + known + ")");
+}
+
+sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::uint32_t>& imu_ids) {
   std::vector<sim::Fault> out;
   if (!list || list.IsNull()) return sim::FaultSchedule{};
   if (!list.IsSequence()) throw ConfigError("configuration faults must be a list");
@@ -200,9 +224,23 @@ sim::FaultSchedule parseFaults(const YAML::Node& list) {
       f.kind = sim::FaultKind::kImuBiasStep;
       f.sensor = sensorKind(n, where);
       f.axis = axisIndex(n, where);
+      f.unit = faultUnit(n, where, imu_ids);
       f.magnitude = f.sensor == sim::SensorKind::kAccelerometer
                         ? bus::require<double>(n, where, "magnitude_mg") * 1e-3 * kG
                         : bus::require<double>(n, where, "magnitude_deg_per_h") * kDegPerHour;
+    } else if (type == "imu_bias_ramp") {
+      f.kind = sim::FaultKind::kImuBiasRamp;
+      f.sensor = sensorKind(n, where);
+      f.axis = axisIndex(n, where);
+      f.unit = faultUnit(n, where, imu_ids);
+      const bool accel = f.sensor == sim::SensorKind::kAccelerometer;
+      const double unit = accel ? 1e-3 * kG : kDegPerHour;
+      f.slope =
+          bus::require<double>(n, where, accel ? "slope_mg_per_s" : "slope_deg_per_h_per_s") * unit;
+      f.saturation =
+          checkRange(get<double>(n, where, accel ? "saturation_mg" : "saturation_deg_per_h", 0.0),
+                     0, 1e9, where + (accel ? ".saturation_mg" : ".saturation_deg_per_h")) *
+          unit;
     } else if (type == "pseudorange_ramp") {
       f.kind = sim::FaultKind::kPseudorangeRamp;
       f.sv_id = static_cast<int>(
@@ -219,6 +257,7 @@ sim::FaultSchedule parseFaults(const YAML::Node& list) {
       f.kind = sim::FaultKind::kSensorStuck;
       f.sensor = sensorKind(n, where);
       f.axis = axisIndex(n, where);
+      f.unit = faultUnit(n, where, imu_ids);
     } else if (type == "gnss_outage") {
       f.kind = sim::FaultKind::kGnssOutage;
     } else if (type == "star_tracker_outage") {
@@ -341,12 +380,13 @@ double parseTiming(const YAML::Node& timing, SimConfig& c) {
   return raw_hz;
 }
 
-void parseImu(const YAML::Node& imu, sim::ImuSpec& spec) {
-  checkImuKeys(imu);
-  parseTriad(imu, "accel_", kMicroG, kMicroG, kMicroG, "accel_noise_ug_per_sqrthz", spec.accel);
-  parseTriad(imu, "gyro_", kDegPerHour, kDegPerHour, kDeg / 60.0, "gyro_arw_deg_per_sqrth",
+void parseImu(const YAML::Node& imu, const std::string& where, sim::ImuSpec& spec) {
+  checkImuKeys(imu, where);
+  parseTriad(imu, where, "accel_", kMicroG, kMicroG, kMicroG, "accel_noise_ug_per_sqrthz",
+             spec.accel);
+  parseTriad(imu, where, "gyro_", kDegPerHour, kDegPerHour, kDeg / 60.0, "gyro_arw_deg_per_sqrth",
              spec.gyro);
-  bus::KeyReader r(imu, "imu");
+  bus::KeyReader r(imu, where);
   // Seed 004 gives the gyro white noise as a rate density [deg/s/sqrt(Hz)]; same quantity.
   r.number("gyro_noise_dps_per_sqrthz", spec.gyro.random_walk, kAny, kDegree)
       // Velocity random walk may also be given per sqrt(h) (seed 001: 10 ug/sqrt(h)).
@@ -354,7 +394,37 @@ void parseImu(const YAML::Node& imu, sim::ImuSpec& spec) {
       .number("accel_quantum_mps", spec.accel.quantum, kAny)
       .number("gyro_quantum_urad", spec.gyro.quantum, kAny, kMicroRad);
   spec.gyro_g_sensitivity.diagonal() =
-      bus::getVector3(imu, "imu", "gyro_g_sensitivity_deg_per_h_per_g", kDegPerHour / kG);
+      bus::getVector3(imu, where, "gyro_g_sensitivity_deg_per_h_per_g", kDegPerHour / kG);
+}
+
+/// Further IMU units (a redundant installation): their sensor ids (after the scenario's IMU's
+/// in `imu_ids`), mountings, lever arms and error models (the scenario's `imu` block when a
+/// unit has none of its own).
+void parseImuUnits(const YAML::Node& list, sim::ScenarioConfig& s,
+                   std::vector<std::uint32_t>& imu_ids) {
+  if (!list || list.IsNull()) return;
+  if (!list.IsSequence()) throw ConfigError("configuration imu_units must be a list");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node n = list[i];
+    const std::string where = "imu_units[" + std::to_string(i) + "]";
+    checkKeys(n, where, {"sensor_id", "mounting_rpy_deg", "lever_arm_b_m", "imu"});
+    const auto id = bus::require<std::uint32_t>(n, where, "sensor_id");
+    if (std::find(imu_ids.begin(), imu_ids.end(), id) != imu_ids.end()) {
+      throw ConfigError("configuration " + where + ".sensor_id = " + std::to_string(id) +
+                        " is already the id of another IMU of the scenario");
+    }
+    imu_ids.push_back(id);
+    sim::ImuUnit u;
+    // The unit's axes are the body axes turned by roll, pitch and yaw (as a body's from NED).
+    u.c_u_b = core::dcmFromEuler(bus::getVector3(n, where, "mounting_rpy_deg", kDeg)).transpose();
+    u.lever_arm_b_m = bus::getVector3(n, where, "lever_arm_b_m", 1.0);
+    u.imu = s.imu;
+    if (n["imu"]) {
+      u.imu = sim::ImuSpec{};
+      parseImu(n["imu"], where + ".imu", u.imu);
+    }
+    s.extra_imus.push_back(u);
+  }
 }
 
 void parseDither(const YAML::Node& dither, double raw_hz, sim::ScenarioConfig& s) {
@@ -451,8 +521,8 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   bus::KeyReader top(root, "");
   top.value("name", s.name)
       .value("seed", s.seed)
-      .nested({"vehicle", "orbit", "timing", "imu", "dither", "vibration", "gnss", "star_tracker",
-               "faults", "ids", "publish"});
+      .nested({"vehicle", "orbit", "timing", "imu", "imu_units", "dither", "vibration", "gnss",
+               "star_tracker", "faults", "ids", "publish"});
   if (orbit) {
     parseOrbit(orbit, s);
   } else {
@@ -463,13 +533,16 @@ SimConfig parseSimConfig(const YAML::Node& root) {
               {"point_mass", core::earth::GravityModel::kPointMass}})
       .finish(bus::kParticipantKeys);
   const double raw_hz = parseTiming(root["timing"], c);
-  parseImu(root["imu"], s.imu);
+  parseImu(root["imu"], "imu", s.imu);
   parseDither(root["dither"], raw_hz, s);
   parseVibration(root["vibration"], raw_hz, s.vibration);
   parseGnss(root["gnss"], s);
   parseStarTracker(root["star_tracker"], s.star_tracker);
-  s.faults = parseFaults(root["faults"]);
   parseOutputs(root, c);
+  std::vector<std::uint32_t> imu_ids{c.imu_sensor_id};
+  parseImuUnits(root["imu_units"], s, imu_ids);
+  c.extra_imu_sensor_ids.assign(imu_ids.begin() + 1, imu_ids.end());
+  s.faults = parseFaults(root["faults"], imu_ids);
   return c;
 }
 

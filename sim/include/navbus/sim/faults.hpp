@@ -12,6 +12,7 @@ namespace navbus::sim {
 
 enum class FaultKind {
   kImuBiasStep,        ///< seed 000 table 2: a step on one accelerometer or gyro axis
+  kImuBiasRamp,        ///< a bias growing at `slope` from start, saturating at `saturation`
   kPseudorangeRamp,    ///< seed 000 table 3: slope [m/s] from start, saturating at `saturation`
   kGnssPositionPulse,  ///< seed 001: a position error [m, NED] on the fixes while active
   kSensorStuck,        ///< seed 003: an axis output frozen at its value at the start
@@ -28,10 +29,14 @@ struct Fault {
   double end_s{1e300};  ///< active while start <= t < end
   SensorKind sensor{SensorKind::kAccelerometer};
   int axis{0};  ///< 0..2
+  /// IMU faults: the unit (0: the scenario's IMU; k: ScenarioConfig::extra_imus[k - 1]).
+  int unit{0};
   int sv_id{0};
-  double magnitude{0.0};                            ///< bias step [m/s^2 | rad/s]
-  double slope{0.0};                                ///< pseudorange ramp [m/s]
-  double saturation{0.0};                           ///< pseudorange ramp limit [m]
+  double magnitude{0.0};  ///< bias step [m/s^2 | rad/s]
+  /// Ramps: pseudorange [m/s], IMU bias [m/s^2 | rad/s per s]
+  double slope{0.0};
+  /// Ramps: the size they stop growing at, 0: none [m | m/s^2 | rad/s]
+  double saturation{0.0};
   Eigen::Vector3d vector{Eigen::Vector3d::Zero()};  ///< position pulse [m, NED] or ST bias [rad]
 };
 
@@ -40,11 +45,16 @@ class FaultSchedule {
   FaultSchedule() = default;
   explicit FaultSchedule(std::vector<Fault> faults) : faults_(std::move(faults)) {}
 
-  /// Additional accelerometer and gyro biases [m/s^2, rad/s] at t.
-  Eigen::Vector3d accelBias(double t) const { return imuBias(t, SensorKind::kAccelerometer); }
-  Eigen::Vector3d gyroBias(double t) const { return imuBias(t, SensorKind::kGyro); }
+  /// Additional accelerometer and gyro biases [m/s^2, rad/s, the unit's axes] of an IMU unit at
+  /// t (steps and ramps).
+  Eigen::Vector3d accelBias(double t, int unit = 0) const {
+    return imuBias(t, SensorKind::kAccelerometer, unit);
+  }
+  Eigen::Vector3d gyroBias(double t, int unit = 0) const {
+    return imuBias(t, SensorKind::kGyro, unit);
+  }
   /// Axes frozen at t: the start time of the stuck fault per axis, or nothing.
-  std::optional<double> stuckSince(SensorKind sensor, int axis, double t) const;
+  std::optional<double> stuckSince(SensorKind sensor, int axis, double t, int unit = 0) const;
   double pseudorangeError(int sv_id, double t) const;
   Eigen::Vector3d positionPulse(double t) const;
   bool gnssOut(double t) const { return any(FaultKind::kGnssOutage, t); }
@@ -53,7 +63,7 @@ class FaultSchedule {
   const std::vector<Fault>& faults() const { return faults_; }
 
  private:
-  Eigen::Vector3d imuBias(double t, SensorKind sensor) const;
+  Eigen::Vector3d imuBias(double t, SensorKind sensor, int unit) const;
   bool any(FaultKind kind, double t) const;
   static bool active(const Fault& f, double t) { return t >= f.start_s && t < f.end_s; }
   std::vector<Fault> faults_;

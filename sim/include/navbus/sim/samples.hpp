@@ -60,11 +60,21 @@ struct StarTrackerSample {
   Eigen::Vector3d sigma_b_rad{Eigen::Vector3d::Zero()};
 };
 
+/// One further IMU unit's increment over the interval (ScenarioConfig::extra_imus).
+struct UnitImuIncrement {
+  core::ImuIncrement increment;  ///< in the unit's own axes
+  /// The unit's total biases at the end of the interval, model + injected faults [unit axes]
+  Eigen::Vector3d truth_accel_bias_u_mps2{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d truth_gyro_bias_u_radps{Eigen::Vector3d::Zero()};
+};
+
 /// Everything the source produces for one navigation interval ending at `time_ns`.
 struct SensorFrame {
   std::int64_t time_ns{0};
   core::ImuIncrement increment;
   RawImuBlock raw;
+  /// The further IMU units, in ScenarioConfig::extra_imus order (unit k + 1 at index k).
+  std::vector<UnitImuIncrement> extra_imus;
   bool has_gnss{false};
   GnssEpoch gnss;
   GnssFixSample fix;

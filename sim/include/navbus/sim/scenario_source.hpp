@@ -1,8 +1,11 @@
 // A scenario: a truth trajectory seen by an IMU (error model, optional RLG dither in the raw
-// stream), a GNSS receiver and a star tracker, with scheduled faults. Produces one SensorFrame
-// per navigation interval; the same seed gives bit-identical data.
+// stream) and by further IMU units of a redundant installation (each with its own mounting,
+// lever arm, error model and noise), a GNSS receiver and a star tracker, with scheduled faults
+// (IMU faults addressed to a unit). Produces one SensorFrame per navigation interval; the same
+// seed gives bit-identical data.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <random>
@@ -21,6 +24,16 @@
 
 namespace navbus::sim {
 
+/// A further IMU of a redundant installation. It senses the body's motion at its own place and in
+/// its own axes: rates C_u_b w and specific force C_u_b (f + dw/dt x r + w x (w x r)) (a rigid
+/// body; r the lever arm), then its own errors; no dither.
+struct ImuUnit {
+  /// Rotates body-axis vectors into the unit's axes (the unit's mounting).
+  Eigen::Matrix3d c_u_b{Eigen::Matrix3d::Identity()};
+  Eigen::Vector3d lever_arm_b_m{Eigen::Vector3d::Zero()};  ///< from the scenario's IMU [m, body]
+  ImuSpec imu;
+};
+
 struct ScenarioConfig {
   std::string name{"default"};
   bool orbit{false};  ///< true: circular orbit (seed 001), else vehicle segments
@@ -34,6 +47,7 @@ struct ScenarioConfig {
   int gnss_every_n_increments{100};         ///< 0: no GNSS
   int star_tracker_every_n_increments{20};  ///< 0: no star tracker
   ImuSpec imu;
+  std::vector<ImuUnit> extra_imus;  ///< units 1, 2, ... beside the scenario's IMU (unit 0)
   bool dither{false};
   DitherSpec dither_spec;
   VibrationSpec vibration;
@@ -57,7 +71,25 @@ class ScenarioSource {
   const ScenarioConfig& config() const { return config_; }
 
  private:
-  Eigen::Vector3d frozen(SensorKind sensor, const Eigen::Vector3d& rate, double t);
+  /// What an IMU unit's outputs remember from one raw sample to the next (stuck axes).
+  struct UnitOutputs {
+    Eigen::Vector3d last_accel{Eigen::Vector3d::Zero()};  ///< last raw outputs
+    Eigen::Vector3d last_gyro{Eigen::Vector3d::Zero()};
+    Eigen::Vector3d stuck_accel{Eigen::Vector3d::Constant(std::nan(""))};
+    Eigen::Vector3d stuck_gyro{Eigen::Vector3d::Constant(std::nan(""))};
+  };
+  struct ExtraUnit {
+    ImuErrorModel model;
+    UnitOutputs outputs;
+    /// The body rate of the previous raw sample, for dw/dt (NaN before the first)
+    Eigen::Vector3d previous_rate_b{Eigen::Vector3d::Constant(std::nan(""))};
+  };
+  Eigen::Vector3d frozen(UnitOutputs& unit, int unit_index, SensorKind sensor,
+                         const Eigen::Vector3d& rate, double t);
+  /// One raw sample of extra unit k, added to its increment in `f`.
+  void senseExtraUnit(int k, const PerfectIncrement& perfect, const Eigen::Vector3d& f_b,
+                      const Eigen::Vector3d& vibration_f_b, const Eigen::Vector3d& vibration_w_b,
+                      double t, double dt, SensorFrame& f);
 
   ScenarioConfig config_;
   std::unique_ptr<Trajectory> trajectory_;
@@ -70,10 +102,8 @@ class ScenarioSource {
   Eigen::Vector3d star_bias_b_rad_{Eigen::Vector3d::Zero()};  ///< at the latest tracker sample
   std::mt19937_64 rng_;
   std::int64_t index_{0};
-  Eigen::Vector3d last_accel_{Eigen::Vector3d::Zero()};  ///< last raw outputs (for stuck axes)
-  Eigen::Vector3d last_gyro_{Eigen::Vector3d::Zero()};
-  Eigen::Vector3d stuck_accel_{Eigen::Vector3d::Constant(std::nan(""))};
-  Eigen::Vector3d stuck_gyro_{Eigen::Vector3d::Constant(std::nan(""))};
+  UnitOutputs outputs_;  ///< the scenario's IMU (unit 0)
+  std::vector<ExtraUnit> extra_;
 };
 
 }  // namespace navbus::sim

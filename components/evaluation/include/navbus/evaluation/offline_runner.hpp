@@ -5,10 +5,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include <navbus_idl/Common.h>
 #include <navbus_idl/Fault.h>
 #include <navbus_idl/Navigation.h>
 #include <Eigen/Core>
@@ -63,8 +65,11 @@ struct OfflineResult {
   std::uint64_t solutions{0};
   std::uint64_t solutions_without_truth{0};  ///< solution times between truth samples
   std::string summary;                       ///< the pipeline's counters
-  core::ConsistencyCounters consistency;     ///< the filter's test of its own innovations
-  std::string fault_summary;                 ///< the fault pipeline's counters
+  /// The filter's refusals of IMU increments by reason (an IMU it was not configured with:
+  /// REJECT_UNEXPECTED_SOURCE).
+  std::map<navbus::RejectReason, std::uint64_t> imu_rejected;
+  core::ConsistencyCounters consistency;  ///< the filter's test of its own innovations
+  std::string fault_summary;              ///< the fault pipeline's counters
   std::vector<navbus::FaultDecision> decisions;
   /// Per decision: how many solutions had been published when it was (an alarm covers the
   /// solutions from this index on).

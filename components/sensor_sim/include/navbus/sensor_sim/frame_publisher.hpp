@@ -3,9 +3,11 @@
 // run is stopped.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <vector>
 
 #include <navbus_idl/GnssPubSubTypes.h>
 #include <navbus_idl/ImuPubSubTypes.h>
@@ -30,6 +32,8 @@ navbus::StarTrackerAttitude toIdl(const sim::StarTrackerSample& st, std::uint32_
 /// Sequence numbers of the last samples emitted per stream.
 struct FrameSequence {
   std::uint64_t imu{0}, raw{0}, gnss_epochs{0}, gnss_fixes{0}, star_tracker{0};
+  std::vector<std::uint64_t>
+      extra_imus;  ///< per further IMU unit (SimConfig::extra_imu_sensor_ids)
 };
 
 /// What a FramePublisher wrote to the bus: measurements per stream and the DDS samples that
@@ -50,10 +54,11 @@ struct WrittenCounts {
 };
 
 /// The bus samples of one simulator frame, in emit order (the increment first, then the raw
-/// block, then the measurements valid at its end time), with their sequence numbers: the one
-/// definition of what the simulator participant publishes, shared by FramePublisher and
-/// `navbus offline`. `emit(sample)` returns false to stop; the sequence advances per sample
-/// emitted. Returns false if stopped.
+/// block, then the further IMU units' increments in unit order, each under its sensor id, then
+/// the measurements valid at its end time), with their sequence numbers: the one definition of
+/// what the simulator participant publishes, shared by FramePublisher and `navbus offline`.
+/// `emit(sample)` returns false to stop; the sequence advances per sample emitted. Returns
+/// false if stopped.
 template <class Emit>
 bool emitFrame(const sim::SensorFrame& f, const SimConfig& c, FrameSequence& seq, Emit&& emit) {
   if (!emit(bus::toIdl(f.increment, c.imu_sensor_id, seq.imu + 1))) return false;
@@ -61,6 +66,14 @@ bool emitFrame(const sim::SensorFrame& f, const SimConfig& c, FrameSequence& seq
   if (c.publish_raw) {
     if (!emit(toIdl(f.raw, c.imu_sensor_id, seq.raw + 1))) return false;
     ++seq.raw;
+  }
+  const std::size_t units = std::min(f.extra_imus.size(), c.extra_imu_sensor_ids.size());
+  if (seq.extra_imus.size() < units) seq.extra_imus.resize(units, 0);
+  for (std::size_t k = 0; k < units; ++k) {
+    if (!emit(bus::toIdl(f.extra_imus[k].increment, c.extra_imu_sensor_ids[k],
+                         seq.extra_imus[k] + 1)))
+      return false;
+    ++seq.extra_imus[k];
   }
   if (c.publish_gnss && f.has_gnss) {
     if (!emit(toIdl(f.gnss, c.gnss_receiver_id, seq.gnss_epochs + 1))) return false;
@@ -106,6 +119,9 @@ class FramePublisher {
   template <class Message>
   bus::Writer<Message> createWriter();
   bool writeIncrement(const navbus::ImuIncrement& increment);
+  /// The batcher of an increment's sensor (the scenario's IMU or a further unit's).
+  ImuBlockBatcher& batcherOf(std::uint32_t sensor_id);
+  bool writeIncrementBlock(ImuBlockBatcher& batcher);
   bool writeRaw(const navbus::ImuRawBlock& raw);
   bool batchRaw(const navbus::ImuRawBlock& raw);
   /// Writes the pending blocks (fast pacing with blocks).
@@ -121,7 +137,9 @@ class FramePublisher {
   bus::Writer<navbus::GnssFix> fix_;
   bus::Writer<navbus::StarTrackerAttitude> star_;
   std::optional<ImuBlockBatcher> batcher_;  ///< with blocks
-  FrameSequence sequence_;                  ///< the frames' sequence numbers (emitFrame)
+  /// With blocks: the further IMU units' increments, one batcher per unit (in unit order)
+  std::vector<ImuBlockBatcher> unit_batchers_;
+  FrameSequence sequence_;  ///< the frames' sequence numbers (emitFrame)
   WrittenCounts written_;
   std::uint64_t write_retries_{0};
 };

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -30,6 +31,8 @@ struct SimConfig {
     int imu{1}, raw_imu{0}, gnss{1}, star_tracker{1};
   } min_readers;
   std::uint32_t imu_sensor_id{1};
+  /// The sensor ids of the scenario's further IMU units (imu_units), in unit order.
+  std::vector<std::uint32_t> extra_imu_sensor_ids;
   std::uint32_t gnss_receiver_id{1};
   std::uint32_t star_tracker_id{1};
   bool publish_raw{true};
