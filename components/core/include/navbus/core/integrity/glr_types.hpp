@@ -1,8 +1,8 @@
 // The GLR monitor's inputs, hypotheses and results (seed 000 eqs. 6-16, glr.hpp): sizes, the
 // epoch the monitored filter publishes, the directions T, the configuration and what a test
-// reports; shared by the window of
-// signature sums (glr_window.hpp), the group statistics (glr_group_fit.hpp), isolation
-// (glr_isolation.hpp) and the monitor that puts them together (glr.hpp).
+// reports; shared by the window of signature sums (glr_window.hpp), the group statistics
+// (glr_group_fit.hpp), isolation (glr_isolation.hpp) and the monitor that puts them together
+// (glr.hpp).
 #pragma once
 
 #include <array>

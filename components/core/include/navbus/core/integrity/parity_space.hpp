@@ -49,10 +49,9 @@ class ParitySpace {
   int dimension() const { return instruments() - 3; }  ///< n - 3
   const parity::Axes& axes() const { return axes_; }
   const parity::Measurements& sigmas() const { return sigmas_; }
-  /// V W (eq. 2): (n - 3) x n.
+  /// V W (eq. 2): (n - 3) x n; its column j is s_j = V W e_j, the parity vector of a unit bias
+  /// on instrument j.
   const parity::Matrix& parityMatrix() const { return vw_; }
-  /// s_j = V W e_j: the parity vector of a unit bias on instrument j.
-  auto signature(int j) const { return vw_.col(j); }
   /// |s_j|^2: the information a sample carries on a bias of instrument j [1 / unit^2].
   double information(int j) const { return vw_.col(j).squaredNorm(); }
   /// |s_i . s_j| / (|s_i| |s_j|): 1 when instruments i and j cannot be told apart.
