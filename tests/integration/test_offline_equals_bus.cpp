@@ -29,7 +29,15 @@ struct Case {
   int seed;
   double duration_s;
   std::vector<std::string> filter_log_says{};  ///< lines the filter's log must contain
+  std::string
+      fault_manager{};       ///< file under config for both runs ("": the defaults, offline none)
+  std::size_t decisions{0};  ///< with fault_manager: the decisions both runs must publish
 };
+
+/// A decision as CSV, without its run_id (the last column: the bus run's start time, 0 offline).
+std::string withoutRunId(const std::string& row) {
+  return row.substr(0, row.rfind(','));
+}
 
 void runCase(const Case& c) {
   test::cleanSharedMemory();
@@ -55,17 +63,38 @@ void runCase(const Case& c) {
           "solution_writer_profile: navbus_solution_writer_lossless\n" +
           "sequencer_max_wait_s: 30\n" +
           "fault_monitor: {participant: navbus-fault-manager, timeout_s: 30}\n" + c.filter_extra);
-  const std::string fm_cfg = test::writeFile(dir / "fm.yaml", domain);
+  const std::string fm_cfg = test::writeFile(
+      dir / "fm.yaml",
+      (c.fault_manager.empty() ? std::string()
+                               : "extends: " + std::string(navbus::test_paths::configDir()) + "/" +
+                                     c.fault_manager + "\n") +
+          domain);
 
   // Offline first: no DDS at all.
-  test::ChildProcess offline(
-      navbus::test_paths::toolExe(),
-      {"offline", "--scenario", sim_cfg, "--filter", filter_cfg, "--start", "config", "--seed",
-       std::to_string(c.seed), "-o", (dir / "offline").string()},
-      (dir / "offline.log").string());
+  std::vector<std::string> offline_args = {"offline",
+                                           "--scenario",
+                                           sim_cfg,
+                                           "--filter",
+                                           filter_cfg,
+                                           "--start",
+                                           "config",
+                                           "--seed",
+                                           std::to_string(c.seed),
+                                           "-o",
+                                           (dir / "offline").string()};
+  if (!c.fault_manager.empty()) {
+    offline_args.push_back("--fault-manager");
+    offline_args.push_back(fm_cfg);
+  }
+  test::ChildProcess offline(navbus::test_paths::toolExe(), offline_args,
+                             (dir / "offline.log").string());
   ASSERT_EQ(offline.wait(120s), 0) << test::readFile(dir / "offline.log");
   const std::vector<std::string> expected = test::csvDataRows(dir / "offline" / "solution.csv");
   ASSERT_GT(expected.size(), 100u);
+  std::vector<std::string> expected_decisions;
+  if (!c.fault_manager.empty())
+    for (const std::string& row : test::csvDataRows(dir / "offline" / "decisions.csv"))
+      expected_decisions.push_back(withoutRunId(row));
 
   // The same over the bus: simulator, filter and fault manager as separate processes.
   bus::ShutdownSignal shutdown;
@@ -77,6 +106,12 @@ void runCase(const Case& c) {
                                                if (s.mode() != MODE_INERTIAL_LOST)
                                                  rows.push_back(records::csvRows(s).at(0));
                                              });
+  std::vector<std::string> decisions;
+  me.subscribe<FaultDecisionPubSubType>(
+      bus::topic::kFaultDecision, bus::profile::kDecisionReader,
+      [&](const FaultDecision& d, const auto&) {
+        decisions.push_back(withoutRunId(records::csvRows(d).at(0)));
+      });
   test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
                             (dir / "filter.log").string());
   test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
@@ -107,6 +142,14 @@ void runCase(const Case& c) {
   EXPECT_NE(log.find("sequencer timeouts 0,"), std::string::npos) << log;
   for (const std::string& line : c.filter_log_says)
     EXPECT_NE(log.find(line), std::string::npos) << line;
+  if (!c.fault_manager.empty()) {
+    // The fault manager's decisions (the parity test's on the units' increments, taken from
+    // the bus in whatever order the units' samples arrive) are the offline run's, field for field.
+    EXPECT_EQ(expected_decisions.size(), c.decisions) << test::readFile(dir / "offline.log");
+    EXPECT_EQ(decisions, expected_decisions) << test::readFile(dir / "fm.log");
+    std::printf("%zu decisions, bus and offline identical: %s\n", decisions.size(),
+                decisions == expected_decisions ? "yes" : "NO");
+  }
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }
@@ -123,16 +166,21 @@ TEST(OfflineEqualsBus, LeoFederatedGnssAndStarTracker) {
 
 // A triplex installation (sensor 1 and units 2 and 3) into a filter configured for sensor 1: the
 // units' increments go over the bus in blocks of their own instances, the filter refuses them
-// as unexpected sources, and its solutions stay those of the offline run.
+// as unexpected sources, and its solutions stay those of the offline run. The fault manager's
+// parity test reads all three units and isolates unit 2's gyro step at 502 s: the same decision
+// as offline (its command is refused by the one-IMU filter, which has no unit 2).
 TEST(OfflineEqualsBus, TriplexUnitsBesideAOneImuFilter) {
   runCase({92,
            "seed000_triplex_gyro_step.yaml",
            "filter_seed000_tc.yaml",
            "",
            2,
-           120.0,
+           520.0,
            {"rejected sample of sensor 2 (unexpected_source: sensor_id = 2",
-            "rejected sample of sensor 3 (unexpected_source: sensor_id = 3"}});
+            "rejected sample of sensor 3 (unexpected_source: sensor_id = 3",
+            "command 1 from 'fault-manager' refused: kind 8: sensor_id 2 is not this filter's IMU"},
+           "fault_manager_triplex.yaml",
+           1});
 }
 
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->

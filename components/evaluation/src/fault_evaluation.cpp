@@ -12,18 +12,28 @@ namespace navbus::evaluation {
 
 namespace {
 
-bool matches(const sim::Fault& f, navbus::FaultSource source, int sv_id, int axis) {
+/// `sensor_id`: the unit a parity decision or candidate names; 0 for the GLR's, which are
+/// about the filter's own IMU (the scenario's, unit 0).
+bool matches(const sim::Fault& f, navbus::FaultSource source, int sv_id, int axis,
+             std::uint32_t sensor_id) {
   if (f.kind == sim::FaultKind::kPseudorangeRamp) {
     return source == navbus::SOURCE_SATELLITE && sv_id == f.sv_id;
   }
   const navbus::FaultSource want = f.sensor == sim::SensorKind::kAccelerometer
                                        ? navbus::SOURCE_ACCELEROMETER
                                        : navbus::SOURCE_GYRO;
-  return source == want && axis == f.axis;
+  const bool unit = sensor_id == 0 ? f.unit == 0 : sensor_id == f.sensor_id;
+  return source == want && axis == f.axis && unit;
+}
+
+std::uint32_t parityUnit(const navbus::FaultDecision& d) {
+  return d.detector() == "parity" ? d.sensor_id() : 0;
 }
 
 double trueMagnitude(const sim::Fault& f) {
-  return f.kind == sim::FaultKind::kPseudorangeRamp ? f.slope : f.magnitude;
+  return f.kind == sim::FaultKind::kPseudorangeRamp || f.kind == sim::FaultKind::kImuBiasRamp
+             ? f.slope
+             : f.magnitude;
 }
 
 std::string describe(const navbus::FaultDecision& d) {
@@ -32,10 +42,12 @@ std::string describe(const navbus::FaultDecision& d) {
     case navbus::SOURCE_ACCELEROMETER:
       s << "accel "
         << "xyz"[d.axis() % 3];
+      if (parityUnit(d) != 0) s << " imu " << d.sensor_id();
       break;
     case navbus::SOURCE_GYRO:
       s << "gyro "
         << "xyz"[d.axis() % 3];
+      if (parityUnit(d) != 0) s << " imu " << d.sensor_id();
       break;
     case navbus::SOURCE_SATELLITE:
       s << "sv " << d.sv_id() << (d.shape() == navbus::SHAPE_RAMP ? " ramp" : " step");
@@ -97,7 +109,8 @@ bool writeGlrCsv(const std::string& path,
 
 std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule) {
   for (const sim::Fault& f : schedule.faults()) {
-    if (f.kind == sim::FaultKind::kImuBiasStep || f.kind == sim::FaultKind::kPseudorangeRamp)
+    if (f.kind == sim::FaultKind::kImuBiasStep || f.kind == sim::FaultKind::kImuBiasRamp ||
+        f.kind == sim::FaultKind::kPseudorangeRamp)
       return f;
   }
   return std::nullopt;
@@ -124,26 +137,29 @@ FaultRunOutcome evaluateRun(const OfflineResult& r, const std::optional<sim::Fau
         1e-9 * static_cast<double>(static_cast<std::int64_t>(d.onset_time_gps_ns()) - start_ns);
     out.decided = describe(d);
     out.ambiguous = d.ambiguous();
-    const bool imu_truth = fault->kind == sim::FaultKind::kImuBiasStep;
+    const bool imu_truth = fault->kind != sim::FaultKind::kPseudorangeRamp;
     const bool imu_decided =
         d.source() == navbus::SOURCE_ACCELEROMETER || d.source() == navbus::SOURCE_GYRO;
     out.class_correct = imu_truth == imu_decided;
-    out.source_correct = matches(*fault, d.source(), d.sv_id(), d.axis());
+    out.source_correct = matches(*fault, d.source(), d.sv_id(), d.axis(), parityUnit(d));
     double magnitude = out.source_correct ? d.magnitude() : std::nan("");
     for (const auto& c : d.candidates()) {
-      if (matches(*fault, c.source(), c.sv_id(), c.axis())) {
+      if (matches(*fault, c.source(), c.sv_id(), c.axis(), c.sensor_id())) {
         out.truth_among_candidates = true;
         if (std::isnan(magnitude)) magnitude = c.magnitude();
       }
     }
     out.magnitude_error = (magnitude - trueMagnitude(*fault)) / trueMagnitude(*fault);
     // A ramp named as a step (or the reverse) has a magnitude in another unit.
+    // An IMU ramp is detected as the step it has grown to (the parity GLR tests steps): its
+    // shape is not scored, nor is its magnitude.
     const bool ramp = fault->kind == sim::FaultKind::kPseudorangeRamp;
     out.shape_correct = !ramp || d.shape() == navbus::SHAPE_RAMP;
-    if (!out.shape_correct) out.magnitude_error = std::nan("");
+    if (!out.shape_correct || fault->kind == sim::FaultKind::kImuBiasRamp)
+      out.magnitude_error = std::nan("");
     for (const navbus::FilterCommand& c : r.commands) {
       if (c.decision_id() == d.decision_id() && c.kind() == navbus::CMD_COMPENSATE_BIAS &&
-          matches(*fault, c.sensor(), 0, c.axis()))
+          matches(*fault, c.sensor(), 0, c.axis(), 0))
         out.commanded_error = (c.bias() - trueMagnitude(*fault)) / trueMagnitude(*fault);
     }
     out.recovery_s = recoveryTime(r.errors, static_cast<std::int64_t>(d.time_gps_ns()));

@@ -170,7 +170,10 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   sensor_sim::FrameSequence seq;
   auto feed = [&pipeline, &faults](const auto& sample) {
     using T = std::decay_t<decltype(sample)>;
-    if constexpr (std::is_same_v<T, navbus::ImuIncrement>) pipeline.onImu(sample);
+    if constexpr (std::is_same_v<T, navbus::ImuIncrement>) {
+      pipeline.onImu(sample);
+      if (faults) faults->onImuIncrement(sample);
+    }
     if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
       pipeline.onGnssObservations(sample);
     if constexpr (std::is_same_v<T, navbus::GnssFix>) pipeline.onGnssFix(sample);

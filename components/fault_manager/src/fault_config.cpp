@@ -1,8 +1,10 @@
 #include "navbus/fault_manager/fault_config.hpp"
 
+#include <cmath>
 #include <string>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
 
 namespace navbus::fault_manager {
@@ -10,6 +12,7 @@ namespace navbus::fault_manager {
 namespace {
 
 using units::kDeg;
+using units::kMicroG;
 using units::kMilliG;
 
 using bus::checkKeys;
@@ -86,11 +89,91 @@ void parseDither(const YAML::Node& n, DitherDetectorConfig& d) {
   }
 }
 
+/// [deg/sqrt(h)] -> [rad/sqrt(s)]
+constexpr double kDegPerSqrtHour = kDeg / 60.0;
+
+void parseParityUnits(const YAML::Node& list, ParityDetectorConfig& d) {
+  if (!list || !list.IsSequence())
+    throw bus::ConfigError("configuration parity.units must be a list of the IMUs");
+  const double dt = 1.0 / d.imu_rate_hz;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node n = list[i];
+    const std::string w = "parity.units[" + std::to_string(i) + "]";
+    checkKeys(n, w,
+              {"sensor_id", "mounting_rpy_deg", "lever_arm_b_m", "gyro_arw_deg_per_sqrth",
+               "accel_noise_ug_per_sqrthz"});
+    if (!n["sensor_id"]) throw bus::ConfigError("configuration " + w + ".sensor_id is missing");
+    const auto id = bus::get<std::uint32_t>(n, w, "sensor_id", 0);
+    for (std::uint32_t known : d.sensor_ids)
+      if (known == id)
+        throw bus::ConfigError("configuration " + w + ".sensor_id " + std::to_string(id) +
+                               " is given twice");
+    core::ImuArrayUnit u;
+    // The unit's axes: rotated from the body by roll, pitch, yaw (body -> unit is the transpose
+    // of the unit -> body rotation those angles make), as the simulator's imu_units.
+    u.c_u_b = core::dcmFromEuler(bus::getVector3(n, w, "mounting_rpy_deg", kDeg)).transpose();
+    u.lever_arm_b_m = bus::getVector3(n, w, "lever_arm_b_m", 1.0);
+    const double arw = bus::checkRange(bus::get<double>(n, w, "gyro_arw_deg_per_sqrth", 0.0), 1e-9,
+                                       1e3, w + ".gyro_arw_deg_per_sqrth");
+    const double vrw = bus::checkRange(bus::get<double>(n, w, "accel_noise_ug_per_sqrthz", 0.0),
+                                       1e-6, 1e7, w + ".accel_noise_ug_per_sqrthz");
+    u.gyro_sigma_rad = arw * kDegPerSqrtHour * std::sqrt(dt);
+    u.accel_sigma_mps = vrw * kMicroG * std::sqrt(dt);
+    d.sensor_ids.push_back(id);
+    d.units.push_back(u);
+  }
+}
+
+void parseParity(const YAML::Node& n, ParityDetectorConfig& d) {
+  if (!n) return;
+  const std::string w = "parity";
+  checkKeys(
+      n, w,
+      {"enabled", "imu_rate_hz", "units", "onsets", "onset_spacing", "false_alarm_probability",
+       "detection_probability", "ambiguity_margin", "ambiguity_correlation", "reference_s",
+       "reference_time_constant_s", "actions", "alignment_depth"});
+  d.enabled = bus::get<bool>(n, w, "enabled", d.enabled);
+  d.imu_rate_hz = bus::checkRange(bus::get<double>(n, w, "imu_rate_hz", d.imu_rate_hz), 1.0, 1e5,
+                                  "parity.imu_rate_hz");
+  core::ImuArrayParityConfig& a = d.array;
+  core::ParityGlrConfig& g = a.glr;
+  g.onsets = bus::get<int>(n, w, "onsets", g.onsets);
+  g.onset_spacing = bus::get<int>(n, w, "onset_spacing", g.onset_spacing);
+  g.false_alarm_probability =
+      bus::get<double>(n, w, "false_alarm_probability", g.false_alarm_probability);
+  g.detection_probability =
+      bus::get<double>(n, w, "detection_probability", g.detection_probability);
+  g.ambiguity_margin = bus::get<double>(n, w, "ambiguity_margin", g.ambiguity_margin);
+  g.ambiguity_correlation =
+      bus::get<double>(n, w, "ambiguity_correlation", g.ambiguity_correlation);
+  const double reference_s = bus::checkRange(bus::get<double>(n, w, "reference_s", 60.0), 0.01,
+                                             86400.0, "parity.reference_s");
+  const double tau_s = bus::checkRange(bus::get<double>(n, w, "reference_time_constant_s", 1800.0),
+                                       0.0, 1e7, "parity.reference_time_constant_s");
+  a.reference_samples = static_cast<int>(std::lround(reference_s * d.imu_rate_hz));
+  a.reference_time_constant_samples = tau_s * d.imu_rate_hz;
+  d.alignment_depth =
+      static_cast<int>(bus::checkRange(bus::get<double>(n, w, "alignment_depth", d.alignment_depth),
+                                       1.0, 1e5, "parity.alignment_depth"));
+  const YAML::Node act = n["actions"];
+  checkKeys(act, "parity.actions", {"axis"});
+  const auto axis = bus::get<std::string>(act, "parity.actions", "axis", "fail");
+  if (axis != "fail" && axis != "none")
+    throw bus::ConfigError("configuration parity.actions.axis: '" + axis +
+                           "' is not one of fail, none");
+  d.fail_axes = axis == "fail";
+  if (!d.enabled) return;
+  parseParityUnits(n["units"], d);
+  std::string error;  // the array's own rules (geometry, noise, GLR keys), naming the field
+  if (!core::ImuArrayParity::make(d.units, 1.0 / d.imu_rate_hz, a, error))
+    throw bus::ConfigError("configuration parity: " + error);
+}
+
 }  // namespace
 
 FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
   FaultManagerConfig c;
-  checkKeys(root, "", {"vehicle_id", "glr", "dither"}, bus::kParticipantKeys);
+  checkKeys(root, "", {"vehicle_id", "glr", "dither", "parity"}, bus::kParticipantKeys);
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", c.vehicle_id);
   const YAML::Node g = root["glr"];
   checkKeys(g, "glr",
@@ -130,6 +213,7 @@ FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
       bus::get<double>(rep, "glr.repeats", "escalate_after", d.repeats.escalate_after), 1.0, 100.0,
       "glr.repeats.escalate_after"));
   parseDither(root["dither"], c.dither);
+  parseParity(root["parity"], c.parity);
   return c;
 }
 

@@ -30,7 +30,8 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
                  [this](const navbus::FilterCommand& c) { command_writer_.write(c); },
                  [this](const navbus::FaultMonitorProgress& r) { progress_writer_.write(r); }},
                 bus::wallTimeNowNs()),
-      sensors_(p, streamEvents()) {
+      sensors_(p, streamEvents()),
+      parity_sensors_(p, {}) {
   using namespace bus;
   watch<navbus::ImuIncrement>(profile::kSensorWatchdogReader);
   // Fast pacing's blocks of increments: each element is watched as one increment.
@@ -51,11 +52,27 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
           participant_.setState(pipeline_.degraded() ? navbus::STATE_DEGRADED
                                                      : navbus::STATE_RUNNING);
       });
+  if (config.parity.enabled) subscribeIncrements();
   if (config.glr.enabled) {
     p.subscribe<navbus::FilterDiagnosticsPubSubType>(
         topic::kFilterDiagnostics, profile::kDiagnosticsReader,
         [this](const navbus::FilterDiagnostics& m, const auto&) { pipeline_.onDiagnostics(m); });
   }
+}
+
+void FaultManagerNode::subscribeIncrements() {
+  // The parity test needs every increment of every unit: reliable readers (the filter's
+  // profile), which back-pressure the simulator as the filter's do; watchdog events are the
+  // best-effort readers' business.
+  using namespace bus;
+  parity_sensors_.subscribe<navbus::ImuIncrement>(
+      profile::kSensorReader,
+      [this](const navbus::ImuIncrement& m) { pipeline_.onImuIncrement(m); });
+  parity_sensors_.subscribe<navbus::ImuIncrementBlock>(
+      profile::kSensorReader, [this](const navbus::ImuIncrementBlock& m) {
+        for (const navbus::ImuIncrement& increment : m.increments())
+          pipeline_.onImuIncrement(increment);
+      });
 }
 
 std::int64_t FaultManagerNode::running() {

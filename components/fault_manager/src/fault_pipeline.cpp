@@ -25,10 +25,15 @@ FaultPipeline::FaultPipeline(const FaultManagerConfig& config, bus::HealthCounte
       run_id_(run_id),
       outcomes_(kIssuer, run_id) {
   if (config.dither.enabled) dither_.emplace(config.dither);
+  if (config.parity.enabled) parity_.emplace(config.parity);
 }
 
 void FaultPipeline::onRawBlock(const navbus::ImuRawBlock& block) {
   if (dither_) dither_->onRawBlock(block, *this);
+}
+
+void FaultPipeline::onImuIncrement(const navbus::ImuIncrement& increment) {
+  if (parity_) parity_->onIncrement(increment, *this);
 }
 
 void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
@@ -198,6 +203,7 @@ std::string FaultPipeline::summary() const {
       << ", clamped " << outcomes_.clamped() << ", refused " << outcomes_.refused() << ")"
       << "; " << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
+  if (parity_) out << "; " << parity_->summary();
   if (stalls_ > 0)
     out << "; stalls of the fault manager process " << stalls_ << " (longest "
         << 1e-9 * static_cast<double>(longest_stall_ns_) << " s)";

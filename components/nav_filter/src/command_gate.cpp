@@ -10,6 +10,7 @@ namespace navbus::nav_filter {
 CommandGate::CommandGate(const FilterConfig& config, bus::StreamCounters& topic_counters,
                          OutcomeSink outcome_sink)
     : vehicle_id_(config.vehicle_id),
+      imu_id_(config.imu.id),
       issuers_(config.command_issuers),
       issuer_identities_(config.issuer_identities),
       max_accel_compensation_mps2_(config.max_accel_compensation_mps2),
@@ -88,6 +89,13 @@ bool CommandGate::refuseIfStale(const navbus::FilterCommand& c, std::int64_t fir
   return true;
 }
 
+std::optional<std::string> CommandGate::otherImu(const navbus::FilterCommand& c) const {
+  // 0 is this filter's IMU (the GLR's and an operator's commands); a redundant unit's
+  // instrument (the parity detector's) is another IMU's, not this filter's to fail.
+  if (c.sensor_id() == 0 || c.sensor_id() == imu_id_) return std::nullopt;
+  return fmt::format("sensor_id {} is not this filter's IMU (imu.id {})", c.sensor_id(), imu_id_);
+}
+
 std::optional<std::string> CommandGate::check(const navbus::FilterCommand& c) const {
   switch (c.kind()) {
     case navbus::CMD_EXCLUDE_SATELLITE:
@@ -96,6 +104,7 @@ std::optional<std::string> CommandGate::check(const navbus::FilterCommand& c) co
       return std::nullopt;
     case navbus::CMD_FAIL_SENSOR_AXIS:
     case navbus::CMD_RESTORE_SENSOR_AXIS:
+      if (auto other = otherImu(c)) return other;
       if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
         return fmt::format("sensor {} is not an accelerometer or gyro",
                            static_cast<int>(c.sensor()));
@@ -103,6 +112,7 @@ std::optional<std::string> CommandGate::check(const navbus::FilterCommand& c) co
       return std::nullopt;
     case navbus::CMD_COMPENSATE_BIAS:
     case navbus::CMD_RELEARN_BIAS: {
+      if (auto other = otherImu(c)) return other;
       if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
         return fmt::format("sensor {} is not an accelerometer or gyro",
                            static_cast<int>(c.sensor()));

@@ -225,6 +225,7 @@ sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::ui
       f.sensor = sensorKind(n, where);
       f.axis = axisIndex(n, where);
       f.unit = faultUnit(n, where, imu_ids);
+      f.sensor_id = imu_ids[static_cast<std::size_t>(f.unit)];
       f.magnitude = f.sensor == sim::SensorKind::kAccelerometer
                         ? bus::require<double>(n, where, "magnitude_mg") * 1e-3 * kG
                         : bus::require<double>(n, where, "magnitude_deg_per_h") * kDegPerHour;
@@ -233,6 +234,7 @@ sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::ui
       f.sensor = sensorKind(n, where);
       f.axis = axisIndex(n, where);
       f.unit = faultUnit(n, where, imu_ids);
+      f.sensor_id = imu_ids[static_cast<std::size_t>(f.unit)];
       const bool accel = f.sensor == sim::SensorKind::kAccelerometer;
       const double unit = accel ? 1e-3 * kG : kDegPerHour;
       f.slope =
@@ -258,6 +260,7 @@ sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::ui
       f.sensor = sensorKind(n, where);
       f.axis = axisIndex(n, where);
       f.unit = faultUnit(n, where, imu_ids);
+      f.sensor_id = imu_ids[static_cast<std::size_t>(f.unit)];
     } else if (type == "gnss_outage") {
       f.kind = sim::FaultKind::kGnssOutage;
     } else if (type == "star_tracker_outage") {

@@ -3,8 +3,12 @@
 // counts it, and its solutions are bit for bit those of the same scenario without the units.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "navbus/bus/config.hpp"
+#include "navbus/core/math/units.hpp"
 #include "navbus/evaluation/offline_runner.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
 #include "test_paths.hpp"
 
 namespace evaluation = navbus::evaluation;
@@ -47,4 +51,74 @@ TEST(RedundantUnits, AOneImuFilterRefusesTheFurtherUnitsCountedAndUnchanged) {
     ASSERT_EQ(a.errors[i].pos_ned_m, b.errors[i].pos_ned_m) << "solution " << i;
     ASSERT_EQ(a.errors[i].pos_sigma_ned_m, b.errors[i].pos_sigma_ned_m) << "solution " << i;
   }
+}
+
+namespace {
+
+/// The triplex scenario `file` through the seed-000 filter and the triplex fault manager (its
+/// parity test on the three units' increments), `duration_s` of it.
+evaluation::OfflineResult runWithParity(const std::string& file, double duration_s) {
+  const std::string dir = navbus::test_paths::scenarioDir();
+  evaluation::OfflineSetup s;
+  s.sim = navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(dir + "/" + file));
+  s.filter = navbus::nav_filter::parseFilterConfig(navbus::bus::loadYamlFile(
+      std::string(navbus::test_paths::configDir()) + "/filter_seed000_tc.yaml"));
+  s.filter.engine.initial_state = evaluation::initialTruth(s.sim.scenario);
+  s.fault_manager = navbus::fault_manager::parseFaultManagerConfig(navbus::bus::loadYamlFile(
+      std::string(navbus::test_paths::configDir()) + "/fault_manager_triplex.yaml"));
+  s.duration_s = duration_s;
+  return evaluation::runOffline(s);
+}
+
+double secondsIntoRun(std::uint64_t time_gps_ns) {
+  return 1e-9 * static_cast<double>(time_gps_ns - 1400000000000000000ull);  // the scenario start
+}
+
+}  // namespace
+
+TEST(RedundantUnits, TheParityTestIsolatesUnit2sGyroStepWithinFiveSeconds) {
+  // Given the triplex scenario (a 10 deg/h x-gyro step on unit 2 at 502 s) and the fault
+  // manager's parity test on the three units (config/fault_manager_triplex.yaml), when 520 s run
+  // offline, then exactly one decision comes, from the parity test, after the onset and within
+  // 5 s of it, naming unit 2's gyro x, not ambiguous, its size within 20 % of 10 deg/h; its
+  // command fails that unit's axis, and the one-IMU filter (sensor 1) refuses it, naming why.
+  const evaluation::OfflineResult r = runWithParity("seed000_triplex_gyro_step.yaml", 520.0);
+  ASSERT_EQ(r.decisions.size(), 1u) << r.fault_summary;
+  const navbus::FaultDecision& d = r.decisions[0];
+  EXPECT_EQ(d.detector(), "parity");
+  EXPECT_EQ(d.source(), navbus::SOURCE_GYRO);
+  EXPECT_EQ(d.sensor_id(), 2u);
+  EXPECT_EQ(d.axis(), 0);
+  EXPECT_FALSE(d.ambiguous());
+  EXPECT_GT(secondsIntoRun(d.time_gps_ns()), 502.0);
+  EXPECT_LE(secondsIntoRun(d.time_gps_ns()), 507.0);
+  EXPECT_NEAR(secondsIntoRun(d.onset_time_gps_ns()), 502.0, 0.2);
+  EXPECT_NEAR(d.magnitude() / navbus::units::kDegPerHour, 10.0, 2.0);
+  ASSERT_EQ(r.commands.size(), 1u);
+  EXPECT_EQ(r.commands[0].kind(), navbus::CMD_FAIL_SENSOR_AXIS);
+  EXPECT_EQ(r.commands[0].sensor_id(), 2u);
+  EXPECT_NE(r.summary.find("commands applied 0 refused 1"), std::string::npos) << r.summary;
+}
+
+TEST(RedundantUnits, TheParityTestIsQuietOnAFaultFreeTriplexAndCatchesASlowRampEarly) {
+  // Given the fault-free triplex aircraft, when its 2000 s run with the parity test, then no
+  // decision comes and the largest statistic of either kind stays below the threshold. Given
+  // the same with unit 2's x gyro ramping from 700 s at 0.0026 deg/h per second (3 minimum
+  // detectable biases after 600 s), then the ramp is the one decision, unit 2 gyro x, before it
+  // has reached three minimum detectable biases.
+  const evaluation::OfflineResult quiet = runWithParity("seed000_triplex.yaml", 2000.0);
+  EXPECT_TRUE(quiet.decisions.empty()) << quiet.fault_summary;
+  EXPECT_NE(quiet.fault_summary.find("parity: 200000 aligned samples of 3 IMUs"), std::string::npos)
+      << quiet.fault_summary;
+  const evaluation::OfflineResult ramp = runWithParity("seed000_triplex_gyro_ramp.yaml", 2000.0);
+  ASSERT_EQ(ramp.decisions.size(), 1u) << ramp.fault_summary;
+  const navbus::FaultDecision& d = ramp.decisions[0];
+  EXPECT_EQ(d.sensor_id(), 2u);
+  EXPECT_EQ(d.source(), navbus::SOURCE_GYRO);
+  EXPECT_EQ(d.axis(), 0);
+  const double after_s = secondsIntoRun(d.time_gps_ns()) - 700.0;
+  EXPECT_GT(after_s, 0.0);
+  EXPECT_LT(after_s, 600.0);  // 3 x 0.52 deg/h at 0.0026 deg/h/s
+  std::printf("ramp detected %.1f s after its start, at %.3f deg/h (3 x MDB = 1.56 deg/h)\n",
+              after_s, 0.0026 * after_s);
 }

@@ -2,6 +2,7 @@
 // the scenario start; sizes are SI. Each query answers what is active at a time.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +32,7 @@ struct Fault {
   int axis{0};  ///< 0..2
   /// IMU faults: the unit (0: the scenario's IMU; k: ScenarioConfig::extra_imus[k - 1]).
   int unit{0};
+  std::uint32_t sensor_id{0};  ///< IMU faults: the unit's sensor id (ImuIncrement.sensor_id)
   int sv_id{0};
   double magnitude{0.0};  ///< bias step [m/s^2 | rad/s]
   /// Ramps: pseudorange [m/s], IMU bias [m/s^2 | rad/s per s]

@@ -3,11 +3,13 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
 #include "navbus/core/integrity/dither_monitor.hpp"
 #include "navbus/core/integrity/glr.hpp"
+#include "navbus/core/integrity/imu_array_parity.hpp"
 #include "navbus/fault_manager/repeat_guard.hpp"
 
 namespace navbus::fault_manager {
@@ -36,10 +38,26 @@ struct DitherDetectorConfig {
   bool fail_axes{true};  ///< command CMD_FAIL_SENSOR_AXIS for a failed axis
 };
 
+/// The parity detector of redundant IMUs (parity_detector.hpp): the units on the bus, their
+/// geometry and noise, converted to SI and per sample here.
+struct ParityDetectorConfig {
+  bool enabled{false};
+  double imu_rate_hz{100.0};  ///< [Hz] every unit's increment rate (samples are time-aligned)
+  std::vector<std::uint32_t> sensor_ids;  ///< ImuIncrement.sensor_id of each unit
+  std::vector<core::ImuArrayUnit> units;  ///< same order
+  core::ImuArrayParityConfig array;
+  bool fail_axes{true};  ///< command CMD_FAIL_SENSOR_AXIS (unit, axis) for an isolated instrument
+  /// Times waiting for a unit's increment (units are received in any order between them; a
+  /// unit that has passed a time without its increment lost it). Beyond this many, a silent unit
+  /// holds up the others: the oldest time is dropped, counted, and the tests restart.
+  int alignment_depth{6000};
+};
+
 struct FaultManagerConfig {
   std::uint32_t vehicle_id{1};  ///< the filter monitored and commanded
   GlrDetectorConfig glr;
   DitherDetectorConfig dither;
+  ParityDetectorConfig parity;
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid or unknown entry.

@@ -28,6 +28,8 @@ class FaultManagerNode {
   template <class Message>
   void watch(const char* profile);
   bus::SensorReaders::Events streamEvents();
+  /// Reliable readers of every IMU's increments for the parity detector.
+  void subscribeIncrements();
   /// The steady clock now, after telling the pipeline of a stall of this process that just
   /// ended (bus::StallDetector).
   std::int64_t running();
@@ -38,8 +40,9 @@ class FaultManagerNode {
   bus::Writer<navbus::FilterCommand> command_writer_;
   bus::Writer<navbus::FaultMonitorProgress> progress_writer_;  ///< how far diagnostics are judged
   FaultPipeline pipeline_;
-  bus::StallDetector stalls_;   ///< pauses of this process between two turns of its loop
-  bus::SensorReaders sensors_;  ///< the watched sensor streams (owning writers only)
+  bus::StallDetector stalls_;          ///< pauses of this process between two turns of its loop
+  bus::SensorReaders sensors_;         ///< the watched sensor streams (owning writers only)
+  bus::SensorReaders parity_sensors_;  ///< every IMU's increments, reliably (parity detector)
 };
 
 }  // namespace navbus::fault_manager

@@ -22,6 +22,7 @@
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/fault_manager/fault_output.hpp"
 #include "navbus/fault_manager/glr_detector.hpp"
+#include "navbus/fault_manager/parity_detector.hpp"
 #include "navbus/fault_manager/stream_watchdog.hpp"
 
 namespace navbus::fault_manager {
@@ -71,10 +72,15 @@ class FaultPipeline : private FaultOutput {
   /// A raw IMU block, for the dither monitor (watchdog bookkeeping goes through
   /// onStreamSample as for every stream).
   void onRawBlock(const navbus::ImuRawBlock& block);
+  /// A navigation-rate increment of any IMU unit, for the parity detector (every increment,
+  /// a fast-pacing block's elements one by one).
+  void onImuIncrement(const navbus::ImuIncrement& increment);
 
   const GlrDetector& glr() const { return glr_; }
   /// The dither detector, when configured.
   const std::optional<DitherDetector>& dither() const { return dither_; }
+  /// The parity detector of redundant IMUs, when configured.
+  const std::optional<ParityDetector>& parity() const { return parity_; }
   std::uint64_t decisions() const { return next_decision_id_ - 1; }
   std::uint64_t commands() const { return next_command_id_ - 1; }
   /// The filter's answer to a command (its own are counted; others ignored). A refusal or a
@@ -97,6 +103,7 @@ class FaultPipeline : private FaultOutput {
   StreamWatchdog watchdog_;
   GlrDetector glr_;
   std::optional<DitherDetector> dither_;
+  std::optional<ParityDetector> parity_;
   bus::StreamGate diagnostics_gate_;
   std::map<StreamKind, bus::SequenceTracker> trackers_;
   std::map<StreamKind, double> deadline_s_;

@@ -202,7 +202,8 @@ IfMessage<M, navbus::FaultDecision> visitFields(M& m, V& v) {
   std::ostringstream candidates;
   for (const auto& c : m.candidates()) {
     candidates << enumName(c.source()) << ":" << c.sv_id() << ":" << c.axis() << ":"
-               << enumName(c.shape()) << ":" << c.statistic() << ":" << c.magnitude() << " ";
+               << enumName(c.shape()) << ":" << c.statistic() << ":" << c.magnitude() << ":"
+               << c.sensor_id() << " ";
   }
   v.text("candidates", candidates.str());
   v("detector", m.detector());

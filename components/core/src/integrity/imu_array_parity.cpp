@@ -1,0 +1,229 @@
+#include "navbus/core/integrity/imu_array_parity.hpp"
+
+#include <cmath>
+
+#include <Eigen/Dense>
+
+namespace navbus::core {
+
+namespace {
+
+constexpr double kRotationTolerance = 1e-6;  ///< |C C^T - I| and |det C - 1| of a mounting
+
+std::string unitField(std::size_t u, const char* field) {
+  return "IMU array unit " + std::to_string(u) + ": " + field;
+}
+
+}  // namespace
+
+std::optional<ImuArrayParity> ImuArrayParity::make(const std::vector<ImuArrayUnit>& units,
+                                                   double interval_s,
+                                                   const ImuArrayParityConfig& config,
+                                                   std::string& error) {
+  if (units.size() < 2 || units.size() > static_cast<std::size_t>(kMaxUnits)) {
+    error = "IMU array: " + std::to_string(units.size()) + " units; it must have 2 to " +
+            std::to_string(kMaxUnits);
+    return std::nullopt;
+  }
+  if (!(interval_s > 0.0) || !std::isfinite(interval_s)) {
+    error = "IMU array: sample interval " + std::to_string(interval_s) + " s is not positive";
+    return std::nullopt;
+  }
+  if (config.reference_samples < 1 || !(config.reference_time_constant_samples >= 0.0)) {
+    error = "IMU array: reference_samples " + std::to_string(config.reference_samples) +
+            " must be >= 1 and the reference time constant " +
+            std::to_string(config.reference_time_constant_samples) + " >= 0";
+    return std::nullopt;
+  }
+  for (std::size_t u = 0; u < units.size(); ++u) {
+    const ImuArrayUnit& unit = units[u];
+    const Eigen::Matrix3d& c = unit.c_u_b;
+    if (!c.allFinite() ||
+        (c * c.transpose() - Eigen::Matrix3d::Identity()).norm() > kRotationTolerance ||
+        std::abs(c.determinant() - 1.0) > kRotationTolerance) {
+      error = unitField(u, "the mounting is not a rotation");
+      return std::nullopt;
+    }
+    if (!unit.lever_arm_b_m.allFinite()) {
+      error = unitField(u, "lever_arm_b_m is not finite");
+      return std::nullopt;
+    }
+    if (!(unit.gyro_sigma_rad > 0.0) || !(unit.accel_sigma_mps > 0.0)) {
+      error = unitField(u, "the gyro and accelerometer noise must be positive (gyro ") +
+              std::to_string(unit.gyro_sigma_rad) + " rad, accelerometer " +
+              std::to_string(unit.accel_sigma_mps) + " m/s per sample)";
+      return std::nullopt;
+    }
+  }
+  ImuArrayParity array(units, interval_s, config);
+  for (int k = 0; k < kImuInstrumentKinds; ++k) {
+    if (!array.build(static_cast<ImuInstrument>(k), error)) {
+      error = std::string("IMU array, ") + (k == 0 ? "gyros" : "accelerometers") + ": " + error;
+      return std::nullopt;
+    }
+  }
+  return array;
+}
+
+ImuArrayParity::ImuArrayParity(std::vector<ImuArrayUnit> array_units, double interval_s,
+                               const ImuArrayParityConfig& config)
+    : units_(std::move(array_units)), interval_s_(interval_s), config_(config) {
+  for (Channel& c : channels_) {
+    c.rows = 3 * units();
+    for (int i = 0; i < c.rows; ++i) c.instrument[static_cast<std::size_t>(i)] = i;
+    c.reference = parity::Measurements::Zero(c.rows);
+  }
+}
+
+bool ImuArrayParity::build(ImuInstrument kind, std::string& error) {
+  Channel& c = channel(kind);
+  parity::Axes axes(c.rows, 3);
+  parity::Measurements sigmas(c.rows);
+  for (int r = 0; r < c.rows; ++r) {
+    const int i = c.instrument[static_cast<std::size_t>(r)];
+    const ImuArrayUnit& unit = units_[static_cast<std::size_t>(i / 3)];
+    axes.row(r) = unit.c_u_b.row(i % 3);  // eq. 1: the axis in body coordinates
+    sigmas[r] = kind == ImuInstrument::kGyro ? unit.gyro_sigma_rad : unit.accel_sigma_mps;
+  }
+  std::optional<ParitySpace> space = ParitySpace::make(axes, sigmas, error);
+  c.glr.reset();
+  if (!space) return false;
+  c.glr = ParityGlr::make(*space, config_.glr, error);
+  return c.glr.has_value();
+}
+
+bool ImuArrayParity::exclude(ImuInstrument kind, int unit, int axis) {
+  Channel& c = channel(kind);
+  const int target = 3 * unit + axis;
+  int kept = 0;
+  for (int r = 0; r < c.rows; ++r) {
+    const auto row = static_cast<std::size_t>(r);
+    if (c.instrument[row] == target) continue;
+    c.instrument[static_cast<std::size_t>(kept)] = c.instrument[row];
+    c.reference[kept] = c.reference[r];
+    ++kept;
+  }
+  if (kept == c.rows) return testing(kind);
+  c.rows = kept;
+  c.reference.conservativeResize(kept);
+  // The kept part of o still removes the biases' parity (o = P b + H c restricted is
+  // b' - H'(-c) up to the new projector), so the mean need not be learned again.
+  std::string error;
+  return build(kind, error);
+}
+
+void ImuArrayParity::restart() {
+  for (Channel& c : channels_)
+    if (c.glr) c.glr->reset();
+  have_previous_rate_ = false;
+}
+
+int ImuArrayParity::instruments(ImuInstrument kind) const {
+  return channel(kind).rows;
+}
+
+double ImuArrayParity::threshold(ImuInstrument kind) const {
+  const Channel& c = channel(kind);
+  return c.glr ? c.glr->threshold() : 0.0;
+}
+
+double ImuArrayParity::minimumDetectableBias(ImuInstrument kind, int unit, int axis) const {
+  const Channel& c = channel(kind);
+  if (!c.glr) return 0.0;
+  for (int r = 0; r < c.rows; ++r)
+    if (c.instrument[static_cast<std::size_t>(r)] == 3 * unit + axis)
+      return c.glr->minimumDetectableBias(r) / interval_s_;
+  return 0.0;
+}
+
+void ImuArrayParity::fillGyro(const std::array<ImuIncrement, kMaxUnits>& increments) {
+  Channel& c = channel(ImuInstrument::kGyro);
+  c.m.resize(c.rows);
+  for (int r = 0; r < c.rows; ++r) {
+    const int i = c.instrument[static_cast<std::size_t>(r)];
+    c.m[r] = increments[static_cast<std::size_t>(i / 3)].delta_angle_b_rad[i % 3];
+  }
+  // w: every gyro still in the array, the learned mean removed (the common bias left in it is
+  // the array's, far below what the lever-arm term needs).
+  if (c.glr) {
+    const parity::Measurements corrected = c.m - c.reference;
+    rate_b_radps_ = c.glr->space().estimate(corrected) / interval_s_;
+  }
+}
+
+void ImuArrayParity::fillAccelerometer(const std::array<ImuIncrement, kMaxUnits>& increments) {
+  Channel& c = channel(ImuInstrument::kAccelerometer);
+  // Eq. 1's lever-arm term, first order: dw/dt from the previous sample's rate.
+  const Eigen::Vector3d& w = rate_b_radps_;
+  const Eigen::Vector3d w_dot = have_previous_rate_
+                                    ? Eigen::Vector3d((w - previous_rate_b_radps_) / interval_s_)
+                                    : Eigen::Vector3d::Zero();
+  previous_rate_b_radps_ = w;
+  have_previous_rate_ = true;
+  c.m.resize(c.rows);
+  for (int r = 0; r < c.rows; ++r) {
+    const int i = c.instrument[static_cast<std::size_t>(r)];
+    const ImuArrayUnit& unit = units_[static_cast<std::size_t>(i / 3)];
+    const Eigen::Vector3d& arm = unit.lever_arm_b_m;
+    const Eigen::Vector3d arm_f_b = w_dot.cross(arm) + w.cross(w.cross(arm));
+    c.m[r] = increments[static_cast<std::size_t>(i / 3)].delta_vel_b_mps[i % 3] -
+             unit.c_u_b.row(i % 3).dot(arm_f_b) * interval_s_;
+  }
+}
+
+void ImuArrayParity::test(ImuInstrument kind) {
+  Channel& c = channel(kind);
+  auto& detection = result_.detections[static_cast<std::size_t>(kind)];
+  detection.reset();
+  result_.statistic[static_cast<std::size_t>(kind)] = 0.0;
+  if (!c.glr) return;
+  const ParitySpace& space = c.glr->space();
+  const auto tracking = [&](double gain) {
+    const parity::Measurements corrected = c.m - c.reference;
+    const parity::Measurements residual = corrected - space.axes() * space.estimate(corrected);
+    c.reference += gain * residual;
+  };
+  if (result_.learning) {
+    tracking(1.0 / static_cast<double>(samples_));  // the running mean of the residual
+    return;
+  }
+  const ParityGlrResult& r = c.glr->update(c.m - c.reference);
+  result_.statistic[static_cast<std::size_t>(kind)] = r.statistic;
+  if (r.detected) {
+    detection = this->detection(kind);
+  } else if (config_.reference_time_constant_samples > 0.0) {
+    tracking(1.0 / config_.reference_time_constant_samples);
+  }
+}
+
+std::optional<ImuArrayDetection> ImuArrayParity::detection(ImuInstrument kind) const {
+  const Channel& c = channel(kind);
+  const ParityGlrResult& r = c.glr->last();
+  ImuArrayDetection d;
+  d.kind = kind;
+  d.glr = r;
+  const int i = c.instrument[static_cast<std::size_t>(r.instrument)];
+  d.unit = i / 3;
+  d.axis = i % 3;
+  d.magnitude = r.magnitude / interval_s_;
+  d.magnitude_sigma = r.magnitude_sigma / interval_s_;
+  if (r.runner_up >= 0) {
+    const int j = c.instrument[static_cast<std::size_t>(r.runner_up)];
+    d.runner_up_unit = j / 3;
+    d.runner_up_axis = j % 3;
+  }
+  return d;
+}
+
+const ImuArrayParity::Result& ImuArrayParity::update(
+    const std::array<ImuIncrement, kMaxUnits>& increments) {
+  ++samples_;
+  result_.learning = samples_ <= config_.reference_samples;
+  fillGyro(increments);
+  fillAccelerometer(increments);
+  test(ImuInstrument::kGyro);
+  test(ImuInstrument::kAccelerometer);
+  return result_;
+}
+
+}  // namespace navbus::core

@@ -1,0 +1,82 @@
+// The parity detector of the fault pipeline (issue "redundant sensors"): the navigation-rate
+// increments of every configured IMU unit, aligned by their time, go through
+// core::ImuArrayParity (the parity space of all the units' gyros and of all their
+// accelerometers, lever arms accounted for, the GLR of seed 000 on the parity residual). An
+// isolation becomes a decision (detector "parity") naming the unit in `sensor_id` and its axis,
+// and, when configured, CMD_FAIL_SENSOR_AXIS for that unit and axis; an ambiguous isolation
+// (two instruments whose signatures cannot be told apart, e.g. the same axis of two parallel
+// units) is a decision with both candidates and no command. Either way the instruments decided
+// leave the parity test, which goes on with the others while they have parity.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include <navbus_idl/Imu.h>
+
+#include "navbus/bus/validation.hpp"
+#include "navbus/core/integrity/imu_array_parity.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/fault_manager/fault_output.hpp"
+
+namespace navbus::fault_manager {
+
+class ParityDetector {
+ public:
+  /// Throws bus::ConfigError (naming the field) when the array cannot be monitored.
+  explicit ParityDetector(const ParityDetectorConfig& config);
+
+  /// One increment as received (any unit, any order between units; in time order per unit).
+  /// Increments of other sensor ids, failing validation or at another interval are counted and
+  /// not used.
+  void onIncrement(const navbus::ImuIncrement& msg, FaultOutput& out);
+
+  struct Counters {
+    std::uint64_t increments{0}, other_sensors{0}, invalid{0}, wrong_interval{0};
+    std::uint64_t late{0};        ///< older than the last time tested (or repeated)
+    std::uint64_t samples{0};     ///< aligned samples of all units tested (or learning)
+    std::uint64_t incomplete{0};  ///< times dropped: a unit's increment lost, or a unit silent
+    std::uint64_t gaps{0};        ///< breaks in the aligned times: the tests restarted
+    std::uint64_t detections{0}, ambiguous{0}, commands{0};
+    std::array<double, core::kImuInstrumentKinds> max_statistic{};
+  };
+  const Counters& counters() const { return counters_; }
+  const core::ImuArrayParity& array() const { return *array_; }
+  /// The largest statistic of the latest aligned sample, per kind (0 while learning).
+  const core::ImuArrayParity::Result& latest() const { return latest_; }
+  /// The minimum detectable biases, one line per kind (printed at start-up).
+  std::string minimumDetectableBiases() const;
+  std::string summary() const;
+
+ private:
+  struct Slot {
+    std::array<core::ImuIncrement, core::ImuArrayParity::kMaxUnits> units{};
+    int received{0};
+    std::uint32_t mask{0};
+  };
+  /// Index of a sensor id among the units, or -1.
+  int unitOf(std::uint32_t sensor_id) const;
+  /// A unit missing at that time has delivered a later one: it will not come.
+  bool lost(std::int64_t time_ns, const Slot& slot) const;
+  /// Tests the complete slots in time order; drops the oldest when a missing unit's increment
+  /// is lost or too many times wait.
+  void drain(FaultOutput& out);
+  void test(std::int64_t time_ns, const Slot& slot, FaultOutput& out);
+  void report(std::int64_t time_ns, const core::ImuArrayDetection& d, FaultOutput& out);
+
+  ParityDetectorConfig config_;
+  std::optional<core::ImuArrayParity> array_;
+  std::int64_t period_ns_;
+  bus::ValidationLimits limits_;
+  std::map<std::int64_t, Slot> pending_;  ///< by time, waiting for every unit
+  std::int64_t last_tested_ns_{-1};       ///< -1: the next time tested starts a new window
+  std::int64_t late_before_ns_{-1};       ///< increments at or before this time come too late
+  std::array<std::int64_t, core::ImuArrayParity::kMaxUnits> latest_ns_{};  ///< per unit
+  core::ImuArrayParity::Result latest_;
+  Counters counters_;
+};
+
+}  // namespace navbus::fault_manager

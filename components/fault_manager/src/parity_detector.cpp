@@ -1,0 +1,241 @@
+#include "navbus/fault_manager/parity_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/bus/conversions.hpp"
+#include "navbus/core/math/units.hpp"
+
+namespace navbus::fault_manager {
+
+namespace {
+
+using core::ImuInstrument;
+
+constexpr const char* kKindNames[core::kImuInstrumentKinds] = {"gyro", "accelerometer"};
+
+const char* kindName(ImuInstrument k) {
+  return kKindNames[static_cast<int>(k)];
+}
+
+/// A bias in the unit a reader of that kind expects: deg/h for gyros, ug for accelerometers.
+double readable(ImuInstrument k, double si) {
+  return k == ImuInstrument::kGyro ? si / units::kDegPerHour : si / units::kMicroG;
+}
+
+const char* readableUnit(ImuInstrument k) {
+  return k == ImuInstrument::kGyro ? "deg/h" : "ug";
+}
+
+navbus::FaultSource source(ImuInstrument k) {
+  return k == ImuInstrument::kGyro ? navbus::SOURCE_GYRO : navbus::SOURCE_ACCELEROMETER;
+}
+
+}  // namespace
+
+ParityDetector::ParityDetector(const ParityDetectorConfig& config)
+    : config_(config), period_ns_(std::llround(1e9 / config.imu_rate_hz)) {
+  std::string error;
+  array_ = core::ImuArrayParity::make(config_.units, 1e-9 * static_cast<double>(period_ns_),
+                                      config_.array, error);
+  if (!array_) throw bus::ConfigError("configuration parity: " + error);
+  spdlog::info("parity detector: {} IMU units, {}", config_.units.size(),
+               minimumDetectableBiases());
+}
+
+int ParityDetector::unitOf(std::uint32_t sensor_id) const {
+  for (std::size_t u = 0; u < config_.sensor_ids.size(); ++u)
+    if (config_.sensor_ids[u] == sensor_id) return static_cast<int>(u);
+  return -1;
+}
+
+void ParityDetector::onIncrement(const navbus::ImuIncrement& msg, FaultOutput& out) {
+  const int unit = unitOf(msg.sensor_id());
+  if (unit < 0) {
+    ++counters_.other_sensors;
+    return;
+  }
+  if (bus::validate(msg, limits_)) {
+    ++counters_.invalid;  // its time waits in vain and is dropped as incomplete
+    return;
+  }
+  if (std::llabs(static_cast<long long>(msg.interval_ns()) - period_ns_) > 1) {
+    if (counters_.wrong_interval++ == 0)
+      spdlog::warn("parity detector: IMU {} increments over {} ns, configured {} Hz: not used",
+                   msg.sensor_id(), msg.interval_ns(), config_.imu_rate_hz);
+    return;
+  }
+  const auto time_ns = static_cast<std::int64_t>(msg.time_gps_ns());
+  if (time_ns <= std::max(last_tested_ns_, late_before_ns_)) {
+    ++counters_.late;
+    return;
+  }
+  ++counters_.increments;
+  Slot& slot = pending_[time_ns];
+  const std::uint32_t bit = 1u << static_cast<unsigned>(unit);
+  if (slot.mask & bit) {
+    ++counters_.late;  // the same unit twice at one time
+    return;
+  }
+  slot.mask |= bit;
+  ++slot.received;
+  slot.units[static_cast<std::size_t>(unit)] = bus::toCore(msg);
+  latest_ns_[static_cast<std::size_t>(unit)] =
+      std::max(latest_ns_[static_cast<std::size_t>(unit)], time_ns);
+  drain(out);
+}
+
+bool ParityDetector::lost(std::int64_t time_ns, const Slot& slot) const {
+  // Each unit's increments come in time order (a reliable reader per unit instance; the units'
+  // instances are taken in any order between them): a unit that delivered a later time never
+  // delivers this one.
+  for (int u = 0; u < array_->units(); ++u) {
+    if (slot.mask & (1u << static_cast<unsigned>(u))) continue;
+    if (latest_ns_[static_cast<std::size_t>(u)] <= time_ns) return false;
+  }
+  return true;
+}
+
+void ParityDetector::drain(FaultOutput& out) {
+  const int units = array_->units();
+  while (!pending_.empty()) {
+    auto oldest = pending_.begin();
+    if (oldest->second.received < units) {
+      // Wait for the missing unit's increment until it has passed that time, or a silent unit
+      // holds alignment_depth times waiting.
+      if (!lost(oldest->first, oldest->second) &&
+          static_cast<int>(pending_.size()) <= config_.alignment_depth)
+        return;
+      ++counters_.incomplete;
+      array_->restart();  // the window's sums need consecutive samples
+      last_tested_ns_ = -1;
+      late_before_ns_ = oldest->first;
+      pending_.erase(oldest);
+      continue;
+    }
+    test(oldest->first, oldest->second, out);
+    pending_.erase(oldest);
+  }
+}
+
+void ParityDetector::test(std::int64_t time_ns, const Slot& slot, FaultOutput& out) {
+  if (last_tested_ns_ >= 0 && time_ns - last_tested_ns_ != period_ns_) {
+    ++counters_.gaps;  // the window's sums need consecutive samples
+    array_->restart();
+  }
+  last_tested_ns_ = time_ns;
+  late_before_ns_ = time_ns;
+  ++counters_.samples;
+  latest_ = array_->update(slot.units);
+  for (int k = 0; k < core::kImuInstrumentKinds; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    counters_.max_statistic[i] = std::max(counters_.max_statistic[i], latest_.statistic[i]);
+    if (latest_.detections[i]) report(time_ns, *latest_.detections[i], out);
+  }
+}
+
+void ParityDetector::report(std::int64_t time_ns, const core::ImuArrayDetection& det,
+                            FaultOutput& out) {
+  const core::ParityGlrResult& r = det.glr;
+  const bool ambiguous = r.ambiguous && det.runner_up_unit >= 0;
+  navbus::FaultDecision d;
+  d.time_gps_ns(static_cast<std::uint64_t>(time_ns));
+  d.event(navbus::EVENT_FAULT_DETECTED);
+  d.source(source(det.kind));
+  d.sensor_id(config_.sensor_ids[static_cast<std::size_t>(det.unit)]);
+  d.axis(static_cast<std::uint16_t>(det.axis));
+  d.shape(navbus::SHAPE_STEP);
+  d.test_statistic(r.statistic);
+  d.threshold(r.threshold);
+  d.magnitude(det.magnitude);
+  // The first faulty sample is the onset's: the fault began after the sample before it.
+  d.onset_time_gps_ns(static_cast<std::uint64_t>(time_ns - r.samples_since_onset * period_ns_));
+  d.ambiguous(ambiguous);
+  d.detector("parity");
+  navbus::FaultCandidate best;
+  best.source(d.source());
+  best.sensor_id(d.sensor_id());
+  best.axis(d.axis());
+  best.shape(navbus::SHAPE_STEP);
+  best.statistic(r.statistic);
+  best.magnitude(det.magnitude);
+  d.candidates().push_back(best);
+  if (det.runner_up_unit >= 0) {
+    navbus::FaultCandidate second = best;
+    second.sensor_id(config_.sensor_ids[static_cast<std::size_t>(det.runner_up_unit)]);
+    second.axis(static_cast<std::uint16_t>(det.runner_up_axis));
+    d.candidates().push_back(second);
+  }
+  const std::uint32_t id = out.decide(d);
+  ++counters_.detections;
+  if (ambiguous) ++counters_.ambiguous;
+  spdlog::warn(
+      "decision {}: parity {} IMU {} axis {}{} bias {:.4g} {} (+- {:.2g}), l {:.4g} >= h {:.4g}, "
+      "onset {:.3f} s before",
+      id, kindName(det.kind), d.sensor_id(), "xyz"[det.axis],
+      ambiguous ? fmt::format(" or IMU {} axis {} (cannot be told apart)",
+                              d.candidates()[1].sensor_id(), "xyz"[det.runner_up_axis])
+                : std::string(),
+      readable(det.kind, det.magnitude), readableUnit(det.kind),
+      readable(det.kind, det.magnitude_sigma), r.statistic, r.threshold,
+      1e-9 * static_cast<double>(r.samples_since_onset * period_ns_));
+  // The instruments decided leave the test (the others go on while they have parity).
+  bool still = array_->exclude(det.kind, det.unit, det.axis);
+  if (ambiguous) still = array_->exclude(det.kind, det.runner_up_unit, det.runner_up_axis);
+  if (!still)
+    spdlog::warn("parity detector: the {}s left have no parity: {} detection stops",
+                 kindName(det.kind), kindName(det.kind));
+  if (ambiguous || !config_.fail_axes) return;  // which one: the lanes' evidence, not ours
+  navbus::FilterCommand c;
+  c.kind(navbus::CMD_FAIL_SENSOR_AXIS);
+  c.decision_id(id);
+  c.time_gps_ns(d.time_gps_ns());
+  c.onset_time_gps_ns(d.onset_time_gps_ns());
+  c.sensor(d.source());
+  c.sensor_id(d.sensor_id());
+  c.axis(d.axis());
+  out.command(c);
+  ++counters_.commands;
+}
+
+std::string ParityDetector::minimumDetectableBiases() const {
+  std::ostringstream s;
+  const core::ImuArrayParity& a = *array_;
+  for (int k = 0; k < core::kImuInstrumentKinds; ++k) {
+    const auto kind = static_cast<ImuInstrument>(k);
+    if (k > 0) s << "; ";
+    s << kindName(kind) << "s: " << a.instruments(kind) << " axes, h " << a.threshold(kind)
+      << ", minimum detectable bias (" << config_.array.glr.detection_probability
+      << " probability over a " << config_.array.glr.onsets * config_.array.glr.onset_spacing
+      << "-sample window) [" << readableUnit(kind) << "]";
+    for (int u = 0; u < a.units(); ++u) {
+      s << " IMU " << config_.sensor_ids[static_cast<std::size_t>(u)];
+      for (int axis = 0; axis < 3; ++axis)
+        s << (axis == 0 ? " " : "/")
+          << fmt::format("{:.3g}", readable(kind, a.minimumDetectableBias(kind, u, axis)));
+    }
+  }
+  return s.str();
+}
+
+std::string ParityDetector::summary() const {
+  const Counters& c = counters_;
+  std::ostringstream s;
+  s << "parity: " << c.samples << " aligned samples of " << array_->units() << " IMUs ("
+    << c.increments << " increments), detections " << c.detections << " (ambiguous " << c.ambiguous
+    << ", commands " << c.commands << "), largest statistic gyros " << c.max_statistic[0]
+    << " accelerometers " << c.max_statistic[1] << " (h " << array_->threshold(ImuInstrument::kGyro)
+    << " / " << array_->threshold(ImuInstrument::kAccelerometer) << ")";
+  if (c.other_sensors + c.invalid + c.wrong_interval + c.late + c.incomplete + c.gaps > 0)
+    s << "; not used: other IMUs " << c.other_sensors << ", invalid " << c.invalid
+      << ", other interval " << c.wrong_interval << ", late or repeated " << c.late
+      << ", times without every unit " << c.incomplete << ", gaps " << c.gaps;
+  return s.str();
+}
+
+}  // namespace navbus::fault_manager
