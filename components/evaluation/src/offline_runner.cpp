@@ -13,7 +13,7 @@
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/evaluation/frame_prefetcher.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
-#include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/nav_filter/lane_set.hpp"
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sim/scenario_source.hpp"
 
@@ -95,7 +95,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   sim::ScenarioSource source(sim.scenario);
   bus::HealthCounters health("navbus-offline");
   std::deque<Truth> truths;
-  const nav_filter::FilterPipeline* pipeline_ptr = nullptr;
+  const nav_filter::LaneSet* pipeline_ptr = nullptr;
   auto on_solution = [&](const navbus::NavigationSolution& sol) {
     ++result.solutions;
     const auto t = static_cast<std::int64_t>(sol.time_gps_ns());
@@ -105,6 +105,12 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
       return;
     }
     const core::NavigationEngine& engine = pipeline_ptr->engine();
+    if (engine.state().time_ns != t) {
+      // With lanes, the selection waits for the slowest lane: the selected lane's engine may
+      // have moved on (its covariance at this time is gone). Counted, not scored.
+      ++result.solutions_without_engine_state;
+      return;
+    }
     const Truth& truth = truths.front();
     EpochError err = epochError(engine.state(), truth.state);
     const core::StateMatrix& P = engine.covariance();
@@ -136,7 +142,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   // The fault manager's pipeline, when configured, sees every diagnostics sample as the
   // filter emits it and its commands go back to the filter at once.
   std::optional<fault_manager::FaultPipeline> faults;
-  nav_filter::FilterPipeline* filter_ptr = nullptr;
+  nav_filter::LaneSet* filter_ptr = nullptr;
   if (setup.fault_manager) {
     faults.emplace(*setup.fault_manager, health,
                    fault_manager::FaultPipeline::Sinks{
@@ -159,8 +165,11 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   std::function<void(const navbus::FilterCommandOutcome&)> on_outcome;
   if (faults)
     on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };
-  nav_filter::FilterPipeline pipeline(setup.filter, health,
-                                      {on_solution, on_diagnostics, nullptr, on_outcome});
+  std::function<void(const navbus::LaneSolution&)> on_lane;
+  if (setup.keep_lane_solutions)
+    on_lane = [&](const navbus::LaneSolution& l) { result.lane_solutions.push_back(l); };
+  nav_filter::LaneSet pipeline(setup.filter, health,
+                               {{on_solution, on_diagnostics, nullptr, on_outcome}, on_lane});
   pipeline_ptr = &pipeline;
   filter_ptr = &pipeline;
 

@@ -531,6 +531,45 @@ void parseGeometry(const YAML::Node& node, FilterConfig& c) {
     bus::checkRange(lever[i], -100.0, 100.0, "geometry.antenna_lever_arm_b_m");
   c.engine.antenna_lever_arm_b_m = lever;
 }
+/// Redundant IMUs: one lane per unit (LanesConfig).
+void parseLanes(const YAML::Node& node, FilterConfig& c) {
+  bus::KeyReader r(node, "lanes");
+  LanesConfig& l = c.lanes;
+  r.number("switch_ratio", l.selector.switch_ratio, {0.01, 1.0})
+      .integer("confirm_epochs", l.selector.confirm_epochs, {1, 100000})
+      .integer("max_pending", l.max_pending, {1, 100000})
+      .nested({"units"})
+      .finish();
+  if (!node) return;
+  const YAML::Node list = node["units"];
+  if (!list || !list.IsSequence() || list.size() < 2)
+    throw bus::ConfigError("configuration lanes.units must list two or more IMUs");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string w = "lanes.units[" + std::to_string(i) + "]";
+    bus::KeyReader u(list[i], w);
+    LaneUnit unit;
+    u.value("sensor_id", unit.sensor_id).nested({"mounting_rpy_deg", "lever_arm_b_m"}).finish();
+    if (!list[i]["sensor_id"])
+      throw bus::ConfigError("configuration " + w + ".sensor_id is missing");
+    for (const LaneUnit& known : l.units)
+      if (known.sensor_id == unit.sensor_id)
+        throw bus::ConfigError(
+            fmt::format("configuration {}.sensor_id {} is given twice", w, unit.sensor_id));
+    const Eigen::Vector3d rpy = bus::getVector3(list[i], w, "mounting_rpy_deg", 1.0);
+    for (int k = 0; k < 3; ++k) bus::checkRange(rpy[k], -360.0, 360.0, w + ".mounting_rpy_deg");
+    unit.c_b_u = core::dcmFromEuler(rpy * units::kDeg);
+    unit.lever_arm_b_m = bus::getVector3(list[i], w, "lever_arm_b_m", 1.0);
+    for (int k = 0; k < 3; ++k)
+      bus::checkRange(unit.lever_arm_b_m[k], -100.0, 100.0, w + ".lever_arm_b_m");
+    l.units.push_back(unit);
+  }
+  if (l.units.front().sensor_id != c.imu.id)
+    throw bus::ConfigError(fmt::format(
+        "configuration lanes.units[0].sensor_id {} must be inputs.imu's id {} (the first lane is "
+        "the filter's own IMU: its diagnostics feed the fault manager's GLR)",
+        l.units.front().sensor_id, c.imu.id));
+}
+
 }  // namespace
 
 FilterConfig parseFilterConfig(const YAML::Node& root) {
@@ -557,7 +596,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
       .nested({"low_latency_output", "recovery", "time_jump", "fault_monitor", "initial_state",
                "inputs", "ekf", "failed_axis", "adaptive", "federated", "multi_dimensional",
                "alignment", "integrity", "consistency", "adaptive_noise", "adaptive_process_noise",
-               "geometry"})
+               "geometry", "lanes"})
       .finish(bus::kParticipantKeys);
   parseLowLatency(root["low_latency_output"], c);
   parseRecovery(root["recovery"], c);
@@ -576,6 +615,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   parseAdaptiveNoise(root["adaptive_noise"], e);
   parseAdaptiveProcessNoise(root["adaptive_process_noise"], e);
   parseGeometry(root["geometry"], c);
+  parseLanes(root["lanes"], c);
   return c;
 }
 

@@ -42,20 +42,27 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
               : bus::Writer<navbus::NavigationSolution>()),
       outcome_writer_(p.createWriter<navbus::FilterCommandOutcomePubSubType>(
           bus::topic::kCommandOutcome, bus::profile::kDecisionWriter)),
+      lane_writer_(config.lanes.units.empty()
+                       ? bus::Writer<navbus::LaneSolution>()
+                       : p.createWriter<navbus::LaneSolutionPubSubType>(
+                             bus::topic::kLaneSolution, config.solution_writer_profile)),
       pipeline_(
           config, p.health(),
-          {[this](const navbus::NavigationSolution& s) {
-             if (!solution_writer_.write(s)) return;
-             const bool first = last_solution_ns_ < 0;
-             last_solution_ns_ = steadyNowNs();
-             if (first) updateState();  // health says RUNNING at once
-           },
-           publishesDiagnostics(config)
-               ? std::function<void(const navbus::FilterDiagnostics&)>(
-                     [this](const navbus::FilterDiagnostics& d) { diagnostics_writer_.write(d); })
-               : nullptr,
-           [this](const navbus::NavigationSolution& s) { low_latency_writer_.write(s); },
-           [this](const navbus::FilterCommandOutcome& o) { outcome_writer_.write(o); }}),
+          {{[this](const navbus::NavigationSolution& s) {
+              if (!solution_writer_.write(s)) return;
+              const bool first = last_solution_ns_ < 0;
+              last_solution_ns_ = steadyNowNs();
+              if (first) updateState();  // health says RUNNING at once
+            },
+            publishesDiagnostics(config)
+                ? std::function<void(const navbus::FilterDiagnostics&)>(
+                      [this](const navbus::FilterDiagnostics& d) { diagnostics_writer_.write(d); })
+                : nullptr,
+            [this](const navbus::NavigationSolution& s) { low_latency_writer_.write(s); },
+            [this](const navbus::FilterCommandOutcome& o) { outcome_writer_.write(o); }},
+           config.lanes.units.empty()
+               ? std::function<void(const navbus::LaneSolution&)>()
+               : [this](const navbus::LaneSolution& l) { lane_writer_.write(l); }}),
       not_producing_ns_(
           std::max(kNotProducingMinNs, kNotProducingPeriods * config.engine.solution_period_ns)),
       sensors_(p, sensorEvents()) {

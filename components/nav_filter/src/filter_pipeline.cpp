@@ -335,8 +335,9 @@ void FilterPipeline::publishSolution() {
   const bool monitored_now = monitored();
   const std::uint32_t flags = (flags_.flags() & ~navbus::FAULT_NO_FAULT_MONITOR) |
                               (monitored_now ? 0U : navbus::FAULT_NO_FAULT_MONITOR);
-  const navbus::NavigationSolution sol =
+  navbus::NavigationSolution sol =
       buildSolution(engine_, config_.vehicle_id, ++solution_seq_, flags, monitored_now);
+  sol.lane_id(config_.imu.id);
   counters_.solutions_untrusted += sol.covariance_valid() ? 0 : 1;
   sinks_.solution(sol);
   if (config_.low_latency_output && sinks_.low_latency) {

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "navbus/bus/config.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/evaluation/offline_runner.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
@@ -103,8 +104,8 @@ TEST(RedundantUnits, TheParityTestIsolatesUnit2sGyroStepWithinFiveSeconds) {
 TEST(RedundantUnits, TheParityTestIsQuietOnAFaultFreeTriplexAndCatchesASlowRampEarly) {
   // Given the fault-free triplex aircraft, when its 2000 s run with the parity test, then no
   // decision comes and the largest statistic of either kind stays below the threshold. Given
-  // the same with unit 2's x gyro ramping from 700 s at 0.0026 deg/h per second (3 minimum
-  // detectable biases after 600 s), then the ramp is the one decision, unit 2 gyro x, before it
+  // the same with unit 1's x gyro ramping from 700 s at 0.0026 deg/h per second (3 minimum
+  // detectable biases after 600 s), then the ramp is the one decision, unit 1 gyro x, before it
   // has reached three minimum detectable biases.
   const evaluation::OfflineResult quiet = runWithParity("seed000_triplex.yaml", 2000.0);
   EXPECT_TRUE(quiet.decisions.empty()) << quiet.fault_summary;
@@ -113,7 +114,7 @@ TEST(RedundantUnits, TheParityTestIsQuietOnAFaultFreeTriplexAndCatchesASlowRampE
   const evaluation::OfflineResult ramp = runWithParity("seed000_triplex_gyro_ramp.yaml", 2000.0);
   ASSERT_EQ(ramp.decisions.size(), 1u) << ramp.fault_summary;
   const navbus::FaultDecision& d = ramp.decisions[0];
-  EXPECT_EQ(d.sensor_id(), 2u);
+  EXPECT_EQ(d.sensor_id(), 1u);
   EXPECT_EQ(d.source(), navbus::SOURCE_GYRO);
   EXPECT_EQ(d.axis(), 0);
   const double after_s = secondsIntoRun(d.time_gps_ns()) - 700.0;
@@ -121,4 +122,71 @@ TEST(RedundantUnits, TheParityTestIsQuietOnAFaultFreeTriplexAndCatchesASlowRampE
   EXPECT_LT(after_s, 600.0);  // 3 x 0.52 deg/h at 0.0026 deg/h/s
   std::printf("ramp detected %.1f s after its start, at %.3f deg/h (3 x MDB = 1.56 deg/h)\n",
               after_s, 0.0026 * after_s);
+}
+
+TEST(RedundantUnits, LanesLeaveTheFailedUnitAndPublishTheJumpTheyMake) {
+  // Given the triplex aircraft with unit 1's x gyro ramping from 700 s, the filter in three lanes
+  // (config/filter_triplex.yaml) and the parity test, when 900 s run offline, then the parity
+  // decision fails unit 1's axis, the selector leaves lane 1 for another at once (one switch,
+  // counter 1), and the published solution at the switch is the new lane's: its reset deltas are
+  // the new lane's solution minus lane 1's at that time, to 1 mm and 1 mm/s, and stay on every
+  // later solution with the counter; before the switch lane 1 is published, with zero deltas.
+  const std::string dir = navbus::test_paths::scenarioDir();
+  evaluation::OfflineSetup s;
+  s.sim = navbus::sensor_sim::parseSimConfig(
+      navbus::bus::loadYamlFile(dir + "/seed000_triplex_gyro_ramp.yaml"));
+  s.filter = navbus::nav_filter::parseFilterConfig(navbus::bus::loadYamlFile(
+      std::string(navbus::test_paths::configDir()) + "/filter_triplex.yaml"));
+  s.filter.engine.initial_state = evaluation::initialTruth(s.sim.scenario);
+  s.fault_manager = navbus::fault_manager::parseFaultManagerConfig(navbus::bus::loadYamlFile(
+      std::string(navbus::test_paths::configDir()) + "/fault_manager_triplex.yaml"));
+  s.duration_s = 900.0;
+  s.keep_lane_solutions = true;
+  std::vector<navbus::NavigationSolution> published;
+  const evaluation::OfflineResult r =
+      evaluation::runOffline(s, [&](const navbus::NavigationSolution& sol, const auto&,
+                                    const auto&) { published.push_back(sol); });
+  ASSERT_EQ(r.decisions.size(), 1u) << r.fault_summary;
+  EXPECT_EQ(r.decisions[0].sensor_id(), 1u);
+  // The hook sees the solutions scored against the truth: a few published once the selected
+  // lane's engine had moved on are counted instead.
+  EXPECT_EQ(published.size() + r.solutions_without_engine_state, r.solutions);
+  EXPECT_LT(r.solutions_without_engine_state, 20u);
+  ASSERT_EQ(r.lane_solutions.size(), 3 * r.solutions);
+  std::size_t switch_at = published.size();
+  for (std::size_t i = 0; i < published.size(); ++i) {
+    if (published[i].lane_id() != 1u) {
+      switch_at = i;
+      break;
+    }
+    EXPECT_EQ(published[i].reset_count(), 0u);
+    EXPECT_EQ(published[i].reset_delta_pos_ned_m()[0], 0.0);
+  }
+  ASSERT_LT(switch_at, published.size()) << "no switch";
+  const navbus::NavigationSolution& after = published[switch_at];
+  EXPECT_GE(after.time_gps_ns(), r.decisions[0].time_gps_ns());
+  EXPECT_LE(after.time_gps_ns(), r.decisions[0].time_gps_ns() + 200'000'000ull);
+  EXPECT_EQ(after.reset_count(), 1u);
+  // Lane 1's own solution at the switch's time, from the lanes' stream.
+  const navbus::LaneSolution* old_lane = nullptr;
+  for (const navbus::LaneSolution& l : r.lane_solutions)
+    if (l.lane_id() == 1u && l.solution().time_gps_ns() == after.time_gps_ns()) old_lane = &l;
+  ASSERT_NE(old_lane, nullptr);
+  EXPECT_FALSE(old_lane->available());
+  const navbus::NavigationSolution& old = old_lane->solution();
+  const Eigen::Vector3d jump = navbus::core::earth::differenceNed(
+      {after.latitude_rad(), after.longitude_rad(), after.height_m()},
+      {old.latitude_rad(), old.longitude_rad(), old.height_m()});
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(after.reset_delta_pos_ned_m()[i], jump[i], 1e-3);
+    EXPECT_NEAR(after.reset_delta_vel_ned_mps()[i], after.vel_ned_mps()[i] - old.vel_ned_mps()[i],
+                1e-3);
+  }
+  for (std::size_t i = switch_at; i < published.size(); ++i) {
+    EXPECT_EQ(published[i].lane_id(), after.lane_id());
+    EXPECT_EQ(published[i].reset_count(), 1u);
+    EXPECT_EQ(published[i].reset_delta_pos_ned_m()[2], after.reset_delta_pos_ned_m()[2]);
+  }
+  std::printf("switch to lane %u at %.1f s; reset deltas position %.3f %.3f %.3f m\n",
+              after.lane_id(), secondsIntoRun(after.time_gps_ns()), jump[0], jump[1], jump[2]);
 }

@@ -19,6 +19,7 @@ void ConsistencyMonitor::restart() {
   inconsistent_ = false;
   reinitialise_due_ = false;
   last_probability_ = 1.0;
+  window_nis_per_row_ = 0.0;
 }
 
 void ConsistencyMonitor::onEpoch(std::int64_t time_ns, double nis, int dof) {
@@ -36,6 +37,7 @@ void ConsistencyMonitor::onEpoch(std::int64_t time_ns, double nis, int dof) {
     sum_dof += window_[static_cast<std::size_t>(i)].dof;
   }
   last_probability_ = chiSquareSurvival(sum, sum_dof);
+  window_nis_per_row_ = sum / static_cast<double>(sum_dof);
   ++counters_.epochs_tested;
   const bool failed = last_probability_ < config_.false_alarm_probability;
   if (failed) {

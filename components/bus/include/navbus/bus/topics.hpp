@@ -14,6 +14,8 @@ inline constexpr const char* kGnssFix = "navbus/gnss/fix";
 inline constexpr const char* kStarTracker = "navbus/startracker/attitude";
 inline constexpr const char* kNavSolution = "navbus/nav/solution";
 inline constexpr const char* kNavSolutionLowLatency = "navbus/nav/solution_low_latency";
+/// Every filter lane's solution (redundant IMUs, filter `lanes:`), one instance per lane.
+inline constexpr const char* kLaneSolution = "navbus/nav/lane_solution";
 inline constexpr const char* kFilterDiagnostics = "navbus/nav/diagnostics";
 inline constexpr const char* kFaultDecision = "navbus/fault/decision";
 inline constexpr const char* kFilterCommand = "navbus/filter/command";

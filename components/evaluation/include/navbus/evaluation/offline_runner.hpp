@@ -58,13 +58,19 @@ struct OfflineSetup {
   /// commands to the filter); none: the filter runs alone.
   std::optional<fault_manager::FaultManagerConfig> fault_manager;
   double duration_s{0.0};  ///< of simulated data
+  /// Keep every filter lane's solution (OfflineResult::lane_solutions; filter `lanes:`).
+  bool keep_lane_solutions{false};
 };
 
 struct OfflineResult {
   std::vector<EpochError> errors;
   std::uint64_t solutions{0};
   std::uint64_t solutions_without_truth{0};  ///< solution times between truth samples
-  std::string summary;                       ///< the pipeline's counters
+  /// Solutions published after the selected lane's engine had moved past them (lanes): not
+  /// scored against the truth.
+  std::uint64_t solutions_without_engine_state{0};
+  std::vector<navbus::LaneSolution> lane_solutions;  ///< with keep_lane_solutions
+  std::string summary;                               ///< the pipeline's counters
   /// The filter's refusals of IMU increments by reason (an IMU it was not configured with:
   /// REJECT_UNEXPECTED_SOURCE).
   std::map<navbus::RejectReason, std::uint64_t> imu_rejected;

@@ -12,6 +12,7 @@
 #include "navbus/bus/topics.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
+#include "navbus/core/filter/lane_selector.hpp"
 #include "navbus/core/ins/imu_mounting.hpp"
 #include "navbus/core/math/units.hpp"
 
@@ -42,6 +43,26 @@ struct FaultMonitorWatch {
   /// The monitor runs from the start: the output waits for its first judgement too (at most
   /// judgement_wait_ns if it never reports), not only once it has reported.
   bool judged_from_start{false};
+};
+
+/// One IMU of a filter with several (`lanes:`): it runs a lane of its own.
+struct LaneUnit {
+  std::uint32_t sensor_id{1};  ///< its increments' ImuIncrement.sensor_id
+  /// Its axes into body axes (`mounting_rpy_deg`, the simulator's imu_units and the fault
+  /// manager's parity.units convention: the unit's axes are the body's turned by roll, pitch and
+  /// yaw, so v_b = dcmFromEuler(rpy) v_u).
+  Eigen::Matrix3d c_b_u{Eigen::Matrix3d::Identity()};
+  Eigen::Vector3d lever_arm_b_m{Eigen::Vector3d::Zero()};  ///< its place from the body origin
+};
+
+/// Redundant IMUs (lane_set.hpp): one filter lane per unit, every lane fed every aiding
+/// measurement, the published solution the selected lane's.
+struct LanesConfig {
+  std::vector<LaneUnit> units;  ///< empty: one lane, the `inputs.imu` IMU
+  core::LaneSelectorConfig selector;
+  /// Solutions a lane may be ahead of the slowest before the slowest is passed over (it is then
+  /// unavailable at those times, counted): the bound on the selection's wait.
+  std::size_t max_pending{1000};
 };
 
 struct FilterConfig {
@@ -92,6 +113,7 @@ struct FilterConfig {
   /// How the IMU's axes sit in the body (`geometry.imu_mounting_rpy_deg`): every increment is
   /// turned into body axes as it enters.
   core::ImuMounting imu_mounting;
+  LanesConfig lanes;
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid entry.

@@ -14,7 +14,7 @@
 #include "navbus/bus/sensor_readers.hpp"
 #include "navbus/bus/stall_detector.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
-#include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/nav_filter/lane_set.hpp"
 #include "navbus/nav_filter/monitor_liveness.hpp"
 
 namespace navbus::nav_filter {
@@ -48,7 +48,8 @@ class FilterNode {
   bus::Writer<navbus::FilterDiagnostics> diagnostics_writer_;
   bus::Writer<navbus::NavigationSolution> low_latency_writer_;  ///< when configured
   bus::Writer<navbus::FilterCommandOutcome> outcome_writer_;    ///< answers to commands
-  FilterPipeline pipeline_;
+  bus::Writer<navbus::LaneSolution> lane_writer_;  ///< every lane's solutions (with `lanes:`)
+  LaneSet pipeline_;
   std::int64_t not_producing_ns_;      ///< silence of the solution output that is "not producing"
   bus::StallDetector stalls_;          ///< pauses of this process between two pumps
   std::int64_t last_solution_ns_{-1};  ///< steady time of the latest solution written (-1: none)

@@ -156,6 +156,11 @@ IfMessage<M, navbus::NavigationSolution> visitFields(M& m, V& v) {
   v("vertical_protection_level_m", m.vertical_protection_level_m());
   v("output", m.output());
   v("propagated_from_gps_ns", m.propagated_from_gps_ns());
+  v("lane_id", m.lane_id());
+  v("reset_count", m.reset_count());
+  v("reset_delta_pos_ned_m", m.reset_delta_pos_ned_m());
+  v("reset_delta_vel_ned_mps", m.reset_delta_vel_ned_mps());
+  v("reset_delta_att_ned_rad", m.reset_delta_att_ned_rad());
 }
 template <class M, class V>
 IfMessage<M, navbus::FilterDiagnostics> visitFields(M& m, V& v) {

@@ -66,6 +66,9 @@ class ConsistencyMonitor {
   void restart();
   /// Tail probability of the latest full window (1 before the window is full).
   double lastProbability() const { return last_probability_; }
+  /// The latest full window's NIS per row (about 1 when consistent; 0 before the window is
+  /// full): a filter lane's test ratio.
+  double windowNisPerRow() const { return window_nis_per_row_; }
   const ConsistencyCounters& counters() const { return counters_; }
   const ConsistencyConfig& config() const { return config_; }
 
@@ -81,6 +84,7 @@ class ConsistencyMonitor {
   bool reinitialise_due_{false};
   std::int64_t alarm_since_ns_{0};
   double last_probability_{1.0};
+  double window_nis_per_row_{0.0};
   ConsistencyCounters counters_;
 };
 

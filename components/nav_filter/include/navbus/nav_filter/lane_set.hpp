@@ -1,0 +1,110 @@
+// navbus-filter's lanes (redundant IMUs, filter `lanes:`): one FilterPipeline per IMU unit, each
+// with that unit's increments turned into body axes (its mounting) and the antenna seen from the
+// unit's place (its lever arm), every lane fed every aiding measurement and command; the
+// published solution is the selected lane's (core::LaneSelector: the best innovation fit with
+// hysteresis, an unavailable lane left at once), moved to the body origin, naming its lane, with
+// the reset deltas and counter of the latest switch. Every lane's solution at every time also
+// goes out on its own (LaneSolution). A filter without `lanes:` is one lane: its solutions pass
+// through unchanged but for lane_id.
+//
+// Lanes run on the same inputs in the same order, each from its own IMU, so they reach a data
+// time in turn; the selection at a time waits until every lane has passed it (or is
+// max_pending solutions behind: then it is unavailable there, counted), so the bus and offline
+// select the same. What belongs to the filter as a whole stays with lane 0 (the filter's own
+// IMU, inputs.imu): the participant's health counters, the diagnostics the fault manager's GLR
+// reads, the answers to commands and the fault monitor's watch.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <navbus_idl/Navigation.h>
+
+#include "navbus/core/filter/lane_selector.hpp"
+#include "navbus/nav_filter/filter_pipeline.hpp"
+
+namespace navbus::nav_filter {
+
+class LaneSet {
+ public:
+  struct Sinks {
+    FilterPipeline::Sinks filter;  ///< the published solution and what lane 0 answers for
+    std::function<void(const navbus::LaneSolution&)> lane{};  ///< every lane's; may be empty
+  };
+
+  LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks);
+
+  // The inputs of FilterPipeline, given to the lanes they concern.
+  void onImu(const navbus::ImuIncrement& msg);
+  void onImuBlock(const navbus::ImuIncrementBlock& msg);
+  void onGnssObservations(const navbus::GnssObservationEpoch& msg);
+  void onGnssFix(const navbus::GnssFix& msg);
+  void onStarTracker(const navbus::StarTrackerAttitude& msg);
+  void onStreamEnded(bus::StreamKind kind, std::uint32_t id);
+  void onDecision(const navbus::FaultDecision& d) { lanes_.front()->onDecision(d); }
+  /// An IMU-axis or IMU-stream command naming a unit goes to that unit's lane (failing it takes
+  /// the lane out of the selection); every other command to every lane (lane 0 answers).
+  void onCommand(const navbus::FilterCommand& c,
+                 const std::optional<std::string>& writer_identity = std::nullopt);
+  void pump(std::int64_t now_ns);
+  void resumedAfterStall(std::int64_t now_ns, std::int64_t stalled_ns);
+  void setWritersAlive(bus::StreamKind kind, bool alive, std::int64_t now_ns);
+  void flush(std::int64_t now_ns);
+  void publishHeldSolution();
+  void onFaultMonitorProgress(const navbus::FaultMonitorProgress& report) {
+    lanes_.front()->onFaultMonitorProgress(report);
+  }
+  void setFaultMonitorAlive(bool alive);
+  bool degraded() const { return lanes_[static_cast<std::size_t>(selectedIndex())]->degraded(); }
+  std::uint64_t newRuns() const { return lanes_.front()->newRuns(); }
+
+  int lanes() const { return static_cast<int>(lanes_.size()); }
+  /// The selected lane's engine (lane 0 before any selection).
+  const core::NavigationEngine& engine() const {
+    return lanes_[static_cast<std::size_t>(selectedIndex())]->engine();
+  }
+  const FilterPipeline& lane(int k) const { return *lanes_[static_cast<std::size_t>(k)]; }
+  const core::LaneSelection& selection() const { return selector_.last(); }
+  std::string summary() const;
+
+ private:
+  struct Pending {
+    navbus::NavigationSolution solution;  ///< at the body origin
+    double test_ratio{0.0};
+  };
+  int selectedIndex() const { return selector_.last().lane < 0 ? 0 : selector_.last().lane; }
+  int laneOf(std::uint32_t sensor_id) const;
+  template <class Fn>
+  void forEach(Fn&& fn) {
+    for (auto& lane : lanes_) fn(*lane);
+  }
+  void onLaneSolution(int k, const navbus::NavigationSolution& s);
+  /// Selects at every time all lanes have passed, oldest first; `all` releases what is held.
+  void release(bool all);
+  void select(std::int64_t time_ns);
+  bool available(int k, const Pending* p) const;
+
+  FilterConfig config_;
+  Sinks sinks_;
+  std::vector<std::unique_ptr<bus::HealthCounters>> lane_health_;  ///< lanes 1..: their own
+  std::vector<std::unique_ptr<FilterPipeline>> lanes_;
+  std::vector<std::deque<Pending>> pending_;
+  std::vector<bool> excluded_;  ///< the lane's IMU was failed or declared lost by a command
+  std::vector<bool> ended_;     ///< the lane's IMU stream ended as announced: not waited for
+  /// Commands given to one lane (issuer, run, id): that lane answers them.
+  std::set<std::tuple<std::string, std::uint64_t, std::uint64_t>> routed_;
+  core::LaneSelector selector_;
+  std::vector<core::LaneStatus> statuses_;
+  core::LaneResetDelta last_delta_;
+  std::uint64_t seq_{0};
+  std::uint64_t passed_over_{0};  ///< lane solutions missing at a selection (max_pending)
+};
+
+}  // namespace navbus::nav_filter
