@@ -30,6 +30,11 @@
       against the filter's 3-sigma (and the smoother's, with --smooth) -> NAME.png (default
       real_car). A benchmark run without outages (no outages.csv) gives the trajectory and the
       horizontal error of every judged epoch against 3-sigma, per run (filter, spp, smoothed).
+  plot_navbus.py triplex SCENARIO LANES_DIR SINGLE_DIR -o OUT_DIR
+      the triplex demo (scripts/demo_triplex.sh): the parity test's statistics against their
+      thresholds (parity.csv), the published lane with the switch and its reset deltas
+      (solution.csv, lanes.csv), and the horizontal position error of the lanes' published
+      solution beside a single-lane filter on the faulty unit's data -> triplex.png
   plot_navbus.py demo SCENARIO DEMO_DIR -o OUT_DIR
       the main demo's figures (errors, with/without the fault manager, GLR statistic) from
       scripts/demo.sh's output directory
@@ -429,6 +434,60 @@ def realcar(bench_dir, out_dir, name="real_car"):
     return _save(fig, out_dir, f"{name}.png")
 
 
+def triplex(scenario_path, lanes_dir, single_dir, out_dir):
+    start_ns = int(load_scenario(scenario_path)["timing"]["start"])
+    decisions = read_csv(os.path.join(lanes_dir, "decisions.csv"))
+    fig, axes = plt.subplots(3, 1, figsize=(11, 9), sharex=True)
+    parity = read_csv(os.path.join(lanes_dir, "parity.csv"))
+    t = _time_s(parity, start_ns)
+    for key, color, label in (("gyro", "tab:blue", "gyros"),
+                              ("accelerometer", "tab:orange", "accelerometers")):
+        axes[0].semilogy(t, np.maximum([float(r[key + "_statistic"]) for r in parity], 1e-2),
+                         color=color, lw=0.7, label=f"parity GLR statistic l, {label}")
+    axes[0].axhline(float(parity[0]["gyro_threshold"]), color="black", ls=":",
+                    label="threshold h (from P_fa)")
+    _mark_decisions(axes[0], decisions, start_ns)
+    axes[0].set_ylabel("largest l per 100 ms")
+    axes[0].legend(fontsize=7, loc="upper left")
+    sol = read_csv(os.path.join(lanes_dir, "solution.csv"))
+    ts = _time_s(sol, start_ns)
+    axes[1].step(ts, [int(r["lane_id"]) for r in sol], where="post", color="tab:green",
+                 label="published lane (IMU sensor id)")
+    switches = [r for i, r in enumerate(sol)
+                if i > 0 and r["reset_count"] != sol[i - 1]["reset_count"]]
+    for r in switches:
+        ts0 = (int(r["time_gps_ns"]) - start_ns) * 1e-9
+        d = vector(r, "reset_delta_pos_ned_m")
+        a = np.linalg.norm(vector(r, "reset_delta_att_ned_rad")) * 1e3
+        axes[1].annotate(f"switch {r['reset_count']}: reset deltas |dp| {np.linalg.norm(d):.3f} m,"
+                         f" |dv| {np.linalg.norm(vector(r, 'reset_delta_vel_ned_mps')):.3f} m/s,"
+                         f" |datt| {a:.1f} mrad", (ts0, int(r["lane_id"])), fontsize=8,
+                         xytext=(10, 10), textcoords="offset points")
+    _mark_decisions(axes[1], decisions, start_ns)
+    axes[1].set_ylabel("lane")
+    axes[1].legend(fontsize=7, loc="lower left")
+    for d, label, color in ((single_dir, "single lane on the faulty unit (no parity test)",
+                             "tab:red"),
+                            (lanes_dir, "lanes + parity test (published)", "tab:green")):
+        rows = read_csv(os.path.join(d, "error.csv"))
+        te = _time_s(rows, start_ns)
+        e = np.array([vector(r, "pos_err_ned_m") for r in rows])
+        axes[2].plot(te, np.hypot(e[:, 0], e[:, 1]), color=color, lw=0.8, label=label)
+        if d == lanes_dir:
+            s = np.array([vector(r, "pos_sigma_ned_m") for r in rows])
+            axes[2].plot(te, 3 * np.hypot(s[:, 0], s[:, 1]), color="tab:blue", lw=0.7, ls=":",
+                         label="3-sigma (horizontal), lanes")
+    _mark_decisions(axes[2], decisions, start_ns)
+    axes[2].set_ylabel("horizontal position error [m]")
+    axes[2].set_xlabel("time [s]")
+    axes[2].legend(fontsize=7, loc="upper left")
+    for a in axes:
+        a.grid(alpha=0.3, which="both")
+    fig.suptitle("triplex IMUs: a slow gyro ramp on the filter's own unit; dashed: the parity "
+                 "decision", fontsize=10)
+    return _save(fig, out_dir, "triplex.png")
+
+
 def demo(scenario_path, demo_dir, out_dir):
     start_ns = int(load_scenario(scenario_path)["timing"]["start"])
     paths = [errors(os.path.join(demo_dir, "offline"), out_dir, start_ns,
@@ -471,6 +530,11 @@ def main():
     a.add_argument("bench_dir")
     a.add_argument("--name", default="real_car")
     a.add_argument("-o", "--out", required=True)
+    a = sub.add_parser("triplex")
+    a.add_argument("scenario")
+    a.add_argument("lanes_dir")
+    a.add_argument("single_dir")
+    a.add_argument("-o", "--out", required=True)
     a = sub.add_parser("demo")
     a.add_argument("scenario")
     a.add_argument("demo_dir")
@@ -494,6 +558,8 @@ def main():
         paths = [latency(args.raw, args.e2e, args.out)]
     elif args.cmd == "realcar":
         paths = [realcar(args.bench_dir, args.out, args.name)]
+    elif args.cmd == "triplex":
+        paths = [triplex(args.scenario, args.lanes_dir, args.single_dir, args.out)]
     else:
         paths = demo(args.scenario, args.demo_dir, args.out)
     for path in paths:

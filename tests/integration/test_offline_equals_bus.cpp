@@ -183,6 +183,25 @@ TEST(OfflineEqualsBus, TriplexUnitsBesideAOneImuFilter) {
            1});
 }
 
+// The triplex aircraft with unit 1's gyro ramping (seed000_triplex_gyro_ramp.yaml) into the filter
+// in three lanes (config/filter_triplex.yaml) beside the fault manager's parity test: the parity
+// decision fails unit 1's axis, the selector leaves lane 1 at the decision's data time, and every
+// published solution (its lane, reset counter and deltas included) is the offline run's bit for
+// bit: the selection waits for the parity test's judgement of each time (FaultMonitorProgress
+// imu_judged_up_to_gps_ns) and the command it names.
+TEST(OfflineEqualsBus, TriplexLanesSwitchWhereOfflineTheyDo) {
+  runCase({84,
+           "seed000_triplex_gyro_ramp.yaml",
+           "filter_triplex.yaml",
+           "",
+           3,
+           900.0,
+           {"lanes: switched from IMU 1 to IMU", "switches 1,",
+            "selections made without the parity test's judgement (its wait ran out) 0"},
+           "fault_manager_triplex.yaml",
+           1});
+}
+
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->
 // federated -> adaptive, and a structure that does not apply is refused (the solution keeps the
 // last one).

@@ -83,6 +83,16 @@ void fillSolution(const core::NavState& s, navbus::NavigationSolution& out) {
   out.yaw_rad(rpy.z());
 }
 
+core::NavState toCore(const navbus::NavigationSolution& s) {
+  core::NavState n;
+  n.time_ns = static_cast<std::int64_t>(s.time_gps_ns());
+  n.position = {s.latitude_rad(), s.longitude_rad(), s.height_m()};
+  n.vel_ned_mps = toVector(s.vel_ned_mps());
+  n.q_b_to_n =
+      Eigen::Quaterniond(s.q_b_to_n()[0], s.q_b_to_n()[1], s.q_b_to_n()[2], s.q_b_to_n()[3]);
+  return n;
+}
+
 namespace {
 struct LayoutEntry {
   const char* name;

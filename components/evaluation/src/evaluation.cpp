@@ -316,8 +316,9 @@ double chiSquareQuantile(double p, double dof) {
 }
 
 int runOfflineCommand(const OfflineOptions& o) {
-  const OfflineSetup setup = loadSetup(o.scenario, filterYaml(o.filter, o.align), o.filter, o.seed,
-                                       o.duration_s, o.fault_manager);
+  OfflineSetup setup = loadSetup(o.scenario, filterYaml(o.filter, o.align), o.filter, o.seed,
+                                 o.duration_s, o.fault_manager);
+  setup.keep_lane_solutions = !setup.filter.lanes.units.empty();  // lanes.csv
   std::filesystem::create_directories(o.out_dir);
   std::ofstream sol_f(o.out_dir + "/solution.csv"), truth_f(o.out_dir + "/truth.csv"),
       err_f(o.out_dir + "/error.csv");
@@ -390,10 +391,16 @@ int runOfflineCommand(const OfflineOptions& o) {
         !records::writeCsvFile(o.out_dir + "/commands.csv", r.commands) ||
         !writeGlrCsv(o.out_dir + "/glr.csv", r.glr_trace))
       spdlog::error("could not write decisions.csv / commands.csv / glr.csv in {}", o.out_dir);
+    if (!r.parity_trace.empty() && !writeParityCsv(o.out_dir + "/parity.csv", r.parity_trace))
+      spdlog::error("could not write parity.csv in {}", o.out_dir);
+    if (!r.lane_solutions.empty() &&
+        !records::writeCsvFile(o.out_dir + "/lanes.csv", r.lane_solutions))
+      spdlog::error("could not write lanes.csv in {}", o.out_dir);
     spdlog::info("fault manager: {}", r.fault_summary);
     spdlog::info(
-        "wrote {}/solution.csv, truth.csv, error.csv, decisions.csv, commands.csv, glr.csv",
-        o.out_dir);
+        "wrote {}/solution.csv, truth.csv, error.csv, decisions.csv, commands.csv, glr.csv{}{}",
+        o.out_dir, r.parity_trace.empty() ? "" : ", parity.csv",
+        r.lane_solutions.empty() ? "" : ", lanes.csv");
   } else {
     spdlog::info("wrote {}/solution.csv, truth.csv, error.csv", o.out_dir);
   }

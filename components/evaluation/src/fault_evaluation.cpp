@@ -107,6 +107,18 @@ bool writeGlrCsv(const std::string& path,
   return static_cast<bool>(f);
 }
 
+bool writeParityCsv(const std::string& path, const std::vector<OfflineResult::ParityEpoch>& trace) {
+  std::ofstream f(path);
+  f << "time_gps_ns,gyro_statistic,accelerometer_statistic,gyro_threshold,"
+       "accelerometer_threshold\n";
+  for (const OfflineResult::ParityEpoch& e : trace) {
+    f << e.time_ns << "," << records::formatNumber(e.gyro) << ","
+      << records::formatNumber(e.accelerometer) << "," << records::formatNumber(e.gyro_threshold)
+      << "," << records::formatNumber(e.accelerometer_threshold) << "\n";
+  }
+  return static_cast<bool>(f);
+}
+
 std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule) {
   for (const sim::Fault& f : schedule.faults()) {
     if (f.kind == sim::FaultKind::kImuBiasStep || f.kind == sim::FaultKind::kImuBiasRamp ||

@@ -1,5 +1,6 @@
 #include "navbus/evaluation/offline_runner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <random>
@@ -66,6 +67,62 @@ double blockNees(const core::StateMatrix& P, const core::StateMask& active,
   return error.dot(P.block<3, 3>(b.index, b.index).ldlt().solve(error));
 }
 
+/// The error of the engine's estimate against the truth, with its covariance's sigmas and NEES.
+EpochError engineError(const core::NavigationEngine& engine, const Truth& truth) {
+  EpochError err = epochError(engine.state(), truth.state);
+  const core::StateMatrix& P = engine.covariance();
+  using namespace core::layout;
+  err.pos_sigma_ned_m = P.block<3, 3>(kPos.index, kPos.index).diagonal().cwiseSqrt();
+  err.vel_sigma_ned_mps = P.block<3, 3>(kVel.index, kVel.index).diagonal().cwiseSqrt();
+  err.att_sigma_ned_rad = P.block<3, 3>(kAtt.index, kAtt.index).diagonal().cwiseSqrt();
+  Eigen::Matrix<double, 9, 1> d;
+  d << err.pos_ned_m, err.vel_ned_mps, err.att_ned_rad;
+  const Eigen::Matrix<double, 9, 9> P9 = P.topLeftCorner<9, 9>();
+  err.nees9 = d.dot(P9.ldlt().solve(d));
+  const core::StateMask& active = engine.activeStates();
+  err.accel_bias_err_b_mps2 = engine.accelBias() - truth.accel_bias_b_mps2;
+  err.gyro_bias_err_b_radps = engine.gyroBias() - truth.gyro_bias_b_radps;
+  err.star_tracker_bias_err_b_rad = engine.starTrackerBias() - truth.star_tracker_bias_b_rad;
+  err.nees_blocks << blockNees(P, active, kPos, err.pos_ned_m),
+      blockNees(P, active, kVel, err.vel_ned_mps), blockNees(P, active, kAtt, err.att_ned_rad),
+      blockNees(P, active, kAccelBias, err.accel_bias_err_b_mps2),
+      blockNees(P, active, kGyroBias, err.gyro_bias_err_b_radps),
+      blockNees(P, active, kStarTrackerBias, err.star_tracker_bias_err_b_rad);
+  return err;
+}
+
+/// The error of a published solution against the truth, with its sigmas (no covariance: no
+/// NEES, no bias errors).
+EpochError messageError(const navbus::NavigationSolution& sol, const core::NavState& truth) {
+  EpochError err = epochError(bus::toCore(sol), truth);
+  const auto vec = [](const auto& a) { return Eigen::Vector3d(a[0], a[1], a[2]); };
+  err.pos_sigma_ned_m = vec(sol.pos_sigma_ned_m());
+  err.vel_sigma_ned_mps = vec(sol.vel_sigma_ned_mps());
+  err.att_sigma_ned_rad = vec(sol.att_sigma_ned_rad());
+  const double nan = std::nan("");
+  err.nees9 = nan;
+  err.accel_bias_err_b_mps2.setConstant(nan);
+  err.gyro_bias_err_b_radps.setConstant(nan);
+  err.star_tracker_bias_err_b_rad.setConstant(nan);
+  err.nees_blocks.setConstant(nan);
+  return err;
+}
+
+/// The parity test's statistics, the largest of every 100 ms of data (OfflineResult::parity_trace).
+void traceParity(const fault_manager::ParityDetector& parity, std::int64_t time_ns,
+                 OfflineResult& result) {
+  constexpr std::int64_t kPeriodNs = 100'000'000;
+  auto& trace = result.parity_trace;
+  const std::int64_t slot = (time_ns + kPeriodNs - 1) / kPeriodNs * kPeriodNs;
+  if (trace.empty() || trace.back().time_ns != slot) trace.push_back({slot});
+  OfflineResult::ParityEpoch& e = trace.back();
+  const auto& latest = parity.latest();
+  e.gyro = std::max(e.gyro, latest.statistic[0]);
+  e.accelerometer = std::max(e.accelerometer, latest.statistic[1]);
+  e.gyro_threshold = parity.array().threshold(core::ImuInstrument::kGyro);
+  e.accelerometer_threshold = parity.array().threshold(core::ImuInstrument::kAccelerometer);
+}
+
 /// Once, when the engine has just aligned: its start against the truth at the start's time.
 void recordAlignedStart(const core::NavigationEngine& engine, const std::deque<Truth>& truths,
                         OfflineResult& result) {
@@ -105,32 +162,13 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
       return;
     }
     const core::NavigationEngine& engine = pipeline_ptr->engine();
-    if (engine.state().time_ns != t) {
-      // With lanes, the selection waits for the slowest lane: the selected lane's engine may
-      // have moved on (its covariance at this time is gone). Counted, not scored.
-      ++result.solutions_without_engine_state;
-      return;
-    }
     const Truth& truth = truths.front();
-    EpochError err = epochError(engine.state(), truth.state);
-    const core::StateMatrix& P = engine.covariance();
-    using namespace core::layout;
-    err.pos_sigma_ned_m = P.block<3, 3>(kPos.index, kPos.index).diagonal().cwiseSqrt();
-    err.vel_sigma_ned_mps = P.block<3, 3>(kVel.index, kVel.index).diagonal().cwiseSqrt();
-    err.att_sigma_ned_rad = P.block<3, 3>(kAtt.index, kAtt.index).diagonal().cwiseSqrt();
-    Eigen::Matrix<double, 9, 1> d;
-    d << err.pos_ned_m, err.vel_ned_mps, err.att_ned_rad;
-    const Eigen::Matrix<double, 9, 9> P9 = P.topLeftCorner<9, 9>();
-    err.nees9 = d.dot(P9.ldlt().solve(d));
-    const core::StateMask& active = engine.activeStates();
-    err.accel_bias_err_b_mps2 = engine.accelBias() - truth.accel_bias_b_mps2;
-    err.gyro_bias_err_b_radps = engine.gyroBias() - truth.gyro_bias_b_radps;
-    err.star_tracker_bias_err_b_rad = engine.starTrackerBias() - truth.star_tracker_bias_b_rad;
-    err.nees_blocks << blockNees(P, active, kPos, err.pos_ned_m),
-        blockNees(P, active, kVel, err.vel_ned_mps), blockNees(P, active, kAtt, err.att_ned_rad),
-        blockNees(P, active, kAccelBias, err.accel_bias_err_b_mps2),
-        blockNees(P, active, kGyroBias, err.gyro_bias_err_b_radps),
-        blockNees(P, active, kStarTrackerBias, err.star_tracker_bias_err_b_rad);
+    // With lanes, the selection waits for the slowest lane: the selected lane's engine may have
+    // moved on (its covariance at this time is gone). Scored from the message then (its sigmas;
+    // no NEES, no bias errors), and counted.
+    EpochError err =
+        engine.state().time_ns == t ? engineError(engine, truth) : messageError(sol, truth.state);
+    result.solutions_without_engine_state += engine.state().time_ns == t ? 0 : 1;
     err.mode = static_cast<int>(sol.mode());
     err.integrity = static_cast<int>(sol.integrity());
     err.covariance_valid = sol.covariance_valid();
@@ -203,6 +241,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     sensor_sim::emitFrame(f, emitted, seq, feed);
     // Data time bounds the wait for a silent stream (the bus uses steady time).
     pipeline.pump(f.increment.time_ns);
+    if (faults && faults->parity()) traceParity(*faults->parity(), f.increment.time_ns, result);
     recordAlignedStart(pipeline.engine(), truths, result);
   }
   // End of data: whatever waits for a stream that will not speak again is released.

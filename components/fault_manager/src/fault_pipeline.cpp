@@ -33,7 +33,14 @@ void FaultPipeline::onRawBlock(const navbus::ImuRawBlock& block) {
 }
 
 void FaultPipeline::onImuIncrement(const navbus::ImuIncrement& increment) {
-  if (parity_) parity_->onIncrement(increment, *this);
+  if (!parity_) return;
+  parity_->onIncrement(increment, *this);
+  // How far the units' data is judged, every kParityReportPeriodNs of it (after its commands).
+  const std::int64_t tested = parity_->testedUpToNs();
+  if (tested < 0 || tested / kParityReportPeriodNs == parity_reported_ / kParityReportPeriodNs)
+    return;
+  parity_reported_ = tested;
+  reportProgress(judged_);
 }
 
 void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
@@ -156,6 +163,7 @@ bool FaultPipeline::onDiagnostics(const navbus::FilterDiagnostics& msg) {
 }
 
 void FaultPipeline::reportProgress(const navbus::FilterDiagnostics& judged) {
+  judged_ = judged;
   if (!sinks_.progress) return;
   navbus::FaultMonitorProgress p;
   p.vehicle_id(config_.vehicle_id);
@@ -164,6 +172,8 @@ void FaultPipeline::reportProgress(const navbus::FilterDiagnostics& judged) {
   p.last_command_id(next_command_id_ - 1);
   p.issuer(kIssuer);
   p.run_id(run_id_);
+  p.imu_judged_up_to_gps_ns(
+      static_cast<std::uint64_t>(std::max<std::int64_t>(parity_reported_, 0)));
   sinks_.progress(p);
 }
 

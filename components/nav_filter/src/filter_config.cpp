@@ -537,7 +537,7 @@ void parseLanes(const YAML::Node& node, FilterConfig& c) {
   LanesConfig& l = c.lanes;
   r.number("switch_ratio", l.selector.switch_ratio, {0.01, 1.0})
       .integer("confirm_epochs", l.selector.confirm_epochs, {1, 100000})
-      .integer("max_pending", l.max_pending, {1, 100000})
+      .integer("max_pending", l.max_pending, {1, 1000000})
       .nested({"units"})
       .finish();
   if (!node) return;

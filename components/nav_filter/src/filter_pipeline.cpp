@@ -30,6 +30,10 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   s.push_back({kCommandStream, 0, true, monitored,
                monitored ? c.fault_monitor->judgement_wait_ns : 0,
                monitored && c.fault_monitor->judged_from_start});
+  // The judgement of the IMU data itself (the parity test of redundant IMUs): carries no
+  // samples, holds the merge where owed once its judge has reported (setImuJudged).
+  if (monitored)
+    s.push_back({kImuJudgementStream, 0, true, true, c.fault_monitor->judgement_wait_ns, false});
   return s;
 }
 
@@ -264,6 +268,7 @@ void FilterPipeline::resumedAfterStall(std::int64_t now_ns, std::int64_t stalled
 
 void FilterPipeline::flush(std::int64_t now_ns) {
   sequencer_.setActive(kCommandStream, false);  // nothing more will be judged
+  sequencer_.setActive(kImuJudgementStream, false);
   for (int round = 0; round < 8 && sequencer_.pending() > 0; ++round) {  // a stream a round
     now_ns += config_.sequencer_max_wait_ns;
     pump(now_ns);
@@ -281,6 +286,9 @@ void FilterPipeline::process(StreamId stream, std::int64_t time_ns, const Filter
   if (first_input_ns_ < 0 && !std::holds_alternative<CommandInput>(input))
     first_input_ns_ = time_ns;
   if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {
+    // A parity test judges the IMU data itself: a command answering it takes its place in the
+    // order as offline (nothing later is released before this time is judged).
+    if (owe_imu_judgement_ && !replaying_) sequencer_.owe(kImuJudgementStream, time_ns);
     if (engine_.addImu(*inc) && !replaying_ && time_ns > published_up_to_ns_) {
       published_up_to_ns_ = time_ns;  // each solution time once, also after a rewind
       publishSolution();

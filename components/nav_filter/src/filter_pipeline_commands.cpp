@@ -77,6 +77,9 @@ void FilterPipeline::onFaultMonitorProgress(const navbus::FaultMonitorProgress& 
 void FilterPipeline::noteJudged(std::int64_t judged_up_to_ns) {
   sequencer_.judged(kCommandStream, judged_up_to_ns);
   judged_up_to_ns_ = std::max(judged_up_to_ns_, judged_up_to_ns);
+  // The IMU data's own judgement (setImuJudged): its report's imu_judged_up_to_gps_ns.
+  if (owe_imu_judgement_ && judgements_.imuJudged() > 0)
+    sequencer_.judged(kImuJudgementStream, judgements_.imuJudged());
 }
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c,

@@ -27,6 +27,8 @@ std::optional<std::int64_t> JudgementTracker::release() {
       return std::nullopt;
   }
   const auto judged = static_cast<std::int64_t>(held_->judged_up_to_gps_ns());
+  imu_judged_ns_ =
+      std::max(imu_judged_ns_, static_cast<std::int64_t>(held_->imu_judged_up_to_gps_ns()));
   held_.reset();
   return judged;
 }

@@ -1,11 +1,13 @@
 #include "navbus/nav_filter/lane_set.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
 #include <Eigen/Geometry>
 
+#include "navbus/bus/conversions.hpp"
 #include "navbus/core/math/earth.hpp"
 
 namespace navbus::nav_filter {
@@ -13,17 +15,14 @@ namespace navbus::nav_filter {
 namespace {
 
 /// The configuration of the lane of `unit`: its IMU, its mounting, the antenna seen from it.
-/// Lanes after the first neither answer the fault monitor nor run the low-latency output.
+/// Lanes after the first do not run the low-latency output.
 FilterConfig laneConfig(const FilterConfig& base, const LaneUnit& unit, bool first) {
   FilterConfig c = base;
   c.lanes = {};
   c.imu.id = unit.sensor_id;
   c.imu_mounting.sensor_to_body = unit.c_b_u;
   c.engine.antenna_lever_arm_b_m = base.engine.antenna_lever_arm_b_m - unit.lever_arm_b_m;
-  if (!first) {
-    c.fault_monitor.reset();
-    c.low_latency_output = false;
-  }
+  if (!first) c.low_latency_output = false;
   return c;
 }
 
@@ -42,20 +41,10 @@ bool isImuCommand(const navbus::FilterCommand& c) {
   }
 }
 
-core::NavState navState(const navbus::NavigationSolution& s) {
-  core::NavState n;
-  n.time_ns = static_cast<std::int64_t>(s.time_gps_ns());
-  n.position = {s.latitude_rad(), s.longitude_rad(), s.height_m()};
-  n.vel_ned_mps = {s.vel_ned_mps()[0], s.vel_ned_mps()[1], s.vel_ned_mps()[2]};
-  n.q_b_to_n =
-      Eigen::Quaterniond(s.q_b_to_n()[0], s.q_b_to_n()[1], s.q_b_to_n()[2], s.q_b_to_n()[3]);
-  return n;
-}
-
 /// The lane's solution (its IMU's place) moved to the body origin, r_b from it.
 navbus::NavigationSolution atBodyOrigin(navbus::NavigationSolution s, const Eigen::Vector3d& r_b) {
   if (r_b.isZero()) return s;
-  const core::NavState n = navState(s);
+  const core::NavState n = bus::toCore(s);
   const core::earth::Geodetic origin = core::earth::offsetNed(n.position, -(n.q_b_to_n * r_b));
   s.latitude_rad(origin.latitude_rad);
   s.longitude_rad(origin.longitude_rad);
@@ -107,7 +96,8 @@ LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks 
   }
   pending_.resize(units.size());
   excluded_.assign(units.size(), false);
-  ended_.assign(units.size(), false);
+  excluded_from_ns_.assign(units.size(), std::numeric_limits<std::int64_t>::max());
+  heard_ns_.assign(units.size(), -1);
   statuses_.resize(units.size());
 }
 
@@ -146,16 +136,35 @@ void LaneSet::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
     forEach([&](FilterPipeline& l) { l.onStreamEnded(kind, id); });
     return;
   }
+  // The lane still has what its merge holds to process: it is waited for until it has (or it
+  // falls silent). Another IMU's end goes to lane 0, which logs it as not in use.
   const int k = laneOf(id);
-  if (k < 0) return lanes_.front()->onStreamEnded(kind, id);  // logged there as not in use
-  ended_[static_cast<std::size_t>(k)] = true;                 // no longer waited for
-  lanes_[static_cast<std::size_t>(k)]->onStreamEnded(kind, id);
+  lanes_[static_cast<std::size_t>(std::max(k, 0))]->onStreamEnded(kind, id);
+}
+
+void LaneSet::onFaultMonitorProgress(const navbus::FaultMonitorProgress& report) {
+  if (lanes_.size() == 1 || report.vehicle_id() != config_.vehicle_id ||
+      report.imu_judged_up_to_gps_ns() == 0) {
+    lanes_.front()->onFaultMonitorProgress(report);
+    return;
+  }
+  // The parity test judges every lane's IMU data: each lane waits for it (lane 0 for it and for
+  // the GLR's judgement of its diagnostics, whichever is behind), and so does the selection.
+  if (!parity_reported_) forEach([](FilterPipeline& l) { l.setImuJudged(); });
+  parity_reported_ = true;
+  forEach([&](FilterPipeline& l) { l.onFaultMonitorProgress(report); });
+  navbus::FaultMonitorProgress parity = report;
+  parity.judged_up_to_gps_ns(report.imu_judged_up_to_gps_ns());
+  if (const auto judged = parity_judgements_.onProgress(parity))
+    parity_judged_ns_ = std::max(parity_judged_ns_, *judged);
   release(false);
 }
 
 void LaneSet::onCommand(const navbus::FilterCommand& c,
                         const std::optional<std::string>& writer_identity) {
   if (lanes_.size() == 1) return lanes_.front()->onCommand(c, writer_identity);
+  if (const auto judged = parity_judgements_.onCommand(c))
+    parity_judged_ns_ = std::max(parity_judged_ns_, *judged);
   if (!isImuCommand(c)) {
     forEach([&](FilterPipeline& l) { l.onCommand(c, writer_identity); });
     release(false);
@@ -167,18 +176,26 @@ void LaneSet::onCommand(const navbus::FilterCommand& c,
   const auto k = static_cast<std::size_t>(std::max(named, 0));
   if (named > 0) routed_.insert({c.issuer().to_string(), c.run_id(), c.command_id()});
   if (named >= 0) {
-    const bool out =
-        c.kind() == navbus::CMD_FAIL_SENSOR_AXIS || c.kind() == navbus::CMD_EXCLUDE_STREAM;
-    const bool back =
-        c.kind() == navbus::CMD_RESTORE_SENSOR_AXIS || c.kind() == navbus::CMD_READMIT_STREAM;
+    // A failed axis is a fact of the data (the decision's time). A stream declared lost is not
+    // (a watchdog's wall-time judgement, which a stalled process may have made): the lane keeps
+    // its place and is left only if it stops producing (MODE_INERTIAL_LOST, or silent).
+    const bool out = c.kind() == navbus::CMD_FAIL_SENSOR_AXIS;
+    const bool back = c.kind() == navbus::CMD_RESTORE_SENSOR_AXIS;
     if (out || back) excluded_[k] = out;
+    // Data time, not arrival: the lane is unavailable from the decision's time on.
+    if (out) excluded_from_ns_[k] = static_cast<std::int64_t>(c.time_gps_ns());
+    if (back) excluded_from_ns_[k] = std::numeric_limits<std::int64_t>::max();
   }
   lanes_[k]->onCommand(c, writer_identity);
   release(false);
 }
 
 void LaneSet::pump(std::int64_t now_ns) {
+  now_ns_ = now_ns;
+  for (std::int64_t& heard : heard_ns_)
+    if (heard < 0) heard = now_ns;  // a lane's silence counts from the first turn
   forEach([&](FilterPipeline& l) { l.pump(now_ns); });
+  if (lanes_.size() > 1) release(false);
 }
 
 void LaneSet::resumedAfterStall(std::int64_t now_ns, std::int64_t stalled_ns) {
@@ -204,6 +221,11 @@ void LaneSet::setFaultMonitorAlive(bool alive) {
 
 void LaneSet::onLaneSolution(int k, const navbus::NavigationSolution& s) {
   const auto i = static_cast<std::size_t>(k);
+  heard_ns_[i] = now_ns_;
+  if (static_cast<std::int64_t>(s.time_gps_ns()) <= last_selected_ns_) {
+    ++late_;  // its time was selected without it (passed over): not selected again
+    return;
+  }
   // The lane's fit as it stands at this solution (the engine moves on before the selection).
   pending_[i].push_back({atBodyOrigin(s, config_.lanes.units[i].lever_arm_b_m),
                          lanes_[i]->engine().consistency().windowNisPerRow()});
@@ -214,33 +236,71 @@ void LaneSet::release(bool all) {
   for (;;) {
     std::int64_t t = -1;
     std::size_t deepest = 0;
-    bool waiting = false;
-    for (std::size_t k = 0; k < pending_.size(); ++k) {
-      deepest = std::max(deepest, pending_[k].size());
-      if (pending_[k].empty()) {
-        waiting = waiting || !(excluded_[k] || ended_[k]);
-        continue;
-      }
-      const auto front = static_cast<std::int64_t>(pending_[k].front().solution.time_gps_ns());
+    for (const auto& lane : pending_) {
+      deepest = std::max(deepest, lane.size());
+      if (lane.empty()) continue;
+      const auto front = static_cast<std::int64_t>(lane.front().solution.time_gps_ns());
       if (t < 0 || front < t) t = front;
     }
     if (t < 0) return;
-    if (waiting && !all) {
-      if (deepest <= config_.lanes.max_pending) return;
+    if (!all && missing(t)) {
+      // A lane behind the others is waited for while it speaks (a lane holding for its fault
+      // monitor's judgement lags, and is still right); one silent beyond the waits, or
+      // max_pending solutions behind, is passed over at this time.
+      if (!anySilentLaneMissing(t) && deepest <= config_.lanes.max_pending) return;
       ++passed_over_;  // the slow lane is unavailable at this time
     }
+    if (!all && holdForParity(t)) return;
     select(t);
   }
 }
 
+bool LaneSet::missing(std::int64_t time_ns) const {
+  // A lane failed at or before this time is not waited for (data time: the bus and offline
+  // agree whenever the command arrives).
+  for (std::size_t k = 0; k < pending_.size(); ++k)
+    if (pending_[k].empty() && time_ns < excluded_from_ns_[k]) return true;
+  return false;
+}
+
+bool LaneSet::anySilentLaneMissing(std::int64_t time_ns) const {
+  // A lane may hold its output for its fault monitor's judgement: silent is longer than both.
+  const std::int64_t wait_ns =
+      std::max(config_.sequencer_max_wait_ns,
+               config_.fault_monitor ? config_.fault_monitor->judgement_wait_ns : 0);
+  for (std::size_t k = 0; k < pending_.size(); ++k) {
+    if (!pending_[k].empty() || time_ns >= excluded_from_ns_[k]) continue;
+    if (heard_ns_[k] >= 0 && now_ns_ - heard_ns_[k] > wait_ns) return true;
+  }
+  return false;
+}
+
+bool LaneSet::holdForParity(std::int64_t time_ns) {
+  if (!parity_reported_ || time_ns <= parity_judged_ns_) {
+    held_since_ns_ = -1;
+    return false;
+  }
+  const std::int64_t wait_ns =
+      config_.fault_monitor ? config_.fault_monitor->judgement_wait_ns : 5'000'000'000;
+  if (held_since_ns_ < 0) held_since_ns_ = now_ns_;
+  if (now_ns_ - held_since_ns_ < wait_ns) return true;
+  ++parity_waits_timed_out_;  // the monitor is silent: selected without its judgement
+  held_since_ns_ = -1;
+  return false;
+}
+
 bool LaneSet::available(int k, const Pending* p) const {
-  if (!p || excluded_[static_cast<std::size_t>(k)]) return false;
+  if (!p) return false;
+  if (static_cast<std::int64_t>(p->solution.time_gps_ns()) >=
+      excluded_from_ns_[static_cast<std::size_t>(k)])
+    return false;
   const navbus::NavigationSolution& s = p->solution;
   return s.covariance_valid() && s.mode() != navbus::MODE_ALIGNING &&
          s.mode() != navbus::MODE_INERTIAL_LOST;
 }
 
 void LaneSet::select(std::int64_t time_ns) {
+  last_selected_ns_ = time_ns;
   std::vector<const Pending*> at(pending_.size(), nullptr);
   for (std::size_t k = 0; k < pending_.size(); ++k) {
     if (!pending_[k].empty() &&
@@ -249,7 +309,7 @@ void LaneSet::select(std::int64_t time_ns) {
     core::LaneStatus& st = statuses_[k];
     st.available = available(static_cast<int>(k), at[k]);
     st.test_ratio = at[k] ? at[k]->test_ratio : 0.0;
-    if (at[k]) st.solution = navState(at[k]->solution);
+    if (at[k]) st.solution = bus::toCore(at[k]->solution);
   }
   const core::LaneSelection& sel = selector_.update(statuses_);
   if (sel.switched) {
@@ -297,8 +357,11 @@ std::string LaneSet::summary() const {
   s << "lanes: " << lanes_.size() << ", selected IMU "
     << (sel.lane >= 0 ? config_.lanes.units[static_cast<std::size_t>(sel.lane)].sensor_id : 0)
     << ", switches " << sel.reset_count << ", solutions published " << seq_
-    << ", lane solutions passed over (a lane " << config_.lanes.max_pending << " solutions behind) "
-    << passed_over_;
+    << ", times selected without a lane (silent beyond the sequencer's and the judgement's waits, "
+    << "or " << config_.lanes.max_pending << " solutions behind) " << passed_over_
+    << " (its solutions came later " << late_ << ")"
+    << ", selections made without the parity test's judgement (its wait ran out) "
+    << parity_waits_timed_out_;
   for (std::size_t k = 0; k < lanes_.size(); ++k)
     s << (k == 0 ? "; " : "\n") << "lane IMU " << config_.lanes.units[k].sensor_id
       << (excluded_[k] ? " (excluded)" : "") << ": " << lanes_[k]->summary();

@@ -62,6 +62,8 @@ std::vector<TopicEntry> makeRegistry() {
       entry<navbus::NavigationSolutionPubSubType>(topic::kNavSolution, profile::kSolutionReader));
   registry.push_back(entry<navbus::NavigationSolutionPubSubType>(
       topic::kNavSolutionLowLatency, profile::kLowLatencySolutionReader));
+  registry.push_back(
+      entry<navbus::LaneSolutionPubSubType>(topic::kLaneSolution, profile::kSolutionReader));
   registry.push_back(entry<navbus::FilterDiagnosticsPubSubType>(topic::kFilterDiagnostics,
                                                                 profile::kDiagnosticsReader));
   registry.push_back(

@@ -53,5 +53,7 @@ std::optional<Rejection> toGlrEpoch(const navbus::FilterDiagnostics& msg, core::
 
 /// Fills time, position, velocity and attitude fields of a solution from a navigation state.
 void fillSolution(const core::NavState& state, navbus::NavigationSolution& out);
+/// The navigation state a solution carries (time, position, velocity, attitude).
+core::NavState toCore(const navbus::NavigationSolution& solution);
 
 }  // namespace navbus::bus

@@ -43,6 +43,8 @@ bool writeGlrCsv(const std::string& path,
 
 /// The first fault of the schedule that a GLR can detect (IMU bias step or pseudorange ramp).
 std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule);
+/// parity.csv: the parity test's statistics every 100 ms (OfflineResult::parity_trace).
+bool writeParityCsv(const std::string& path, const std::vector<OfflineResult::ParityEpoch>& trace);
 
 /// Compares the run's decisions and commands with the fault.
 FaultRunOutcome evaluateRun(const OfflineResult& r, const std::optional<sim::Fault>& fault,

@@ -70,7 +70,15 @@ struct OfflineResult {
   /// scored against the truth.
   std::uint64_t solutions_without_engine_state{0};
   std::vector<navbus::LaneSolution> lane_solutions;  ///< with keep_lane_solutions
-  std::string summary;                               ///< the pipeline's counters
+  /// The fault manager's parity test (redundant IMUs), every 100 ms of data: the largest
+  /// statistic of each kind over those samples and the thresholds.
+  struct ParityEpoch {
+    std::int64_t time_ns{0};
+    double gyro{0.0}, accelerometer{0.0};
+    double gyro_threshold{0.0}, accelerometer_threshold{0.0};
+  };
+  std::vector<ParityEpoch> parity_trace;
+  std::string summary;  ///< the pipeline's counters
   /// The filter's refusals of IMU increments by reason (an IMU it was not configured with:
   /// REJECT_UNEXPECTED_SOURCE).
   std::map<navbus::RejectReason, std::uint64_t> imu_rejected;

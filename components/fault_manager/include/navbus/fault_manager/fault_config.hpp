@@ -47,10 +47,12 @@ struct ParityDetectorConfig {
   std::vector<core::ImuArrayUnit> units;  ///< same order
   core::ImuArrayParityConfig array;
   bool fail_axes{true};  ///< command CMD_FAIL_SENSOR_AXIS (unit, axis) for an isolated instrument
-  /// Times waiting for a unit's increment (units are received in any order between them; a
-  /// unit that has passed a time without its increment lost it). Beyond this many, a silent unit
-  /// holds up the others: the oldest time is dropped, counted, and the tests restart.
-  int alignment_depth{6000};
+  /// Times waiting for a unit's increment (units are received in any order between them: a DDS
+  /// reader hands out one instance's backlog, up to its history's max_samples (20000 for the
+  /// sensor reader profile), before the next's; a unit that has passed a time without its
+  /// increment lost it). Beyond this many, a silent unit holds up the others: the oldest time is
+  /// dropped, counted, and the tests restart. About 450 bytes a time.
+  int alignment_depth{20000};
 };
 
 struct FaultManagerConfig {

@@ -104,6 +104,10 @@ class FaultPipeline : private FaultOutput {
   GlrDetector glr_;
   std::optional<DitherDetector> dither_;
   std::optional<ParityDetector> parity_;
+  /// The parity test's progress is reported every this much data time.
+  static constexpr std::int64_t kParityReportPeriodNs = 100'000'000;
+  std::int64_t parity_reported_{-1};  ///< data time of the latest report of it
+  navbus::FilterDiagnostics judged_;  ///< the latest diagnostics epoch judged (reports quote it)
   bus::StreamGate diagnostics_gate_;
   std::map<StreamKind, bus::SequenceTracker> trackers_;
   std::map<StreamKind, double> deadline_s_;

@@ -9,6 +9,7 @@
 // leave the parity test, which goes on with the others while they have parity.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <map>
@@ -44,6 +45,8 @@ class ParityDetector {
     std::array<double, core::kImuInstrumentKinds> max_statistic{};
   };
   const Counters& counters() const { return counters_; }
+  /// Every time up to this one is tested, or dropped (-1: none yet).
+  std::int64_t testedUpToNs() const { return std::max(last_tested_ns_, late_before_ns_); }
   const core::ImuArrayParity& array() const { return *array_; }
   /// The largest statistic of the latest aligned sample, per kind (0 while learning).
   const core::ImuArrayParity::Result& latest() const { return latest_; }

@@ -60,9 +60,11 @@ struct LaneUnit {
 struct LanesConfig {
   std::vector<LaneUnit> units;  ///< empty: one lane, the `inputs.imu` IMU
   core::LaneSelectorConfig selector;
-  /// Solutions a lane may be ahead of the slowest before the slowest is passed over (it is then
-  /// unavailable at those times, counted): the bound on the selection's wait.
-  std::size_t max_pending{1000};
+  /// Solutions the other lanes may be ahead of a lane that still speaks (one holding for its
+  /// fault monitor lags) before it is passed over at those times (unavailable, counted): the
+  /// bound on the memory the wait takes. A silent lane is passed over after
+  /// sequencer_max_wait_s of running time.
+  std::size_t max_pending{100000};
 };
 
 struct FilterConfig {

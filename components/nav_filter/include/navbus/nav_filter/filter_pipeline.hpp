@@ -49,6 +49,9 @@ static_assert(kRankCommand > kRankImu && kRankCommand > kRankGnssObs &&
               "a command follows every measurement of its data time");
 /// The commands' place in the merge (one stream, whoever issues them).
 inline constexpr StreamId kCommandStream{kRankCommand, 0};
+/// The fault manager's judgement of the IMU data itself (FaultMonitorProgress
+/// imu_judged_up_to_gps_ns): a judging stream without samples (setImuJudged).
+inline constexpr StreamId kImuJudgementStream{kRankCommand, 1};
 
 /// A validated GNSS observation epoch: satellite clock corrections applied.
 struct GnssEpochInput {
@@ -152,6 +155,10 @@ class FilterPipeline {
   /// its judgement does not follow this: a monitor stopped for longer than its health timeout
   /// but within judgement_wait_ns is still waited for; a dead one costs one budget.)
   void setFaultMonitorAlive(bool alive) { flags_.setFaultMonitorAlive(alive); }
+  /// A fault monitor judges this filter's IMU data (the parity test of redundant IMUs, whose
+  /// reports then give how far it is judged): every increment processed is owed a judgement,
+  /// so that a command about it acts where offline it does (lane_set.hpp).
+  void setImuJudged() { owe_imu_judgement_ = true; }
   /// Some stream is currently lost, no fault monitor is alive, or the filter does not trust
   /// its own covariance (the participant reports DEGRADED).
   bool degraded() const { return flags_.degraded() || !engine_.trustworthy(); }
@@ -198,6 +205,7 @@ class FilterPipeline {
   bool monitored() const;
   void noteJudged(std::int64_t judged_up_to_ns);
   void publishDiagnostics();
+  bool owe_imu_judgement_{false};
   /// Propagates the low-latency output with an arrived increment and publishes it.
   void publishLowLatency(const core::ImuIncrement& inc);
   bool applyStreamCommand(const navbus::FilterCommand& c);

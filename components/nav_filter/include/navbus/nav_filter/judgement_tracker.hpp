@@ -23,6 +23,9 @@ class JudgementTracker {
   std::optional<std::int64_t> onCommand(const navbus::FilterCommand& command);
 
   std::uint64_t reports() const { return reports_; }
+  /// How far the released reports say the IMU data is judged (imu_judged_up_to_gps_ns; 0:
+  /// no parity test).
+  std::int64_t imuJudged() const { return imu_judged_ns_; }
   /// Reports that arrived before the command they name (held until it came).
   std::uint64_t heldForCommand() const { return held_for_command_; }
 
@@ -33,6 +36,7 @@ class JudgementTracker {
   std::map<Run, std::uint64_t> latest_command_id_;    ///< per issuer run
   std::optional<navbus::FaultMonitorProgress> held_;
   std::uint64_t reports_{0};
+  std::int64_t imu_judged_ns_{0};
   std::uint64_t held_for_command_{0};
 };
 

@@ -8,11 +8,11 @@
 // through unchanged but for lane_id.
 //
 // Lanes run on the same inputs in the same order, each from its own IMU, so they reach a data
-// time in turn; the selection at a time waits until every lane has passed it (or is
-// max_pending solutions behind: then it is unavailable there, counted), so the bus and offline
-// select the same. What belongs to the filter as a whole stays with lane 0 (the filter's own
-// IMU, inputs.imu): the participant's health counters, the diagnostics the fault manager's GLR
-// reads, the answers to commands and the fault monitor's watch.
+// time in turn; the selection at a time waits until every lane has passed it (a lane silent for
+// sequencer_max_wait_s of running time, or max_pending solutions behind, is unavailable there,
+// counted), so the bus and offline select the same. What belongs to the filter as a whole stays
+// with lane 0 (the filter's own IMU, inputs.imu): the participant's health counters, the
+// diagnostics the fault manager's GLR reads, the answers to commands and the fault monitor's watch.
 #pragma once
 
 #include <cstdint>
@@ -29,6 +29,7 @@
 
 #include "navbus/core/filter/lane_selector.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/nav_filter/judgement_tracker.hpp"
 
 namespace navbus::nav_filter {
 
@@ -49,8 +50,9 @@ class LaneSet {
   void onStarTracker(const navbus::StarTrackerAttitude& msg);
   void onStreamEnded(bus::StreamKind kind, std::uint32_t id);
   void onDecision(const navbus::FaultDecision& d) { lanes_.front()->onDecision(d); }
-  /// An IMU-axis or IMU-stream command naming a unit goes to that unit's lane (failing it takes
-  /// the lane out of the selection); every other command to every lane (lane 0 answers).
+  /// An IMU-axis or IMU-stream command naming a unit goes to that unit's lane (failing an axis
+  /// takes the lane out of the selection from the command's data time); every other command to
+  /// every lane (lane 0 answers).
   void onCommand(const navbus::FilterCommand& c,
                  const std::optional<std::string>& writer_identity = std::nullopt);
   void pump(std::int64_t now_ns);
@@ -58,9 +60,12 @@ class LaneSet {
   void setWritersAlive(bus::StreamKind kind, bool alive, std::int64_t now_ns);
   void flush(std::int64_t now_ns);
   void publishHeldSolution();
-  void onFaultMonitorProgress(const navbus::FaultMonitorProgress& report) {
-    lanes_.front()->onFaultMonitorProgress(report);
-  }
+  /// Lane 0 follows the diagnostics' judgement; the selection follows the parity test's
+  /// (imu_judged_up_to_gps_ns): once a fault manager reports it, a time is selected only when it
+  /// is judged and the commands the report names are in (or judgement_wait_ns of running time
+  /// has passed: counted), so that a unit failed at a time is left at that time on the bus as
+  /// offline.
+  void onFaultMonitorProgress(const navbus::FaultMonitorProgress& report);
   void setFaultMonitorAlive(bool alive);
   bool degraded() const { return lanes_[static_cast<std::size_t>(selectedIndex())]->degraded(); }
   std::uint64_t newRuns() const { return lanes_.front()->newRuns(); }
@@ -90,21 +95,37 @@ class LaneSet {
   void release(bool all);
   void select(std::int64_t time_ns);
   bool available(int k, const Pending* p) const;
+  /// Whether the selection at `time_ns` waits for the parity test's judgement.
+  bool holdForParity(std::int64_t time_ns);
+  /// A lane not failed by `time_ns` has no solution pending: the selection waits for it.
+  bool missing(std::int64_t time_ns) const;
+  /// Such a lane has been silent beyond the waits (it is passed over).
+  bool anySilentLaneMissing(std::int64_t time_ns) const;
 
   FilterConfig config_;
   Sinks sinks_;
   std::vector<std::unique_ptr<bus::HealthCounters>> lane_health_;  ///< lanes 1..: their own
   std::vector<std::unique_ptr<FilterPipeline>> lanes_;
   std::vector<std::deque<Pending>> pending_;
-  std::vector<bool> excluded_;  ///< the lane's IMU was failed or declared lost by a command
-  std::vector<bool> ended_;     ///< the lane's IMU stream ended as announced: not waited for
+  std::vector<bool> excluded_;  ///< the lane's IMU axis was failed by a command
+  /// ... from this data time on (the command's): unavailable at the times since
+  std::vector<std::int64_t> excluded_from_ns_;
+  JudgementTracker parity_judgements_;  ///< the parity test's progress, with its commands
+  bool parity_reported_{false};
+  std::int64_t parity_judged_ns_{-1};
+  std::int64_t now_ns_{0};          ///< running time of the latest pump
+  std::int64_t held_since_ns_{-1};  ///< running time the selection began to wait for it
+  std::uint64_t parity_waits_timed_out_{0};
   /// Commands given to one lane (issuer, run, id): that lane answers them.
   std::set<std::tuple<std::string, std::uint64_t, std::uint64_t>> routed_;
   core::LaneSelector selector_;
   std::vector<core::LaneStatus> statuses_;
   core::LaneResetDelta last_delta_;
   std::uint64_t seq_{0};
-  std::uint64_t passed_over_{0};  ///< lane solutions missing at a selection (max_pending)
+  std::uint64_t passed_over_{0};  ///< times selected while a lane was not there yet
+  std::uint64_t late_{0};         ///< lane solutions of times already selected (dropped)
+  std::int64_t last_selected_ns_{-1};
+  std::vector<std::int64_t> heard_ns_;  ///< per lane: running time of its latest solution
 };
 
 }  // namespace navbus::nav_filter

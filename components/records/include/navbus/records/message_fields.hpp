@@ -116,6 +116,33 @@ IfMessage<M, navbus::StarTrackerAttitude> visitFields(M& m, V& v) {
   v("sigma_b_rad", m.sigma_b_rad());
   v("valid", m.valid());
 }
+/// A filter lane's solution: the lane, its selection, its fit, and the solution's navigation
+/// fields (the rest of the solution is in navbus/nav/solution when the lane is selected).
+template <class M, class V>
+IfMessage<M, navbus::LaneSolution> visitFields(M& m, V& v) {
+  v("vehicle_id", m.vehicle_id());
+  v("lane_id", m.lane_id());
+  v("selected", m.selected());
+  v("available", m.available());
+  v("test_ratio", m.test_ratio());
+  auto& s = m.solution();
+  v("seq", s.seq());
+  v("time_gps_ns", s.time_gps_ns());
+  v("latitude_rad", s.latitude_rad());
+  v("longitude_rad", s.longitude_rad());
+  v("height_m", s.height_m());
+  v("vel_ned_mps", s.vel_ned_mps());
+  v("roll_rad", s.roll_rad());
+  v("pitch_rad", s.pitch_rad());
+  v("yaw_rad", s.yaw_rad());
+  v("pos_sigma_ned_m", s.pos_sigma_ned_m());
+  v("vel_sigma_ned_mps", s.vel_sigma_ned_mps());
+  v("att_sigma_ned_rad", s.att_sigma_ned_rad());
+  v("gyro_bias_b_radps", s.gyro_bias_b_radps());
+  v("mode", s.mode());
+  v("covariance_valid", s.covariance_valid());
+  v("active_fault_flags", s.active_fault_flags());
+}
 template <class M, class V>
 IfMessage<M, navbus::NavigationSolution> visitFields(M& m, V& v) {
   v("vehicle_id", m.vehicle_id());
