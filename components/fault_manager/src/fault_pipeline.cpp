@@ -39,6 +39,9 @@ void FaultPipeline::onImuIncrement(const navbus::ImuIncrement& increment) {
   const std::int64_t tested = parity_->testedUpToNs();
   if (tested < 0 || tested / kParityReportPeriodNs == parity_reported_ / kParityReportPeriodNs)
     return;
+  // With the GLR, the first report is its first judgement: a report that judged no diagnostics
+  // yet would tell the filter its diagnostics are unjudged (its solutions then say no monitor).
+  if (config_.glr.enabled && judged_.time_gps_ns() == 0) return;
   parity_reported_ = tested;
   reportProgress(judged_);
 }
