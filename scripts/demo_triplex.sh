@@ -28,6 +28,12 @@ cat > "$out/scenario.yaml" <<YAML
 extends: $(pwd)/$scenario
 timing: {duration_s: $duration_s}
 YAML
+# Offline first, without DDS: the lanes with the parity test (what the bus run must equal), and
+# one filter on IMU 1 alone without the parity test.
+"$bin/navbus" offline --scenario "$out/scenario.yaml" --filter "$lanes_cfg" --fault-manager "$fm_cfg" \
+  --start config -o "$out/offline" > "$out/offline.log" 2>&1
+"$bin/navbus" offline --scenario "$out/scenario.yaml" --filter "$single_cfg" --start config \
+  -o "$out/offline_single_lane" > "$out/offline_single_lane.log" 2>&1
 # The recorder gets every solution (lossless writer), as in the main demo.
 cat > "$out/filter.yaml" <<YAML
 extends: $(pwd)/$lanes_cfg
@@ -46,7 +52,14 @@ pids=($filter $fm $rec)
 echo "demo (triplex): filter (three lanes), fault manager (parity test) and recorder on domain $domain;"
 echo "      the simulator publishes $duration_s s of three IMUs as fast as they take it (IMU 1's x gyro ramps from 700 s)"
 "$bin/navbus-sensor-sim" -c "$out/scenario.yaml" -d "$domain" > "$out/sensor_sim.log" 2>&1
-sleep 1
+# The lanes finish after the simulator: each waits for the fault manager's judgement of the
+# data. Wait until the recorder has every solution the offline run published (at most 60 s).
+solutions="$out/record/navbus_nav_solution.csv"
+expected=$(( $(wc -l < "$out/offline/solution.csv") - 1 ))
+for _ in $(seq 1 120); do
+  [ $(( $(wc -l < "$solutions" 2>/dev/null || echo 1) - 1 )) -ge "$expected" ] && break
+  sleep 0.5
+done
 kill -TERM $filter $fm
 wait $filter $fm 2>/dev/null || true
 sleep 0.5
@@ -54,10 +67,6 @@ kill -TERM $rec
 wait $rec 2>/dev/null || true
 trap - EXIT
 
-"$bin/navbus" offline --scenario "$out/scenario.yaml" --filter "$lanes_cfg" --fault-manager "$fm_cfg" \
-  --start config -o "$out/offline" > "$out/offline.log" 2>&1
-"$bin/navbus" offline --scenario "$out/scenario.yaml" --filter "$single_cfg" --start config \
-  -o "$out/offline_single_lane" > "$out/offline_single_lane.log" 2>&1
 echo
 echo "================ navbus triplex demo summary ================"
 grep -h "lanes: switched" "$out/filter.log" | sed 's/.*\] //' || true

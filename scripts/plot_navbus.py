@@ -462,7 +462,7 @@ def triplex(scenario_path, lanes_dir, single_dir, out_dir):
         axes[1].annotate(f"switch {r['reset_count']}: reset deltas |dp| {np.linalg.norm(d):.3f} m,"
                          f" |dv| {np.linalg.norm(vector(r, 'reset_delta_vel_ned_mps')):.3f} m/s,"
                          f" |datt| {a:.1f} mrad", (ts0, int(r["lane_id"])), fontsize=8,
-                         xytext=(10, 10), textcoords="offset points")
+                         xytext=(-420, -30), textcoords="offset points")
     _mark_decisions(axes[1], decisions, start_ns)
     axes[1].set_ylabel("lane")
     axes[1].legend(fontsize=7, loc="lower left")

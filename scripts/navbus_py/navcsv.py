@@ -22,16 +22,25 @@ def vector(row, name, n=3):
     return [float(row[f"{name}[{i}]"]) for i in range(n)]
 
 
+def _merge(base, over):
+    """`over` onto `base` as the tools do: maps merge key by key, anything else replaces."""
+    if not isinstance(base, dict) or not isinstance(over, dict):
+        return over
+    out = dict(base)
+    for k, v in over.items():
+        out[k] = _merge(base[k], v) if k in base else v
+    return out
+
+
 def load_scenario(path):
-    """The scenario YAML with `extends` resolved; top-level keys replace the base's (shallow:
-    the tools merge nested maps, which the summary and figures do not need)."""
+    """The scenario YAML with `extends` resolved (relative to the file, or absolute), merged as
+    the tools merge it."""
     import os
     with open(path) as f:
         s = yaml.safe_load(f)
     if "extends" in s:
         base = load_scenario(os.path.join(os.path.dirname(path), s.pop("extends")))
-        base.update(s)
-        s = base
+        s = _merge(base, s)
     return s
 
 

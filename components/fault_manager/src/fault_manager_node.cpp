@@ -31,7 +31,7 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
                  [this](const navbus::FaultMonitorProgress& r) { progress_writer_.write(r); }},
                 bus::wallTimeNowNs()),
       sensors_(p, streamEvents()),
-      parity_sensors_(p, {}) {
+      parity_sensors_(p, parityEvents()) {
   using namespace bus;
   watch<navbus::ImuIncrement>(profile::kSensorWatchdogReader);
   // Fast pacing's blocks of increments: each element is watched as one increment.
@@ -58,6 +58,14 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
         topic::kFilterDiagnostics, profile::kDiagnosticsReader,
         [this](const navbus::FilterDiagnostics& m, const auto&) { pipeline_.onDiagnostics(m); });
   }
+}
+
+bus::SensorReaders::Events FaultManagerNode::parityEvents() {
+  bus::SensorReaders::Events events;
+  events.ended = [this](StreamKind kind, std::uint32_t id) {
+    if (kind == StreamKind::kImu) pipeline_.onParityUnitEnded(id);
+  };
+  return events;
 }
 
 void FaultManagerNode::subscribeIncrements() {

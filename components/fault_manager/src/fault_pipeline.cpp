@@ -88,6 +88,16 @@ void FaultPipeline::resumedAfterStall(std::int64_t wall_now_ns, std::int64_t sta
       1e-9 * static_cast<double>(StreamWatchdog::kLivelinessGraceNs));
 }
 
+void FaultPipeline::onParityUnitEnded(std::uint32_t sensor_id) {
+  if (!parity_ || !parity_->onUnitEnded(sensor_id)) return;
+  // Every unit has delivered its last increment: all of their data is judged, also the last
+  // part of a report period.
+  const std::int64_t tested = parity_->testedUpToNs();
+  if (tested <= parity_reported_) return;
+  parity_reported_ = tested;
+  reportProgress(judged_);
+}
+
 void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id,
                                   std::uint64_t end_time_gps_ns) {
   // An IMU's raw stream ends with its increment stream, at the same data time (the same

@@ -90,6 +90,12 @@ void ParityDetector::onIncrement(const navbus::ImuIncrement& msg, FaultOutput& o
   drain(out);
 }
 
+bool ParityDetector::onUnitEnded(std::uint32_t sensor_id) {
+  const int unit = unitOf(sensor_id);
+  if (unit >= 0) ended_units_ |= 1u << static_cast<unsigned>(unit);
+  return ended_units_ == (1u << static_cast<unsigned>(array_->units())) - 1u;
+}
+
 bool ParityDetector::lost(std::int64_t time_ns, const Slot& slot) const {
   // Each unit's increments come in time order (a reliable reader per unit instance; the units'
   // instances are taken in any order between them): a unit that delivered a later time never

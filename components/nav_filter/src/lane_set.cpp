@@ -98,6 +98,7 @@ LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks 
   excluded_.assign(units.size(), false);
   excluded_from_ns_.assign(units.size(), std::numeric_limits<std::int64_t>::max());
   heard_ns_.assign(units.size(), -1);
+  previous_.assign(units.size(), std::nullopt);
   statuses_.resize(units.size());
 }
 
@@ -187,6 +188,8 @@ void LaneSet::onCommand(const navbus::FilterCommand& c,
     if (back) excluded_from_ns_[k] = std::numeric_limits<std::int64_t>::max();
   }
   lanes_[k]->onCommand(c, writer_identity);
+  for (std::size_t other = 0; other < lanes_.size(); ++other)
+    if (other != k) lanes_[other]->onCommandElsewhere(c);
   release(false);
 }
 
@@ -313,7 +316,15 @@ void LaneSet::select(std::int64_t time_ns) {
   }
   const core::LaneSelection& sel = selector_.update(statuses_);
   if (sel.switched) {
-    last_delta_ = sel.delta;
+    // The jump a consumer sees is from the old lane's last published solution to the new one's:
+    // the lanes' difference at that last time, when the old lane was still as published (a lane
+    // failed by a command changes at once: its rollback re-processes its data). Both lanes had
+    // a solution then; otherwise their difference now.
+    const auto from = static_cast<std::size_t>(sel.previous_lane);
+    const auto to = static_cast<std::size_t>(sel.lane);
+    last_delta_ = previous_[from] && previous_[to]
+                      ? core::laneResetDelta(*previous_[from], *previous_[to])
+                      : sel.delta;
     spdlog::warn(
         "lanes: switched from IMU {} to IMU {} at {:.3f} s ({}), reset {}: position "
         "{:.3f} m, velocity {:.4f} m/s, attitude {:.3g} mrad",
@@ -322,8 +333,8 @@ void LaneSet::select(std::int64_t time_ns) {
         1e-9 * static_cast<double>(time_ns),
         sel.reason == core::LaneSwitchReason::kUnavailable ? "the lane became unavailable"
                                                            : "a clearly better fit",
-        sel.reset_count, sel.delta.position_ned_m.norm(), sel.delta.velocity_ned_mps.norm(),
-        1e3 * sel.delta.attitude_ned_rad.norm());
+        sel.reset_count, last_delta_.position_ned_m.norm(), last_delta_.velocity_ned_mps.norm(),
+        1e3 * last_delta_.attitude_ned_rad.norm());
   }
   // Every lane's solution on its own instance; the selected one published.
   for (std::size_t k = 0; k < pending_.size(); ++k) {
@@ -346,8 +357,10 @@ void LaneSet::select(std::int64_t time_ns) {
     setDelta(out, last_delta_);
     sinks_.filter.solution(out);
   }
-  for (std::size_t k = 0; k < pending_.size(); ++k)
+  for (std::size_t k = 0; k < pending_.size(); ++k) {
+    previous_[k] = at[k] ? std::optional<core::NavState>(statuses_[k].solution) : std::nullopt;
     if (at[k]) pending_[k].pop_front();
+  }
 }
 
 std::string LaneSet::summary() const {

@@ -129,8 +129,9 @@ TEST(RedundantUnits, LanesLeaveTheFailedUnitAndPublishTheJumpTheyMake) {
   // (config/filter_triplex.yaml) and the parity test, when 900 s run offline, then the parity
   // decision fails unit 1's axis, the selector leaves lane 1 for another at once (one switch,
   // counter 1), and the published solution at the switch is the new lane's: its reset deltas are
-  // the new lane's solution minus lane 1's at that time, to 1 mm and 1 mm/s, and stay on every
-  // later solution with the counter; before the switch lane 1 is published, with zero deltas.
+  // the new lane's solution minus lane 1's at the last time lane 1 was published, to 1 mm and
+  // 1 mm/s (the published jump is that plus the new lane's motion over the step, to 1 mm), and
+  // stay on every later solution with the counter; before the switch, lane 1 with zero deltas.
   const std::string dir = navbus::test_paths::scenarioDir();
   evaluation::OfflineSetup s;
   s.sim = navbus::sensor_sim::parseSimConfig(
@@ -166,21 +167,41 @@ TEST(RedundantUnits, LanesLeaveTheFailedUnitAndPublishTheJumpTheyMake) {
   EXPECT_GE(after.time_gps_ns(), r.decisions[0].time_gps_ns());
   EXPECT_LE(after.time_gps_ns(), r.decisions[0].time_gps_ns() + 200'000'000ull);
   EXPECT_EQ(after.reset_count(), 1u);
-  // Lane 1's own solution at the switch's time, from the lanes' stream.
-  const navbus::LaneSolution* old_lane = nullptr;
-  for (const navbus::LaneSolution& l : r.lane_solutions)
-    if (l.lane_id() == 1u && l.solution().time_gps_ns() == after.time_gps_ns()) old_lane = &l;
+  // The jump a consumer sees: from lane 1's last published solution to the new lane's. The
+  // deltas are the two lanes' difference at that last time (lane 1 still as published), from
+  // the lanes' stream.
+  ASSERT_GT(switch_at, 0u);
+  const std::uint64_t last_ns = published[switch_at - 1].time_gps_ns();
+  const navbus::LaneSolution *old_lane = nullptr, *new_lane = nullptr, *old_now = nullptr;
+  for (const navbus::LaneSolution& l : r.lane_solutions) {
+    if (l.solution().time_gps_ns() == last_ns && l.lane_id() == 1u) old_lane = &l;
+    if (l.solution().time_gps_ns() == last_ns && l.lane_id() == after.lane_id()) new_lane = &l;
+    if (l.solution().time_gps_ns() == after.time_gps_ns() && l.lane_id() == 1u) old_now = &l;
+  }
   ASSERT_NE(old_lane, nullptr);
-  EXPECT_FALSE(old_lane->available());
+  ASSERT_NE(new_lane, nullptr);
+  ASSERT_NE(old_now, nullptr);
+  EXPECT_FALSE(old_now->available());
+  EXPECT_TRUE(old_lane->selected());
   const navbus::NavigationSolution& old = old_lane->solution();
-  const Eigen::Vector3d jump = navbus::core::earth::differenceNed(
-      {after.latitude_rad(), after.longitude_rad(), after.height_m()},
-      {old.latitude_rad(), old.longitude_rad(), old.height_m()});
+  const navbus::NavigationSolution& now = new_lane->solution();
+  const Eigen::Vector3d jump =
+      navbus::core::earth::differenceNed({now.latitude_rad(), now.longitude_rad(), now.height_m()},
+                                         {old.latitude_rad(), old.longitude_rad(), old.height_m()});
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(after.reset_delta_pos_ned_m()[i], jump[i], 1e-3);
-    EXPECT_NEAR(after.reset_delta_vel_ned_mps()[i], after.vel_ned_mps()[i] - old.vel_ned_mps()[i],
+    EXPECT_NEAR(after.reset_delta_vel_ned_mps()[i], now.vel_ned_mps()[i] - old.vel_ned_mps()[i],
                 1e-3);
   }
+  // The published jump is that difference plus the new lane's own motion over the step.
+  const navbus::NavigationSolution& before = published[switch_at - 1];
+  const Eigen::Vector3d seen = navbus::core::earth::differenceNed(
+      {after.latitude_rad(), after.longitude_rad(), after.height_m()},
+      {before.latitude_rad(), before.longitude_rad(), before.height_m()});
+  const Eigen::Vector3d motion = navbus::core::earth::differenceNed(
+      {after.latitude_rad(), after.longitude_rad(), after.height_m()},
+      {now.latitude_rad(), now.longitude_rad(), now.height_m()});
+  EXPECT_LT((seen - motion - jump).norm(), 1e-3);
   for (std::size_t i = switch_at; i < published.size(); ++i) {
     EXPECT_EQ(published[i].lane_id(), after.lane_id());
     EXPECT_EQ(published[i].reset_count(), 1u);

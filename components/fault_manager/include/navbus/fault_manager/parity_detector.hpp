@@ -45,6 +45,8 @@ class ParityDetector {
     std::array<double, core::kImuInstrumentKinds> max_statistic{};
   };
   const Counters& counters() const { return counters_; }
+  /// The unit's increments ended as announced; true once every unit's have.
+  bool onUnitEnded(std::uint32_t sensor_id);
   /// Every time up to this one is tested, or dropped (-1: none yet).
   std::int64_t testedUpToNs() const { return std::max(last_tested_ns_, late_before_ns_); }
   const core::ImuArrayParity& array() const { return *array_; }
@@ -75,6 +77,7 @@ class ParityDetector {
   std::int64_t period_ns_;
   bus::ValidationLimits limits_;
   std::map<std::int64_t, Slot> pending_;  ///< by time, waiting for every unit
+  std::uint32_t ended_units_{0};          ///< bit per unit whose increments ended
   std::int64_t last_tested_ns_{-1};       ///< -1: the next time tested starts a new window
   std::int64_t late_before_ns_{-1};       ///< increments at or before this time come too late
   std::array<std::int64_t, core::ImuArrayParity::kMaxUnits> latest_ns_{};  ///< per unit

@@ -150,6 +150,11 @@ class FilterPipeline {
   /// FaultMonitorWatch::judgement_wait_ns), so that a command answering it acts where offline
   /// it does, before the next solution is published.
   void onFaultMonitorProgress(const navbus::FaultMonitorProgress& report);
+  /// A command given to another lane (lane_set.hpp): not this filter's to apply, but a report
+  /// naming it may count now (a judgement waits for every command it names).
+  void onCommandElsewhere(const navbus::FilterCommand& c) {
+    if (const auto judged = judgements_.onCommand(c)) noteJudged(*judged);
+  }
   /// Whether a fault monitor is alive (the participant watches its reports): while not,
   /// solutions carry FAULT_NO_FAULT_MONITOR. Changes are logged and counted. (The wait for
   /// its judgement does not follow this: a monitor stopped for longer than its health timeout

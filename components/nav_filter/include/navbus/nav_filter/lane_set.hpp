@@ -121,6 +121,8 @@ class LaneSet {
   core::LaneSelector selector_;
   std::vector<core::LaneStatus> statuses_;
   core::LaneResetDelta last_delta_;
+  /// Every lane's solution at the previous selected time (the reset deltas' reference).
+  std::vector<std::optional<core::NavState>> previous_;
   std::uint64_t seq_{0};
   std::uint64_t passed_over_{0};  ///< times selected while a lane was not there yet
   std::uint64_t late_{0};         ///< lane solutions of times already selected (dropped)
