@@ -139,9 +139,12 @@ void accumulate(Stats& st, const OfflineResult& r, std::int64_t from_ns, const M
       st.nees_runs.resize(k + 1, 0);
       st.nees_time_s.push_back(1e-9 * static_cast<double>(e.time_ns - start_ns));
     }
-    st.nees_sum[k] += e.nees9;
-    st.nees_blocks_sum[k] += e.nees_blocks;
-    ++st.nees_runs[k];
+    // A solution scored from its message (a lane's engine had moved on) has no covariance.
+    if (std::isfinite(e.nees9)) {
+      st.nees_sum[k] += e.nees9;
+      st.nees_blocks_sum[k] += e.nees_blocks;
+      ++st.nees_runs[k];
+    }
     ++k;
   }
   for (double t_s : o.recovery_after_s) {
