@@ -32,6 +32,7 @@ struct Case {
   std::string
       fault_manager{};       ///< file under config for both runs ("": the defaults, offline none)
   std::size_t decisions{0};  ///< with fault_manager: the decisions both runs must publish
+  std::string sim_extra{};   ///< YAML appended to the scenario (e.g. its faults)
 };
 
 /// A decision as CSV, without its run_id (the last column: the bus run's start time, 0 offline).
@@ -45,9 +46,10 @@ void runCase(const Case& c) {
   const std::string scenario = std::string(navbus::test_paths::scenarioDir()) + "/" + c.scenario;
   const std::string filter_base = std::string(navbus::test_paths::configDir()) + "/" + c.filter;
   const std::string domain = "domain_id: " + std::to_string(c.domain) + "\n";
-  const std::string sim_cfg = test::writeFile(
-      dir / "sim.yaml", "extends: " + scenario + "\n" + domain +
-                            "timing: {duration_s: " + std::to_string(c.duration_s) + "}\n");
+  const std::string sim_cfg =
+      test::writeFile(dir / "sim.yaml", "extends: " + scenario + "\n" + domain +
+                                            "timing: {duration_s: " + std::to_string(c.duration_s) +
+                                            "}\n" + c.sim_extra);
   // Every solution must reach the test even though the data runs through at full speed. The
   // sequencer's bounded wait is the one place where wall time enters the bus run (a stream
   // silent for longer is set aside, which the offline run never does); on a loaded machine or
@@ -189,17 +191,21 @@ TEST(OfflineEqualsBus, TriplexUnitsBesideAOneImuFilter) {
 // published solution (its lane, reset counter and deltas included) is the offline run's bit for
 // bit: the selection waits for the parity test's judgement of each time (FaultMonitorProgress
 // imu_judged_up_to_gps_ns) and the command it names.
+// The ramp starts at 100 s and grows four times faster than the demo's, so that 200 s of data
+// hold the decision and the switch (the sanitizers' build runs it too).
 TEST(OfflineEqualsBus, TriplexLanesSwitchWhereOfflineTheyDo) {
   runCase({84,
            "seed000_triplex_gyro_ramp.yaml",
            "filter_triplex.yaml",
            "",
            3,
-           900.0,
+           200.0,
            {"lanes: switched from IMU 1 to IMU", "switches 1,",
             "selections made without the parity test's judgement (its wait ran out) 0"},
            "fault_manager_triplex.yaml",
-           1});
+           1,
+           "faults:\n  - {type: imu_bias_ramp, sensor: gyro, axis: x, start_s: 100,\n"
+           "     slope_deg_per_h_per_s: 0.01, saturation_deg_per_h: 3, sensor_id: 1}\n"});
 }
 
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->
