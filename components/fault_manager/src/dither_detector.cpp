@@ -84,14 +84,7 @@ void DitherDetector::report(int channel, const core::DitherWindow& w, FaultOutpu
       check.peak_frequency_hz, check.peak_amplitude, expected[0], expected[1], expected[2],
       config_.monitor.tolerance_hz, monitor_.minAmplitude(channel));
   if (!failed || !config_.fail_axes) return;
-  navbus::FilterCommand c;
-  c.kind(navbus::CMD_FAIL_SENSOR_AXIS);
-  c.decision_id(id);
-  c.time_gps_ns(d.time_gps_ns());
-  c.onset_time_gps_ns(d.onset_time_gps_ns());
-  c.sensor(d.source());
-  c.sensor_id(config_.imu_id);
-  c.axis(axis);
+  navbus::FilterCommand c = failAxisCommand(d);  // decide() stamped its id
   out.command(c);
 }
 

@@ -196,15 +196,8 @@ void ParityDetector::report(std::int64_t time_ns, const core::ImuArrayDetection&
   if (!still)
     spdlog::warn("parity detector: the {}s left have no parity: {} detection stops",
                  kindName(det.kind), kindName(det.kind));
-  if (ambiguous || !config_.fail_axes) return;  // which one: the lanes' evidence, not ours
-  navbus::FilterCommand c;
-  c.kind(navbus::CMD_FAIL_SENSOR_AXIS);
-  c.decision_id(id);
-  c.time_gps_ns(d.time_gps_ns());
-  c.onset_time_gps_ns(d.onset_time_gps_ns());
-  c.sensor(d.source());
-  c.sensor_id(d.sensor_id());
-  c.axis(d.axis());
+  if (ambiguous || !config_.fail_axes) return;   // which one: the lanes' evidence, not ours
+  navbus::FilterCommand c = failAxisCommand(d);  // decide() stamped its id
   out.command(c);
   ++counters_.commands;
 }

@@ -304,7 +304,8 @@ bool LaneSet::available(int k, const Pending* p) const {
 
 void LaneSet::select(std::int64_t time_ns) {
   last_selected_ns_ = time_ns;
-  std::vector<const Pending*> at(pending_.size(), nullptr);
+  std::vector<const Pending*>& at = at_;  // reused: no allocation per selection
+  at.assign(pending_.size(), nullptr);
   for (std::size_t k = 0; k < pending_.size(); ++k) {
     if (!pending_[k].empty() &&
         static_cast<std::int64_t>(pending_[k].front().solution.time_gps_ns()) == time_ns)

@@ -17,4 +17,18 @@ class FaultOutput {
   virtual void command(navbus::FilterCommand& c) = 0;
 };
 
+/// CMD_FAIL_SENSOR_AXIS for the sensor, unit and axis a published decision names (its id, time
+/// and onset), as the dither and parity detectors command it.
+inline navbus::FilterCommand failAxisCommand(const navbus::FaultDecision& d) {
+  navbus::FilterCommand c;
+  c.kind(navbus::CMD_FAIL_SENSOR_AXIS);
+  c.decision_id(d.decision_id());
+  c.time_gps_ns(d.time_gps_ns());
+  c.onset_time_gps_ns(d.onset_time_gps_ns());
+  c.sensor(d.source());
+  c.sensor_id(d.sensor_id());
+  c.axis(d.axis());
+  return c;
+}
+
 }  // namespace navbus::fault_manager

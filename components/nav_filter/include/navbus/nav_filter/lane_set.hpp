@@ -120,6 +120,7 @@ class LaneSet {
   std::set<std::tuple<std::string, std::uint64_t, std::uint64_t>> routed_;
   core::LaneSelector selector_;
   std::vector<core::LaneStatus> statuses_;
+  std::vector<const Pending*> at_;  ///< each lane's solution at the time being selected
   core::LaneResetDelta last_delta_;
   /// Every lane's solution at the previous selected time (the reset deltas' reference).
   std::vector<std::optional<core::NavState>> previous_;
