@@ -38,7 +38,7 @@ t0=$SECONDS
 # 56-byte one in RTPSWriter::~RTPSWriter (sized delete in a library navbus does not build).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:new_delete_type_mismatch=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-# Left to the normal build: cpu_load and fault_loop_load (timing under CPU load, which the
+# Left to the normal build: cpu_load, fault_loop_load and lanes_load (timing under CPU load, which the
 # sanitizers change), figures (Python plotting; the runs it plots are the real_car and
 # unit_evaluation tests here) and mcap_foxglove (two recorders of one fast-paced run compared
 # message by message: under ASan only 1 of the 1,200 IMU blocks and 400 of the 1,200 solutions
@@ -47,5 +47,5 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # to compare the simulator's throughput with and without the bridge: a timing measurement;
 # foxglove_bridge runs the bridge here).
 (cd build-san && ctest --output-on-failure -j2 --timeout 600 \
-  -E "^(cpu_load|fault_loop_load|figures|mcap_foxglove|foxglove_load)$")
+  -E "^(cpu_load|fault_loop_load|lanes_load|figures|mcap_foxglove|foxglove_load)$")
 echo "sanitizers: tests $((SECONDS - t0)) s"

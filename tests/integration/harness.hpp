@@ -194,17 +194,21 @@ struct SensorInputWriters {
 struct Seed000Loop {
   std::string sim, filter, fault_manager;
 };
+/// `filter` and `fault_manager` name files under config/ (without .yaml).
 inline Seed000Loop writeSeed000Loop(const std::filesystem::path& dir, int domain,
                                     const std::string& sim_extra,
-                                    const std::string& scenario = "seed000_aircraft") {
+                                    const std::string& scenario = "seed000_aircraft",
+                                    const std::string& filter = "filter_seed000_tc",
+                                    const std::string& fault_manager = "fault_manager") {
   const std::string src = navbus::test_paths::sourceDir();
   const std::string dom = "domain_id: " + std::to_string(domain) + "\n";
   return {writeFile(dir / "sim.yaml",
                     "extends: " + src + "/sim/scenarios/" + scenario + ".yaml\n" + dom + sim_extra),
           writeFile(dir / "filter.yaml",
-                    "extends: " + src + "/config/filter_seed000_tc.yaml\n" + dom +
+                    "extends: " + src + "/config/" + filter + ".yaml\n" + dom +
                         "solution_writer_profile: navbus_solution_writer_lossless\n"),
-          writeFile(dir / "fm.yaml", "extends: " + src + "/config/fault_manager.yaml\n" + dom)};
+          writeFile(dir / "fm.yaml",
+                    "extends: " + src + "/config/" + fault_manager + ".yaml\n" + dom)};
 }
 
 /// `navbus offline` on the loop's files from the configured start into `dir`/offline (log

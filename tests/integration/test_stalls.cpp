@@ -3,10 +3,12 @@
 // would), the fault manager stopped, or both starved of CPU by two busy loops: no increment is
 // refused as late, every solution time is published once, and every solution and every
 // decision equals `navbus offline`'s (docs/architecture.md, the ordered merge and the fault
-// manager's judgement). Fault-free flight (ctest stalls) and the fault loop with an IMU step
-// and a pseudorange ramp (ctest fault_loop_load).
+// manager's judgement). Fault-free flight (ctest stalls), the fault loop with an IMU step
+// and a pseudorange ramp (ctest fault_loop_load), and the triplex IMUs in three filter lanes
+// through a parity decision and a lane switch, every lane's solution compared too.
 #include <csignal>
 #include <map>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <navbus_idl/FaultPubSubTypes.h>
@@ -28,6 +30,10 @@ struct LoadCase {
   int filter_stops;   ///< stops of the filter for 1.5 s, spread over the run
   int monitor_stops;  ///< stops of the fault manager for 2 s, spread over the run
   int cpu_hogs;       ///< busy loops beside the participants
+  std::string filter{"filter_seed000_tc"};  ///< files under config/ (without .yaml)
+  std::string fault_manager{"fault_manager"};
+  std::string sim_extra{};                  ///< YAML appended to the scenario
+  std::vector<std::string> filter_log_says{};
 };
 
 /// A decision row without its run_id (the fault manager's start time; 0 offline).
@@ -68,8 +74,9 @@ void run(const LoadCase& c) {
   test::cleanSharedMemory();
   const auto dir = test::scratchDir("stalls-" + std::to_string(c.domain));
   const test::Seed000Loop cfg = test::writeSeed000Loop(
-      dir, c.domain, "timing: {duration_s: " + std::to_string(c.duration_s) + ", pacing: fast}\n",
-      c.scenario);
+      dir, c.domain,
+      "timing: {duration_s: " + std::to_string(c.duration_s) + ", pacing: fast}\n" + c.sim_extra,
+      c.scenario, c.filter, c.fault_manager);
   ASSERT_EQ(test::runOffline(cfg, dir, "3"), 0) << test::readFile(dir / "offline.log");
   std::vector<std::string> expected;
   for (const std::string& row : test::csvDataRows(dir / "offline" / "solution.csv"))
@@ -78,12 +85,25 @@ void run(const LoadCase& c) {
   for (const std::string& row : test::csvDataRows(dir / "offline" / "decisions.csv"))
     expected_decisions.push_back(withoutRunId(row));
   ASSERT_GT(expected.size(), 2000u);
+  // Every lane's own solutions (lanes.csv; none without `lanes:`).
+  std::set<std::string> expected_lanes;
+  if (std::filesystem::exists(dir / "offline" / "lanes.csv")) {
+    for (const std::string& row : test::csvDataRows(dir / "offline" / "lanes.csv"))
+      expected_lanes.insert(row);
+  }
 
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(c.domain, "stalls"), shutdown);
   std::map<std::uint64_t, int> published;  // solution time -> how many times
   std::vector<std::string> rows, decisions;
   int watchdog_decisions = 0;  // stream-lost decisions (not in the offline run)
+  std::set<std::string> lanes;  // every lane's solutions, as CSV rows
+  int repeated_lanes = 0;
+  me.subscribe<LaneSolutionPubSubType>(
+      bus::topic::kLaneSolution, bus::profile::kSolutionReader,
+      [&](const LaneSolution& s, const auto&) {
+        repeated_lanes += lanes.insert(records::csvRows(s).at(0)).second ? 0 : 1;
+      });
   me.subscribe<NavigationSolutionPubSubType>(
       bus::topic::kNavSolution, bus::profile::kSolutionReader,
       [&](const NavigationSolution& s, const auto&) {
@@ -123,7 +143,9 @@ void run(const LoadCase& c) {
   }
   while (sim.running()) me.spinOnce(50ms);
   EXPECT_EQ(sim.wait(1s), 0) << test::readFile(dir / "sim.log");
-  test::spinUntil(me, 60s, [&] { return rows.size() >= expected.size(); });
+  test::spinUntil(me, 60s, [&] {
+    return rows.size() >= expected.size() && lanes.size() >= expected_lanes.size();
+  });
   me.spinOnce(500ms);
   hogs.clear();
   filter.signal(SIGTERM);
@@ -138,6 +160,18 @@ void run(const LoadCase& c) {
     EXPECT_NE(log.find("stalls of the filter process"), std::string::npos) << log;
   }
   EXPECT_NE(log.find("judgements waited for beyond the budget 0"), std::string::npos) << log;
+  for (const std::string& says : c.filter_log_says)
+    EXPECT_NE(log.find(says), std::string::npos) << "the filter's log says '" << says << "'" << log;
+  EXPECT_EQ(repeated_lanes, 0) << "each lane's solution time once";
+  EXPECT_EQ(lanes.size(), expected_lanes.size());
+  std::size_t lanes_differing = 0;
+  std::string first_missing;
+  for (const std::string& row : expected_lanes) {
+    if (lanes.count(row) > 0) continue;
+    if (++lanes_differing <= 3) first_missing += row.substr(0, 80) + "\n";
+  }
+  EXPECT_EQ(lanes_differing, 0u) << "every lane's solutions as offline; missing, e.g.:\n"
+                                 << first_missing << log;
   int repeated = 0;
   for (const auto& [time, n] : published) repeated += n > 1 ? 1 : 0;
   EXPECT_EQ(repeated, 0) << "each solution time once";
@@ -147,11 +181,12 @@ void run(const LoadCase& c) {
   EXPECT_EQ(decisions, expected_decisions) << test::readFile(dir / "fm.log");
   std::printf(
       "%s, %d s, filter stopped %d x 1.5 s, fault manager stopped %d x 2 s, %d CPU hogs: %zu "
-      "solutions, %zu differ from offline (fault flags aside); decisions %zu (offline %zu), %s; "
-      "watchdog decisions %d\n",
+      "solutions, %zu differ from offline (fault flags aside); lane solutions %zu (offline %zu), "
+      "%zu differ; decisions %zu (offline %zu), %s; watchdog decisions %d\n",
       c.scenario.c_str(), c.duration_s, c.filter_stops, c.monitor_stops, c.cpu_hogs, rows.size(),
-      differing, decisions.size(), expected_decisions.size(),
-      decisions == expected_decisions ? "equal" : "DIFFERENT", watchdog_decisions);
+      differing, lanes.size(), expected_lanes.size(), lanes_differing, decisions.size(),
+      expected_decisions.size(), decisions == expected_decisions ? "equal" : "DIFFERENT",
+      watchdog_decisions);
   test::cleanSharedMemory();
   std::filesystem::remove_all(dir);
 }
@@ -172,4 +207,16 @@ TEST(LoadedFaultLoop, GyroStepWithTheFilterStoppedAndTwoCpuHogsEqualsOffline) {
 
 TEST(LoadedFaultLoop, PseudorangeRampWithTheFaultManagerStoppedEqualsOffline) {
   run({105, "seed000_pseudorange_ramp", 720, 0, 2, 2});
+}
+
+// Three IMUs in three filter lanes (config/filter_triplex.yaml) beside the parity test: unit 1's
+// gyro ramps from 100 s (four times the demo's slope), the parity decision fails it and the
+// selector leaves lane 1; the filter is stopped twice and the fault manager once, two busy loops
+// beside them. The published solutions, every lane's own and the decision equal offline's.
+TEST(LoadedLanes, TriplexLanesThroughASwitchWithStopsAndCpuHogsEqualOffline) {
+  run({85, "seed000_triplex_gyro_ramp", 240, 2, 1, 2, "filter_triplex", "fault_manager_triplex",
+       "faults:\n  - {type: imu_bias_ramp, sensor: gyro, axis: x, start_s: 100,\n"
+       "     slope_deg_per_h_per_s: 0.01, saturation_deg_per_h: 3, sensor_id: 1}\n",
+       {"lanes: switched from IMU 1 to IMU", "switches 1,",
+        "selections made without the parity test's judgement (its wait ran out) 0"}});
 }

@@ -1,8 +1,11 @@
 #include "navbus/evaluation/integrity_evaluation.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <navbus_idl/Navigation.h>
 
 namespace navbus::evaluation {
@@ -80,8 +83,19 @@ void HonestyTally::add(const OfflineResult& r, double probability) {
   consistency.rows += r.consistency.rows;
   ++runs;
   std::uint64_t beyond = 0;
+  bool left_3_sigma_h = false;
   for (const EpochError& e : r.errors) {
     ++epochs;
+    const double error_h = e.pos_ned_m.head<2>().norm();
+    const double sigma_h = e.pos_sigma_ned_m.head<2>().norm();
+    if (std::isfinite(error_h) && std::isfinite(sigma_h)) {
+      coverage_h.add(error_h, sigma_h, e.covariance_valid);
+      if (!left_3_sigma_h && e.covariance_valid && !(error_h <= 3.0 * sigma_h)) {
+        left_3_sigma_h = true;
+        first_beyond_3_sigma_h_s.push_back(
+            1e-9 * static_cast<double>(e.time_ns - r.errors.front().time_ns));
+      }
+    }
     if (!e.covariance_valid) {
       ++flagged;
       continue;
@@ -94,6 +108,7 @@ void HonestyTally::add(const OfflineResult& r, double probability) {
   }
   unflagged_beyond_5_sigma += beyond;
   runs_unflagged_beyond_5_sigma += beyond > 0 ? 1 : 0;
+  runs_unflagged_beyond_3_sigma_h += left_3_sigma_h ? 1 : 0;
 }
 
 void printHonestyTable(const std::vector<std::pair<std::string, HonestyTally>>& rows) {
@@ -118,6 +133,19 @@ void printHonestyTable(const std::vector<std::pair<std::string, HonestyTally>>& 
                 t.design_probability, static_cast<unsigned long long>(t.consistency.alarms),
                 static_cast<unsigned long long>(t.flagged), t.runs_unflagged_beyond_5_sigma, t.runs,
                 t.max_unflagged_ratio);
+  }
+  std::printf("\ncoverage: the published horizontal error e against its own sigma_h, every epoch of "
+              "every run\n%s", coverageHeader().c_str());
+  for (const auto& [label, t] : rows) std::printf("%s", coverageRow(label, t.coverage_h, true).c_str());
+  std::printf("%s", coverageFooter().c_str());
+  for (const auto& [label, t] : rows) {
+    const double epochs = static_cast<double>(t.coverage_h.epochs());
+    std::printf(
+        "%s: runs with an unflagged epoch beyond 3 sigma_h: %d of %d (the first at %s s); epochs "
+        "beyond 3 sigma_h %.0f (a consistent filter: %.0f)\n",
+        label.c_str(), t.runs_unflagged_beyond_3_sigma_h, t.runs,
+        fmt::format("{:.1f}", fmt::join(t.first_beyond_3_sigma_h_s, ", ")).c_str(),
+        epochs * (1.0 - t.coverage_h.insideShare(3)), epochs * (1.0 - consistentShare(3)));
   }
 }
 

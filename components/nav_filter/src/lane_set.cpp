@@ -225,13 +225,18 @@ void LaneSet::setFaultMonitorAlive(bool alive) {
 void LaneSet::onLaneSolution(int k, const navbus::NavigationSolution& s) {
   const auto i = static_cast<std::size_t>(k);
   heard_ns_[i] = now_ns_;
+  // The lane's fit as it stands at this solution (the engine moves on before the selection).
+  Pending p{atBodyOrigin(s, config_.lanes.units[i].lever_arm_b_m),
+            lanes_[i]->engine().consistency().windowNisPerRow()};
   if (static_cast<std::int64_t>(s.time_gps_ns()) <= last_selected_ns_) {
-    ++late_;  // its time was selected without it (passed over): not selected again
+    // Its time was selected without it (a lane failed by a command is not waited for, one
+    // silent too long is passed over): not selected, but on the lanes topic all the same, as
+    // offline, where no lane comes late, it is.
+    ++late_;
+    publishLane(i, p, false);
     return;
   }
-  // The lane's fit as it stands at this solution (the engine moves on before the selection).
-  pending_[i].push_back({atBodyOrigin(s, config_.lanes.units[i].lever_arm_b_m),
-                         lanes_[i]->engine().consistency().windowNisPerRow()});
+  pending_[i].push_back(std::move(p));
   release(false);
 }
 
@@ -338,19 +343,8 @@ void LaneSet::select(std::int64_t time_ns) {
         1e3 * last_delta_.attitude_ned_rad.norm());
   }
   // Every lane's solution on its own instance; the selected one published.
-  for (std::size_t k = 0; k < pending_.size(); ++k) {
-    if (!at[k]) continue;
-    if (sinks_.lane) {
-      navbus::LaneSolution l;
-      l.vehicle_id(config_.vehicle_id);
-      l.lane_id(config_.lanes.units[k].sensor_id);
-      l.selected(static_cast<int>(k) == sel.lane);
-      l.available(statuses_[k].available);
-      l.test_ratio(at[k]->test_ratio);
-      l.solution(at[k]->solution);
-      sinks_.lane(l);
-    }
-  }
+  for (std::size_t k = 0; k < pending_.size(); ++k)
+    if (at[k]) publishLane(k, *at[k], static_cast<int>(k) == sel.lane);
   if (sel.lane >= 0 && at[static_cast<std::size_t>(sel.lane)]) {
     navbus::NavigationSolution out = at[static_cast<std::size_t>(sel.lane)]->solution;
     out.seq(++seq_);
@@ -362,6 +356,18 @@ void LaneSet::select(std::int64_t time_ns) {
     previous_[k] = at[k] ? std::optional<core::NavState>(statuses_[k].solution) : std::nullopt;
     if (at[k]) pending_[k].pop_front();
   }
+}
+
+void LaneSet::publishLane(std::size_t k, const Pending& p, bool selected) const {
+  if (!sinks_.lane) return;
+  navbus::LaneSolution l;
+  l.vehicle_id(config_.vehicle_id);
+  l.lane_id(config_.lanes.units[k].sensor_id);
+  l.selected(selected);
+  l.available(available(static_cast<int>(k), &p));
+  l.test_ratio(p.test_ratio);
+  l.solution(p.solution);
+  sinks_.lane(l);
 }
 
 std::string LaneSet::summary() const {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "navbus/evaluation/coverage.hpp"
 #include "navbus/evaluation/offline_runner.hpp"
 
 namespace navbus::evaluation {
@@ -32,8 +33,10 @@ struct IntegrityTally {
 };
 
 /// Whether the filter's own claims hold: its consistency monitor's alarms (on fault-free runs
-/// the false-alarm rate, against its design probability) and the epochs whose 3-D position
-/// error exceeds 5 times the 3-D sigma while the solution says its covariance is valid.
+/// the false-alarm rate, against its design probability), the epochs whose 3-D position
+/// error exceeds 5 times the 3-D sigma while the solution says its covariance is valid, and
+/// the published horizontal error against its own sigma_h at every epoch (coverage.hpp), with
+/// the runs in which an unflagged epoch left 3 sigma_h ("inside 3 sigma throughout").
 struct HonestyTally {
   core::ConsistencyCounters consistency;  ///< summed over the runs
   double design_probability{0.0};
@@ -41,6 +44,9 @@ struct HonestyTally {
   std::uint64_t unflagged_beyond_5_sigma{0};
   int runs{0}, runs_unflagged_beyond_5_sigma{0};
   double max_unflagged_ratio{0.0};  ///< largest 3-D error / 3-D sigma, unflagged epochs
+  CoverageTally coverage_h;         ///< every epoch with a finite error and sigma
+  int runs_unflagged_beyond_3_sigma_h{0};
+  std::vector<double> first_beyond_3_sigma_h_s;  ///< of those runs: the first such epoch [s from start]
 
   void add(const OfflineResult& r, double design_probability);
 };

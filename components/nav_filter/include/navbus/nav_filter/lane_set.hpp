@@ -94,6 +94,8 @@ class LaneSet {
   /// Selects at every time all lanes have passed, oldest first; `all` releases what is held.
   void release(bool all);
   void select(std::int64_t time_ns);
+  /// Lane k's own solution on the lanes topic (selected: the one published at its time).
+  void publishLane(std::size_t k, const Pending& p, bool selected) const;
   bool available(int k, const Pending* p) const;
   /// Whether the selection at `time_ns` waits for the parity test's judgement.
   bool holdForParity(std::int64_t time_ns);
@@ -126,7 +128,7 @@ class LaneSet {
   std::vector<std::optional<core::NavState>> previous_;
   std::uint64_t seq_{0};
   std::uint64_t passed_over_{0};  ///< times selected while a lane was not there yet
-  std::uint64_t late_{0};         ///< lane solutions of times already selected (dropped)
+  std::uint64_t late_{0};  ///< lane solutions of times already selected (on the lanes topic only)
   std::int64_t last_selected_ns_{-1};
   std::vector<std::int64_t> heard_ns_;  ///< per lane: running time of its latest solution
 };
