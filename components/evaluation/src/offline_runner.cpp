@@ -57,7 +57,26 @@ struct Truth {
   Eigen::Vector3d accel_bias_b_mps2;
   Eigen::Vector3d gyro_bias_b_radps;
   Eigen::Vector3d star_tracker_bias_b_rad;
+  /// The further IMU units' biases in their own axes (SimConfig::extra_imu_sensor_ids order).
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> unit_biases_u{};  ///< accel, gyro
 };
+
+/// The truth as lane `unit`'s engine estimates it: its unit's biases turned into body axes
+/// (the lane's increments are, by its mounting) and the position at the unit's place (the lane
+/// integrates the motion there; the velocity's w x r is left out, as in the lane's
+/// solution at the body origin).
+Truth laneTruth(const Truth& t, const nav_filter::LaneUnit& unit, const sensor_sim::SimConfig& sim) {
+  Truth out = t;
+  const auto& ids = sim.extra_imu_sensor_ids;
+  for (std::size_t k = 0; k < ids.size() && k < t.unit_biases_u.size(); ++k) {
+    if (ids[k] != unit.sensor_id) continue;
+    out.accel_bias_b_mps2 = unit.c_b_u * t.unit_biases_u[k].first;
+    out.gyro_bias_b_radps = unit.c_b_u * t.unit_biases_u[k].second;
+  }
+  out.state.position = core::earth::offsetNed(t.state.position,
+                                              t.state.q_b_to_n * unit.lever_arm_b_m);
+  return out;
+}
 
 /// NEES of one 3-state block of the error (estimate minus truth) against its covariance
 /// block; NaN when the filter does not estimate the block.
@@ -162,12 +181,19 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
       return;
     }
     const core::NavigationEngine& engine = pipeline_ptr->engine();
-    const Truth& truth = truths.front();
+    const auto& units = setup.filter.lanes.units;
+    const Truth truth =
+        units.empty()
+            ? truths.front()
+            : laneTruth(truths.front(),
+                        units[static_cast<std::size_t>(pipeline_ptr->selectedLane())], sim);
     // With lanes, the selection waits for the slowest lane: the selected lane's engine may have
-    // moved on (its covariance at this time is gone). Scored from the message then (its sigmas;
-    // no NEES, no bias errors), and counted.
+    // moved on (its covariance at this time is gone). Scored from the message then (at the body
+    // origin, its sigmas; no NEES, no bias errors), and counted. The engine, when it is there,
+    // against the truth at its unit's place and that unit's biases.
     EpochError err =
-        engine.state().time_ns == t ? engineError(engine, truth) : messageError(sol, truth.state);
+        engine.state().time_ns == t ? engineError(engine, truth)
+                                    : messageError(sol, truths.front().state);
     result.solutions_without_engine_state += engine.state().time_ns == t ? 0 : 1;
     err.mode = static_cast<int>(sol.mode());
     err.integrity = static_cast<int>(sol.integrity());
@@ -175,7 +201,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     err.hpl_m = sol.horizontal_protection_level_m();
     err.vpl_m = sol.vertical_protection_level_m();
     result.errors.push_back(err);
-    if (hook) hook(sol, truth.state, err);
+    if (hook) hook(sol, truths.front().state, err);
   };
   // The fault manager's pipeline, when configured, sees every diagnostics sample as the
   // filter emits it and its commands go back to the filter at once.
@@ -236,6 +262,8 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     const sim::SensorFrame& f = *next;
     truths.push_back({f.truth, f.truth_accel_bias_b_mps2, f.truth_gyro_bias_b_radps,
                       f.truth_star_tracker_bias_b_rad});
+    for (const sim::UnitImuIncrement& u : f.extra_imus)
+      truths.back().unit_biases_u.emplace_back(u.truth_accel_bias_u_mps2, u.truth_gyro_bias_u_radps);
     // The same samples, in the same order and with the same sequence numbers as the
     // simulator participant publishes them.
     sensor_sim::emitFrame(f, emitted, seq, feed);

@@ -76,6 +76,8 @@ class LaneSet {
     return lanes_[static_cast<std::size_t>(selectedIndex())]->engine();
   }
   const FilterPipeline& lane(int k) const { return *lanes_[static_cast<std::size_t>(k)]; }
+  /// The lane whose solutions are published (0 before any selection; config lanes.units order).
+  int selectedLane() const { return selectedIndex(); }
   const core::LaneSelection& selection() const { return selector_.last(); }
   std::string summary() const;
 
