@@ -28,10 +28,14 @@ std::optional<double> FaultSchedule::stuckSince(SensorKind sensor, int axis, dou
   return std::nullopt;
 }
 
-double FaultSchedule::pseudorangeError(int sv_id, double t) const {
+double FaultSchedule::pseudorangeError(int sv_id, double t, int receiver) const {
   double e = 0.0;
   for (const auto& f : faults_) {
-    if (f.kind != FaultKind::kPseudorangeRamp || f.sv_id != sv_id || !active(f, t)) continue;
+    if (f.receiver != receiver || !active(f, t)) continue;
+    if (f.kind == FaultKind::kReceiverClockJump) e += f.magnitude;
+    if (f.sv_id != sv_id) continue;
+    if (f.kind == FaultKind::kPseudorangeStep) e += f.magnitude;
+    if (f.kind != FaultKind::kPseudorangeRamp) continue;
     const double ramp = f.slope * (t - f.start_s);
     // Saturation keeps the sign of the slope (seed 000: 12.5 m/s saturating at 125 m after 10 s).
     e += f.saturation > 0.0 ? std::copysign(std::min(std::abs(ramp), f.saturation), ramp) : ramp;
@@ -76,6 +80,10 @@ const char* faultKindName(FaultKind kind) {
       return "gnss_outage";
     case FaultKind::kStarTrackerOutage:
       return "star_tracker_outage";
+    case FaultKind::kPseudorangeStep:
+      return "pseudorange_step";
+    case FaultKind::kReceiverClockJump:
+      return "receiver_clock_jump";
     case FaultKind::kStarTrackerBias:
       return "star_tracker_bias";
   }

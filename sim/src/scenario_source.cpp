@@ -44,6 +44,30 @@ ScenarioSource::ScenarioSource(const ScenarioConfig& c)
         {ImuErrorModel(c.extra_imus[k].imu, c.seed * 4 + 1 + 0x9E3779B97F4A7C15ull * (k + 1)),
          {},
          Eigen::Vector3d::Constant(std::nan(""))});
+  // Each further receiver: the scenario's receiver model with its own clock, its own noise.
+  extra_receivers_.reserve(c.extra_receivers.size());
+  for (std::size_t k = 0; k < c.extra_receivers.size(); ++k) {
+    GnssReceiverConfig g = c.gnss;
+    g.clock_bias_m = c.extra_receivers[k].clock_bias_m;
+    g.clock_drift_mps = c.extra_receivers[k].clock_drift_mps;
+    extra_receivers_.push_back({GnssReceiverModel(g, constellation_),
+                                std::mt19937_64(c.seed * 4 + 0x9E3779B97F4A7C15ull * (k + 1))});
+  }
+}
+
+void ScenarioSource::observeExtraReceivers(std::int64_t t_ns, const Eigen::Vector3d& r_e,
+                                           const Eigen::Matrix3d& C_n_e, double t_s,
+                                           SensorFrame& f) {
+  const Eigen::Matrix3d C_b_e = C_n_e * f.truth.q_b_to_n.toRotationMatrix();
+  const Eigen::Vector3d v_e = C_n_e * f.truth.vel_ned_mps;  // the body's (w x r left out)
+  f.extra_gnss.resize(extra_receivers_.size());
+  for (std::size_t k = 0; k < extra_receivers_.size(); ++k) {
+    ExtraReceiver& rx = extra_receivers_[k];
+    const Eigen::Vector3d antenna_e = r_e + C_b_e * config_.extra_receivers[k].antenna_b_m;
+    f.extra_gnss[k] = rx.model.observe(t_ns, config_.start_time_ns, antenna_e, v_e, rx.rng);
+    for (auto& sat : f.extra_gnss[k].satellites)
+      sat.pseudorange_m += config_.faults.pseudorangeError(sat.sv_id, t_s, static_cast<int>(k) + 1);
+  }
 }
 
 Eigen::Vector3d ScenarioSource::frozen(UnitOutputs& unit, int unit_index, SensorKind sensor,
@@ -104,11 +128,14 @@ namespace {
 void clearKeepingBuffers(SensorFrame& f) {
   std::vector<RawImuSample> raw = std::move(f.raw.samples);
   std::vector<UnitImuIncrement> units = std::move(f.extra_imus);
+  std::vector<GnssEpoch> receivers = std::move(f.extra_gnss);
   f = SensorFrame{};
   raw.clear();
   units.clear();
+  receivers.clear();
   f.raw.samples = std::move(raw);
   f.extra_imus = std::move(units);
+  f.extra_gnss = std::move(receivers);
 }
 }  // namespace
 
@@ -200,6 +227,7 @@ void ScenarioSource::next(SensorFrame& f) {
     for (auto& s : f.gnss.satellites)
       s.pseudorange_m += config_.faults.pseudorangeError(s.sv_id, t_s);
     f.fix = receiver_.fix(f.gnss, f.truth.position, f.truth.vel_ned_mps, rng_);
+    observeExtraReceivers(t_end, r_e, C_n_e, t_s, f);
     const Eigen::Vector3d pulse = config_.faults.positionPulse(t_s);
     if (pulse.squaredNorm() > 0.0) f.fix.position = earth::offsetNed(f.fix.position, pulse);
   }

@@ -208,6 +208,25 @@ TEST(OfflineEqualsBus, TriplexLanesSwitchWhereOfflineTheyDo) {
            "     slope_deg_per_h_per_s: 0.01, saturation_deg_per_h: 3, sensor_id: 1}\n"});
 }
 
+// Two GNSS receivers (seed000_dual_receivers.yaml: receiver 2 beside the filter's receiver 1)
+// with the fault manager's cross-receiver test: the simulator publishes receiver 2's epochs under
+// its id, the filter refuses them (counted), the fault manager reads both reliably, and receiver
+// 2's clock jump at 100 s is the one decision, field for field the offline one; the solutions
+// are unchanged by it (decisions only).
+TEST(OfflineEqualsBus, DualReceiversClockJumpDecidedAsOffline) {
+  runCase({100,
+           "seed000_dual_receivers_clock_jump.yaml",
+           "filter_seed000_tc.yaml",
+           "",
+           3,
+           120.0,
+           {"unexpected_source: sensor_id = 2"},
+           "fault_manager_dual_receivers.yaml",
+           1,
+           "faults:\n  - {type: receiver_clock_jump, start_s: 100, magnitude_ms: 1, receiver_id: "
+           "2}\n"});
+}
+
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->
 // federated -> adaptive, and a structure that does not apply is refused (the solution keeps the
 // last one).

@@ -12,11 +12,18 @@ namespace navbus::evaluation {
 
 namespace {
 
-/// `sensor_id`: the unit a parity decision or candidate names; 0 for the GLR's, which are
-/// about the filter's own IMU (the scenario's, unit 0).
+bool gnssFault(const sim::Fault& f) {
+  return f.kind == sim::FaultKind::kPseudorangeRamp || f.kind == sim::FaultKind::kPseudorangeStep ||
+         f.kind == sim::FaultKind::kReceiverClockJump;
+}
+
+/// `sensor_id`: the unit a parity decision or candidate names, the receiver a "receivers" one
+/// names; 0 for the GLR's, which are about the filter's own IMU (the scenario's, unit 0).
 bool matches(const sim::Fault& f, navbus::FaultSource source, int sv_id, int axis,
              std::uint32_t sensor_id) {
-  if (f.kind == sim::FaultKind::kPseudorangeRamp) {
+  if (f.kind == sim::FaultKind::kReceiverClockJump)
+    return source == navbus::SOURCE_RECEIVER_CLOCK && sensor_id == f.receiver_id;
+  if (f.kind == sim::FaultKind::kPseudorangeRamp || f.kind == sim::FaultKind::kPseudorangeStep) {
     return source == navbus::SOURCE_SATELLITE && sv_id == f.sv_id;
   }
   const navbus::FaultSource want = f.sensor == sim::SensorKind::kAccelerometer
@@ -27,13 +34,16 @@ bool matches(const sim::Fault& f, navbus::FaultSource source, int sv_id, int axi
 }
 
 std::uint32_t parityUnit(const navbus::FaultDecision& d) {
-  return d.detector() == "parity" ? d.sensor_id() : 0;
+  return d.detector() == "parity" || d.detector() == "receivers" ? d.sensor_id() : 0;
 }
 
 double trueMagnitude(const sim::Fault& f) {
-  return f.kind == sim::FaultKind::kPseudorangeRamp || f.kind == sim::FaultKind::kImuBiasRamp
-             ? f.slope
-             : f.magnitude;
+  if (f.kind == sim::FaultKind::kPseudorangeRamp || f.kind == sim::FaultKind::kImuBiasRamp)
+    return f.slope;
+  // A pseudorange step as the cross-receiver test reports it: the reference receiver's range
+  // minus the other's.
+  if (f.kind == sim::FaultKind::kPseudorangeStep && f.receiver != 0) return -f.magnitude;
+  return f.magnitude;
 }
 
 std::string describe(const navbus::FaultDecision& d) {
@@ -51,6 +61,9 @@ std::string describe(const navbus::FaultDecision& d) {
       break;
     case navbus::SOURCE_SATELLITE:
       s << "sv " << d.sv_id() << (d.shape() == navbus::SHAPE_RAMP ? " ramp" : " step");
+      break;
+    case navbus::SOURCE_RECEIVER_CLOCK:
+      s << "clock rx " << d.sensor_id();
       break;
     default:
       s << "source " << static_cast<int>(d.source());
@@ -122,7 +135,7 @@ bool writeParityCsv(const std::string& path, const std::vector<OfflineResult::Pa
 std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule) {
   for (const sim::Fault& f : schedule.faults()) {
     if (f.kind == sim::FaultKind::kImuBiasStep || f.kind == sim::FaultKind::kImuBiasRamp ||
-        f.kind == sim::FaultKind::kPseudorangeRamp)
+        gnssFault(f))
       return f;
   }
   return std::nullopt;
@@ -149,9 +162,10 @@ FaultRunOutcome evaluateRun(const OfflineResult& r, const std::optional<sim::Fau
         1e-9 * static_cast<double>(static_cast<std::int64_t>(d.onset_time_gps_ns()) - start_ns);
     out.decided = describe(d);
     out.ambiguous = d.ambiguous();
-    const bool imu_truth = fault->kind != sim::FaultKind::kPseudorangeRamp;
+    const bool imu_truth = !gnssFault(*fault);
     const bool imu_decided =
         d.source() == navbus::SOURCE_ACCELEROMETER || d.source() == navbus::SOURCE_GYRO;
+    // (a receiver's clock is a GNSS class: not an IMU)
     out.class_correct = imu_truth == imu_decided;
     out.source_correct = matches(*fault, d.source(), d.sv_id(), d.axis(), parityUnit(d));
     double magnitude = out.source_correct ? d.magnitude() : std::nan("");

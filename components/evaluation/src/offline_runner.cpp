@@ -65,7 +65,8 @@ struct Truth {
 /// (the lane's increments are, by its mounting) and the position at the unit's place (the lane
 /// integrates the motion there; the velocity's w x r is left out, as in the lane's
 /// solution at the body origin).
-Truth laneTruth(const Truth& t, const nav_filter::LaneUnit& unit, const sensor_sim::SimConfig& sim) {
+Truth laneTruth(const Truth& t, const nav_filter::LaneUnit& unit,
+                const sensor_sim::SimConfig& sim) {
   Truth out = t;
   const auto& ids = sim.extra_imu_sensor_ids;
   for (std::size_t k = 0; k < ids.size() && k < t.unit_biases_u.size(); ++k) {
@@ -73,8 +74,8 @@ Truth laneTruth(const Truth& t, const nav_filter::LaneUnit& unit, const sensor_s
     out.accel_bias_b_mps2 = unit.c_b_u * t.unit_biases_u[k].first;
     out.gyro_bias_b_radps = unit.c_b_u * t.unit_biases_u[k].second;
   }
-  out.state.position = core::earth::offsetNed(t.state.position,
-                                              t.state.q_b_to_n * unit.lever_arm_b_m);
+  out.state.position =
+      core::earth::offsetNed(t.state.position, t.state.q_b_to_n * unit.lever_arm_b_m);
   return out;
 }
 
@@ -191,9 +192,8 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     // moved on (its covariance at this time is gone). Scored from the message then (at the body
     // origin, its sigmas; no NEES, no bias errors), and counted. The engine, when it is there,
     // against the truth at its unit's place and that unit's biases.
-    EpochError err =
-        engine.state().time_ns == t ? engineError(engine, truth)
-                                    : messageError(sol, truths.front().state);
+    EpochError err = engine.state().time_ns == t ? engineError(engine, truth)
+                                                 : messageError(sol, truths.front().state);
     result.solutions_without_engine_state += engine.state().time_ns == t ? 0 : 1;
     err.mode = static_cast<int>(sol.mode());
     err.integrity = static_cast<int>(sol.integrity());
@@ -247,8 +247,10 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
       pipeline.onImu(sample);
       if (faults) faults->onImuIncrement(sample);
     }
-    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
+    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>) {
       pipeline.onGnssObservations(sample);
+      if (faults) faults->onGnssEpoch(sample);
+    }
     if constexpr (std::is_same_v<T, navbus::GnssFix>) pipeline.onGnssFix(sample);
     if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) pipeline.onStarTracker(sample);
     if constexpr (std::is_same_v<T, navbus::ImuRawBlock>) faults->onRawBlock(sample);
@@ -263,7 +265,8 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     truths.push_back({f.truth, f.truth_accel_bias_b_mps2, f.truth_gyro_bias_b_radps,
                       f.truth_star_tracker_bias_b_rad});
     for (const sim::UnitImuIncrement& u : f.extra_imus)
-      truths.back().unit_biases_u.emplace_back(u.truth_accel_bias_u_mps2, u.truth_gyro_bias_u_radps);
+      truths.back().unit_biases_u.emplace_back(u.truth_accel_bias_u_mps2,
+                                               u.truth_gyro_bias_u_radps);
     // The same samples, in the same order and with the same sequence numbers as the
     // simulator participant publishes them.
     sensor_sim::emitFrame(f, emitted, seq, feed);
@@ -277,6 +280,8 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   result.summary = pipeline.summary();
   if (const bus::StreamCounters* imu = health.find(bus::topic::kImuIncrement))
     result.imu_rejected = imu->rejected;
+  if (const bus::StreamCounters* gnss = health.find(bus::topic::kGnssObservations))
+    result.gnss_rejected = gnss->rejected;
   result.consistency = pipeline.engine().consistency().counters();
   if (faults) {
     result.fault_summary = faults->summary();

@@ -1,5 +1,6 @@
 #include "navbus/fault_manager/fault_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -169,11 +170,69 @@ void parseParity(const YAML::Node& n, ParityDetectorConfig& d) {
     throw bus::ConfigError("configuration parity: " + error);
 }
 
+void parseReceiverUnits(const YAML::Node& list, ReceiverDetectorConfig& d) {
+  if (!list || !list.IsSequence() || list.size() < 2)
+    throw bus::ConfigError(
+        "configuration receivers.units must be a list of at least two receivers (the first is "
+        "the reference)");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node n = list[i];
+    const std::string w = "receivers.units[" + std::to_string(i) + "]";
+    checkKeys(n, w, {"receiver_id", "antenna_b_m"});
+    const auto id = bus::require<std::uint32_t>(n, w, "receiver_id");
+    if (std::find(d.receiver_ids.begin(), d.receiver_ids.end(), id) != d.receiver_ids.end())
+      throw bus::ConfigError("configuration " + w + ".receiver_id " + std::to_string(id) +
+                             " is given twice");
+    d.receiver_ids.push_back(id);
+    d.antennas_b_m.push_back(bus::getVector3(n, w, "antenna_b_m", 1.0));
+  }
+}
+
+void parseReceivers(const YAML::Node& n, ReceiverDetectorConfig& d) {
+  if (!n) return;
+  const std::string w = "receivers";
+  checkKeys(n, w,
+            {"enabled", "units", "onsets", "onset_spacing", "false_alarm_probability",
+             "detection_probability", "ambiguity_margin", "clock_false_alarm_probability",
+             "clock_bias_noise_m_per_sqrts", "clock_drift_noise_mps_per_sqrts", "alignment_depth"});
+  d.enabled = bus::get<bool>(n, w, "enabled", d.enabled);
+  core::ParityGlrConfig& g = d.glr;
+  g.onsets = bus::get<int>(n, w, "onsets", g.onsets);
+  g.onset_spacing = bus::get<int>(n, w, "onset_spacing", g.onset_spacing);
+  g.false_alarm_probability =
+      bus::get<double>(n, w, "false_alarm_probability", g.false_alarm_probability);
+  g.detection_probability =
+      bus::get<double>(n, w, "detection_probability", g.detection_probability);
+  g.ambiguity_margin = bus::get<double>(n, w, "ambiguity_margin", g.ambiguity_margin);
+  core::ReceiverClockConfig& c = d.clock;
+  c.false_alarm_probability = bus::checkRange(
+      bus::get<double>(n, w, "clock_false_alarm_probability", c.false_alarm_probability), 1e-15,
+      0.5, "receivers.clock_false_alarm_probability");
+  c.bias_noise_m_per_sqrts = bus::checkRange(
+      bus::get<double>(n, w, "clock_bias_noise_m_per_sqrts", c.bias_noise_m_per_sqrts), 0.0, 1e6,
+      "receivers.clock_bias_noise_m_per_sqrts");
+  c.drift_noise_mps_per_sqrts = bus::checkRange(
+      bus::get<double>(n, w, "clock_drift_noise_mps_per_sqrts", c.drift_noise_mps_per_sqrts), 0.0,
+      1e6, "receivers.clock_drift_noise_mps_per_sqrts");
+  d.alignment_depth =
+      static_cast<int>(bus::checkRange(bus::get<double>(n, w, "alignment_depth", d.alignment_depth),
+                                       1.0, 1e5, "receivers.alignment_depth"));
+  if (!d.enabled) return;
+  parseReceiverUnits(n["units"], d);
+  // The GLR's own rules (onsets, probabilities), naming the key, on a space of two satellites.
+  std::string error;
+  const std::optional<core::ParitySpace> space =
+      core::ParitySpace::makeCommonMode(core::parity::Measurements::Ones(2), error);
+  if (!space || !core::ParityGlr::make(*space, g, error))
+    throw bus::ConfigError("configuration receivers: " + error);
+}
+
 }  // namespace
 
 FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
   FaultManagerConfig c;
-  checkKeys(root, "", {"vehicle_id", "glr", "dither", "parity"}, bus::kParticipantKeys);
+  checkKeys(root, "", {"vehicle_id", "glr", "dither", "parity", "receivers"},
+            bus::kParticipantKeys);
   c.vehicle_id = bus::get<std::uint32_t>(root, "", "vehicle_id", c.vehicle_id);
   const YAML::Node g = root["glr"];
   checkKeys(g, "glr",
@@ -214,6 +273,7 @@ FaultManagerConfig parseFaultManagerConfig(const YAML::Node& root) {
       "glr.repeats.escalate_after"));
   parseDither(root["dither"], c.dither);
   parseParity(root["parity"], c.parity);
+  parseReceivers(root["receivers"], c.receivers);
   return c;
 }
 

@@ -31,7 +31,8 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
                  [this](const navbus::FaultMonitorProgress& r) { progress_writer_.write(r); }},
                 bus::wallTimeNowNs()),
       sensors_(p, streamEvents()),
-      parity_sensors_(p, parityEvents()) {
+      parity_sensors_(p, parityEvents()),
+      receiver_sensors_(p, bus::SensorReaders::Events{}) {
   using namespace bus;
   watch<navbus::ImuIncrement>(profile::kSensorWatchdogReader);
   // Fast pacing's blocks of increments: each element is watched as one increment.
@@ -53,6 +54,13 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
                                                      : navbus::STATE_RUNNING);
       });
   if (config.parity.enabled) subscribeIncrements();
+  // The cross-receiver test needs every epoch of every receiver: a reliable reader (the
+  // filter's profile for observations).
+  if (config.receivers.enabled) {
+    receiver_sensors_.subscribe<navbus::GnssObservationEpoch>(
+        profile::kMeasurementReader,
+        [this](const navbus::GnssObservationEpoch& m) { pipeline_.onGnssEpoch(m); });
+  }
   if (config.glr.enabled) {
     p.subscribe<navbus::FilterDiagnosticsPubSubType>(
         topic::kFilterDiagnostics, profile::kDiagnosticsReader,

@@ -26,6 +26,7 @@ FaultPipeline::FaultPipeline(const FaultManagerConfig& config, bus::HealthCounte
       outcomes_(kIssuer, run_id) {
   if (config.dither.enabled) dither_.emplace(config.dither);
   if (config.parity.enabled) parity_.emplace(config.parity);
+  if (config.receivers.enabled) receivers_.emplace(config.receivers);
 }
 
 void FaultPipeline::onRawBlock(const navbus::ImuRawBlock& block) {
@@ -227,6 +228,7 @@ std::string FaultPipeline::summary() const {
       << "; " << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
   if (parity_) out << "; " << parity_->summary();
+  if (receivers_) out << "; " << receivers_->summary();
   if (stalls_ > 0)
     out << "; stalls of the fault manager process " << stalls_ << " (longest "
         << 1e-9 * static_cast<double>(longest_stall_ns_) << " s)";

@@ -101,6 +101,8 @@ const char* enumName(navbus::FaultSource v) {
       return "SATELLITE";
     case navbus::SOURCE_STAR_TRACKER:
       return "STAR_TRACKER";
+    case navbus::SOURCE_RECEIVER_CLOCK:
+      return "RECEIVER_CLOCK";
   }
   return "UNKNOWN";
 }

@@ -208,7 +208,7 @@ bool FramePublisher::readersMatched() const {
   };
   return imuReaders() >= static_cast<std::size_t>(m.imu) &&
          (!config_.publish_raw || enough(raw_, m.raw_imu)) &&
-         (!config_.publish_gnss || (enough(gnss_, m.gnss) && enough(fix_, m.gnss))) &&
+         (!config_.publish_gnss || (enough(gnss_, m.gnss) && enough(fix_, m.gnss_fix))) &&
          (!config_.publish_star_tracker || enough(star_, m.star_tracker));
 }
 
@@ -249,9 +249,14 @@ void FramePublisher::endStreams() {
   navbus::ImuRawBlock raw;
   raw.sensor_id(config_.imu_sensor_id);
   disposeIfPublished(raw_, written_.raw_blocks, raw);
-  navbus::GnssObservationEpoch gnss;
-  gnss.receiver_id(config_.gnss_receiver_id);
-  disposeIfPublished(gnss_, written_.gnss_epochs, gnss);
+  std::vector<std::uint32_t> receiver_ids{config_.gnss_receiver_id};
+  receiver_ids.insert(receiver_ids.end(), config_.extra_gnss_receiver_ids.begin(),
+                      config_.extra_gnss_receiver_ids.end());
+  for (const std::uint32_t id : receiver_ids) {
+    navbus::GnssObservationEpoch gnss;
+    gnss.receiver_id(id);
+    disposeIfPublished(gnss_, written_.gnss_epochs, gnss);
+  }
   navbus::GnssFix fix;
   fix.receiver_id(config_.gnss_receiver_id);
   disposeIfPublished(fix_, written_.gnss_fixes, fix);

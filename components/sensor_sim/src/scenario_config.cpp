@@ -5,6 +5,7 @@
 
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/key_reader.hpp"
+#include "navbus/core/math/earth.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
 
@@ -153,7 +154,11 @@ void checkFaultKeys(const YAML::Node& n, const std::string& where, const std::st
                "saturation_deg_per_h"},
               kImuFaultKeys);
   else if (type == "pseudorange_ramp")
-    checkKeys(n, where, {"sv_id", "slope_mps", "saturation_m"}, kFaultCommonKeys);
+    checkKeys(n, where, {"sv_id", "slope_mps", "saturation_m", "receiver_id"}, kFaultCommonKeys);
+  else if (type == "pseudorange_step")
+    checkKeys(n, where, {"sv_id", "magnitude_m", "receiver_id"}, kFaultCommonKeys);
+  else if (type == "receiver_clock_jump")
+    checkKeys(n, where, {"magnitude_ms", "receiver_id"}, kFaultCommonKeys);
   else if (type == "gnss_position_pulse")
     checkKeys(n, where, {"north_m", "east_m", "down_m"}, kFaultCommonKeys);
   else if (type == "sensor_stuck")
@@ -204,7 +209,24 @@ int faultUnit(const YAML::Node& n, const std::string& where,
                     " is not an IMU of the scenario (ids.imu and imu_units: " + known + ")");
 }
 
-sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::uint32_t>& imu_ids) {
+/// The receiver a pseudorange or clock fault is addressed to (`receiver_id`, default the
+/// scenario's receiver): its index in `receiver_ids` (0: the scenario's).
+int faultReceiver(const YAML::Node& n, const std::string& where,
+                  const std::vector<std::uint32_t>& receiver_ids) {
+  if (!n["receiver_id"]) return 0;
+  const auto id = bus::require<std::uint32_t>(n, where, "receiver_id");
+  for (std::size_t k = 0; k < receiver_ids.size(); ++k) {
+    if (receiver_ids[k] == id) return static_cast<int>(k);
+  }
+  std::string known;
+  for (const std::uint32_t i : receiver_ids)
+    known += (known.empty() ? "" : ", ") + std::to_string(i);
+  throw ConfigError("configuration " + where + ".receiver_id = " + std::to_string(id) +
+                    " is not a receiver of the scenario (ids.gnss and gnss_units: " + known + ")");
+}
+
+sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::uint32_t>& imu_ids,
+                               const std::vector<std::uint32_t>& receiver_ids) {
   std::vector<sim::Fault> out;
   if (!list || list.IsNull()) return sim::FaultSchedule{};
   if (!list.IsSequence()) throw ConfigError("configuration faults must be a list");
@@ -243,13 +265,27 @@ sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::ui
           checkRange(get<double>(n, where, accel ? "saturation_mg" : "saturation_deg_per_h", 0.0),
                      0, 1e9, where + (accel ? ".saturation_mg" : ".saturation_deg_per_h")) *
           unit;
-    } else if (type == "pseudorange_ramp") {
-      f.kind = sim::FaultKind::kPseudorangeRamp;
+    } else if (type == "pseudorange_ramp" || type == "pseudorange_step") {
+      const bool ramp = type == "pseudorange_ramp";
+      f.kind = ramp ? sim::FaultKind::kPseudorangeRamp : sim::FaultKind::kPseudorangeStep;
+      f.receiver = faultReceiver(n, where, receiver_ids);
+      f.receiver_id = receiver_ids[static_cast<std::size_t>(f.receiver)];
       f.sv_id = static_cast<int>(
           checkRange(bus::require<int>(n, where, "sv_id"), 1, 32, where + ".sv_id"));
+      if (!ramp) {
+        f.magnitude = bus::require<double>(n, where, "magnitude_m");
+        out.push_back(f);
+        continue;
+      }
       f.slope = bus::require<double>(n, where, "slope_mps");
       f.saturation =
           checkRange(get<double>(n, where, "saturation_m", 0.0), 0, 1e7, where + ".saturation_m");
+    } else if (type == "receiver_clock_jump") {
+      f.kind = sim::FaultKind::kReceiverClockJump;
+      f.receiver = faultReceiver(n, where, receiver_ids);
+      f.receiver_id = receiver_ids[static_cast<std::size_t>(f.receiver)];
+      f.magnitude =
+          bus::require<double>(n, where, "magnitude_ms") * 1e-3 * core::earth::kSpeedOfLight_mps;
     } else if (type == "gnss_position_pulse") {
       f.kind = sim::FaultKind::kGnssPositionPulse;
       f.vector = Eigen::Vector3d(get<double>(n, where, "north_m", 0.0),
@@ -377,7 +413,9 @@ double parseTiming(const YAML::Node& timing, SimConfig& c) {
   bus::KeyReader readers(child(timing, "min_readers"), "timing.min_readers");
   readers.integer("imu", c.min_readers.imu, {0, 64})
       .integer("raw_imu", c.min_readers.raw_imu, {0, 64})
-      .integer("gnss", c.min_readers.gnss, {0, 64})
+      .integer("gnss", c.min_readers.gnss, {0, 64});
+  c.min_readers.gnss_fix = c.min_readers.gnss;  // unless said apart
+  readers.integer("gnss_fix", c.min_readers.gnss_fix, {0, 64})
       .integer("star_tracker", c.min_readers.star_tracker, {0, 64})
       .finish();
   return raw_hz;
@@ -427,6 +465,32 @@ void parseImuUnits(const YAML::Node& list, sim::ScenarioConfig& s,
       parseImu(n["imu"], where + ".imu", u.imu);
     }
     s.extra_imus.push_back(u);
+  }
+}
+
+/// Further GNSS receivers: their ids (after the scenario receiver's in `receiver_ids`), antenna
+/// places and clocks.
+void parseGnssUnits(const YAML::Node& list, sim::ScenarioConfig& s,
+                    std::vector<std::uint32_t>& receiver_ids) {
+  if (!list || list.IsNull()) return;
+  if (!list.IsSequence()) throw ConfigError("configuration gnss_units must be a list");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node n = list[i];
+    const std::string where = "gnss_units[" + std::to_string(i) + "]";
+    checkKeys(n, where, {"receiver_id", "antenna_b_m", "clock_bias_m", "clock_drift_mps"});
+    const auto id = bus::require<std::uint32_t>(n, where, "receiver_id");
+    if (std::find(receiver_ids.begin(), receiver_ids.end(), id) != receiver_ids.end()) {
+      throw ConfigError("configuration " + where + ".receiver_id = " + std::to_string(id) +
+                        " is already the id of another receiver of the scenario");
+    }
+    receiver_ids.push_back(id);
+    sim::GnssUnit u;
+    u.antenna_b_m = bus::getVector3(n, where, "antenna_b_m", 1.0);
+    u.clock_bias_m = checkRange(get<double>(n, where, "clock_bias_m", s.gnss.clock_bias_m), -1e9,
+                                1e9, where + ".clock_bias_m");
+    u.clock_drift_mps = checkRange(get<double>(n, where, "clock_drift_mps", s.gnss.clock_drift_mps),
+                                   -1e6, 1e6, where + ".clock_drift_mps");
+    s.extra_receivers.push_back(u);
   }
 }
 
@@ -525,7 +589,7 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   top.value("name", s.name)
       .value("seed", s.seed)
       .nested({"vehicle", "orbit", "timing", "imu", "imu_units", "dither", "vibration", "gnss",
-               "star_tracker", "faults", "ids", "publish"});
+               "gnss_units", "star_tracker", "faults", "ids", "publish"});
   if (orbit) {
     parseOrbit(orbit, s);
   } else {
@@ -545,7 +609,10 @@ SimConfig parseSimConfig(const YAML::Node& root) {
   std::vector<std::uint32_t> imu_ids{c.imu_sensor_id};
   parseImuUnits(root["imu_units"], s, imu_ids);
   c.extra_imu_sensor_ids.assign(imu_ids.begin() + 1, imu_ids.end());
-  s.faults = parseFaults(root["faults"], imu_ids);
+  std::vector<std::uint32_t> receiver_ids{c.gnss_receiver_id};
+  parseGnssUnits(root["gnss_units"], s, receiver_ids);
+  c.extra_gnss_receiver_ids.assign(receiver_ids.begin() + 1, receiver_ids.end());
+  s.faults = parseFaults(root["faults"], imu_ids, receiver_ids);
   return c;
 }
 

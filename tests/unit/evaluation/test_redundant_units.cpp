@@ -224,8 +224,64 @@ TEST(RedundantUnits, LanesLeaveTheFailedUnitAndPublishTheJumpTheyMake) {
   ASSERT_GT(scored, 500);
   EXPECT_LT(accel_nees / scored, 15.0);  // 3 degrees of freedom: about 3 when consistent
   EXPECT_LT(gyro_nees / scored, 15.0);
-  std::printf("switch to lane %u at %.1f s; reset deltas position %.3f %.3f %.3f m; after it, "
-              "mean bias NEES accelerometer %.2f gyro %.2f over %d solutions\n",
-              after.lane_id(), secondsIntoRun(after.time_gps_ns()), jump[0], jump[1], jump[2],
-              accel_nees / scored, gyro_nees / scored, scored);
+  std::printf(
+      "switch to lane %u at %.1f s; reset deltas position %.3f %.3f %.3f m; after it, "
+      "mean bias NEES accelerometer %.2f gyro %.2f over %d solutions\n",
+      after.lane_id(), secondsIntoRun(after.time_gps_ns()), jump[0], jump[1], jump[2],
+      accel_nees / scored, gyro_nees / scored, scored);
+}
+
+namespace {
+
+/// A dual-receiver scenario `file` (first `duration_s`) through the seed-000 filter and
+/// config/fault_manager_dual_receivers.yaml.
+evaluation::OfflineResult runDualReceivers(const std::string& file, double duration_s) {
+  evaluation::OfflineSetup s;
+  s.sim = navbus::sensor_sim::parseSimConfig(
+      navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) + "/" + file));
+  s.filter = navbus::nav_filter::parseFilterConfig(navbus::bus::loadYamlFile(
+      std::string(navbus::test_paths::configDir()) + "/filter_seed000_tc.yaml"));
+  s.filter.engine.initial_state = evaluation::initialTruth(s.sim.scenario);
+  s.fault_manager = navbus::fault_manager::parseFaultManagerConfig(navbus::bus::loadYamlFile(
+      std::string(navbus::test_paths::configDir()) + "/fault_manager_dual_receivers.yaml"));
+  s.duration_s = duration_s;
+  return evaluation::runOffline(s);
+}
+
+}  // namespace
+
+TEST(RedundantReceivers, AClockJumpAndASpoofedSatelliteAreDecidedAtTheirFirstEpoch) {
+  // Given the dual-receiver aircraft (receiver 2 beside the filter's receiver 1), when 720 s run
+  // with the cross-receiver test: fault-free up to 700 s, nothing is decided, and the filter
+  // refuses receiver 2's epochs as an unexpected source (one per epoch); when receiver 2's clock
+  // jumps 1 ms at 700 s, the one decision names receiver 2's clock at 700 s with 299.79 km; when
+  // satellite 13 of receiver 2 reads 100 m long from 700 s, the one decision names satellite 13
+  // at 700 s, ambiguous between receivers 1 and 2, its difference about -100 m.
+  const evaluation::OfflineResult jump =
+      runDualReceivers("seed000_dual_receivers_clock_jump.yaml", 720.0);
+  ASSERT_EQ(jump.decisions.size(), 1u) << jump.fault_summary;
+  const navbus::FaultDecision& c = jump.decisions[0];
+  EXPECT_EQ(c.source(), navbus::SOURCE_RECEIVER_CLOCK);
+  EXPECT_EQ(c.sensor_id(), 2u);
+  EXPECT_EQ(c.detector(), "receivers");
+  EXPECT_NEAR(secondsIntoRun(c.time_gps_ns()), 700.0, 1e-6);
+  EXPECT_NEAR(c.magnitude(), 299792.458, 50.0);
+  const auto refused = jump.gnss_rejected.find(navbus::REJECT_UNEXPECTED_SOURCE);
+  ASSERT_NE(refused, jump.gnss_rejected.end()) << jump.summary;
+  EXPECT_EQ(refused->second, 720u);
+
+  const evaluation::OfflineResult spoof =
+      runDualReceivers("seed000_dual_receivers_spoofed.yaml", 720.0);
+  ASSERT_EQ(spoof.decisions.size(), 1u) << spoof.fault_summary;
+  const navbus::FaultDecision& s = spoof.decisions[0];
+  EXPECT_EQ(s.source(), navbus::SOURCE_SATELLITE);
+  EXPECT_EQ(s.sv_id(), 13u);
+  EXPECT_TRUE(s.ambiguous());
+  ASSERT_GE(s.candidates().size(), 2u);
+  EXPECT_EQ(s.candidates()[0].sensor_id(), 1u);
+  EXPECT_EQ(s.candidates()[1].sensor_id(), 2u);
+  EXPECT_NEAR(secondsIntoRun(s.time_gps_ns()), 700.0, 1e-6);
+  EXPECT_NEAR(s.magnitude(), -100.0, 20.0);
+  EXPECT_NE(spoof.fault_summary.find("clock jumps 0, satellites decided 1"), std::string::npos)
+      << spoof.fault_summary;
 }

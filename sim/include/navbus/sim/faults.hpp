@@ -19,7 +19,11 @@ enum class FaultKind {
   kSensorStuck,        ///< seed 003: an axis output frozen at its value at the start
   kGnssOutage,         ///< seed 004: no GNSS epochs or fixes while active
   kStarTrackerOutage,  ///< no star-tracker solution while active
-  kStarTrackerBias     ///< a star-tracker attitude bias [rad, body] while active
+  kStarTrackerBias,    ///< a star-tracker attitude bias [rad, body] while active
+  kPseudorangeStep,   ///< one satellite's pseudoranges of one receiver offset by `magnitude` [m] (a
+                      ///< spoofed satellite)
+  kReceiverClockJump  ///< a receiver's clock steps: every pseudorange of it + `magnitude` [m] = c *
+                      ///< the jump
 };
 
 enum class SensorKind { kAccelerometer, kGyro };
@@ -33,8 +37,12 @@ struct Fault {
   /// IMU faults: the unit (0: the scenario's IMU; k: ScenarioConfig::extra_imus[k - 1]).
   int unit{0};
   std::uint32_t sensor_id{0};  ///< IMU faults: the unit's sensor id (ImuIncrement.sensor_id)
+  /// Pseudorange and clock faults: the receiver (0: the scenario's; k:
+  /// ScenarioConfig::extra_receivers[k - 1]).
+  int receiver{0};
+  std::uint32_t receiver_id{0};  ///< ... its receiver id (GnssObservationEpoch.receiver_id)
   int sv_id{0};
-  double magnitude{0.0};  ///< bias step [m/s^2 | rad/s]
+  double magnitude{0.0};  ///< bias step [m/s^2 | rad/s]; pseudorange step or clock jump [m]
   /// Ramps: pseudorange [m/s], IMU bias [m/s^2 | rad/s per s]
   double slope{0.0};
   /// Ramps: the size they stop growing at, 0: none [m | m/s^2 | rad/s]
@@ -57,7 +65,9 @@ class FaultSchedule {
   }
   /// Axes frozen at t: the start time of the stuck fault per axis, or nothing.
   std::optional<double> stuckSince(SensorKind sensor, int axis, double t, int unit = 0) const;
-  double pseudorangeError(int sv_id, double t) const;
+  /// Error added to a satellite's pseudorange of a receiver at t [m]: ramps, steps and the
+  /// receiver's clock jumps.
+  double pseudorangeError(int sv_id, double t, int receiver = 0) const;
   Eigen::Vector3d positionPulse(double t) const;
   bool gnssOut(double t) const { return any(FaultKind::kGnssOutage, t); }
   bool starTrackerOut(double t) const { return any(FaultKind::kStarTrackerOutage, t); }

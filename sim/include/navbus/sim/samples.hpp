@@ -78,6 +78,8 @@ struct SensorFrame {
   bool has_gnss{false};
   GnssEpoch gnss;
   GnssFixSample fix;
+  /// With has_gnss: the further receivers' epochs (ScenarioConfig::extra_receivers order).
+  std::vector<GnssEpoch> extra_gnss;
   bool has_star_tracker{false};
   StarTrackerSample star_tracker;
   core::NavState truth;

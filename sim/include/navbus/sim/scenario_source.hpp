@@ -1,7 +1,8 @@
 // A scenario: a truth trajectory seen by an IMU (error model, optional RLG dither in the raw
 // stream) and by further IMU units of a redundant installation (each with its own mounting,
 // lever arm, error model and noise), a GNSS receiver and a star tracker, with scheduled faults
-// (IMU faults addressed to a unit). Produces one SensorFrame per navigation interval; the same
+// (IMU faults addressed to a unit) and by further GNSS receivers (pseudorange and clock faults
+// addressed to a receiver). Produces one SensorFrame per navigation interval; the same
 // seed gives bit-identical data.
 #pragma once
 
@@ -34,6 +35,14 @@ struct ImuUnit {
   ImuSpec imu;
 };
 
+/// A further GNSS receiver of a redundant installation: its antenna's place, its own clock and
+/// noise (the scenario's receiver model otherwise), the same satellites in view; the same epochs.
+struct GnssUnit {
+  Eigen::Vector3d antenna_b_m{Eigen::Vector3d::Zero()};  ///< from the body origin [m, body]
+  double clock_bias_m{0.0};                              ///< c * clock bias at the start
+  double clock_drift_mps{0.0};                           ///< c * clock drift at the start
+};
+
 struct ScenarioConfig {
   std::string name{"default"};
   bool orbit{false};  ///< true: circular orbit (seed 001), else vehicle segments
@@ -53,6 +62,8 @@ struct ScenarioConfig {
   VibrationSpec vibration;
   ConstellationConfig constellation;
   GnssReceiverConfig gnss;
+  std::vector<GnssUnit>
+      extra_receivers;  ///< receivers 1, 2, ... beside the scenario's (receiver 0)
   StarTrackerSpec star_tracker;
   FaultSchedule faults;
   std::uint64_t seed{1};
@@ -98,6 +109,14 @@ class ScenarioSource {
   VehicleVibration vibration_;
   Constellation constellation_;
   GnssReceiverModel receiver_;
+  struct ExtraReceiver {
+    GnssReceiverModel model;
+    std::mt19937_64 rng;
+  };
+  std::vector<ExtraReceiver> extra_receivers_;
+  /// The further receivers' epochs at the scenario receiver's epoch time (f.extra_gnss).
+  void observeExtraReceivers(std::int64_t t_ns, const Eigen::Vector3d& r_e,
+                             const Eigen::Matrix3d& C_n_e, double t_s, SensorFrame& f);
   StarTrackerModel star_;
   Eigen::Vector3d star_bias_b_rad_{Eigen::Vector3d::Zero()};  ///< at the latest tracker sample
   std::mt19937_64 rng_;

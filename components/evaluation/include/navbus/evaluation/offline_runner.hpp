@@ -82,6 +82,9 @@ struct OfflineResult {
   /// The filter's refusals of IMU increments by reason (an IMU it was not configured with:
   /// REJECT_UNEXPECTED_SOURCE).
   std::map<navbus::RejectReason, std::uint64_t> imu_rejected;
+  /// GNSS observation epochs the filter refused, by reason (e.g. a receiver it is not
+  /// configured for: REJECT_UNEXPECTED_SOURCE).
+  std::map<navbus::RejectReason, std::uint64_t> gnss_rejected;
   core::ConsistencyCounters consistency;  ///< the filter's test of its own innovations
   std::string fault_summary;              ///< the fault pipeline's counters
   std::vector<navbus::FaultDecision> decisions;

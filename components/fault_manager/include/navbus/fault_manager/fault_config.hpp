@@ -10,6 +10,7 @@
 #include "navbus/core/integrity/dither_monitor.hpp"
 #include "navbus/core/integrity/glr.hpp"
 #include "navbus/core/integrity/imu_array_parity.hpp"
+#include "navbus/core/integrity/receiver_consistency.hpp"
 #include "navbus/fault_manager/repeat_guard.hpp"
 
 namespace navbus::fault_manager {
@@ -55,11 +56,25 @@ struct ParityDetectorConfig {
   int alignment_depth{20000};
 };
 
+/// The cross-receiver test of redundant GNSS receivers (receiver_detector.hpp): the receivers on
+/// the bus (the first is the reference of the single differences), their antennas, the tests'
+/// false-alarm probabilities.
+struct ReceiverDetectorConfig {
+  bool enabled{false};
+  std::vector<std::uint32_t> receiver_ids;                  ///< GnssObservationEpoch.receiver_id
+  std::vector<Eigen::Vector3d> antennas_b_m;                ///< same order [m, body]
+  core::ParityGlrConfig glr{5, 1, 1e-9, 0.999, 2.0, 0.95};  ///< the satellites' test, per epoch
+  core::ReceiverClockConfig clock;
+  int alignment_depth{
+      64};  ///< epoch times that may wait for a receiver before the oldest is dropped
+};
+
 struct FaultManagerConfig {
   std::uint32_t vehicle_id{1};  ///< the filter monitored and commanded
   GlrDetectorConfig glr;
   DitherDetectorConfig dither;
   ParityDetectorConfig parity;
+  ReceiverDetectorConfig receivers;
 };
 
 /// Throws bus::ConfigError naming the key and the value on any invalid or unknown entry.

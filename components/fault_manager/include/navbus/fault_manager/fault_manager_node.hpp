@@ -42,9 +42,10 @@ class FaultManagerNode {
   bus::Writer<navbus::FilterCommand> command_writer_;
   bus::Writer<navbus::FaultMonitorProgress> progress_writer_;  ///< how far diagnostics are judged
   FaultPipeline pipeline_;
-  bus::StallDetector stalls_;          ///< pauses of this process between two turns of its loop
-  bus::SensorReaders sensors_;         ///< the watched sensor streams (owning writers only)
-  bus::SensorReaders parity_sensors_;  ///< every IMU's increments, reliably (parity detector)
+  bus::StallDetector stalls_;            ///< pauses of this process between two turns of its loop
+  bus::SensorReaders sensors_;           ///< the watched sensor streams (owning writers only)
+  bus::SensorReaders parity_sensors_;    ///< every IMU's increments, reliably (parity detector)
+  bus::SensorReaders receiver_sensors_;  ///< every receiver's epochs, reliably (receiver detector)
 };
 
 }  // namespace navbus::fault_manager

@@ -23,6 +23,7 @@
 #include "navbus/fault_manager/fault_output.hpp"
 #include "navbus/fault_manager/glr_detector.hpp"
 #include "navbus/fault_manager/parity_detector.hpp"
+#include "navbus/fault_manager/receiver_detector.hpp"
 #include "navbus/fault_manager/stream_watchdog.hpp"
 
 namespace navbus::fault_manager {
@@ -82,6 +83,12 @@ class FaultPipeline : private FaultOutput {
   const GlrDetector& glr() const { return glr_; }
   /// The dither detector, when configured.
   const std::optional<DitherDetector>& dither() const { return dither_; }
+  /// An observation epoch of any GNSS receiver, for the cross-receiver detector (every epoch,
+  /// reliably; none without `receivers:`).
+  void onGnssEpoch(const navbus::GnssObservationEpoch& epoch) {
+    if (receivers_) receivers_->onEpoch(epoch, *this);
+  }
+  const std::optional<ReceiverDetector>& receivers() const { return receivers_; }
   /// The parity detector of redundant IMUs, when configured.
   const std::optional<ParityDetector>& parity() const { return parity_; }
   std::uint64_t decisions() const { return next_decision_id_ - 1; }
@@ -107,6 +114,7 @@ class FaultPipeline : private FaultOutput {
   GlrDetector glr_;
   std::optional<DitherDetector> dither_;
   std::optional<ParityDetector> parity_;
+  std::optional<ReceiverDetector> receivers_;
   /// The parity test's progress is reported every this much data time.
   static constexpr std::int64_t kParityReportPeriodNs = 100'000'000;
   std::int64_t parity_reported_{-1};  ///< data time of the latest report of it

@@ -34,6 +34,8 @@ struct FrameSequence {
   std::uint64_t imu{0}, raw{0}, gnss_epochs{0}, gnss_fixes{0}, star_tracker{0};
   std::vector<std::uint64_t>
       extra_imus;  ///< per further IMU unit (SimConfig::extra_imu_sensor_ids)
+  std::vector<std::uint64_t>
+      extra_gnss;  ///< per further receiver (SimConfig::extra_gnss_receiver_ids)
 };
 
 /// What a FramePublisher wrote to the bus: measurements per stream and the DDS samples that
@@ -55,7 +57,8 @@ struct WrittenCounts {
 
 /// The bus samples of one simulator frame, in emit order (the increment first, then the raw
 /// block, then the further IMU units' increments in unit order, each under its sensor id, then
-/// the measurements valid at its end time), with their sequence numbers: the one definition of
+/// the measurements valid at its end time, the further receivers' epochs after the scenario
+/// receiver's fix), with their sequence numbers: the one definition of
 /// what the simulator participant publishes, shared by FramePublisher and `navbus offline`.
 /// `emit(sample)` returns false to stop; the sequence advances per sample emitted. Returns
 /// false if stopped.
@@ -80,6 +83,14 @@ bool emitFrame(const sim::SensorFrame& f, const SimConfig& c, FrameSequence& seq
     ++seq.gnss_epochs;
     if (!emit(toIdl(f.fix, c.gnss_receiver_id, seq.gnss_fixes + 1))) return false;
     ++seq.gnss_fixes;
+    // The further receivers' epochs (no fixes of their own), each under its receiver id.
+    const std::size_t receivers = std::min(f.extra_gnss.size(), c.extra_gnss_receiver_ids.size());
+    if (seq.extra_gnss.size() < receivers) seq.extra_gnss.resize(receivers, 0);
+    for (std::size_t k = 0; k < receivers; ++k) {
+      if (!emit(toIdl(f.extra_gnss[k], c.extra_gnss_receiver_ids[k], seq.extra_gnss[k] + 1)))
+        return false;
+      ++seq.extra_gnss[k];
+    }
   }
   if (c.publish_star_tracker && f.has_star_tracker) {
     if (!emit(toIdl(f.star_tracker, c.star_tracker_id, seq.star_tracker + 1))) return false;

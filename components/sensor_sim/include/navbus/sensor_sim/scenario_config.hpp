@@ -29,11 +29,14 @@ struct SimConfig {
   /// Readers to wait for before publishing, per topic.
   struct MinReaders {
     int imu{1}, raw_imu{0}, gnss{1}, star_tracker{1};
+    int gnss_fix{1};  ///< readers of the fixes (the observations' `gnss` unless given apart)
   } min_readers;
   std::uint32_t imu_sensor_id{1};
   /// The sensor ids of the scenario's further IMU units (imu_units), in unit order.
   std::vector<std::uint32_t> extra_imu_sensor_ids;
   std::uint32_t gnss_receiver_id{1};
+  /// The receiver ids of the scenario's further GNSS receivers (gnss_units), in receiver order.
+  std::vector<std::uint32_t> extra_gnss_receiver_ids;
   std::uint32_t star_tracker_id{1};
   bool publish_raw{true};
   bool publish_gnss{true};

@@ -28,7 +28,7 @@ namespace navbus::core {
 
 namespace parity {
 inline constexpr int kMaxInstruments = 18;  ///< six triads, or 18 single-axis instruments
-inline constexpr int kMaxParity = kMaxInstruments - 3;
+inline constexpr int kMaxParity = kMaxInstruments - 1;  ///< one common unknown (makeCommonMode)
 using Axes = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxInstruments, 3>;
 using Measurements = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxInstruments, 1>;
 using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxParity, 1>;
@@ -44,9 +44,15 @@ class ParitySpace {
   /// is not positive, or the axes do not span three dimensions.
   static std::optional<ParitySpace> make(const parity::Axes& axes,
                                          const parity::Measurements& sigmas, std::string& error);
+  /// The parity space of instruments that all measure one common unknown (H a column of ones:
+  /// e.g. two receivers' pseudorange differences of their shared satellites, whose common part
+  /// is the difference of their clocks); nullopt with `error` set when there are fewer than 2 or
+  /// more than kMaxInstruments, or a sigma is not positive. estimate() gives the unknown in x[0].
+  static std::optional<ParitySpace> makeCommonMode(const parity::Measurements& sigmas,
+                                                   std::string& error);
 
   int instruments() const { return static_cast<int>(axes_.rows()); }
-  int dimension() const { return instruments() - 3; }  ///< n - 3
+  int dimension() const { return instruments() - unknowns_; }  ///< n - 3 (n - 1: common mode)
   const parity::Axes& axes() const { return axes_; }
   const parity::Measurements& sigmas() const { return sigmas_; }
   /// V W (eq. 2): (n - 3) x n; its column j is s_j = V W e_j, the parity vector of a unit bias
@@ -59,11 +65,15 @@ class ParitySpace {
 
   /// p = V W m (eq. 2).
   parity::Vector parityVector(const parity::Measurements& m) const;
-  /// x^ = (H^T W^2 H)^-1 H^T W^2 m: every instrument, weighted by 1 / sigma^2.
+  /// x^ = (H^T W^2 H)^-1 H^T W^2 m: every instrument, weighted by 1 / sigma^2 (with one common
+  /// unknown: x[0], the rest 0).
   Eigen::Vector3d estimate(const parity::Measurements& m) const { return estimator_ * m; }
 
  private:
   ParitySpace() = default;
+  /// V W and the estimator from the whitened geometry W H of `unknowns` columns (eq. 2).
+  bool build(const parity::Axes& wh, int unknowns, std::string& error);
+  int unknowns_{3};
   parity::Axes axes_;
   parity::Measurements sigmas_;
   parity::Matrix vw_;
