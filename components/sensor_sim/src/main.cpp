@@ -143,7 +143,10 @@ int main(int argc, char** argv) {
     const double wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
     participant.finish();
     const auto& n = publisher.counts();
-    const double data_s = static_cast<double>(n.increments) * static_cast<double>(period_ns) * 1e-9;
+    // Seconds of data: the increments of one IMU (every unit publishes one per frame).
+    const double units = 1.0 + static_cast<double>(config.extra_imu_sensor_ids.size());
+    const double data_s =
+        static_cast<double>(n.increments) / units * static_cast<double>(period_ns) * 1e-9;
     spdlog::info(
         "summary: published {} IMU increments in {} samples, {} raw samples in {} blocks, {} GNSS "
         "epochs, {} GNSS fixes, {} star-tracker attitudes ({:.3f} s of data), {} write retries",

@@ -65,8 +65,10 @@ struct ReceiverDetectorConfig {
   std::vector<Eigen::Vector3d> antennas_b_m;                ///< same order [m, body]
   core::ParityGlrConfig glr{5, 1, 1e-9, 0.999, 2.0, 0.95};  ///< the satellites' test, per epoch
   core::ReceiverClockConfig clock;
-  int alignment_depth{
-      64};  ///< epoch times that may wait for a receiver before the oldest is dropped
+  /// Epoch times that may wait for a receiver before the oldest is dropped (counted): a DDS
+  /// reader hands out one receiver's backlog, up to its history's 1000 samples per instance (the
+  /// measurement reader profile), before the next's. About 2 kB a time with 12 satellites.
+  int alignment_depth{1000};
 };
 
 struct FaultManagerConfig {

@@ -1,0 +1,126 @@
+// The fault manager's cross-receiver detector (receiver_detector.hpp): its configuration (the
+// receivers named by id, refusals naming the field), the alignment of the receivers' epochs
+// whatever order they arrive in (a DDS reader hands out one receiver's backlog before the
+// next's), and a clock-jump decision naming the receiver.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "navbus/bus/config.hpp"
+#include "navbus/core/math/earth.hpp"
+#include "navbus/fault_manager/fault_config.hpp"
+#include "navbus/fault_manager/receiver_detector.hpp"
+
+namespace fm = navbus::fault_manager;
+namespace nc = navbus::core;
+
+namespace {
+
+constexpr const char* kTwoReceivers = R"(
+receivers:
+  enabled: true
+  units:
+    - {receiver_id: 1, antenna_b_m: [0, 0, 0]}
+    - {receiver_id: 2, antenna_b_m: [-1.5, 0, -0.3]}
+)";
+
+class Recorder : public fm::FaultOutput {
+ public:
+  std::uint32_t decide(navbus::FaultDecision& d) override {
+    d.decision_id(static_cast<std::uint32_t>(decisions.size() + 1));
+    decisions.push_back(d);
+    return d.decision_id();
+  }
+  void command(navbus::FilterCommand& c) override { commands.push_back(c); }
+  std::vector<navbus::FaultDecision> decisions;
+  std::vector<navbus::FilterCommand> commands;
+};
+
+/// Receiver `id`'s epoch at second t: five satellites, 3 m noise, its clock (+ `jump_m`).
+navbus::GnssObservationEpoch epoch(std::uint32_t id, int t, std::mt19937_64& rng,
+                                   double jump_m = 0.0) {
+  const nc::earth::Geodetic p{0.637, 2.225, 1000.0};
+  const Eigen::Vector3d rx = nc::earth::geodeticToEcef(p);
+  const Eigen::Matrix3d C_n_e = nc::earth::C_n_e(p.latitude_rad, p.longitude_rad);
+  std::normal_distribution<double> noise(0.0, 3.0);
+  navbus::GnssObservationEpoch e;
+  e.receiver_id(id);
+  e.seq(static_cast<std::uint64_t>(t + 1));
+  e.time_gps_ns(1400000000000000000ull + static_cast<std::uint64_t>(t) * 1000000000ull);
+  const double clock = (id == 1 ? 3000.0 : -12000.0) + jump_m;
+  for (int k = 0; k < 5; ++k) {
+    const double az = 1.2 * k, el = 0.3 + 0.2 * k;
+    const Eigen::Vector3d sat =
+        rx + C_n_e * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
+                                     -std::sin(el)) *
+                 2.02e7;
+    navbus::GnssSatelliteMeasurement m;
+    m.sv_id(static_cast<std::uint16_t>(k + 1));
+    m.pseudorange_m((sat - rx).norm() + clock + noise(rng));
+    m.pseudorange_rate_mps(0.0);
+    for (int i = 0; i < 3; ++i) m.sat_pos_ecef_m()[static_cast<std::size_t>(i)] = sat[i];
+    m.pseudorange_sigma_m(3.0);
+    m.pseudorange_rate_sigma_mps(0.05);
+    m.valid(true);
+    e.satellites().push_back(m);
+  }
+  return e;
+}
+
+}  // namespace
+
+TEST(ReceiverDetector, RefusesAConfigurationWithOneReceiverNamingTheField) {
+  // Given `receivers:` with one unit, or an id twice, then the configuration is refused naming
+  // receivers.units.
+  const std::string one = R"(
+receivers: {enabled: true, units: [{receiver_id: 1, antenna_b_m: [0, 0, 0]}]})";
+  try {
+    fm::parseFaultManagerConfig(YAML::Load(one));
+    FAIL() << "one receiver accepted";
+  } catch (const navbus::bus::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("receivers.units"), std::string::npos) << e.what();
+  }
+  const std::string twice = R"(
+receivers: {enabled: true, units: [{receiver_id: 1, antenna_b_m: [0, 0, 0]},
+                                   {receiver_id: 1, antenna_b_m: [1, 0, 0]}]})";
+  try {
+    fm::parseFaultManagerConfig(YAML::Load(twice));
+    FAIL() << "an id twice accepted";
+  } catch (const navbus::bus::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("receivers.units[1].receiver_id 1"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ReceiverDetector, AlignsABacklogOfOneReceiverBeforeTheOtherAndNamesAClockJump) {
+  // Given two receivers, when receiver 2's 300 epochs all arrive before receiver 1's (a DDS
+  // reader's backlog of one instance), then every time is tested (none incomplete or late);
+  // and when receiver 1's clock jumps 1 ms at second 200, the one decision names receiver 1's
+  // clock at that second.
+  const fm::FaultManagerConfig config = fm::parseFaultManagerConfig(YAML::Load(kTwoReceivers));
+  fm::ReceiverDetector detector(config.receivers);
+  Recorder out;
+  std::mt19937_64 rng(5);
+  std::vector<navbus::GnssObservationEpoch> first, second;
+  const double jump = 1e-3 * nc::earth::kSpeedOfLight_mps;
+  for (int t = 0; t < 300; ++t) {
+    second.push_back(epoch(2, t, rng));
+    first.push_back(epoch(1, t, rng, t >= 200 ? jump : 0.0));
+  }
+  for (const auto& e : second) detector.onEpoch(e, out);
+  for (const auto& e : first) detector.onEpoch(e, out);
+  const fm::ReceiverDetector::Counters& c = detector.counters();
+  EXPECT_EQ(c.tested, 300u);
+  EXPECT_EQ(c.incomplete, 0u);
+  EXPECT_EQ(c.late, 0u);
+  ASSERT_EQ(out.decisions.size(), 1u) << detector.summary();
+  const navbus::FaultDecision& d = out.decisions[0];
+  EXPECT_EQ(d.source(), navbus::SOURCE_RECEIVER_CLOCK);
+  EXPECT_EQ(d.sensor_id(), 1u);
+  EXPECT_EQ(d.time_gps_ns(), 1400000200000000000ull);
+  EXPECT_NEAR(d.magnitude(), jump, 30.0);
+  EXPECT_TRUE(out.commands.empty());
+}
