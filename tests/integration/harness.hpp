@@ -202,13 +202,13 @@ inline Seed000Loop writeSeed000Loop(const std::filesystem::path& dir, int domain
                                     const std::string& fault_manager = "fault_manager") {
   const std::string src = navbus::test_paths::sourceDir();
   const std::string dom = "domain_id: " + std::to_string(domain) + "\n";
-  return {writeFile(dir / "sim.yaml",
-                    "extends: " + src + "/sim/scenarios/" + scenario + ".yaml\n" + dom + sim_extra),
-          writeFile(dir / "filter.yaml",
-                    "extends: " + src + "/config/" + filter + ".yaml\n" + dom +
-                        "solution_writer_profile: navbus_solution_writer_lossless\n"),
-          writeFile(dir / "fm.yaml",
-                    "extends: " + src + "/config/" + fault_manager + ".yaml\n" + dom)};
+  return {
+      writeFile(dir / "sim.yaml",
+                "extends: " + src + "/sim/scenarios/" + scenario + ".yaml\n" + dom + sim_extra),
+      writeFile(dir / "filter.yaml",
+                "extends: " + src + "/config/" + filter + ".yaml\n" + dom +
+                    "solution_writer_profile: navbus_solution_writer_lossless\n"),
+      writeFile(dir / "fm.yaml", "extends: " + src + "/config/" + fault_manager + ".yaml\n" + dom)};
 }
 
 /// `navbus offline` on the loop's files from the configured start into `dir`/offline (log

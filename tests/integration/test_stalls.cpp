@@ -32,7 +32,7 @@ struct LoadCase {
   int cpu_hogs;       ///< busy loops beside the participants
   std::string filter{"filter_seed000_tc"};  ///< files under config/ (without .yaml)
   std::string fault_manager{"fault_manager"};
-  std::string sim_extra{};                  ///< YAML appended to the scenario
+  std::string sim_extra{};  ///< YAML appended to the scenario
   std::vector<std::string> filter_log_says{};
 };
 
@@ -96,14 +96,14 @@ void run(const LoadCase& c) {
   bus::Participant me(test::testParticipant(c.domain, "stalls"), shutdown);
   std::map<std::uint64_t, int> published;  // solution time -> how many times
   std::vector<std::string> rows, decisions;
-  int watchdog_decisions = 0;  // stream-lost decisions (not in the offline run)
+  int watchdog_decisions = 0;   // stream-lost decisions (not in the offline run)
   std::set<std::string> lanes;  // every lane's solutions, as CSV rows
   int repeated_lanes = 0;
-  me.subscribe<LaneSolutionPubSubType>(
-      bus::topic::kLaneSolution, bus::profile::kSolutionReader,
-      [&](const LaneSolution& s, const auto&) {
-        repeated_lanes += lanes.insert(records::csvRows(s).at(0)).second ? 0 : 1;
-      });
+  me.subscribe<LaneSolutionPubSubType>(bus::topic::kLaneSolution, bus::profile::kSolutionReader,
+                                       [&](const LaneSolution& s, const auto&) {
+                                         repeated_lanes +=
+                                             lanes.insert(records::csvRows(s).at(0)).second ? 0 : 1;
+                                       });
   me.subscribe<NavigationSolutionPubSubType>(
       bus::topic::kNavSolution, bus::profile::kSolutionReader,
       [&](const NavigationSolution& s, const auto&) {
@@ -214,7 +214,14 @@ TEST(LoadedFaultLoop, PseudorangeRampWithTheFaultManagerStoppedEqualsOffline) {
 // selector leaves lane 1; the filter is stopped twice and the fault manager once, two busy loops
 // beside them. The published solutions, every lane's own and the decision equal offline's.
 TEST(LoadedLanes, TriplexLanesThroughASwitchWithStopsAndCpuHogsEqualOffline) {
-  run({85, "seed000_triplex_gyro_ramp", 240, 2, 1, 2, "filter_triplex", "fault_manager_triplex",
+  run({85,
+       "seed000_triplex_gyro_ramp",
+       240,
+       2,
+       1,
+       2,
+       "filter_triplex",
+       "fault_manager_triplex",
        "faults:\n  - {type: imu_bias_ramp, sensor: gyro, axis: x, start_s: 100,\n"
        "     slope_deg_per_h_per_s: 0.01, saturation_deg_per_h: 3, sensor_id: 1}\n",
        {"lanes: switched from IMU 1 to IMU", "switches 1,",

@@ -125,6 +125,20 @@ void parseParityUnits(const YAML::Node& list, ParityDetectorConfig& d) {
   }
 }
 
+/// The keys of a parity GLR (parity_glr.hpp) present in block `w`; their ranges are the
+/// GLR's own (ParityGlr::make names the key).
+void parseParityGlr(const YAML::Node& n, const std::string& w, core::ParityGlrConfig& g) {
+  g.onsets = bus::get<int>(n, w, "onsets", g.onsets);
+  g.onset_spacing = bus::get<int>(n, w, "onset_spacing", g.onset_spacing);
+  g.false_alarm_probability =
+      bus::get<double>(n, w, "false_alarm_probability", g.false_alarm_probability);
+  g.detection_probability =
+      bus::get<double>(n, w, "detection_probability", g.detection_probability);
+  g.ambiguity_margin = bus::get<double>(n, w, "ambiguity_margin", g.ambiguity_margin);
+  g.ambiguity_correlation =
+      bus::get<double>(n, w, "ambiguity_correlation", g.ambiguity_correlation);
+}
+
 void parseParity(const YAML::Node& n, ParityDetectorConfig& d) {
   if (!n) return;
   const std::string w = "parity";
@@ -137,16 +151,7 @@ void parseParity(const YAML::Node& n, ParityDetectorConfig& d) {
   d.imu_rate_hz = bus::checkRange(bus::get<double>(n, w, "imu_rate_hz", d.imu_rate_hz), 1.0, 1e5,
                                   "parity.imu_rate_hz");
   core::ImuArrayParityConfig& a = d.array;
-  core::ParityGlrConfig& g = a.glr;
-  g.onsets = bus::get<int>(n, w, "onsets", g.onsets);
-  g.onset_spacing = bus::get<int>(n, w, "onset_spacing", g.onset_spacing);
-  g.false_alarm_probability =
-      bus::get<double>(n, w, "false_alarm_probability", g.false_alarm_probability);
-  g.detection_probability =
-      bus::get<double>(n, w, "detection_probability", g.detection_probability);
-  g.ambiguity_margin = bus::get<double>(n, w, "ambiguity_margin", g.ambiguity_margin);
-  g.ambiguity_correlation =
-      bus::get<double>(n, w, "ambiguity_correlation", g.ambiguity_correlation);
+  parseParityGlr(n, w, a.glr);
   const double reference_s = bus::checkRange(bus::get<double>(n, w, "reference_s", 60.0), 0.01,
                                              86400.0, "parity.reference_s");
   const double tau_s = bus::checkRange(bus::get<double>(n, w, "reference_time_constant_s", 1800.0),
@@ -193,17 +198,12 @@ void parseReceivers(const YAML::Node& n, ReceiverDetectorConfig& d) {
   const std::string w = "receivers";
   checkKeys(n, w,
             {"enabled", "units", "onsets", "onset_spacing", "false_alarm_probability",
-             "detection_probability", "ambiguity_margin", "clock_false_alarm_probability",
-             "clock_bias_noise_m_per_sqrts", "clock_drift_noise_mps_per_sqrts", "alignment_depth"});
+             "detection_probability", "ambiguity_margin", "ambiguity_correlation",
+             "clock_false_alarm_probability", "clock_bias_noise_m_per_sqrts",
+             "clock_drift_noise_mps_per_sqrts", "alignment_depth"});
   d.enabled = bus::get<bool>(n, w, "enabled", d.enabled);
   core::ParityGlrConfig& g = d.glr;
-  g.onsets = bus::get<int>(n, w, "onsets", g.onsets);
-  g.onset_spacing = bus::get<int>(n, w, "onset_spacing", g.onset_spacing);
-  g.false_alarm_probability =
-      bus::get<double>(n, w, "false_alarm_probability", g.false_alarm_probability);
-  g.detection_probability =
-      bus::get<double>(n, w, "detection_probability", g.detection_probability);
-  g.ambiguity_margin = bus::get<double>(n, w, "ambiguity_margin", g.ambiguity_margin);
+  parseParityGlr(n, w, g);
   core::ReceiverClockConfig& c = d.clock;
   c.false_alarm_probability = bus::checkRange(
       bus::get<double>(n, w, "clock_false_alarm_probability", c.false_alarm_probability), 1e-15,

@@ -5,9 +5,9 @@
 namespace navbus::tool {
 
 bool spinUntil(bus::Participant& p, double timeout_s, const std::function<bool()>& done) {
-  using Clock = std::chrono::steady_clock;
-  const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
-  while (!done() && !p.stopping() && Clock::now() < end) p.spinOnce(std::chrono::milliseconds(5));
+  using SteadyClock = std::chrono::steady_clock;
+  const auto end = SteadyClock::now() + std::chrono::duration<double>(timeout_s);
+  while (!done() && !p.stopping() && SteadyClock::now() < end) p.spinOnce(std::chrono::milliseconds(5));
   return done();
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "fault_recorder.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/math/units.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
@@ -36,18 +37,7 @@ fm::FaultManagerConfig parityConfig(const std::string& yaml = kTriplexParity) {
   return fm::parseFaultManagerConfig(YAML::Load(yaml));
 }
 
-/// Decisions and commands as they come.
-class Recorder : public fm::FaultOutput {
- public:
-  std::uint32_t decide(navbus::FaultDecision& d) override {
-    d.decision_id(static_cast<std::uint32_t>(decisions.size() + 1));
-    decisions.push_back(d);
-    return d.decision_id();
-  }
-  void command(navbus::FilterCommand& c) override { commands.push_back(c); }
-  std::vector<navbus::FaultDecision> decisions;
-  std::vector<navbus::FilterCommand> commands;
-};
+using Recorder = fm::test::Recorder;
 
 /// A level, still body sensed by the three units (their axes: rows of the mountings), white
 /// noise of the configured grade; unit 12's y gyro gains `step_radps` from sample `step_from`.

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "fault_recorder.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/math/earth.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
@@ -27,17 +28,7 @@ receivers:
     - {receiver_id: 2, antenna_b_m: [-1.5, 0, -0.3]}
 )";
 
-class Recorder : public fm::FaultOutput {
- public:
-  std::uint32_t decide(navbus::FaultDecision& d) override {
-    d.decision_id(static_cast<std::uint32_t>(decisions.size() + 1));
-    decisions.push_back(d);
-    return d.decision_id();
-  }
-  void command(navbus::FilterCommand& c) override { commands.push_back(c); }
-  std::vector<navbus::FaultDecision> decisions;
-  std::vector<navbus::FilterCommand> commands;
-};
+using Recorder = fm::test::Recorder;
 
 /// Receiver `id`'s epoch at second t: five satellites, 3 m noise, its clock (+ `jump_m`).
 navbus::GnssObservationEpoch epoch(std::uint32_t id, int t, std::mt19937_64& rng,
@@ -54,8 +45,9 @@ navbus::GnssObservationEpoch epoch(std::uint32_t id, int t, std::mt19937_64& rng
   for (int k = 0; k < 5; ++k) {
     const double az = 1.2 * k, el = 0.3 + 0.2 * k;
     const Eigen::Vector3d sat =
-        rx + C_n_e * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
-                                     -std::sin(el)) *
+        rx + C_n_e *
+                 Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
+                                 -std::sin(el)) *
                  2.02e7;
     navbus::GnssSatelliteMeasurement m;
     m.sv_id(static_cast<std::uint16_t>(k + 1));

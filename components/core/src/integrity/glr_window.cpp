@@ -467,14 +467,14 @@ void GlrWindow::positionSignatures(std::vector<PositionSignature>& out) const {
   out.clear();
   if (!have_previous_ || onset_count_ == 0) return;
   // mu+ = mu - K (H mu + D) on the position rows (doc eqs. C1, C3), with this epoch's K and H.
-  constexpr int kPos = layout::kPos.index;
+  constexpr int kPosRow = layout::kPos.index;
   const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxRows> k_pos =
-      prev_k_.middleRows<3>(kPos);
+      prev_k_.middleRows<3>(kPosRow);
   const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kSupport> kh = k_pos * h_support_;
   const auto after = [&](int column, double d, int row) {
     Eigen::Vector3d p = -kh * mu_.col(column).head(support_count_);
     for (int i = 0; i < 3; ++i) {
-      const int live_row = row_of_[static_cast<std::size_t>(kPos + i)];
+      const int live_row = row_of_[static_cast<std::size_t>(kPosRow + i)];
       if (live_row >= 0) p[i] += mu_(live_row, column);
     }
     if (row >= 0) p -= d * k_pos.col(row);
