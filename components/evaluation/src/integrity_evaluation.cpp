@@ -134,9 +134,12 @@ void printHonestyTable(const std::vector<std::pair<std::string, HonestyTally>>& 
                 static_cast<unsigned long long>(t.flagged), t.runs_unflagged_beyond_5_sigma, t.runs,
                 t.max_unflagged_ratio);
   }
-  std::printf("\ncoverage: the published horizontal error e against its own sigma_h, every epoch of "
-              "every run\n%s", coverageHeader().c_str());
-  for (const auto& [label, t] : rows) std::printf("%s", coverageRow(label, t.coverage_h, true).c_str());
+  std::printf(
+      "\ncoverage: the published horizontal error e against its own sigma_h, every epoch of "
+      "every run\n%s",
+      coverageHeader().c_str());
+  for (const auto& [label, t] : rows)
+    std::printf("%s", coverageRow(label, t.coverage_h, true).c_str());
   std::printf("%s", coverageFooter().c_str());
   for (const auto& [label, t] : rows) {
     const double epochs = static_cast<double>(t.coverage_h.epochs());

@@ -183,11 +183,12 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     }
     const core::NavigationEngine& engine = pipeline_ptr->engine();
     const auto& units = setup.filter.lanes.units;
-    const Truth truth =
-        units.empty()
-            ? truths.front()
-            : laneTruth(truths.front(),
-                        units[static_cast<std::size_t>(pipeline_ptr->selectedLane())], sim);
+    // One lane: the frame's truth as it is (no copy per solution).
+    std::optional<Truth> lane_truth;
+    if (!units.empty())
+      lane_truth = laneTruth(truths.front(),
+                             units[static_cast<std::size_t>(pipeline_ptr->selectedLane())], sim);
+    const Truth& truth = lane_truth ? *lane_truth : truths.front();
     // With lanes, the selection waits for the slowest lane: the selected lane's engine may have
     // moved on (its covariance at this time is gone). Scored from the message then (at the body
     // origin, its sigmas; no NEES, no bias errors), and counted. The engine, when it is there,

@@ -6,6 +6,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "navbus/core/math/earth.hpp"
+
 namespace navbus::fault_manager {
 
 namespace {
@@ -99,24 +101,28 @@ void ReceiverDetector::onEpoch(const navbus::GnssObservationEpoch& msg, FaultOut
 }
 
 void ReceiverDetector::drain(FaultOutput& out) {
-  // A complete time is tested; the incomplete ones before it will not complete (each receiver
-  // delivers in time order), nor will the oldest when too many wait.
-  for (auto it = pending_.begin(); it != pending_.end();) {
-    const bool complete = it->second.received == config_.receiver_ids.size();
-    const bool later_complete = std::any_of(std::next(it), pending_.end(), [&](const auto& p) {
-      return p.second.received == config_.receiver_ids.size();
-    });
-    if (!complete && !later_complete &&
-        pending_.size() <= static_cast<std::size_t>(config_.alignment_depth))
-      return;
-    if (complete) {
+  // Every time up to the latest complete one is settled: the complete ones are tested, the
+  // incomplete ones before will not complete (each receiver delivers in time order). Beyond
+  // that, the oldest times are dropped while too many wait.
+  const std::size_t n = config_.receiver_ids.size();
+  auto last_complete = pending_.end();
+  for (auto it = pending_.begin(); it != pending_.end(); ++it)
+    if (it->second.received == n) last_complete = it;
+  const auto settle = [&](std::map<std::int64_t, Slot>::iterator it) {
+    if (it->second.received == n) {
       test(it->first, it->second, out);
     } else {
       ++counters_.incomplete;
     }
     last_tested_ns_ = it->first;
-    it = pending_.erase(it);
+    return pending_.erase(it);
+  };
+  if (last_complete != pending_.end()) {
+    const auto stop = std::next(last_complete);
+    for (auto it = pending_.begin(); it != stop;) it = settle(it);
   }
+  while (pending_.size() > static_cast<std::size_t>(config_.alignment_depth))
+    settle(pending_.begin());
 }
 
 void ReceiverDetector::test(std::int64_t time_ns, const Slot& slot, FaultOutput& out) {
@@ -177,8 +183,8 @@ void ReceiverDetector::reportClock(std::int64_t time_ns, std::size_t r, const co
   ++counters_.clock_jumps;
   spdlog::warn(
       "decision {}: receiver {} clock jumped {:.6g} m ({:.4g} ms), v^2/var {:.4g} >= {:.4g}", id,
-      config_.receiver_ids[r], j.magnitude_m, 1e3 * j.magnitude_m / 299792458.0, j.statistic,
-      j.threshold);
+      config_.receiver_ids[r], j.magnitude_m, 1e3 * j.magnitude_m / core::earth::kSpeedOfLight_mps,
+      j.statistic, j.threshold);
 }
 
 void ReceiverDetector::reportSatellite(std::int64_t time_ns, std::size_t r,

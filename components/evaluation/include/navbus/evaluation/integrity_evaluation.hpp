@@ -46,7 +46,8 @@ struct HonestyTally {
   double max_unflagged_ratio{0.0};  ///< largest 3-D error / 3-D sigma, unflagged epochs
   CoverageTally coverage_h;         ///< every epoch with a finite error and sigma
   int runs_unflagged_beyond_3_sigma_h{0};
-  std::vector<double> first_beyond_3_sigma_h_s;  ///< of those runs: the first such epoch [s from start]
+  std::vector<double>
+      first_beyond_3_sigma_h_s;  ///< of those runs: the first such epoch [s from start]
 
   void add(const OfflineResult& r, double design_probability);
 };
