@@ -208,6 +208,9 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   // filter emits it and its commands go back to the filter at once.
   std::optional<fault_manager::FaultPipeline> faults;
   nav_filter::LaneSet* filter_ptr = nullptr;
+  // How far the fault manager has judged: to the filter after each frame, as its reader takes
+  // them on the bus (a filter that waits for judgements from the start waits offline too).
+  std::vector<navbus::FaultMonitorProgress> progress;
   if (setup.fault_manager) {
     faults.emplace(*setup.fault_manager, health,
                    fault_manager::FaultPipeline::Sinks{
@@ -219,7 +222,8 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
                          result.commands.push_back(c);
                          result.command_after_solutions.push_back(result.errors.size());
                          filter_ptr->onCommand(c);
-                       }});
+                       },
+                       [&](const navbus::FaultMonitorProgress& p) { progress.push_back(p); }});
   }
   std::function<void(const navbus::FilterDiagnostics&)> on_diagnostics;
   if (faults) {
@@ -271,6 +275,8 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     // The same samples, in the same order and with the same sequence numbers as the
     // simulator participant publishes them.
     sensor_sim::emitFrame(f, emitted, seq, feed);
+    for (const navbus::FaultMonitorProgress& p : progress) pipeline.onFaultMonitorProgress(p);
+    progress.clear();
     // Data time bounds the wait for a silent stream (the bus uses steady time).
     pipeline.pump(f.increment.time_ns);
     if (faults && faults->parity()) traceParity(*faults->parity(), f.increment.time_ns, result);

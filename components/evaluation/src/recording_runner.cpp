@@ -18,7 +18,7 @@
 #include "navbus/core/math/units.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
 #include "navbus/importers/importer.hpp"
-#include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/nav_filter/lane_set.hpp"
 #include "navbus/records/csv_messages.hpp"
 #include "navbus/records/formatters.hpp"
 #include "navbus/records/mcap.hpp"
@@ -30,26 +30,19 @@ namespace navbus::evaluation {
 namespace {
 
 using Sample =
-    std::variant<navbus::ImuIncrement, navbus::ImuIncrementBlock, navbus::GnssObservationEpoch,
-                 navbus::GnssFix, navbus::StarTrackerAttitude>;
+    std::variant<navbus::ImuIncrement, navbus::ImuIncrementBlock, navbus::ImuRawBlock,
+                 navbus::GnssObservationEpoch, navbus::GnssFix, navbus::StarTrackerAttitude>;
 
 /// One recorded sample in the merged order: by data time, then by topic (IMU first, as the
-/// filter's merge ranks them), then file order.
+/// filter's merge ranks them), then by sensor (the units of a redundant set in their ids'
+/// order, whichever the recorder received first), then file order.
 struct Event {
   std::int64_t time_ns;
   int rank;
+  std::uint32_t sensor_id;
   std::size_t index;
   Sample sample;
 };
-
-std::int64_t dataTimeNs(const navbus::ImuIncrementBlock& b) {
-  return b.increments().empty() ? 0
-                                : static_cast<std::int64_t>(b.increments().back().time_gps_ns());
-}
-template <class T>
-std::int64_t dataTimeNs(const T& m) {
-  return static_cast<std::int64_t>(m.time_gps_ns());
-}
 
 /// A recording's sensor samples: a directory of CSV files, or one MCAP file (read once; a file
 /// cut short is read up to its last complete record, and `inputs` says what was lost).
@@ -83,11 +76,18 @@ class RecordedSamples {
       messages = records::parseMessages<T>(table, records::messageRowRanges(table));
       from = file.string();
     }
-    for (const T& m : messages) out.push_back({dataTimeNs(m), rank, out.size(), m});
+    for (const T& m : messages) add(m, rank, out);
     inputs_ += fmt::format("{}: {} samples\n", from, messages.size());
   }
 
  private:
+  template <class T>
+  static void add(const T& m, int rank, std::vector<Event>& out) {
+    using Traits = bus::SensorMessage<T>;
+    out.push_back({static_cast<std::int64_t>(Traits::timeGpsNs(m)), rank, Traits::sensorId(m),
+                   out.size(), m});
+  }
+
   std::filesystem::path path_;
   std::string& inputs_;
   std::optional<records::McapContents> mcap_;
@@ -105,12 +105,17 @@ ImportedRun importForRun(const std::string& dataset_yaml, const std::string& fil
   return run;
 }
 
-RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolutionHook& hook) {
-  RecordingResult result;
+namespace {
+
+/// The recording's sensor samples in the merged order; raw IMU blocks only when the fault
+/// manager's dither monitor reads them.
+std::vector<Event> loadEvents(const RecordingSetup& setup, RecordingResult& result) {
   std::vector<Event> events;
   RecordedSamples recorded(setup.dir, result.inputs);
   recorded.load<navbus::ImuIncrementPubSubType>(bus::topic::kImuIncrement, 0, events);
   recorded.load<navbus::ImuIncrementBlockPubSubType>(bus::topic::kImuIncrementBlock, 0, events);
+  if (setup.fault_manager && setup.fault_manager->dither.enabled)
+    recorded.load<navbus::ImuRawBlockPubSubType>(bus::topic::kImuRaw, 0, events);
   recorded.load<navbus::GnssObservationEpochPubSubType>(bus::topic::kGnssObservations, 1, events);
   recorded.load<navbus::GnssFixPubSubType>(bus::topic::kGnssFix, 2, events);
   recorded.load<navbus::StarTrackerAttitudePubSubType>(bus::topic::kStarTracker, 3, events);
@@ -130,12 +135,65 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
     result.fixes_withheld = before - events.size();
   }
   std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
-    return std::tie(a.time_ns, a.rank, a.index) < std::tie(b.time_ns, b.rank, b.index);
+    return std::tie(a.time_ns, a.rank, a.sensor_id, a.index) <
+           std::tie(b.time_ns, b.rank, b.sensor_id, b.index);
   });
+  return events;
+}
+
+/// The smoother's and the innovations' logs follow one engine: with lanes, whose engine is
+/// published changes at a switch, they are refused.
+void refuseLogsWithLanes(const RecordingSetup& setup) {
+  if (setup.filter.lanes.units.empty()) return;
+  if (setup.smooth)
+    throw bus::ConfigError(
+        "--smooth: the filter configuration has lanes (" +
+        std::to_string(setup.filter.lanes.units.size()) +
+        " units); the smoother follows one engine, run it on a filter without lanes");
+}
+
+/// One recorded sample to the filter's lanes and, as the fault manager's readers take it, to
+/// the fault manager's pipeline (its parity test reads every increment of every unit, its
+/// dither monitor the raw blocks, its cross-receiver test every receiver's epochs).
+void feed(const Sample& sample, nav_filter::LaneSet& filter,
+          std::optional<fault_manager::FaultPipeline>& faults) {
+  std::visit(
+      [&](const auto& m) {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, navbus::ImuIncrement>) {
+          filter.onImu(m);
+          if (faults) faults->onImuIncrement(m);
+        }
+        if constexpr (std::is_same_v<T, navbus::ImuIncrementBlock>) {
+          filter.onImuBlock(m);
+          if (faults)
+            for (const navbus::ImuIncrement& increment : m.increments())
+              faults->onImuIncrement(increment);
+        }
+        if constexpr (std::is_same_v<T, navbus::ImuRawBlock>) {
+          if (faults) faults->onRawBlock(m);
+        }
+        if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>) {
+          filter.onGnssObservations(m);
+          if (faults) faults->onGnssEpoch(m);
+        }
+        if constexpr (std::is_same_v<T, navbus::GnssFix>) filter.onGnssFix(m);
+        if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) filter.onStarTracker(m);
+      },
+      sample);
+}
+
+}  // namespace
+
+RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolutionHook& hook) {
+  refuseLogsWithLanes(setup);
+  RecordingResult result;
+  const std::vector<Event> events = loadEvents(setup, result);
 
   bus::HealthCounters health("navbus-offline");
   std::optional<fault_manager::FaultPipeline> faults;
-  nav_filter::FilterPipeline* filter_ptr = nullptr;
+  nav_filter::LaneSet* filter_ptr = nullptr;
+  std::vector<navbus::FaultMonitorProgress> progress;  // delivered after each sample, as a reader
   if (setup.fault_manager) {
     faults.emplace(*setup.fault_manager, health,
                    fault_manager::FaultPipeline::Sinks{
@@ -143,7 +201,8 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
                        [&](const navbus::FilterCommand& c) {
                          result.commands.push_back(c);
                          filter_ptr->onCommand(c);
-                       }});
+                       },
+                       [&](const navbus::FaultMonitorProgress& p) { progress.push_back(p); }});
   }
   std::function<void(const navbus::FilterDiagnostics&)> on_diagnostics;
   std::function<void(const navbus::FilterCommandOutcome&)> on_outcome;
@@ -155,30 +214,27 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
     };
     on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };
   }
+  const bool lanes = !setup.filter.lanes.units.empty();
   core::SmoothingLog smoothing_log;
   core::FixInnovationLog innovation_log;
   nav_filter::FilterConfig filter_config = setup.filter;
   if (setup.smooth) filter_config.engine.smoothing_log = &smoothing_log;
-  filter_config.engine.fix_innovation_log = &innovation_log;
-  nav_filter::FilterPipeline pipeline(filter_config, health,
-                                      {[&](const navbus::NavigationSolution& s) {
-                                         ++result.solutions;
-                                         if (hook) hook(s);
-                                       },
-                                       on_diagnostics, nullptr, on_outcome});
+  // One engine's fixes (a lane set would log every lane's into one list).
+  if (!lanes) filter_config.engine.fix_innovation_log = &innovation_log;
+  std::function<void(const navbus::LaneSolution&)> on_lane;
+  if (lanes) on_lane = [&](const navbus::LaneSolution& l) { result.lane_solutions.push_back(l); };
+  nav_filter::LaneSet pipeline(filter_config, health,
+                               {{[&](const navbus::NavigationSolution& s) {
+                                   ++result.solutions;
+                                   if (hook) hook(s);
+                                 },
+                                 on_diagnostics, nullptr, on_outcome},
+                                on_lane});
   filter_ptr = &pipeline;
   for (const Event& e : events) {
-    std::visit(
-        [&](const auto& m) {
-          using T = std::decay_t<decltype(m)>;
-          if constexpr (std::is_same_v<T, navbus::ImuIncrement>) pipeline.onImu(m);
-          if constexpr (std::is_same_v<T, navbus::ImuIncrementBlock>) pipeline.onImuBlock(m);
-          if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
-            pipeline.onGnssObservations(m);
-          if constexpr (std::is_same_v<T, navbus::GnssFix>) pipeline.onGnssFix(m);
-          if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) pipeline.onStarTracker(m);
-        },
-        e.sample);
+    feed(e.sample, pipeline, faults);
+    for (const navbus::FaultMonitorProgress& p : progress) pipeline.onFaultMonitorProgress(p);
+    progress.clear();
     pipeline.pump(e.time_ns);  // data time bounds the wait for a silent stream
   }
   pipeline.flush(events.back().time_ns);
@@ -286,6 +342,11 @@ int runRecordingCommand(const RecordingOptions& o) {
   if (setup.fault_manager) {
     records::writeCsvFile(o.out_dir + "/decisions.csv", r.decisions);
     records::writeCsvFile(o.out_dir + "/commands.csv", r.commands);
+  }
+  if (!r.lane_solutions.empty()) {
+    records::writeCsvFile(o.out_dir + "/lanes.csv", r.lane_solutions);
+    std::printf("%zu lane solutions written to %s/lanes.csv\n", r.lane_solutions.size(),
+                o.out_dir.c_str());
   }
   std::printf("%s%s\n%s%s%zu solutions written to %s\n", r.inputs.c_str(), r.summary.c_str(),
               r.fault_summary.c_str(), r.fault_summary.empty() ? "" : "\n",

@@ -33,7 +33,8 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   // The judgement of the IMU data itself (the parity test of redundant IMUs): carries no
   // samples, holds the merge where owed once its judge has reported (setImuJudged).
   if (monitored)
-    s.push_back({kImuJudgementStream, 0, true, true, c.fault_monitor->judgement_wait_ns, false});
+    s.push_back({kImuJudgementStream, 0, true, true, c.fault_monitor->judgement_wait_ns,
+                 c.fault_monitor->judged_from_start});
   return s;
 }
 

@@ -94,6 +94,14 @@ LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks 
     bus::HealthCounters& h = first ? health : *lane_health_.back();
     lanes_.push_back(std::make_unique<FilterPipeline>(laneConfig(config_, units[k], first), h, s));
   }
+  // A fault manager started with the filter (fault_monitor.judged_from_start) judges the
+  // lanes' IMU data from the first sample: every lane and the selection wait for it from the
+  // start, not only once it has reported (a replay as fast as the readers take would otherwise
+  // run ahead of its first report and select before a decision it was owed).
+  if (config_.fault_monitor && config_.fault_monitor->judged_from_start) {
+    forEach([](FilterPipeline& l) { l.setImuJudged(); });
+    parity_reported_ = true;
+  }
   pending_.resize(units.size());
   excluded_.assign(units.size(), false);
   excluded_from_ns_.assign(units.size(), std::numeric_limits<std::int64_t>::max());
@@ -294,6 +302,7 @@ bool LaneSet::holdForParity(std::int64_t time_ns) {
   if (now_ns_ - held_since_ns_ < wait_ns) return true;
   ++parity_waits_timed_out_;  // the monitor is silent: selected without its judgement
   held_since_ns_ = -1;
+  parity_reported_ = false;  // and not waited for again until it reports
   return false;
 }
 

@@ -59,7 +59,7 @@ class Stream {
   virtual bool publish(std::size_t i, const std::function<bool()>& stopping) = 0;
   /// Writes retried because a reliable reader had not acknowledged within max_blocking_time.
   virtual std::uint64_t writeWaits() const = 0;
-  /// Disposes the instance (end of stream) and waits for the readers' acknowledgments.
+  /// Disposes every instance it wrote (end of stream) and waits for the readers' acknowledgments.
   virtual void end() = 0;
 };
 
@@ -89,9 +89,21 @@ class TypedStream : public Stream {
   }
   std::uint64_t writeWaits() const override { return write_waits_; }
   void end() override {
-    if (messages_.empty()) return;
-    writer_.dispose(messages_.back());
-    writer_.raw()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0));
+    // Every instance the stream wrote ends: on a keyed topic each sensor's (each unit of a
+    // redundant set), with its last message, in the order the instances fell silent.
+    std::vector<eprosima::fastrtps::rtps::InstanceHandle_t> ended;
+    std::vector<std::size_t> last;
+    PubSubType type;
+    for (std::size_t i = messages_.size(); i-- > 0;) {
+      eprosima::fastrtps::rtps::InstanceHandle_t key;
+      type.getKey(&messages_[i], &key);
+      if (std::find(ended.begin(), ended.end(), key) != ended.end()) continue;
+      ended.push_back(key);
+      last.push_back(i);
+    }
+    for (auto i = last.rbegin(); i != last.rend(); ++i) writer_.dispose(messages_[*i]);
+    if (!last.empty())
+      writer_.raw()->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0));
   }
 
  private:

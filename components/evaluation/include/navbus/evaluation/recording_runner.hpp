@@ -45,6 +45,8 @@ struct RecordingResult {
   std::string fault_summary;
   std::vector<navbus::FaultDecision> decisions;
   std::vector<navbus::FilterCommand> commands;
+  /// Every lane's solution at every time (filter `lanes:`; empty without).
+  std::vector<navbus::LaneSolution> lane_solutions;
   /// With a fault manager: the adaptive noise scales of the last diagnostics the filter
   /// published (empty when its noise does not adapt).
   std::vector<navbus::NoiseScale> last_noise_scales;
