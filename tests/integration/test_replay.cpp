@@ -7,8 +7,12 @@
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <memory>
+#include <optional>
 #include <regex>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <navbus_idl/FaultPubSubTypes.h>
@@ -25,6 +29,40 @@ namespace {
 
 std::size_t dataRows(const std::filesystem::path& file) {
   return test::csvDataRows(file).size();
+}
+
+/// The simulator's run on `domain`, recorded from the bus into dir/rec (every sensor topic, as
+/// CSV; the recorder is its only reader); returns the simulator's exit code, or the recorder's
+/// if the simulator's is 0 (nullopt: one did not end; logs in dir/sim.log and dir/record.log).
+std::optional<int> recordSimulatorRun(int domain, const std::filesystem::path& dir, const std::string& sim_cfg,
+                       const std::string& seed) {
+  test::ChildProcess recorder(
+      navbus::test_paths::toolExe(),
+      {"-d", std::to_string(domain), "record", "navbus/imu/increment_block", "navbus/imu/raw",
+       "navbus/gnss/observations", "navbus/gnss/fix", "-o", (dir / "rec").string()},
+      (dir / "record.log").string());
+  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg, "--seed", seed},
+                         (dir / "sim.log").string());
+  const std::optional<int> sim_exit = sim.wait(120s);
+  std::this_thread::sleep_for(1s);  // the recorder writes what it took last
+  recorder.signal(SIGTERM);
+  const std::optional<int> recorder_exit = recorder.wait(10s);
+  return sim_exit != 0 ? sim_exit : recorder_exit;
+}
+
+/// `navbus replay dir/rec --speed 0` on `domain`, once the readers `min_readers` counts (topic,
+/// readers) are matched; its log in dir/replay.log.
+std::unique_ptr<test::ChildProcess> startReplay(
+    int domain, const std::filesystem::path& dir,
+    const std::vector<std::pair<std::string, int>>& min_readers) {
+  std::vector<std::string> args = {
+      "-d", std::to_string(domain), "replay", (dir / "rec").string(), "--speed", "0"};
+  for (const auto& [topic, n] : min_readers) {
+    args.push_back("--min-readers");
+    args.push_back(topic + "=" + std::to_string(n));
+  }
+  return std::make_unique<test::ChildProcess>(navbus::test_paths::toolExe(), args,
+                                              (dir / "replay.log").string());
 }
 
 }  // namespace
@@ -54,18 +92,8 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
   ASSERT_GT(expected.size(), 500u);
 
   // 1. The simulator's run, recorded from the bus (the recorder is its only reader).
-  const std::string rec = (dir / "rec").string();
-  test::ChildProcess recorder(
-      navbus::test_paths::toolExe(),
-      {"-d", std::to_string(kDomain), "record", "navbus/imu/increment_block", "navbus/imu/raw",
-       "navbus/gnss/observations", "navbus/gnss/fix", "-o", rec},
-      (dir / "record.log").string());
-  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg, "--seed", "5"},
-                         (dir / "sim.log").string());
-  ASSERT_EQ(sim.wait(120s), 0) << test::readFile(dir / "sim.log");
-  std::this_thread::sleep_for(1s);  // the recorder writes what it took last
-  recorder.signal(SIGTERM);
-  ASSERT_EQ(recorder.wait(10s), 0) << test::readFile(dir / "record.log");
+  ASSERT_EQ(recordSimulatorRun(kDomain, dir, sim_cfg, "5"), 0)
+      << test::readFile(dir / "sim.log") << test::readFile(dir / "record.log");
   // 60 s of 50 Hz increments in blocks of 0.1 s (a CSV row per increment); the scenario's
   // GNSS fixes as the simulator reports them.
   const std::string record_log = test::readFile(dir / "record.log");
@@ -92,14 +120,12 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
                             (dir / "filter.log").string());
   test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
                         (dir / "fm.log").string());
-  test::ChildProcess replay(navbus::test_paths::toolExe(),
-                            {"-d", std::to_string(kDomain), "replay", rec, "--speed", "0",
-                             "--min-readers", "navbus/imu/increment_block=2", "--min-readers",
-                             "navbus/gnss/observations=2", "--min-readers", "navbus/gnss/fix=2"},
-                            (dir / "replay.log").string());
-  while (replay.running()) me.spinOnce(50ms);
+  const auto replay = startReplay(
+      kDomain, dir,
+      {{"navbus/imu/increment_block", 2}, {"navbus/gnss/observations", 2}, {"navbus/gnss/fix", 2}});
+  while (replay->running()) me.spinOnce(50ms);
   const std::string replay_log = test::readFile(dir / "replay.log");
-  EXPECT_EQ(replay.wait(1s), 0) << replay_log;
+  EXPECT_EQ(replay->wait(1s), 0) << replay_log;
   EXPECT_NE(replay_log.find("replayed 600 of 600 samples of navbus/imu/increment_block"),
             std::string::npos)
       << replay_log;
@@ -371,17 +397,8 @@ TEST(Replay, ATriplexRecordingReplaysEveryLaneBitIdentical) {
 
   // 1. The simulator's run, recorded from the bus.
   const std::string rec = (dir / "rec").string();
-  test::ChildProcess recorder(
-      navbus::test_paths::toolExe(),
-      {"-d", std::to_string(kDomain), "record", "navbus/imu/increment_block", "navbus/imu/raw",
-       "navbus/gnss/observations", "navbus/gnss/fix", "-o", rec},
-      (dir / "record.log").string());
-  test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg, "--seed", "3"},
-                         (dir / "sim.log").string());
-  ASSERT_EQ(sim.wait(120s), 0) << test::readFile(dir / "sim.log");
-  std::this_thread::sleep_for(1s);  // the recorder writes what it took last
-  recorder.signal(SIGTERM);
-  ASSERT_EQ(recorder.wait(10s), 0) << test::readFile(dir / "record.log");
+  ASSERT_EQ(recordSimulatorRun(kDomain, dir, sim_cfg, "3"), 0)
+      << test::readFile(dir / "sim.log") << test::readFile(dir / "record.log");
   // 200 s of three units at 100 Hz in blocks of 10 increments.
   EXPECT_NE(test::readFile(dir / "record.log")
                 .find("recorded 6000 samples of navbus/imu/increment_block"),
@@ -442,14 +459,12 @@ TEST(Replay, ATriplexRecordingReplaysEveryLaneBitIdentical) {
   test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
                         (dir / "fm.log").string());
   // The increments' readers: the filter's, the fault manager's watchdog and its parity test's.
-  test::ChildProcess replay(navbus::test_paths::toolExe(),
-                            {"-d", std::to_string(kDomain), "replay", rec, "--speed", "0",
-                             "--min-readers", "navbus/imu/increment_block=3", "--min-readers",
-                             "navbus/gnss/observations=2", "--min-readers", "navbus/gnss/fix=1"},
-                            (dir / "replay.log").string());
-  while (replay.running()) me.spinOnce(50ms);
+  const auto replay = startReplay(
+      kDomain, dir,
+      {{"navbus/imu/increment_block", 3}, {"navbus/gnss/observations", 2}, {"navbus/gnss/fix", 1}});
+  while (replay->running()) me.spinOnce(50ms);
   const std::string replay_log = test::readFile(dir / "replay.log");
-  EXPECT_EQ(replay.wait(1s), 0) << replay_log;
+  EXPECT_EQ(replay->wait(1s), 0) << replay_log;
   test::spinUntil(me, 60s, [&] {
     return rows.size() >= expected.size() && lanes.size() >= expected_lanes.size();
   });
