@@ -31,8 +31,8 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
                  [this](const navbus::FaultMonitorProgress& r) { progress_writer_.write(r); }},
                 bus::wallTimeNowNs()),
       sensors_(p, streamEvents()),
-      parity_sensors_(p, parityEvents()),
-      receiver_sensors_(p, bus::SensorReaders::Events{}) {
+      parity_sensors_(p, detectorEvents()),
+      receiver_sensors_(p, detectorEvents()) {
   using namespace bus;
   watch<navbus::ImuIncrement>(profile::kSensorWatchdogReader);
   // Fast pacing's blocks of increments: each element is watched as one increment.
@@ -68,15 +68,15 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   }
 }
 
-bus::SensorReaders::Events FaultManagerNode::parityEvents() {
+bus::SensorReaders::Events FaultManagerNode::detectorEvents() {
+  // A detector's reliable reader of a watched topic (the parity test's, the cross-receiver
+  // test's): the writer's dispose may reach it and not the watchdog's best-effort reader of the
+  // same topic (measured: a replay of the triplex, Fast DDS 2.9, 4 of 4 runs: only the parity
+  // reader got the three units' ends, and the watchdog declared them LOST 1 s later). The end
+  // is the stream's either way (a second notice of it changes nothing).
   bus::SensorReaders::Events events;
   events.ended = [this](StreamKind kind, std::uint32_t id) {
-    if (kind != StreamKind::kImu) return;
-    pipeline_.onParityUnitEnded(id);
-    // The watchdog's best-effort reader of the same topic may not see the dispose (measured:
-    // a replay of the triplex, Fast DDS 2.9, 4 of 4 runs: only this reliable reader got the
-    // three units' ends, and the watchdog declared them LOST 1 s later). The end is the
-    // stream's either way (a second notice of it changes nothing).
+    if (kind == StreamKind::kImu) pipeline_.onParityUnitEnded(id);
     running();
     pipeline_.onStreamEnded(kind, id);
   };

@@ -30,8 +30,8 @@ class FaultManagerNode {
   bus::SensorReaders::Events streamEvents();
   /// Reliable readers of every IMU's increments for the parity detector.
   void subscribeIncrements();
-  /// Their events: the end of a unit's increments (after its last sample).
-  bus::SensorReaders::Events parityEvents();
+  /// The events of the detectors' own readers: a stream's end (after its last sample).
+  bus::SensorReaders::Events detectorEvents();
   /// The steady clock now, after telling the pipeline of a stall of this process that just
   /// ended (bus::StallDetector).
   std::int64_t running();
