@@ -108,29 +108,56 @@ std::uint64_t printDeadParticipantsShm(const char* what) {
   return segments;
 }
 
-}  // namespace
+/// The three participants' configuration files of a kill loop, in `dir`.
+struct KillSetup {
+  std::string sim, filter, fault_manager;
+};
 
-TEST(KillLoop, EachParticipantKilledAndRestartedSurvivorsReportAndNothingLeftInShm) {
-  test::cleanSharedMemory();
-  const auto dir = test::scratchDir("kill-loop");
-  const std::string domain = "domain_id: " + std::to_string(kDomain) + "\n";
-  Spawner spawn{
-      dir,
+/// The simulator's default vehicle with one IMU, the filter waiting for the fault manager.
+KillSetup oneImu(const std::filesystem::path& dir, int domain) {
+  const std::string dom = "domain_id: " + std::to_string(domain) + "\n";
+  return {test::writeFile(dir / "sim.yaml",
+                          dom + "seed: 3\n"
+                                "timing: {start: '1400000000000000000', duration_s: 0, "
+                                "pacing: realtime, "
+                                "wait_for_readers_s: 20,\n"
+                                "  min_readers: {imu: 3, raw_imu: 1, gnss: 2, star_tracker: 2}}\n"
+                                "imu: {accel_noise_ug_per_sqrthz: 10, "
+                                "gyro_arw_deg_per_sqrth: 0.005}\n"),
+          test::writeFile(dir / "filter.yaml", test::filterConfig(domain) +
+                                                   "fault_monitor: {participant: "
+                                                   "navbus-fault-manager, timeout_s: 1.0}\n"),
+          test::writeFile(dir / "fm.yaml", dom)};
+}
+
+/// The triplex aircraft: three IMUs, the filter's three lanes (waiting for the parity test from
+/// the first sample, 1 s at most: a dead fault manager costs the output one such budget) and
+/// the fault manager's parity test.
+KillSetup triplex(const std::filesystem::path& dir, int domain) {
+  const std::string src = navbus::test_paths::sourceDir();
+  const std::string dom = "domain_id: " + std::to_string(domain) + "\n";
+  return {
       test::writeFile(dir / "sim.yaml",
-                      domain + "seed: 3\n"
-                               "timing: {start: '1400000000000000000', duration_s: 0, "
-                               "pacing: realtime, "
-                               "wait_for_readers_s: 20,\n"
-                               "  min_readers: {imu: 3, raw_imu: 1, gnss: 2, star_tracker: 2}}\n"
-                               "imu: {accel_noise_ug_per_sqrthz: 10, "
-                               "gyro_arw_deg_per_sqrth: 0.005}\n"),
-      test::writeFile(dir / "filter.yaml", test::filterConfig(kDomain) +
-                                               "fault_monitor: {participant: navbus-fault-manager, "
-                                               "timeout_s: 1.0}\n"),
-      test::writeFile(dir / "fm.yaml", domain)};
+                      "extends: " + src + "/sim/scenarios/seed000_triplex.yaml\n" + dom +
+                          "timing: {duration_s: 0, pacing: realtime, wait_for_readers_s: 20}\n"),
+      test::writeFile(dir / "filter.yaml", "extends: " + src + "/config/filter_triplex.yaml\n" +
+                                               dom +
+                                               "fault_monitor: {participant: "
+                                               "navbus-fault-manager, timeout_s: 1.0, "
+                                               "judgement_wait_s: 1.0, judged_from_start: true}\n"),
+      test::writeFile(dir / "fm.yaml",
+                      "extends: " + src + "/config/fault_manager_triplex.yaml\n" + dom)};
+}
+
+void killLoop(int domain, const std::string& name,
+              KillSetup (*setup)(const std::filesystem::path&, int)) {
+  test::cleanSharedMemory();
+  const auto dir = test::scratchDir(name);
+  const KillSetup files = setup(dir, domain);
+  Spawner spawn{dir, files.sim, files.filter, files.fault_manager};
 
   bus::ShutdownSignal shutdown;
-  auto options = test::testParticipant(kDomain, "kill-loop-test");
+  auto options = test::testParticipant(domain, name + "-test");
   options.dds.participant_profile = profileUnderTest();
   bus::Participant me(options, shutdown);
   Seen seen;
@@ -259,7 +286,21 @@ TEST(KillLoop, EachParticipantKilledAndRestartedSurvivorsReportAndNothingLeftInS
   for (auto& p : procs) EXPECT_EQ(p->wait(15s), 0);
   const std::uint64_t left = printDeadParticipantsShm("left by dead participants after the loop");
   EXPECT_EQ(left, 0u);
-  if (!HasFailure()) std::filesystem::remove_all(dir);
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+
+TEST(KillLoop, EachParticipantKilledAndRestartedSurvivorsReportAndNothingLeftInShm) {
+  killLoop(kDomain, "kill-loop", oneImu);
+}
+
+// The same with redundant IMUs: three units, three lanes, the parity test (its judgement waited
+// for from the first sample). A restarted simulator is a new run for every lane and for the
+// parity test (they published and tested nothing of it before: every new time was older than
+// the last one), a restarted fault manager's parity test is waited for again. Domain 101.
+TEST(KillLoop, WithLanesEachParticipantKilledAndRestartedSurvivorsReport) {
+  killLoop(101, "kill-loop-lanes", triplex);
 }
 
 // A participant on the shared-memory profile killed with SIGKILL leaves its segment and port

@@ -36,6 +36,10 @@ void FaultPipeline::onRawBlock(const navbus::ImuRawBlock& block) {
 void FaultPipeline::onImuIncrement(const navbus::ImuIncrement& increment) {
   if (!parity_) return;
   parity_->onIncrement(increment, *this);
+  if (parity_->counters().new_runs != parity_runs_) {
+    parity_runs_ = parity_->counters().new_runs;  // a new run's times start over
+    parity_reported_ = -1;
+  }
   // How far the units' data is judged, every kParityReportPeriodNs of it (after its commands).
   const std::int64_t tested = parity_->testedUpToNs();
   if (tested < 0 || tested / kParityReportPeriodNs == parity_reported_ / kParityReportPeriodNs)

@@ -71,6 +71,11 @@ void ParityDetector::onIncrement(const navbus::ImuIncrement& msg, FaultOutput& o
     return;
   }
   const auto time_ns = static_cast<std::int64_t>(msg.time_gps_ns());
+  const auto u = static_cast<std::size_t>(unit);
+  // A unit's reliable reader delivers its writer's increments in order: time and sequence both
+  // going back is a new run of its source, not a late sample.
+  if (msg.seq() < latest_seq_[u] && time_ns < latest_ns_[u]) startNewRun();
+  latest_seq_[u] = msg.seq();
   if (time_ns <= std::max(last_tested_ns_, late_before_ns_)) {
     ++counters_.late;
     return;
@@ -88,6 +93,24 @@ void ParityDetector::onIncrement(const navbus::ImuIncrement& msg, FaultOutput& o
   latest_ns_[static_cast<std::size_t>(unit)] =
       std::max(latest_ns_[static_cast<std::size_t>(unit)], time_ns);
   drain(out);
+}
+
+void ParityDetector::startNewRun() {
+  std::string error;
+  array_ = core::ImuArrayParity::make(config_.units, 1e-9 * static_cast<double>(period_ns_),
+                                      config_.array, error);  // made once before: cannot fail
+  pending_.clear();
+  ended_units_ = 0;
+  last_tested_ns_ = -1;
+  late_before_ns_ = -1;
+  latest_ns_.fill(0);
+  latest_seq_.fill(0);
+  latest_ = {};
+  ++counters_.new_runs;
+  spdlog::warn(
+      "parity detector: the IMUs restarted at an earlier time: new run {} (the test "
+      "starts over, every instrument in the array)",
+      counters_.new_runs);
 }
 
 bool ParityDetector::onUnitEnded(std::uint32_t sensor_id) {
@@ -234,6 +257,7 @@ std::string ParityDetector::summary() const {
     s << "; not used: other IMUs " << c.other_sensors << ", invalid " << c.invalid
       << ", other interval " << c.wrong_interval << ", late or repeated " << c.late
       << ", times without every unit " << c.incomplete << ", gaps " << c.gaps;
+  if (c.new_runs > 0) s << "; new runs after a source restart " << c.new_runs;
   return s.str();
 }
 

@@ -229,6 +229,7 @@ void FilterPipeline::startNewRun() {
   diagnosed_up_to_ns_ = -1;
   owed_judgement_ns_ = -1;
   judged_up_to_ns_ = -1;
+  judgements_.newRun();
   time_reference_.latest_ns = 0;
   for (bus::StreamGate* g : {&gnss_obs_gate_, &gnss_fix_gate_, &star_gate_})
     g->tracker().resetAll();

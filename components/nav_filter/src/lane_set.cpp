@@ -236,7 +236,11 @@ void LaneSet::onLaneSolution(int k, const navbus::NavigationSolution& s) {
   // The lane's fit as it stands at this solution (the engine moves on before the selection).
   Pending p{atBodyOrigin(s, config_.lanes.units[i].lever_arm_b_m),
             lanes_[i]->engine().consistency().windowNisPerRow()};
-  if (static_cast<std::int64_t>(s.time_gps_ns()) <= last_selected_ns_) {
+  // A source restart reaches the lanes one by one: the first lane in a new run starts the
+  // selection over; a lane still flushing the earlier run is heard out unselected.
+  const std::uint64_t lane_run = lanes_[i]->newRuns();
+  if (lane_run > run_) startNewRun(lane_run);
+  if (lane_run < run_ || static_cast<std::int64_t>(s.time_gps_ns()) <= last_selected_ns_) {
     // Its time was selected without it (a lane failed by a command is not waited for, one
     // silent too long is passed over): not selected, but on the lanes topic all the same, as
     // offline, where no lane comes late, it is.
@@ -246,6 +250,28 @@ void LaneSet::onLaneSolution(int k, const navbus::NavigationSolution& s) {
   }
   pending_[i].push_back(std::move(p));
   release(false);
+}
+
+void LaneSet::startNewRun(std::uint64_t run) {
+  release(true);
+  run_ = run;
+  const std::size_t n = pending_.size();
+  for (auto& lane : pending_) lane.clear();
+  selector_ = core::LaneSelector(config_.lanes.selector);
+  last_delta_ = {};
+  previous_.assign(n, std::nullopt);
+  excluded_.assign(n, false);
+  excluded_from_ns_.assign(n, std::numeric_limits<std::int64_t>::max());
+  parity_judgements_.newRun();
+  parity_judged_ns_ = -1;
+  held_since_ns_ = -1;
+  last_selected_ns_ = -1;
+  solutions_earlier_runs_ += seq_;
+  seq_ = 0;
+  spdlog::warn(
+      "lanes: the IMUs restarted at an earlier time: new run {} (the selection starts "
+      "over)",
+      run);
 }
 
 void LaneSet::release(bool all) {
@@ -391,6 +417,9 @@ std::string LaneSet::summary() const {
     << " (its solutions came later " << late_ << ")"
     << ", selections made without the parity test's judgement (its wait ran out) "
     << parity_waits_timed_out_;
+  if (run_ > 0)
+    s << ", new runs after a source restart " << run_ << " (solutions of earlier runs "
+      << solutions_earlier_runs_ << ")";
   for (std::size_t k = 0; k < lanes_.size(); ++k)
     s << (k == 0 ? "; " : "\n") << "lane IMU " << config_.lanes.units[k].sensor_id
       << (excluded_[k] ? " (excluded)" : "") << ": " << lanes_[k]->summary();

@@ -10,6 +10,7 @@
 #include "navbus/core/ins/state_layout.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
+#include "navbus/nav_filter/lane_set.hpp"
 #include "navbus/nav_filter/monitor_liveness.hpp"
 #include "navbus/sensor_sim/frame_publisher.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
@@ -285,6 +286,55 @@ TEST(FilterPipelineRestart, SourceRestartingAtAnEarlierTimeStartsANewRun) {
   }
   EXPECT_NE(pipeline.summary().find("new runs after a source restart 1"), std::string::npos)
       << pipeline.summary();
+}
+
+// Lanes (two units, the same increments under ids 1 and 2) whose IMUs restart at an earlier time:
+// the selection starts over with the lanes' new run, as one filter does (it published nothing
+// of the new run before: every new time was at or before the last one selected), sequence
+// numbers from 1, the same solutions as lanes that started with the new run.
+TEST(FilterPipelineRestart, LanesStartTheSelectionOverWhenTheirSourcesRestart) {
+  auto cfg = imuOnlyConfig();
+  cfg.lanes.units = {nav_filter::LaneUnit{1}, nav_filter::LaneUnit{2}};
+  const int confirmations = cfg.time_jump.confirmations;
+  std::int64_t now = 0;
+  auto feed = [&](nav_filter::LaneSet& lanes, sim::ScenarioSource& src, int n, int skip = 0) {
+    for (int k = 0; k < n; ++k) {
+      const auto increment = src.next().increment;
+      if (k >= skip)
+        for (std::uint32_t id : {1u, 2u})
+          lanes.onImu(bus::toIdl(increment, id, static_cast<std::uint64_t>(k + 1)));
+      lanes.pump(now += 10'000'000);
+    }
+  };
+  bus::HealthCounters health("test");
+  std::vector<NavigationSolution> solutions;
+  nav_filter::LaneSet lanes(
+      cfg, health, {{[&](const NavigationSolution& s) { solutions.push_back(s); }, nullptr}});
+  sim::ScenarioSource first(sourceConfig());
+  feed(lanes, first, 300);
+  const std::size_t first_run = solutions.size();
+  ASSERT_GT(first_run, 0u);
+  sim::ScenarioSource restarted(sourceConfig());
+  feed(lanes, restarted, 300);
+  ASSERT_GT(solutions.size(), first_run + 10) << lanes.summary();
+  EXPECT_EQ(solutions[first_run].seq(), 1u);
+  EXPECT_LT(solutions[first_run].time_gps_ns(), solutions[first_run - 1].time_gps_ns());
+  EXPECT_NE(lanes.summary().find("new runs after a source restart 1"), std::string::npos)
+      << lanes.summary();
+
+  bus::HealthCounters fresh_health("fresh");
+  std::vector<NavigationSolution> fresh;
+  nav_filter::LaneSet reference(
+      cfg, fresh_health, {{[&](const NavigationSolution& s) { fresh.push_back(s); }, nullptr}});
+  sim::ScenarioSource again(sourceConfig());
+  feed(reference, again, 300, confirmations - 1);
+  ASSERT_EQ(fresh.size(), solutions.size() - first_run);
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    EXPECT_EQ(fresh[i].time_gps_ns(), solutions[first_run + i].time_gps_ns());
+    EXPECT_EQ(fresh[i].seq(), solutions[first_run + i].seq());
+    EXPECT_EQ(fresh[i].latitude_rad(), solutions[first_run + i].latitude_rad());
+    EXPECT_EQ(fresh[i].q_b_to_n(), solutions[first_run + i].q_b_to_n());
+  }
 }
 
 // A fault manager's re-learn whose sigma exceeds the filter's compensation limit (an ambiguous

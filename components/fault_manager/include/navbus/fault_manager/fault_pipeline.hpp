@@ -118,6 +118,7 @@ class FaultPipeline : private FaultOutput {
   /// The parity test's progress is reported every this much data time.
   static constexpr std::int64_t kParityReportPeriodNs = 100'000'000;
   std::int64_t parity_reported_{-1};  ///< data time of the latest report of it
+  std::uint64_t parity_runs_{0};      ///< the parity test's new runs seen
   navbus::FilterDiagnostics judged_;  ///< the latest diagnostics epoch judged (reports quote it)
   bus::StreamGate diagnostics_gate_;
   std::map<StreamKind, bus::SequenceTracker> trackers_;

@@ -42,6 +42,7 @@ class ParityDetector {
     std::uint64_t incomplete{0};  ///< times dropped: a unit's increment lost, or a unit silent
     std::uint64_t gaps{0};        ///< breaks in the aligned times: the tests restarted
     std::uint64_t detections{0}, ambiguous{0}, commands{0};
+    std::uint64_t new_runs{0};  ///< the units' source restarted at an earlier time
     std::array<double, core::kImuInstrumentKinds> max_statistic{};
   };
   const Counters& counters() const { return counters_; }
@@ -69,6 +70,9 @@ class ParityDetector {
   /// Tests the complete slots in time order; drops the oldest when a missing unit's increment
   /// is lost or too many times wait.
   void drain(FaultOutput& out);
+  /// The units' source started over at an earlier time (a restarted simulator or replay): the
+  /// test starts over too, every instrument back in the array, nothing of the earlier run kept.
+  void startNewRun();
   void test(std::int64_t time_ns, const Slot& slot, FaultOutput& out);
   void report(std::int64_t time_ns, const core::ImuArrayDetection& d, FaultOutput& out);
 
@@ -80,7 +84,8 @@ class ParityDetector {
   std::uint32_t ended_units_{0};          ///< bit per unit whose increments ended
   std::int64_t last_tested_ns_{-1};       ///< -1: the next time tested starts a new window
   std::int64_t late_before_ns_{-1};       ///< increments at or before this time come too late
-  std::array<std::int64_t, core::ImuArrayParity::kMaxUnits> latest_ns_{};  ///< per unit
+  std::array<std::int64_t, core::ImuArrayParity::kMaxUnits> latest_ns_{};    ///< per unit
+  std::array<std::uint64_t, core::ImuArrayParity::kMaxUnits> latest_seq_{};  ///< per unit
   core::ImuArrayParity::Result latest_;
   Counters counters_;
 };

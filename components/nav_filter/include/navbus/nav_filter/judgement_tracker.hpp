@@ -22,6 +22,12 @@ class JudgementTracker {
   /// A command arrived (any issuer): the held report's time, if it counts now.
   std::optional<std::int64_t> onCommand(const navbus::FilterCommand& command);
 
+  /// The data started over at an earlier time (a new run): how far the IMU data is judged
+  /// starts over too (the commands seen are kept: a report may name one of them).
+  void newRun() {
+    imu_judged_ns_ = 0;
+    held_.reset();
+  }
   std::uint64_t reports() const { return reports_; }
   /// How far the released reports say the IMU data is judged (imu_judged_up_to_gps_ns; 0:
   /// no parity test).

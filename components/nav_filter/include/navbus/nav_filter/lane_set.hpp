@@ -93,6 +93,10 @@ class LaneSet {
     for (auto& lane : lanes_) fn(*lane);
   }
   void onLaneSolution(int k, const navbus::NavigationSolution& s);
+  /// The IMUs restarted at an earlier time (a lane began its new run `run`): what the earlier
+  /// run holds goes out, and the selection starts over as a single filter does (sequence
+  /// numbers from 1, lane 0 first, no exclusion, no judgement yet).
+  void startNewRun(std::uint64_t run);
   /// Selects at every time all lanes have passed, oldest first; `all` releases what is held.
   void release(bool all);
   void select(std::int64_t time_ns);
@@ -132,6 +136,8 @@ class LaneSet {
   std::uint64_t passed_over_{0};  ///< times selected while a lane was not there yet
   std::uint64_t late_{0};  ///< lane solutions of times already selected (on the lanes topic only)
   std::int64_t last_selected_ns_{-1};
+  std::uint64_t run_{0};  ///< the lanes' run being selected (FilterPipeline::newRuns())
+  std::uint64_t solutions_earlier_runs_{0};
   std::vector<std::int64_t> heard_ns_;  ///< per lane: running time of its latest solution
 };
 
