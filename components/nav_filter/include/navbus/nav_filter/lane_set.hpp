@@ -95,7 +95,7 @@ class LaneSet {
   void onLaneSolution(int k, const navbus::NavigationSolution& s);
   /// The IMUs restarted at an earlier time (a lane began its new run `run`): what the earlier
   /// run holds goes out, and the selection starts over as a single filter does (sequence
-  /// numbers from 1, lane 0 first, no exclusion, no judgement yet).
+  /// numbers from 1, the best lane taken without a reset counted, no exclusion, no judgement).
   void startNewRun(std::uint64_t run);
   /// Selects at every time all lanes have passed, oldest first; `all` releases what is held.
   void release(bool all);
