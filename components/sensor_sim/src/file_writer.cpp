@@ -27,8 +27,17 @@ std::ofstream FileWriter::open(const std::string& name, const std::string& heade
   return out;
 }
 
-FileWriter::FileWriter(const std::filesystem::path& dir, const sim::ScenarioConfig& scenario)
-    : dir_(dir) {
+FileWriter::FileWriter(const std::filesystem::path& dir, const sim::ScenarioConfig& scenario,
+                       std::vector<std::uint32_t> extra_imu_ids,
+                       std::vector<std::uint32_t> extra_receiver_ids)
+    : dir_(dir), unit_ids_(std::move(extra_imu_ids)), receiver_ids_(std::move(extra_receiver_ids)) {
+  if (unit_ids_.size() != scenario.extra_imus.size() ||
+      receiver_ids_.size() != scenario.extra_receivers.size())
+    throw std::invalid_argument("FileWriter: " + std::to_string(unit_ids_.size()) + " ids for " +
+                                std::to_string(scenario.extra_imus.size()) +
+                                " further IMU units, " + std::to_string(receiver_ids_.size()) +
+                                " ids for " + std::to_string(scenario.extra_receivers.size()) +
+                                " further receivers");
   std::filesystem::create_directories(dir_);
   imu_ = open(
       "imu.csv",
@@ -47,6 +56,17 @@ FileWriter::FileWriter(const std::filesystem::path& dir, const sim::ScenarioConf
               "sigma_n_m,"
               "sigma_e_m,sigma_d_m,num_satellites,pdop");
   star_ = open("star_tracker.csv", "time_gps_ns,qw,qx,qy,qz,sigma_x_rad,sigma_y_rad,sigma_z_rad");
+  if (!unit_ids_.empty())
+    units_ = open("imu_units.csv",
+                  "sensor_id,time_gps_ns,interval_ns,delta_vel_x_mps,delta_vel_y_mps,"
+                  "delta_vel_z_mps,delta_angle_x_rad,delta_angle_y_rad,delta_angle_z_rad,"
+                  "accel_bias_x_mps2,accel_bias_y_mps2,accel_bias_z_mps2,gyro_bias_x_radps,"
+                  "gyro_bias_y_radps,gyro_bias_z_radps");
+  if (!receiver_ids_.empty())
+    receivers_ = open("gnss_receivers.csv",
+                      "receiver_id,time_gps_ns,sv_id,pseudorange_m,pseudorange_rate_mps,sat_x_m,"
+                      "sat_y_m,sat_z_m,sat_vx_mps,sat_vy_mps,sat_vz_mps,sat_clock_correction_m,"
+                      "cn0_dbhz,elevation_rad");
   truth_ = open(
       "truth.csv",
       "time_gps_ns,latitude_rad,longitude_rad,height_m,vel_n_mps,vel_e_mps,vel_d_mps,qw,qx,qy,qz,"
@@ -70,6 +90,27 @@ FileWriter::FileWriter(const std::filesystem::path& dir, const sim::ScenarioConf
   }
 }
 
+void FileWriter::writeSatellites(std::ofstream& out, const std::string& prefix,
+                                 const sim::GnssEpoch& e) {
+  for (const auto& s : e.satellites) {
+    out << prefix << e.time_ns << "," << s.sv_id << "," << num(s.pseudorange_m) << ","
+        << num(s.pseudorange_rate_mps) << "," << vec(s.sat_pos_ecef_m) << ","
+        << vec(s.sat_vel_ecef_mps) << "," << num(s.sat_clock_correction_m) << "," << num(s.cn0_dbhz)
+        << "," << num(s.elevation_rad) << "\n";
+  }
+}
+
+void FileWriter::writeUnits(const sim::SensorFrame& f) {
+  for (std::size_t k = 0; k < f.extra_imus.size() && k < unit_ids_.size(); ++k) {
+    const sim::UnitImuIncrement& u = f.extra_imus[k];
+    units_ << unit_ids_[k] << "," << f.time_ns << "," << std::llround(u.increment.interval_s * 1e9)
+           << "," << vec(u.increment.delta_vel_b_mps) << "," << vec(u.increment.delta_angle_b_rad)
+           << "," << vec(u.truth_accel_bias_u_mps2) << "," << vec(u.truth_gyro_bias_u_radps)
+           << "\n";
+    ++counts_.unit_increments;
+  }
+}
+
 void FileWriter::write(const sim::SensorFrame& f) {
   const auto& inc = f.increment;
   imu_ << f.time_ns << "," << std::llround(inc.interval_s * 1e9) << "," << vec(inc.delta_vel_b_mps)
@@ -82,14 +123,14 @@ void FileWriter::write(const sim::SensorFrame& f) {
     raw_ << t << "," << vec(s.angular_rate_b_radps) << "," << vec(s.specific_force_b_mps2) << "\n";
   }
   ++counts_.raw;
+  writeUnits(f);
   if (f.has_gnss) {
-    for (const auto& s : f.gnss.satellites) {
-      gnss_ << f.gnss.time_ns << "," << s.sv_id << "," << num(s.pseudorange_m) << ","
-            << num(s.pseudorange_rate_mps) << "," << vec(s.sat_pos_ecef_m) << ","
-            << vec(s.sat_vel_ecef_mps) << "," << num(s.sat_clock_correction_m) << ","
-            << num(s.cn0_dbhz) << "," << num(s.elevation_rad) << "\n";
-    }
+    writeSatellites(gnss_, "", f.gnss);
     ++counts_.gnss_epochs;
+    for (std::size_t k = 0; k < f.extra_gnss.size() && k < receiver_ids_.size(); ++k) {
+      writeSatellites(receivers_, std::to_string(receiver_ids_[k]) + ",", f.extra_gnss[k]);
+      ++counts_.receiver_epochs;
+    }
     const auto& x = f.fix;
     fix_ << x.time_ns << "," << (x.valid ? 1 : 0) << "," << num(x.position.latitude_rad) << ","
          << num(x.position.longitude_rad) << "," << num(x.position.height_m) << ","

@@ -76,16 +76,18 @@ int main(int argc, char** argv) {
       // Offline: no DDS participant at all.
       if (config.start_now) startNow();
       nb::sim::ScenarioSource source(config.scenario);
-      nb::sensor_sim::FileWriter files(files_dir, config.scenario);
+      nb::sensor_sim::FileWriter files(files_dir, config.scenario, config.extra_imu_sensor_ids,
+                                       config.extra_gnss_receiver_ids);
       while (!shutdown.requested() && source.index() < total) files.write(source.next());
       const auto& n = files.counts();
       spdlog::info(
           "summary: scenario '{}' seed {}: wrote {} IMU increments, {} raw blocks, {} GNSS epochs, "
           "{} fixes, "
-          "{} star-tracker attitudes ({:.3f} s) to {}",
+          "{} star-tracker attitudes ({:.3f} s), further IMU units' increments {}, further "
+          "receivers' epochs {} to {}",
           config.scenario.name, config.scenario.seed, n.imu, n.raw, n.gnss_epochs, n.gnss_fixes,
           n.star_tracker, static_cast<double>(n.imu) * static_cast<double>(period_ns) * 1e-9,
-          files_dir);
+          n.unit_increments, n.receiver_epochs, files_dir);
       return static_cast<int>(nb::bus::kExitOk);
     }
 

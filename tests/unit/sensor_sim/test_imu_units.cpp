@@ -1,14 +1,20 @@
 // Redundant IMU units in a scenario (imu_units): each senses the body's motion in its own axes
 // at its own place, faults addressed by sensor id reach that unit only, and the configuration
 // refuses ids it cannot place, naming them.
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "navbus/bus/config.hpp"
 #include "navbus/core/math/rotation.hpp"
 #include "navbus/core/math/units.hpp"
+#include "navbus/records/csv_table.hpp"
+#include "navbus/sensor_sim/file_writer.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
 #include "test_paths.hpp"
 
@@ -184,5 +190,50 @@ TEST(ImuUnits, RefusesIdsItCannotPlaceNamingThem) {
   } catch (const navbus::bus::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("faults[0].sensor_id = 7"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("1, 2"), std::string::npos) << e.what();
+  }
+}
+
+// `navbus-sensor-sim --files`: the further IMU units' increments and the further receivers'
+// epochs go to their own files, each row naming its id, the same numbers the bus would carry
+// (they were left out before: nothing said so).
+TEST(ImuUnits, TheFilesHoldEveryFurtherUnitAndReceiver) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("navbus-files-units-" + std::to_string(::getpid()));
+  for (const char* name : {"seed000_triplex.yaml", "seed000_dual_receivers.yaml"}) {
+    const navbus::sensor_sim::SimConfig config = navbus::sensor_sim::parseSimConfig(
+        navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) + "/" + name));
+    std::vector<SensorFrame> frames;
+    {
+      navbus::sensor_sim::FileWriter files(dir, config.scenario, config.extra_imu_sensor_ids,
+                                           config.extra_gnss_receiver_ids);
+      ScenarioSource source(config.scenario);
+      for (int k = 0; k < 300; ++k) {
+        frames.push_back(source.next());
+        files.write(frames.back());
+      }
+      EXPECT_EQ(files.counts().unit_increments, 300 * config.extra_imu_sensor_ids.size());
+      EXPECT_EQ(files.counts().receiver_epochs, 3 * config.extra_gnss_receiver_ids.size());
+    }
+    const SensorFrame& last = frames.back();
+    if (!config.extra_imu_sensor_ids.empty()) {
+      const navbus::records::CsvTable t = navbus::records::readCsv(dir / "imu_units.csv");
+      ASSERT_EQ(t.rows.size(), 300 * config.extra_imu_sensor_ids.size());
+      const auto& row = t.rows.back();  // the last unit's last increment
+      EXPECT_EQ(std::stoul(row[t.column("sensor_id")]), config.extra_imu_sensor_ids.back());
+      EXPECT_EQ(std::stoll(row[t.column("time_gps_ns")]), last.time_ns);
+      EXPECT_EQ(std::stod(row[t.column("delta_angle_z_rad")]),
+                last.extra_imus.back().increment.delta_angle_b_rad.z());
+    }
+    if (!config.extra_gnss_receiver_ids.empty()) {
+      const navbus::records::CsvTable t = navbus::records::readCsv(dir / "gnss_receivers.csv");
+      auto with_gnss = frames.rbegin();
+      while (!with_gnss->has_gnss) ++with_gnss;
+      const auto& epoch = with_gnss->extra_gnss.back();
+      ASSERT_FALSE(epoch.satellites.empty());
+      const auto& row = t.rows.back();
+      EXPECT_EQ(std::stoul(row[t.column("receiver_id")]), config.extra_gnss_receiver_ids.back());
+      EXPECT_EQ(std::stod(row[t.column("pseudorange_m")]), epoch.satellites.back().pseudorange_m);
+    }
+    std::filesystem::remove_all(dir);
   }
 }
