@@ -34,8 +34,8 @@ std::size_t dataRows(const std::filesystem::path& file) {
 /// The simulator's run on `domain`, recorded from the bus into dir/rec (every sensor topic, as
 /// CSV; the recorder is its only reader); returns the simulator's exit code, or the recorder's
 /// if the simulator's is 0 (nullopt: one did not end; logs in dir/sim.log and dir/record.log).
-std::optional<int> recordSimulatorRun(int domain, const std::filesystem::path& dir, const std::string& sim_cfg,
-                       const std::string& seed) {
+std::optional<int> recordSimulatorRun(int domain, const std::filesystem::path& dir,
+                                      const std::string& sim_cfg, const std::string& seed) {
   test::ChildProcess recorder(
       navbus::test_paths::toolExe(),
       {"-d", std::to_string(domain), "record", "navbus/imu/increment_block", "navbus/imu/raw",
