@@ -141,15 +141,13 @@ std::vector<Event> loadEvents(const RecordingSetup& setup, RecordingResult& resu
   return events;
 }
 
-/// The smoother's and the innovations' logs follow one engine: with lanes, whose engine is
-/// published changes at a switch, they are refused.
-void refuseLogsWithLanes(const RecordingSetup& setup) {
-  if (setup.filter.lanes.units.empty()) return;
-  if (setup.smooth)
-    throw bus::ConfigError(
-        "--smooth: the filter configuration has lanes (" +
-        std::to_string(setup.filter.lanes.units.size()) +
-        " units); the smoother follows one engine, run it on a filter without lanes");
+/// The smoother and the fixes' innovations follow one engine; with lanes the published engine
+/// changes at a switch: refused, naming the option (`what`), rather than written wrong or empty.
+void refuseWithLanes(const nav_filter::FilterConfig& filter, bool asked, const char* what) {
+  if (!asked || filter.lanes.units.empty()) return;
+  throw bus::ConfigError(std::string(what) + ": the filter configuration has lanes (" +
+                         std::to_string(filter.lanes.units.size()) + " units); it follows one " +
+                         "engine, run it on a filter without lanes");
 }
 
 /// One recorded sample to the filter's lanes and, as the fault manager's readers take it, to
@@ -186,7 +184,7 @@ void feed(const Sample& sample, nav_filter::LaneSet& filter,
 }  // namespace
 
 RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolutionHook& hook) {
-  refuseLogsWithLanes(setup);
+  refuseWithLanes(setup.filter, setup.smooth, "--smooth");
   RecordingResult result;
   const std::vector<Event> events = loadEvents(setup, result);
 
@@ -323,6 +321,7 @@ int runRecordingCommand(const RecordingOptions& o) {
   setup.smooth = o.smooth;
   setup.dir = o.recording;
   setup.filter = bus::parseFile(o.filter, nav_filter::parseFilterConfig);
+  refuseWithLanes(setup.filter, o.innovations, "--innovations");
   if (!o.fault_manager.empty())
     setup.fault_manager = bus::parseFile(o.fault_manager, fault_manager::parseFaultManagerConfig);
   std::filesystem::create_directories(o.out_dir);

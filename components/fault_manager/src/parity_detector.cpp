@@ -40,10 +40,7 @@ navbus::FaultSource source(ImuInstrument k) {
 
 ParityDetector::ParityDetector(const ParityDetectorConfig& config)
     : config_(config), period_ns_(std::llround(1e9 / config.imu_rate_hz)) {
-  std::string error;
-  array_ = core::ImuArrayParity::make(config_.units, 1e-9 * static_cast<double>(period_ns_),
-                                      config_.array, error);
-  if (!array_) throw bus::ConfigError("configuration parity: " + error);
+  makeArray();
   spdlog::info("parity detector: {} IMU units, {}", config_.units.size(),
                minimumDetectableBiases());
 }
@@ -95,10 +92,15 @@ void ParityDetector::onIncrement(const navbus::ImuIncrement& msg, FaultOutput& o
   drain(out);
 }
 
-void ParityDetector::startNewRun() {
+void ParityDetector::makeArray() {
   std::string error;
   array_ = core::ImuArrayParity::make(config_.units, 1e-9 * static_cast<double>(period_ns_),
-                                      config_.array, error);  // made once before: cannot fail
+                                      config_.array, error);
+  if (!array_) throw bus::ConfigError("configuration parity: " + error);
+}
+
+void ParityDetector::startNewRun() {
+  makeArray();  // as configured (it was made so once: it cannot fail now)
   pending_.clear();
   ended_units_ = 0;
   last_tested_ns_ = -1;

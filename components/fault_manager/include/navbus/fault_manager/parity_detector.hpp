@@ -70,6 +70,9 @@ class ParityDetector {
   /// Tests the complete slots in time order; drops the oldest when a missing unit's increment
   /// is lost or too many times wait.
   void drain(FaultOutput& out);
+  /// The array as configured, every instrument in it; throws bus::ConfigError (naming the
+  /// field) when it cannot be monitored.
+  void makeArray();
   /// The units' source started over at an earlier time (a restarted simulator or replay): the
   /// test starts over too, every instrument back in the array, nothing of the earlier run kept.
   void startNewRun();
