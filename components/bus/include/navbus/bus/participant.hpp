@@ -61,12 +61,38 @@ class Writer {
   /// Disposes the instance whose key `key_holder` carries: readers learn that the stream
   /// ended as announced (not lost). Returns false (and logs) on failure.
   bool dispose(const Sample& key_holder) {
+    if (tryDispose(key_holder)) return true;
+    logDisposeFailure();
+    return false;
+  }
+  /// The dispose of a stream whose readers may be behind: a dispose is a change in the
+  /// writer's history like a sample, refused while a reliable KEEP_ALL history stays full. It is
+  /// tried again as writeWaitingForReaders tries a sample.
+  template <class Stopping>
+  bool disposeWaitingForReaders(const Sample& key_holder, Stopping&& stopping) {
+    bool readers_left = false;
+    while (!tryDispose(key_holder)) {
+      if (stopping() || readers_left) {
+        logDisposeFailure();
+        return false;
+      }
+      readers_left = matchedReaders() == 0;
+    }
+    return true;
+  }
+  /// Waits until every matched reliable reader acknowledged every change written, for as long
+  /// as a reader is matched and `stopping()` is false (a reader far behind takes as long as it
+  /// takes, as the writes waited for it). False, and a warning, if it stopped waiting first.
+  template <class Stopping>
+  bool waitForAcknowledgments(Stopping&& stopping) {
     if (writer_ == nullptr) return false;
-    if (writer_->dispose(const_cast<Sample*>(&key_holder),
-                         eprosima::fastrtps::rtps::c_InstanceHandle_Unknown) !=
-        ReturnCode_t::RETCODE_OK) {
-      spdlog::error("dispose on '{}' failed", writer_->get_topic()->get_name());
-      return false;
+    const eprosima::fastrtps::Duration_t poll(1, 0);
+    while (writer_->wait_for_acknowledgments(poll) != ReturnCode_t::RETCODE_OK) {
+      if (stopping() || matchedReaders() == 0) {
+        spdlog::warn("'{}': not every reader acknowledged what was written ({})",
+                     writer_->get_topic()->get_name(), stopping() ? "stopped" : "no reader left");
+        return false;
+      }
     }
     return true;
   }
@@ -78,6 +104,19 @@ class Writer {
     if (writer_ == nullptr || !writer_->write(const_cast<Sample*>(&sample))) return false;
     health_->countPublished();
     return true;
+  }
+  bool tryDispose(const Sample& key_holder) {
+    return writer_ != nullptr &&
+           writer_->dispose(const_cast<Sample*>(&key_holder),
+                            eprosima::fastrtps::rtps::c_InstanceHandle_Unknown) ==
+               ReturnCode_t::RETCODE_OK;
+  }
+  void logDisposeFailure() const {
+    if (writer_ == nullptr) {
+      spdlog::error("dispose on a writer that was never created");
+    } else {
+      spdlog::error("dispose on '{}' failed", writer_->get_topic()->get_name());
+    }
   }
   void logWriteFailure() const {
     if (writer_ == nullptr) {
@@ -226,7 +265,10 @@ class Participant {
                                    std::uint64_t n);
   void addReader(eprosima::fastdds::dds::DataReader* reader, const std::string& topic,
                  std::function<void()> take_all, ReaderCallbacks callbacks);
+  /// Deadline status, then every sample the reader holds.
   void dispatch(ReaderEntry& entry);
+  /// Liveliness status (writers alive or gone).
+  void dispatchLiveliness(ReaderEntry& entry);
   void runDueTimers();
   /// Sets the state; leaving STARTING for RUNNING or DEGRADED records Health::resume_ns (from
   /// the first input taken) and publishes a report at once.
