@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 #include <navbus_idl/FaultPubSubTypes.h>
+#include <navbus_idl/HealthPubSubTypes.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "harness.hpp"
@@ -33,7 +34,35 @@ struct Case {
       fault_manager{};       ///< file under config for both runs ("": the defaults, offline none)
   std::size_t decisions{0};  ///< with fault_manager: the decisions both runs must publish
   std::string sim_extra{};   ///< YAML appended to the scenario (e.g. its faults)
+  /// The sensors the filter's last health report must count on a topic, each under its id:
+  /// "topic id:accepted id:refused ..." (accepted: samples accepted, none rejected; refused:
+  /// every sample rejected).
+  std::string filter_sensors{};
 };
+
+/// Checks `expected` (Case::filter_sensors) against the input of a health report.
+void expectSensorCounts(const Health& health, const std::string& expected) {
+  std::istringstream words(expected);
+  std::string topic, item;
+  words >> topic;
+  const StreamHealth* in = nullptr;
+  for (const auto& i : health.inputs())
+    if (i.topic().to_string() == topic) in = &i;
+  ASSERT_NE(in, nullptr) << topic << " not among the filter's inputs";
+  std::vector<std::string> seen;
+  for (const SensorStreamHealth& s : in->sensors())
+    seen.push_back(std::to_string(s.sensor_id()) +
+                   (s.rejected() == 0 && s.accepted() > 0   ? ":accepted"
+                    : s.accepted() == 0 && s.rejected() > 0 ? ":refused"
+                                                            : ":mixed"));
+  std::vector<std::string> wanted;
+  while (words >> item) wanted.push_back(item);
+  EXPECT_EQ(seen, wanted) << topic;
+  EXPECT_EQ(in->unlisted_sensor_samples(), 0u);
+  std::uint64_t accepted = 0;
+  for (const SensorStreamHealth& s : in->sensors()) accepted += s.accepted();
+  EXPECT_EQ(accepted, in->accepted()) << "the ids' counts add up to the topic's";
+}
 
 /// A decision as CSV, without its run_id (the last column: the bus run's start time, 0 offline).
 std::string withoutRunId(const std::string& row) {
@@ -114,6 +143,12 @@ void runCase(const Case& c) {
       [&](const FaultDecision& d, const auto&) {
         decisions.push_back(withoutRunId(records::csvRows(d).at(0)));
       });
+  Health filter_health;
+  me.subscribe<HealthPubSubType>(bus::topic::kHealth, bus::profile::kHealthReader,
+                                 [&](const Health& h, const auto&) {
+                                   if (h.participant().to_string() == "navbus-filter")
+                                     filter_health = h;
+                                 });
   test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
                             (dir / "filter.log").string());
   test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
@@ -131,6 +166,11 @@ void runCase(const Case& c) {
   fm.signal(SIGTERM);
   EXPECT_EQ(filter.wait(10s), 0);
   EXPECT_EQ(fm.wait(10s), 0);
+  test::spinUntil(me, 5s, [&] { return filter_health.state() == STATE_STOPPING; });
+  if (!c.filter_sensors.empty()) {
+    ASSERT_EQ(filter_health.state(), STATE_STOPPING) << "the filter's last health report";
+    expectSensorCounts(filter_health, c.filter_sensors);
+  }
 
   ASSERT_EQ(rows.size(), expected.size()) << test::readFile(dir / "filter.log");
   const std::size_t differing = test::countDiffering(rows, expected);
@@ -153,7 +193,11 @@ void runCase(const Case& c) {
                 decisions == expected_decisions ? "yes" : "NO");
   }
   test::cleanSharedMemory();
-  std::filesystem::remove_all(dir);
+  // A failed run keeps its logs for the reader (the path is in the test's output).
+  if (::testing::Test::HasFailure())
+    std::printf("logs kept in %s\n", dir.c_str());
+  else
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace
@@ -182,7 +226,9 @@ TEST(OfflineEqualsBus, TriplexUnitsBesideAOneImuFilter) {
             "rejected sample of sensor 3 (unexpected_source: sensor_id = 3",
             "command 1 from 'fault-manager' refused: kind 8: sensor_id 2 is not this filter's IMU"},
            "fault_manager_triplex.yaml",
-           1});
+           1,
+           "",
+           "navbus/imu/increment_block 1:accepted 2:refused 3:refused"});
 }
 
 // The triplex aircraft with unit 1's gyro ramping (seed000_triplex_gyro_ramp.yaml) into the filter
@@ -205,7 +251,8 @@ TEST(OfflineEqualsBus, TriplexLanesSwitchWhereOfflineTheyDo) {
            "fault_manager_triplex.yaml",
            1,
            "faults:\n  - {type: imu_bias_ramp, sensor: gyro, axis: x, start_s: 100,\n"
-           "     slope_deg_per_h_per_s: 0.01, saturation_deg_per_h: 3, sensor_id: 1}\n"});
+           "     slope_deg_per_h_per_s: 0.01, saturation_deg_per_h: 3, sensor_id: 1}\n",
+           "navbus/imu/increment_block 1:accepted 2:accepted 3:accepted"});
 }
 
 // Two GNSS receivers (seed000_dual_receivers.yaml: receiver 2 beside the filter's receiver 1)
@@ -224,7 +271,8 @@ TEST(OfflineEqualsBus, DualReceiversClockJumpDecidedAsOffline) {
            "fault_manager_dual_receivers.yaml",
            1,
            "faults:\n  - {type: receiver_clock_jump, start_s: 100, magnitude_ms: 1, receiver_id: "
-           "2}\n"});
+           "2}\n",
+           "navbus/gnss/observations 1:accepted 2:refused"});
 }
 
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->

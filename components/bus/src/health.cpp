@@ -13,6 +13,13 @@ std::uint64_t StreamCounters::rejectedTotal() const {
   return n;
 }
 
+SensorCounters* StreamCounters::sensor(std::uint32_t sensor_id) {
+  const auto it = sensors.find(sensor_id);
+  if (it != sensors.end()) return &it->second;
+  if (sensors.size() >= kMaxSensors) return nullptr;
+  return &sensors[sensor_id];
+}
+
 StreamCounters& HealthCounters::stream(const std::string& topic) {
   for (auto& [name, counters] : streams_) {
     if (name == topic) {
@@ -46,6 +53,20 @@ void fillRejectCounts(const Counts& counts, std::vector<navbus::RejectCount>& in
   }
 }
 
+void fillSensorCounts(const std::map<std::uint32_t, SensorCounters>& counts,
+                      std::vector<navbus::SensorStreamHealth>& into) {
+  into.resize(counts.size());
+  std::size_t i = 0;
+  for (const auto& [id, c] : counts) {
+    navbus::SensorStreamHealth& s = into[i++];
+    s.sensor_id(id);
+    s.accepted(c.accepted);
+    s.rejected(c.rejected);
+    s.sequence_gaps(c.sequence_gaps);
+    s.source_restarts(c.source_restarts);
+  }
+}
+
 }  // namespace
 
 void HealthCounters::report(navbus::ParticipantState state, std::uint64_t wall_time_ns,
@@ -68,6 +89,8 @@ void HealthCounters::report(navbus::ParticipantState state, std::uint64_t wall_t
     s.source_restarts(c.source_restarts);
     fillRejectCounts(c.rejected, s.rejected());
     fillRejectCounts(c.elements_rejected, s.elements_rejected());
+    fillSensorCounts(c.sensors, s.sensors());
+    s.unlisted_sensor_samples(c.unlisted_sensor_samples);
   }
 }
 
@@ -91,6 +114,18 @@ std::string HealthCounters::summary() const {
     out << ", sequence gaps " << c.sequence_gaps << ", deadline misses " << c.deadline_misses;
     if (c.source_restarts > 0) out << ", source restarts " << c.source_restarts;
     out << "\n";
+    // One line per sensor when the topic carries several (the one sensor's are the topic's).
+    if (c.sensors.size() > 1 || c.unlisted_sensor_samples > 0) {
+      for (const auto& [id, s] : c.sensors) {
+        out << "    sensor " << id << ": accepted " << s.accepted << ", rejected " << s.rejected
+            << ", sequence gaps " << s.sequence_gaps;
+        if (s.source_restarts > 0) out << ", source restarts " << s.source_restarts;
+        out << "\n";
+      }
+      if (c.unlisted_sensor_samples > 0)
+        out << "    further sensor ids (not counted one by one): " << c.unlisted_sensor_samples
+            << " samples\n";
+    }
   }
   out << "  published: " << published_ << " samples\n";
   return out.str();

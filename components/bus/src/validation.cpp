@@ -354,6 +354,10 @@ namespace navbus::bus {
 
 void StreamGate::reject(const Rejection& r, std::uint32_t sensor_id) {
   const std::uint64_t n = ++counters_.rejected[r.reason];
+  if (SensorCounters* s = counters_.sensor(sensor_id))
+    ++s->rejected;
+  else
+    ++counters_.unlisted_sensor_samples;
   if (n == 1 || n % 1000 == 0) {
     spdlog::warn("{}: rejected sample of sensor {} ({}; {} rejected for this reason so far)",
                  topic_, sensor_id, r.describe(), n);
@@ -375,18 +379,35 @@ void StreamGate::admitHeld(std::uint32_t sensor_id, std::size_t n) {
       it == counters_.rejected.end() ? 0 : std::min<std::uint64_t>(n, it->second);
   if (undone > 0 && (it->second -= undone) == 0) counters_.rejected.erase(it);
   counters_.accepted += n;
+  if (SensorCounters* s = counters_.sensor(sensor_id)) {
+    s->rejected -= std::min(s->rejected, undone);
+    s->accepted += n;
+  }
   spdlog::info(
       "{}: the {} samples of sensor {} refused before the confirmed jump continue to it: used",
       topic_, n, sensor_id);
 }
 
-void StreamGate::unaccept() {
+void StreamGate::unaccept(std::uint32_t sensor_id) {
   if (counters_.accepted > 0) --counters_.accepted;
+  const auto it = counters_.sensors.find(sensor_id);
+  if (it != counters_.sensors.end() && it->second.accepted > 0) --it->second.accepted;
+  // An unlisted id's sample is counted once there, accepted or rejected: the reject after this
+  // counts it again.
+  if (it == counters_.sensors.end() && counters_.unlisted_sensor_samples > 0)
+    --counters_.unlisted_sensor_samples;
 }
 
-void StreamGate::noteSequence(const SequenceTracker::Outcome& o) {
+void StreamGate::noteSequence(const SequenceTracker::Outcome& o, std::uint32_t sensor_id) {
   ++counters_.accepted;
   counters_.sequence_gaps += o.missing;
+  if (SensorCounters* s = counters_.sensor(sensor_id)) {
+    ++s->accepted;
+    s->sequence_gaps += o.missing;
+    s->source_restarts += o.source_restarted ? 1 : 0;
+  } else {
+    ++counters_.unlisted_sensor_samples;
+  }
   if (o.missing_before_first > 0) {
     spdlog::warn(
         "{}: the first sample taken is number {}: the {} before it were not received (the "

@@ -58,6 +58,10 @@ std::size_t historyItems(const FilterConfig& c) {
 }  // namespace
 
 FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks)
+    : FilterPipeline(config, health, health, std::move(sinks)) {}
+
+FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& health,
+                               bus::HealthCounters& imu_health, Sinks sinks)
     : config_(config),
       sinks_(std::move(sinks)),
       sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
@@ -65,11 +69,11 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
                historyItems(config)),
       engine_(config.engine),
       predictor_(config.engine.tuning.gravity, config.low_latency_max_buffered),
-      imu_gate_(bus::topic::kImuIncrement, health.stream(bus::topic::kImuIncrement),
+      imu_gate_(bus::topic::kImuIncrement, imu_health.stream(bus::topic::kImuIncrement),
                 config.time_jump, &time_reference_),
       imu_block_gate_(bus::topic::kImuIncrementBlock,
-                      health.stream(bus::topic::kImuIncrementBlock)),
-      imu_counters_(health.stream(bus::topic::kImuIncrement)),
+                      imu_health.stream(bus::topic::kImuIncrementBlock)),
+      imu_counters_(imu_health.stream(bus::topic::kImuIncrement)),
       gnss_obs_gate_(bus::topic::kGnssObservations, health.stream(bus::topic::kGnssObservations),
                      config.time_jump, &time_reference_),
       gnss_fix_gate_(bus::topic::kGnssFix, health.stream(bus::topic::kGnssFix), config.time_jump,
@@ -89,13 +93,13 @@ void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time
     case InputSequencer<FilterInput>::PushResult::kQueued:
       break;
     case InputSequencer<FilterInput>::PushResult::kLate:  // older than the history reaches
-      gate.unaccept();
+      gate.unaccept(id.sensor_id);
       gate.reject({navbus::REJECT_LATE, "time_gps_ns", static_cast<double>(time_ns)}, id.sensor_id);
       break;
     case InputSequencer<FilterInput>::PushResult::kUnexpected:
       // admit() refuses unconfigured sources before their sequence is tracked; this stays so
       // that a caller which did not go through admit() cannot drop a sample uncounted.
-      gate.unaccept();
+      gate.unaccept(id.sensor_id);
       gate.reject(
           {navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(id.sensor_id)},
           id.sensor_id);
@@ -152,6 +156,15 @@ void FilterPipeline::useImu(const navbus::ImuIncrement& msg) {
 void FilterPipeline::onImuBlock(const navbus::ImuIncrementBlock& msg) {
   const auto& increments = msg.increments();
   const std::uint64_t first_ns = increments.empty() ? 0 : increments.front().time_gps_ns();
+  // Another unit's block is refused whole, under its id on the block topic (its increments
+  // were once taken in and refused one by one under the increment topic, and the block counted
+  // as accepted).
+  if (!sequencer_.expects({kRankImu, msg.sensor_id()})) {
+    imu_block_gate_.reject(
+        {navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(msg.sensor_id())},
+        msg.sensor_id());
+    return;
+  }
   if (!imu_block_gate_.admit(msg, msg.sensor_id(), msg.seq(), first_ns)) return;
   for (const navbus::ImuIncrement& increment : increments) {
     ++imu_counters_.received;

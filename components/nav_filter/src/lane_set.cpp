@@ -92,7 +92,10 @@ LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks 
       lane_health_.push_back(
           std::make_unique<bus::HealthCounters>("lane " + std::to_string(units[k].sensor_id)));
     bus::HealthCounters& h = first ? health : *lane_health_.back();
-    lanes_.push_back(std::make_unique<FilterPipeline>(laneConfig(config_, units[k], first), h, s));
+    // Each lane's own unit is counted in the participant's health under its id; what every
+    // lane is fed is counted once, by the first.
+    lanes_.push_back(
+        std::make_unique<FilterPipeline>(laneConfig(config_, units[k], first), h, health, s));
   }
   // A fault manager started with the filter (fault_monitor.judged_from_start) judges the
   // lanes' IMU data from the first sample: every lane and the selection wait for it from the

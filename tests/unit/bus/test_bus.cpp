@@ -309,6 +309,52 @@ TEST(HealthCounters, ReportCarriesEveryStreamAndReason) {
   EXPECT_EQ(r.seq(), 1u);
 }
 
+TEST(HealthCounters, EachSensorOfATopicIsCountedUnderItsId) {
+  // Three IMU units on one topic: unit 2 skips a sample, unit 3 sends a bad one; then ten ids
+  // nobody configured. The first 8 ids are counted one by one, the rest together.
+  navbus::bus::HealthCounters h("p");
+  navbus::bus::StreamGate gate("imu", h.stream("imu"));
+  for (std::uint32_t unit = 1; unit <= 3; ++unit) {
+    for (std::uint64_t seq = 1; seq <= 5; ++seq) {
+      if (unit == 2 && seq == 3) continue;  // lost on the way
+      navbus::ImuIncrement m = goodImu();
+      m.sensor_id(unit);
+      if (unit == 3 && seq == 4) m.delta_vel_b_mps()[0] = std::nan("");
+      gate.admit(m, unit, seq, 1000 * seq);
+    }
+  }
+  for (std::uint32_t bogus = 100; bogus < 110; ++bogus) {
+    gate.admit(goodImu(), bogus, 1, 1000);
+    gate.unaccept(bogus);  // as the filter does for an id its configuration does not name
+    gate.reject({navbus::REJECT_UNEXPECTED_SOURCE, "sensor_id", static_cast<double>(bogus)}, bogus);
+  }
+  const navbus::Health r = h.report(navbus::STATE_RUNNING, 5);
+  ASSERT_EQ(r.inputs().size(), 1u);
+  const navbus::StreamHealth& in = r.inputs()[0];
+  EXPECT_EQ(in.accepted(), 13u);
+  ASSERT_EQ(in.sensors().size(), navbus::bus::StreamCounters::kMaxSensors);
+  EXPECT_EQ(in.sensors()[0].sensor_id(), 1u);
+  EXPECT_EQ(in.sensors()[0].accepted(), 5u);
+  EXPECT_EQ(in.sensors()[0].sequence_gaps(), 0u);
+  EXPECT_EQ(in.sensors()[1].accepted(), 4u);
+  EXPECT_EQ(in.sensors()[1].sequence_gaps(), 1u);
+  EXPECT_EQ(in.sensors()[2].accepted(), 4u);
+  EXPECT_EQ(in.sensors()[2].rejected(), 1u);
+  for (std::size_t i = 3; i < in.sensors().size(); ++i) {
+    EXPECT_EQ(in.sensors()[i].sensor_id(), 100u + (i - 3));
+    EXPECT_EQ(in.sensors()[i].accepted(), 0u);
+    EXPECT_EQ(in.sensors()[i].rejected(), 1u);
+  }
+  EXPECT_EQ(in.unlisted_sensor_samples(), 5u);  // ids 105 to 109, one sample each
+  const std::string summary = h.summary();
+  EXPECT_NE(summary.find("    sensor 2: accepted 4, rejected 0, sequence gaps 1"),
+            std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("further sensor ids (not counted one by one): 5 samples"),
+            std::string::npos)
+      << summary;
+}
+
 TEST(Config, ErrorsNameTheKeyAndValue) {
   const YAML::Node n = YAML::Load("timing: {imu_rate_hz: fast}");
   try {

@@ -1,6 +1,7 @@
 // Per-input counters of a participant and their Health message.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -10,7 +11,19 @@
 
 namespace navbus::bus {
 
+/// Counters of one sensor id (an IMU unit, a GNSS receiver) on a topic that carries several.
+struct SensorCounters {
+  std::uint64_t accepted{0};
+  std::uint64_t rejected{0};  ///< every reason
+  std::uint64_t sequence_gaps{0};
+  std::uint64_t source_restarts{0};
+};
+
 struct StreamCounters {
+  /// How many sensor ids a stream counts one by one (the bound of StreamHealth::sensors in
+  /// idl/Health.idl): what a source of ever new ids can make a participant hold and publish.
+  static constexpr std::size_t kMaxSensors = 8;
+
   std::uint64_t received{0};
   std::uint64_t accepted{0};
   std::uint64_t sequence_gaps{0};
@@ -19,8 +32,15 @@ struct StreamCounters {
   std::map<navbus::RejectReason, std::uint64_t> rejected;
   /// Elements dropped from accepted samples (satellites of an epoch), by reason.
   std::map<navbus::RejectReason, std::uint64_t> elements_rejected;
+  /// Per sensor id, the first kMaxSensors ids seen.
+  std::map<std::uint32_t, SensorCounters> sensors;
+  /// Samples (accepted or rejected) of ids beyond the first kMaxSensors.
+  std::uint64_t unlisted_sensor_samples{0};
 
   std::uint64_t rejectedTotal() const;
+  /// The counters of `sensor_id`, made on its first sample while fewer than kMaxSensors ids
+  /// are counted; nullptr beyond (the caller counts the sample in unlisted_sensor_samples).
+  SensorCounters* sensor(std::uint32_t sensor_id);
 };
 
 /// Counters of every input topic, in registration order.

@@ -196,7 +196,7 @@ class StreamGate {
       reject(*o.rejection, sensor_id);
       return false;
     }
-    noteSequence(o);
+    noteSequence(o, sensor_id);
     source_restarted_ = o.source_restarted;
     jump_held_ = o.jump_held;
     return true;
@@ -218,14 +218,14 @@ class StreamGate {
   void reject(const Rejection& r, std::uint32_t sensor_id);
   /// Counts an element dropped from an accepted sample (a satellite of an epoch).
   void rejectElement(const Rejection& r, std::uint32_t sensor_id);
-  /// Undoes the accepted count of a sample rejected after admission.
-  void unaccept();
+  /// Undoes the accepted count of a sample of `sensor_id` rejected after admission.
+  void unaccept(std::uint32_t sensor_id);
   const std::string& topic() const { return topic_; }
   const ValidationLimits& limits() const { return limits_; }
   SequenceTracker& tracker() { return tracker_; }
 
  private:
-  void noteSequence(const SequenceTracker::Outcome& o);
+  void noteSequence(const SequenceTracker::Outcome& o, std::uint32_t sensor_id);
 
   std::string topic_;
   StreamCounters& counters_;

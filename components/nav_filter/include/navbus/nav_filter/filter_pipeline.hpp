@@ -95,6 +95,11 @@ class FilterPipeline {
   };
 
   FilterPipeline(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks);
+  /// A lane of a redundant set (LaneSet): its IMU's streams are counted in `imu_health` (the
+  /// participant's, where every unit's counts go under its id), the streams every lane is fed
+  /// (receivers, star tracker, commands) in `health` (the first lane's are the participant's).
+  FilterPipeline(const FilterConfig& config, bus::HealthCounters& health,
+                 bus::HealthCounters& imu_health, Sinks sinks);
 
   void onImu(const navbus::ImuIncrement& msg);
   /// A block of increments (fast pacing): its structure and block sequence are checked under

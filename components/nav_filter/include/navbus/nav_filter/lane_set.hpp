@@ -112,7 +112,8 @@ class LaneSet {
 
   FilterConfig config_;
   Sinks sinks_;
-  std::vector<std::unique_ptr<bus::HealthCounters>> lane_health_;  ///< lanes 1..: their own
+  std::vector<std::unique_ptr<bus::HealthCounters>>
+      lane_health_;  ///< lanes 1..: what every lane is fed, counted once (by lane 0)
   std::vector<std::unique_ptr<FilterPipeline>> lanes_;
   std::vector<std::deque<Pending>> pending_;
   std::vector<bool> excluded_;  ///< the lane's IMU axis was failed by a command

@@ -302,6 +302,13 @@ IfMessage<M, navbus::StreamHealth> visitFields(M& m, V& v) {
   for (const auto& r : m.elements_rejected())
     elements << enumName(r.reason()) << "=" << r.count() << " ";
   v.text("elements_rejected", elements.str());
+  std::ostringstream sensors;
+  for (const auto& s : m.sensors())
+    sensors << s.sensor_id() << ":accepted=" << s.accepted() << ",rejected=" << s.rejected()
+            << ",sequence_gaps=" << s.sequence_gaps() << ",source_restarts=" << s.source_restarts()
+            << " ";
+  v.text("sensors", sensors.str());
+  v("unlisted_sensor_samples", m.unlisted_sensor_samples());
 }
 template <class M, class V>
 IfMessage<M, navbus::Health> visitFields(M& m, V& v) {
