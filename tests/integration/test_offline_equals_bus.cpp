@@ -38,6 +38,7 @@ struct Case {
   /// "topic id:accepted id:refused ..." (accepted: samples accepted, none rejected; refused:
   /// every sample rejected).
   std::string filter_sensors{};
+  std::string fm_sensors{};  ///< the same for the fault manager's last health report
 };
 
 /// Checks `expected` (Case::filter_sensors) against the input of a health report.
@@ -48,7 +49,7 @@ void expectSensorCounts(const Health& health, const std::string& expected) {
   const StreamHealth* in = nullptr;
   for (const auto& i : health.inputs())
     if (i.topic().to_string() == topic) in = &i;
-  ASSERT_NE(in, nullptr) << topic << " not among the filter's inputs";
+  ASSERT_NE(in, nullptr) << topic << " not among the inputs of " << health.participant();
   std::vector<std::string> seen;
   for (const SensorStreamHealth& s : in->sensors())
     seen.push_back(std::to_string(s.sensor_id()) +
@@ -143,11 +144,12 @@ void runCase(const Case& c) {
       [&](const FaultDecision& d, const auto&) {
         decisions.push_back(withoutRunId(records::csvRows(d).at(0)));
       });
-  Health filter_health;
+  Health filter_health, fm_health;
   me.subscribe<HealthPubSubType>(bus::topic::kHealth, bus::profile::kHealthReader,
                                  [&](const Health& h, const auto&) {
-                                   if (h.participant().to_string() == "navbus-filter")
-                                     filter_health = h;
+                                   const std::string who = h.participant().to_string();
+                                   if (who == "navbus-filter") filter_health = h;
+                                   if (who == "navbus-fault-manager") fm_health = h;
                                  });
   test::ChildProcess filter(navbus::test_paths::filterExe(), {"-c", filter_cfg},
                             (dir / "filter.log").string());
@@ -166,10 +168,16 @@ void runCase(const Case& c) {
   fm.signal(SIGTERM);
   EXPECT_EQ(filter.wait(10s), 0);
   EXPECT_EQ(fm.wait(10s), 0);
-  test::spinUntil(me, 5s, [&] { return filter_health.state() == STATE_STOPPING; });
+  test::spinUntil(me, 5s, [&] {
+    return filter_health.state() == STATE_STOPPING && fm_health.state() == STATE_STOPPING;
+  });
   if (!c.filter_sensors.empty()) {
     ASSERT_EQ(filter_health.state(), STATE_STOPPING) << "the filter's last health report";
     expectSensorCounts(filter_health, c.filter_sensors);
+  }
+  if (!c.fm_sensors.empty()) {
+    ASSERT_EQ(fm_health.state(), STATE_STOPPING) << "the fault manager's last health report";
+    expectSensorCounts(fm_health, c.fm_sensors);
   }
 
   ASSERT_EQ(rows.size(), expected.size()) << test::readFile(dir / "filter.log");
@@ -252,7 +260,8 @@ TEST(OfflineEqualsBus, TriplexLanesSwitchWhereOfflineTheyDo) {
            1,
            "faults:\n  - {type: imu_bias_ramp, sensor: gyro, axis: x, start_s: 100,\n"
            "     slope_deg_per_h_per_s: 0.01, saturation_deg_per_h: 3, sensor_id: 1}\n",
-           "navbus/imu/increment_block 1:accepted 2:accepted 3:accepted"});
+           "navbus/imu/increment_block 1:accepted 2:accepted 3:accepted",
+           "navbus/imu/increment 1:accepted 2:accepted 3:accepted"});
 }
 
 // Two GNSS receivers (seed000_dual_receivers.yaml: receiver 2 beside the filter's receiver 1)
@@ -272,7 +281,8 @@ TEST(OfflineEqualsBus, DualReceiversClockJumpDecidedAsOffline) {
            1,
            "faults:\n  - {type: receiver_clock_jump, start_s: 100, magnitude_ms: 1, receiver_id: "
            "2}\n",
-           "navbus/gnss/observations 1:accepted 2:refused"});
+           "navbus/gnss/observations 1:accepted 2:refused",
+           "navbus/gnss/observations 1:accepted 2:accepted"});
 }
 
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->

@@ -20,6 +20,17 @@ SensorCounters* StreamCounters::sensor(std::uint32_t sensor_id) {
   return &sensors[sensor_id];
 }
 
+void StreamCounters::countAccepted(std::uint32_t sensor_id, std::uint64_t missing) {
+  ++accepted;
+  sequence_gaps += missing;
+  if (SensorCounters* s = sensor(sensor_id)) {
+    ++s->accepted;
+    s->sequence_gaps += missing;
+  } else {
+    ++unlisted_sensor_samples;
+  }
+}
+
 StreamCounters& HealthCounters::stream(const std::string& topic) {
   for (auto& [name, counters] : streams_) {
     if (name == topic) {

@@ -399,15 +399,9 @@ void StreamGate::unaccept(std::uint32_t sensor_id) {
 }
 
 void StreamGate::noteSequence(const SequenceTracker::Outcome& o, std::uint32_t sensor_id) {
-  ++counters_.accepted;
-  counters_.sequence_gaps += o.missing;
-  if (SensorCounters* s = counters_.sensor(sensor_id)) {
-    ++s->accepted;
-    s->sequence_gaps += o.missing;
-    s->source_restarts += o.source_restarted ? 1 : 0;
-  } else {
-    ++counters_.unlisted_sensor_samples;
-  }
+  counters_.countAccepted(sensor_id, o.missing);
+  if (SensorCounters* s = counters_.sensor(sensor_id); s && o.source_restarted)
+    ++s->source_restarts;
   if (o.missing_before_first > 0) {
     spdlog::warn(
         "{}: the first sample taken is number {}: the {} before it were not received (the "

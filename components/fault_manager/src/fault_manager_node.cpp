@@ -136,7 +136,7 @@ void FaultManagerNode::watch(const char* profile) {
     if constexpr (std::is_same_v<Message, navbus::ImuIncrementBlock>) {
       // The block is counted under its topic; each element is received (and watched) as
       // one increment, under the increment topic, as the filter counts them.
-      ++participant_.health().stream(Traits::kTopic.topic).accepted;
+      participant_.health().stream(Traits::kTopic.topic).countAccepted(m.sensor_id());
       bus::StreamCounters& increments = participant_.health().stream(bus::topic::kImuIncrement);
       const std::int64_t now = steadyNowNs();
       for (const navbus::ImuIncrement& increment : m.increments()) {

@@ -61,9 +61,8 @@ void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std
     tracker.reset(sensor_id);
     o = tracker.check(sensor_id, seq, time_gps_ns);
   }
-  auto& counters = health_.stream(bus::streamInfo(kind).topic);
-  ++counters.accepted;  // observed, not validated: a monitor
-  counters.sequence_gaps += o.missing;
+  // Observed, not validated: a monitor.
+  health_.stream(bus::streamInfo(kind).topic).countAccepted(sensor_id, o.missing);
   if (auto e = watchdog_.onSample({kind, sensor_id}, time_gps_ns, wall_now_ns)) onWatchdogEvent(*e);
 }
 

@@ -41,6 +41,9 @@ struct StreamCounters {
   /// The counters of `sensor_id`, made on its first sample while fewer than kMaxSensors ids
   /// are counted; nullptr beyond (the caller counts the sample in unlisted_sensor_samples).
   SensorCounters* sensor(std::uint32_t sensor_id);
+  /// One sample of `sensor_id` accepted, `missing` samples of it before it by its sequence
+  /// numbers: counted on the topic and under the id.
+  void countAccepted(std::uint32_t sensor_id, std::uint64_t missing = 0);
 };
 
 /// Counters of every input topic, in registration order.
