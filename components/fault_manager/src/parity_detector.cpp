@@ -72,6 +72,7 @@ void ParityDetector::onIncrement(const navbus::ImuIncrement& msg, FaultOutput& o
   // A unit's reliable reader delivers its writer's increments in order: time and sequence both
   // going back is a new run of its source, not a late sample.
   if (msg.seq() < latest_seq_[u] && time_ns < latest_ns_[u]) startNewRun();
+  if (latest_seq_[u] == 0 && msg.seq() > 1) noteMissedStart(msg);
   latest_seq_[u] = msg.seq();
   if (time_ns <= std::max(last_tested_ns_, late_before_ns_)) {
     ++counters_.late;
@@ -90,6 +91,15 @@ void ParityDetector::onIncrement(const navbus::ImuIncrement& msg, FaultOutput& o
   latest_ns_[static_cast<std::size_t>(unit)] =
       std::max(latest_ns_[static_cast<std::size_t>(unit)], time_ns);
   drain(out);
+}
+
+void ParityDetector::noteMissedStart(const navbus::ImuIncrement& first) {
+  counters_.missed_at_start += first.seq() - 1;
+  spdlog::warn(
+      "parity detector: IMU {}'s first increment taken is number {}: the {} before it were not "
+      "received (this reader joined after the unit's stream began); their times are tested "
+      "without it",
+      first.sensor_id(), first.seq(), first.seq() - 1);
 }
 
 void ParityDetector::makeArray() {
@@ -255,10 +265,13 @@ std::string ParityDetector::summary() const {
     << ", commands " << c.commands << "), largest statistic gyros " << c.max_statistic[0]
     << " accelerometers " << c.max_statistic[1] << " (h " << array_->threshold(ImuInstrument::kGyro)
     << " / " << array_->threshold(ImuInstrument::kAccelerometer) << ")";
-  if (c.other_sensors + c.invalid + c.wrong_interval + c.late + c.incomplete + c.gaps > 0)
+  if (c.other_sensors + c.invalid + c.wrong_interval + c.late + c.incomplete + c.gaps +
+          c.missed_at_start >
+      0)
     s << "; not used: other IMUs " << c.other_sensors << ", invalid " << c.invalid
       << ", other interval " << c.wrong_interval << ", late or repeated " << c.late
-      << ", times without every unit " << c.incomplete << ", gaps " << c.gaps;
+      << ", times without every unit " << c.incomplete << ", gaps " << c.gaps
+      << ", not received before a unit's first " << c.missed_at_start;
   if (c.new_runs > 0) s << "; new runs after a source restart " << c.new_runs;
   return s.str();
 }

@@ -106,6 +106,8 @@ int main(int argc, char** argv) {
       spdlog::warn(
           "readers not all matched after {} s ({} on the IMU topic, {} wanted); publishing anyway",
           config.wait_for_readers_s, publisher.imuReaders(), config.min_readers.imu);
+    } else if (config.wait_for_readers_s > 0.0) {
+      participant.spinFor(nb::bus::kStartSettle);  // the readers' side of the match
     }
     if (config.start_now) startNow();  // after the wait: the data starts now
     nb::sim::ScenarioSource source(config.scenario);

@@ -336,6 +336,10 @@ int runReplayCommand(const bus::Participant::Options& participant, const ReplayO
     p.finish();
     return bus::kExitRuntimeError;
   }
+  const bool waited =
+      std::any_of(min_readers.begin(), min_readers.end(),
+                  [](const auto& topic_readers) { return topic_readers.second > 0; });
+  if (waited) p.spinFor(bus::kStartSettle);  // the readers' side of the match
 
   std::vector<std::uint64_t> published(streams.size(), 0);
   const auto start = Clock::now();

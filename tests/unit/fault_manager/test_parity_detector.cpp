@@ -115,6 +115,27 @@ TEST(ParityDetector, IsolatesTheUnitWhateverOrderItsIncrementsArriveIn) {
   EXPECT_EQ(backlog.counters().incomplete, 0u);
 }
 
+TEST(ParityDetector, AUnitWhoseStartWasNotReceivedIsCountedAndItsTimesDropped) {
+  // Given the fault-free still body, when the reader never got unit 12's first 5 increments
+  // (a reader that matched the unit's writer after it began), then the detector counts the 5
+  // from the first sequence number it took and says so, those 5 times are dropped as without
+  // every unit, and the rest is tested.
+  const fm::FaultManagerConfig config = parityConfig();
+  auto data = stillBodyIncrements(config.parity, 1000);
+  std::vector<navbus::ImuIncrement> late_start;
+  for (const auto& m : data)
+    if (!(m.sensor_id() == 12u && m.seq() <= 5)) late_start.push_back(m);
+  Recorder out;
+  fm::ParityDetector detector(config.parity);
+  for (const auto& m : late_start) detector.onIncrement(m, out);
+  EXPECT_TRUE(out.decisions.empty());
+  EXPECT_EQ(detector.counters().missed_at_start, 5u);
+  EXPECT_EQ(detector.counters().incomplete, 5u);
+  EXPECT_EQ(detector.counters().samples, 995u);
+  EXPECT_NE(detector.summary().find("not received before a unit's first 5"), std::string::npos)
+      << detector.summary();
+}
+
 TEST(ParityDetector, ALostIncrementDropsItsTimeCountedAndRestartsTheWindow) {
   // Given the fault-free still body, when unit 13's increment at sample 600 never comes (and an
   // increment of an unconfigured sensor and one at another interval do), then that time is

@@ -20,6 +20,15 @@ namespace navbus::bus {
 /// streams in one compose run under DDS Security; one replay in four under AddressSanitizer).
 inline constexpr std::chrono::milliseconds kEndOfStreamLinger{300};
 
+/// How long a source waits, once its writers see every reader it waits for, before its first
+/// sample. A writer sees a reader matched when the reader's announcement has arrived; the
+/// reader matches the writer when the writer's has, which can come later on a loaded machine,
+/// and a volatile reliable reader (Fast DDS 2.9) drops what it receives before, for good: the
+/// stream's first samples are lost to it (counted there from the sequence numbers: the
+/// parity test's "not received before a unit's first", the filter's sequence gaps at the
+/// start).
+inline constexpr std::chrono::milliseconds kStartSettle{300};
+
 class StreamEndCounter {
  public:
   /// A change (a data sample) taken from `writer` with its RTPS sequence number.

@@ -43,6 +43,9 @@ class ParityDetector {
     std::uint64_t gaps{0};        ///< breaks in the aligned times: the tests restarted
     std::uint64_t detections{0}, ambiguous{0}, commands{0};
     std::uint64_t new_runs{0};  ///< the units' source restarted at an earlier time
+    /// Increments before each unit's first one taken in a run, by its sequence numbers (which
+    /// start at 1): the reader joined after the unit's stream began.
+    std::uint64_t missed_at_start{0};
     std::array<double, core::kImuInstrumentKinds> max_statistic{};
   };
   const Counters& counters() const { return counters_; }
@@ -76,6 +79,8 @@ class ParityDetector {
   /// The units' source started over at an earlier time (a restarted simulator or replay): the
   /// test starts over too, every instrument back in the array, nothing of the earlier run kept.
   void startNewRun();
+  /// Counts (and says) the increments a unit sent before the first one taken in this run.
+  void noteMissedStart(const navbus::ImuIncrement& first);
   void test(std::int64_t time_ns, const Slot& slot, FaultOutput& out);
   void report(std::int64_t time_ns, const core::ImuArrayDetection& d, FaultOutput& out);
 
