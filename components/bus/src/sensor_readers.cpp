@@ -15,11 +15,11 @@ bool SensorReaders::admit(StreamKind kind, WriterGate& writers, std::uint32_t se
     case WriterPins::Verdict::kTakeover:
       break;
   }
-  instances_[{kind, info.instance_handle}] = sensor_id;
+  instances_[{kind, info.instance_handle}] = Instance{sensor_id, time_gps_ns};
   return true;
 }
 
-const std::uint32_t* SensorReaders::sensorOf(
+const SensorReaders::Instance* SensorReaders::instanceOf(
     StreamKind kind, const eprosima::fastrtps::rtps::InstanceHandle_t& handle) const {
   const auto it = instances_.find({kind, handle});
   return it == instances_.end() ? nullptr : &it->second;
@@ -29,14 +29,15 @@ ReaderCallbacks SensorReaders::callbacks(StreamKind kind) {
   ReaderCallbacks callbacks;
   if (events_.ended) {
     callbacks.on_disposed = [this, kind](const eprosima::fastrtps::rtps::InstanceHandle_t& h) {
-      if (const std::uint32_t* id = sensorOf(kind, h)) events_.ended(kind, *id);
+      if (const Instance* i = instanceOf(kind, h))
+        events_.ended(kind, i->sensor_id, i->last_time_gps_ns);
     };
   }
   if (events_.deadline_missed) {
     callbacks.on_deadline =
         [this, kind](const eprosima::fastdds::dds::RequestedDeadlineMissedStatus& st) {
-          if (const std::uint32_t* id = sensorOf(kind, st.last_instance_handle))
-            events_.deadline_missed(kind, *id);
+          if (const Instance* i = instanceOf(kind, st.last_instance_handle))
+            events_.deadline_missed(kind, i->sensor_id);
         };
   }
   if (events_.writers_gone || events_.writers_alive) {

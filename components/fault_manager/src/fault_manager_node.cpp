@@ -75,10 +75,13 @@ bus::SensorReaders::Events FaultManagerNode::detectorEvents() {
   // reader got the three units' ends, and the watchdog declared them LOST 1 s later). The end
   // is the stream's either way (a second notice of it changes nothing).
   bus::SensorReaders::Events events;
-  events.ended = [this](StreamKind kind, std::uint32_t id) {
+  events.ended = [this](StreamKind kind, std::uint32_t id, std::uint64_t last_time_gps_ns) {
     if (kind == StreamKind::kImu) pipeline_.onParityUnitEnded(id);
     running();
-    pipeline_.onStreamEnded(kind, id);
+    // This reader's last time is the stream's end: the watchdog's reader, behind, may still
+    // take samples up to it, which belong to this run (with the watchdog's own last time as the
+    // end they started a new one, which went LOST 2 s later: a replay under the sanitizers).
+    pipeline_.onStreamEnded(kind, id, last_time_gps_ns);
   };
   return events;
 }
@@ -108,9 +111,9 @@ bus::SensorReaders::Events FaultManagerNode::streamEvents() {
   // Each event first asks whether this process was stopped since its last turn: what DDS
   // reports right after a stall (deadlines, liveliness) may be this process's own silence.
   bus::SensorReaders::Events events;
-  events.ended = [this](StreamKind kind, std::uint32_t id) {
+  events.ended = [this](StreamKind kind, std::uint32_t id, std::uint64_t last_time_gps_ns) {
     running();
-    pipeline_.onStreamEnded(kind, id);
+    pipeline_.onStreamEnded(kind, id, last_time_gps_ns);
     if (kind == StreamKind::kImu && on_imu_ended_) on_imu_ended_();
   };
   events.deadline_missed = [this](StreamKind kind, std::uint32_t id) {

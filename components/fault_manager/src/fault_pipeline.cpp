@@ -108,7 +108,8 @@ void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id,
   // sensor; the raw reader does not see the raw writer's dispose with Fast DDS 2.9, see
   // docs/results.md). Raw blocks up to that time may still arrive after it: they are no new run.
   if (kind == StreamKind::kImu)
-    onStreamEnded(StreamKind::kImuRaw, sensor_id, watchdog_.lastTime({kind, sensor_id}));
+    onStreamEnded(StreamKind::kImuRaw, sensor_id,
+                  std::max(end_time_gps_ns, watchdog_.lastTime({kind, sensor_id})));
   if (!watchdog_.onEnded({kind, sensor_id}, end_time_gps_ns)) return;
   trackers_[kind].reset(sensor_id);
   ++ended_;

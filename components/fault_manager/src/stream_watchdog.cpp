@@ -120,10 +120,13 @@ std::vector<WatchdogEvent> StreamWatchdog::markKindLost(StreamKind kind, std::in
 
 bool StreamWatchdog::onEnded(const StreamKey& key, std::uint64_t end_time_gps_ns) {
   const auto it = states_.find(key);
-  if (it == states_.end()) return false;
-  ended_at_[key] = std::max(end_time_gps_ns, it->second.last_time_gps_ns);
-  states_.erase(it);
-  return true;
+  const bool known = it != states_.end();
+  // Kept for a stream not seen yet too: another reader of the participant told the end, and
+  // this one's samples up to it are still to come.
+  std::uint64_t& ended = ended_at_[key];
+  ended = std::max({ended, end_time_gps_ns, known ? it->second.last_time_gps_ns : 0});
+  if (known) states_.erase(it);
+  return known;
 }
 
 std::uint64_t StreamWatchdog::lastTime(const StreamKey& key) const {

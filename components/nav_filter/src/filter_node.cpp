@@ -114,7 +114,7 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
 
 bus::SensorReaders::Events FilterNode::sensorEvents() {
   bus::SensorReaders::Events events;
-  events.ended = [this](bus::StreamKind kind, std::uint32_t id) {
+  events.ended = [this](bus::StreamKind kind, std::uint32_t id, std::uint64_t) {
     pipeline_.onStreamEnded(kind, id);
     if (kind == bus::StreamKind::kImu && on_imu_ended_) on_imu_ended_();
   };

@@ -51,6 +51,27 @@ TEST(StreamWatchdog, SamplesInFlightAfterAnAnnouncedEndAreNoNewRun) {
   EXPECT_TRUE(w.onDeadlineMissed(raw, 700 * kMs));
 }
 
+TEST(StreamWatchdog, AnEndToldByAnotherReaderAheadCoversTheSamplesStillToCome) {
+  // The parity test's reliable reader takes unit 2's dispose after its last increment at data
+  // time 2000 while the watchdog's own reader has delivered up to 1200 only (and unit 3's not
+  // at all): the rest of both streams, up to 2000, still comes through the watchdog's reader
+  // and is no new run that would fall silent and be declared lost (a replay under the
+  // sanitizers: two units LOST 2 s after their end).
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey unit2{StreamKind::kImu, 2}, unit3{StreamKind::kImu, 3};
+  EXPECT_FALSE(w.onSample(unit2, 1200, 1 * kMs));
+  EXPECT_TRUE(w.onEnded(unit2, 2000));
+  EXPECT_FALSE(w.onEnded(unit3, 2000));  // not seen here yet: its end is kept all the same
+  for (std::uint64_t t = 1300; t <= 2000; t += 100) {
+    EXPECT_FALSE(w.onSample(unit2, t, 10 * kMs));
+    EXPECT_FALSE(w.onSample(unit3, t, 10 * kMs));
+  }
+  EXPECT_FALSE(w.onDeadlineMissed(unit2, 3000 * kMs));
+  EXPECT_FALSE(w.onDeadlineMissed(unit3, 3000 * kMs));
+  EXPECT_TRUE(w.onTick(3000 * kMs).empty());
+  EXPECT_EQ(w.onWritersGone(StreamKind::kImu, 3000 * kMs).size(), 0u);
+}
+
 TEST(StreamWatchdog, DeadlineEventIsConfirmedByTheOwnSilence) {
   // Under CPU load DDS's deadline timer (from reception) can fire before this participant has
   // been silent for the deadline by its own clock (from the hand-over): the stream is only

@@ -47,16 +47,9 @@ class Writer {
   /// no reader matched is not flow control: after one more try, it returns false (and logs).
   template <class Stopping>
   bool writeWaitingForReaders(const Sample& sample, Stopping&& stopping, std::uint64_t& waits) {
-    bool readers_left = false;
-    while (!tryWrite(sample)) {
-      if (stopping() || readers_left) {
-        logWriteFailure();
-        return false;
-      }
-      readers_left = matchedReaders() == 0;
-      ++waits;
-    }
-    return true;
+    if (retryForReaders([&] { return tryWrite(sample); }, stopping, waits)) return true;
+    logWriteFailure();
+    return false;
   }
   /// Disposes the instance whose key `key_holder` carries: readers learn that the stream
   /// ended as announced (not lost). Returns false (and logs) on failure.
@@ -70,15 +63,10 @@ class Writer {
   /// tried again as writeWaitingForReaders tries a sample.
   template <class Stopping>
   bool disposeWaitingForReaders(const Sample& key_holder, Stopping&& stopping) {
-    bool readers_left = false;
-    while (!tryDispose(key_holder)) {
-      if (stopping() || readers_left) {
-        logDisposeFailure();
-        return false;
-      }
-      readers_left = matchedReaders() == 0;
-    }
-    return true;
+    std::uint64_t waits = 0;
+    if (retryForReaders([&] { return tryDispose(key_holder); }, stopping, waits)) return true;
+    logDisposeFailure();
+    return false;
   }
   /// Waits until every matched reliable reader acknowledged every change written, for as long
   /// as a reader is matched and `stopping()` is false (a reader far behind takes as long as it
@@ -100,6 +88,19 @@ class Writer {
   std::size_t matchedReaders() const;
 
  private:
+  /// Tries `attempt` (a write or a dispose that a full history refused) again for as long as a
+  /// reader is matched and `stopping()` is false, counting the retries in `waits`; with no
+  /// reader left, once more. False if it gave up.
+  template <class Attempt, class Stopping>
+  bool retryForReaders(Attempt&& attempt, Stopping&& stopping, std::uint64_t& waits) {
+    bool readers_left = false;
+    while (!attempt()) {
+      if (stopping() || readers_left) return false;
+      readers_left = matchedReaders() == 0;
+      ++waits;
+    }
+    return true;
+  }
   bool tryWrite(const Sample& sample) {
     if (writer_ == nullptr || !writer_->write(const_cast<Sample*>(&sample))) return false;
     health_->countPublished();

@@ -22,7 +22,11 @@ class SensorReaders {
   /// What the owner is told besides the samples; every one may be empty.
   struct Events {
     /// The stream's writer disposed the sensor's instance: the stream ended as announced.
-    std::function<void(StreamKind, std::uint32_t sensor_id)> ended{};
+    /// `last_time_gps_ns`: the data time of the last sample of the stream this reader took (in
+    /// order of the writer, before the dispose): where the stream ended, whatever another reader
+    /// of the participant, behind, has seen of it so far.
+    std::function<void(StreamKind, std::uint32_t sensor_id, std::uint64_t last_time_gps_ns)>
+        ended{};
     /// The reader's requested deadline passed without a sample of the sensor.
     std::function<void(StreamKind, std::uint32_t sensor_id)> deadline_missed{};
     /// Every writer of the topic lost its liveliness.
@@ -58,22 +62,26 @@ class SensorReaders {
   }
 
  private:
+  /// What an instance is: disposals and deadline statuses name only the instance.
+  struct Instance {
+    std::uint32_t sensor_id{0};
+    std::uint64_t last_time_gps_ns{0};  ///< of the last sample taken
+  };
   /// True if the sample is its sensor's owner's (and remembers the sensor's instance handle).
   bool admit(StreamKind kind, WriterGate& writers, std::uint32_t sensor_id,
              std::uint64_t time_gps_ns, const eprosima::fastdds::dds::SampleInfo& info);
   ReaderCallbacks callbacks(StreamKind kind);
-  /// The sensor id of an instance seen on a stream of `kind`; nullptr if none was.
-  const std::uint32_t* sensorOf(StreamKind kind,
-                                const eprosima::fastrtps::rtps::InstanceHandle_t& handle) const;
+  /// An instance seen on a stream of `kind`; nullptr if none was.
+  const Instance* instanceOf(StreamKind kind,
+                             const eprosima::fastrtps::rtps::InstanceHandle_t& handle) const;
 
   Participant& participant_;
   Events events_;
   /// One writer per sensor id on each topic (a second writer's samples are kept out).
   std::map<std::string, WriterGate> gates_;
-  /// DDS instance handle -> sensor id, per stream kind: disposals and deadline statuses name
-  /// only the instance.
-  std::map<std::pair<StreamKind, eprosima::fastrtps::rtps::InstanceHandle_t>, std::uint32_t>
-      instances_;
+  /// DDS instance handle -> its sensor and last data time, per stream kind (disposals and
+  /// deadline statuses name only the instance).
+  std::map<std::pair<StreamKind, eprosima::fastrtps::rtps::InstanceHandle_t>, Instance> instances_;
 };
 
 }  // namespace navbus::bus

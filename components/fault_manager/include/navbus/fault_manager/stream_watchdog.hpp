@@ -84,7 +84,8 @@ class StreamWatchdog {
   /// (or its latest sample seen, if later): forgotten, so that its silence is no loss. Samples
   /// not later than the end still in flight (another reader of the same topic may deliver
   /// them after the dispose) are ignored; a later one starts the stream again. Returns false
-  /// if the stream was not known.
+  /// if the stream was not known (its end is kept all the same: this participant's other
+  /// reader told it before this one's samples came).
   bool onEnded(const StreamKey& key, std::uint64_t end_time_gps_ns = 0);
   /// Sensor time of the stream's latest sample (0: not known).
   std::uint64_t lastTime(const StreamKey& key) const;
