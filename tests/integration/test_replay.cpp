@@ -389,9 +389,15 @@ TEST(Replay, ATriplexRecordingReplaysEveryLaneBitIdentical) {
           "faults:\n  - {type: imu_bias_ramp, sensor: gyro, axis: x, start_s: 100,\n"
           "     slope_deg_per_h_per_s: 0.01, saturation_deg_per_h: 3, sensor_id: 1}\n");
   const std::string filter_cfg = test::writeFile(
-      dir / "filter.yaml", "extends: " + src + "/config/filter_triplex.yaml\n" + domain +
-                               "solution_writer_profile: navbus_solution_writer_lossless\n"
-                               "sequencer_max_wait_s: 30\n");
+      dir / "filter.yaml",
+      "extends: " + src + "/config/filter_triplex.yaml\n" + domain +
+          "solution_writer_profile: navbus_solution_writer_lossless\n"
+          "sequencer_max_wait_s: 30\n"
+          // The monitor's liveness is wall-clock (3 s in the file): under the sanitizers a
+          // starved fault manager's reports came further apart, and 516 solutions said
+          // NOT_MONITORED where offline's carried the protection level. As offline_equals_bus.
+          "fault_monitor: {participant: navbus-fault-manager, timeout_s: 30, "
+          "judged_from_start: true}\n");
   const std::string fm_cfg = test::writeFile(
       dir / "fm.yaml", "extends: " + src + "/config/fault_manager_triplex.yaml\n" + domain);
 
