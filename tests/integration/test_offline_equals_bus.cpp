@@ -39,6 +39,10 @@ struct Case {
   /// every sample rejected).
   std::string filter_sensors{};
   std::string fm_sensors{};  ///< the same for the fault manager's last health report
+  /// The simulator paces its data in real time (as a receiver's epochs come): each of them
+  /// reaches the filter and the fault manager together, and the filter has gone on to its time
+  /// before the fault manager could judge it (default: as fast as the readers take it).
+  bool realtime{false};
 };
 
 /// Checks `expected` (Case::filter_sensors) against the input of a health report.
@@ -76,10 +80,10 @@ void runCase(const Case& c) {
   const std::string scenario = std::string(navbus::test_paths::scenarioDir()) + "/" + c.scenario;
   const std::string filter_base = std::string(navbus::test_paths::configDir()) + "/" + c.filter;
   const std::string domain = "domain_id: " + std::to_string(c.domain) + "\n";
-  const std::string sim_cfg =
-      test::writeFile(dir / "sim.yaml", "extends: " + scenario + "\n" + domain +
-                                            "timing: {duration_s: " + std::to_string(c.duration_s) +
-                                            "}\n" + c.sim_extra);
+  const std::string sim_cfg = test::writeFile(
+      dir / "sim.yaml", "extends: " + scenario + "\n" + domain +
+                            "timing: {duration_s: " + std::to_string(c.duration_s) +
+                            (c.realtime ? ", pacing: realtime" : "") + "}\n" + c.sim_extra);
   // Every solution must reach the test even though the data runs through at full speed. The
   // sequencer's bounded wait is the one place where wall time enters the bus run (a stream
   // silent for longer is set aside, which the offline run never does); on a loaded machine or
@@ -283,6 +287,35 @@ TEST(OfflineEqualsBus, DualReceiversClockJumpDecidedAsOffline) {
            "2}\n",
            "navbus/gnss/observations 1:accepted 2:refused",
            "navbus/gnss/observations 1:accepted 2:accepted"});
+}
+
+// The loop closed for a receiver: receiver 1's clock, the one the filter fuses, jumps 1 ms at
+// 100 s (seed000_dual_receivers_clock_jump_fused.yaml). The fault manager's cross-receiver test
+// names it and commands the compensation at the instant before that epoch; the filter
+// (config/filter_dual_receivers.yaml) fuses each epoch only once the fault manager has judged
+// the time before it (FaultMonitorProgress gnss_judged_up_to_gps_ns), so the command takes effect
+// before the jumped epoch on the bus as offline: the one decision, the command applied, and
+// every solution the offline run's bit for bit (without the command the GLR took the jump for an
+// accelerometer step and the solution ran 282 m off within 60 s). The data come in real time, as
+// a receiver's do: each epoch reaches the filter and the fault manager together (without
+// receivers_judged the filter fused the jumped epoch before the command came, and its solutions
+// after it differed from offline's).
+TEST(OfflineEqualsBus, FusedReceiversClockJumpCompensatedAsOffline) {
+  runCase({117,
+           "seed000_dual_receivers_clock_jump_fused.yaml",
+           "filter_dual_receivers.yaml",
+           "",
+           3,
+           16.0,
+           {"command 1 from 'fault-manager' applied (kind 2)", "commands applied 1 refused 0",
+            "judgements waited for beyond the budget 0"},
+           "fault_manager_dual_receivers.yaml",
+           1,
+           "faults:\n  - {type: receiver_clock_jump, start_s: 10, magnitude_ms: 1, receiver_id: "
+           "1}\n",
+           "navbus/gnss/observations 1:accepted 2:refused",
+           "navbus/gnss/observations 1:accepted 2:accepted",
+           true});
 }
 
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->

@@ -51,6 +51,17 @@ void FaultPipeline::onImuIncrement(const navbus::ImuIncrement& increment) {
   reportProgress(judged_);
 }
 
+void FaultPipeline::onGnssEpoch(const navbus::GnssObservationEpoch& epoch) {
+  if (!receivers_) return;
+  receivers_->onEpoch(epoch, *this);
+  // How far the receivers' epochs are judged, after every time tested (after its commands).
+  const std::int64_t tested = receivers_->testedUpToNs();
+  if (tested <= receivers_reported_) return;
+  if (config_.glr.enabled && judged_.time_gps_ns() == 0) return;  // as the parity test's
+  receivers_reported_ = tested;
+  reportProgress(judged_);
+}
+
 void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
                                    std::uint64_t time_gps_ns, std::int64_t wall_now_ns) {
   // Best-effort watchdog readers may lose samples: count them from the sequence numbers. A
@@ -192,6 +203,8 @@ void FaultPipeline::reportProgress(const navbus::FilterDiagnostics& judged) {
   p.run_id(run_id_);
   p.imu_judged_up_to_gps_ns(
       static_cast<std::uint64_t>(std::max<std::int64_t>(parity_reported_, 0)));
+  p.gnss_judged_up_to_gps_ns(static_cast<std::uint64_t>(
+      receivers_ ? std::max<std::int64_t>(receivers_->testedUpToNs(), 0) : 0));
   sinks_.progress(p);
 }
 

@@ -181,6 +181,17 @@ void ReceiverDetector::reportClock(std::int64_t time_ns, std::size_t r, const co
                                      j.statistic, j.magnitude_m));
   const std::uint32_t id = out.decide(d);
   ++counters_.clock_jumps;
+  // The receiver's clock from the instant before this epoch on: the filter fuses the epoch
+  // with its clock moved by the jump (sigma: the jump's, from v^2 / var v).
+  navbus::FilterCommand c;
+  c.kind(navbus::CMD_COMPENSATE_BIAS);
+  c.decision_id(id);
+  c.time_gps_ns(static_cast<std::uint64_t>(time_ns - 1));
+  c.sensor(navbus::SOURCE_RECEIVER_CLOCK);
+  c.sensor_id(config_.receiver_ids[r]);
+  c.bias(j.magnitude_m);
+  c.bias_sigma(std::abs(j.magnitude_m) / std::sqrt(j.statistic));
+  out.command(c);
   spdlog::warn(
       "decision {}: receiver {} clock jumped {:.6g} m ({:.4g} ms), v^2/var {:.4g} >= {:.4g}", id,
       config_.receiver_ids[r], j.magnitude_m, 1e3 * j.magnitude_m / core::earth::kSpeedOfLight_mps,
@@ -215,6 +226,16 @@ void ReceiverDetector::reportSatellite(std::int64_t time_ns, std::size_t r,
                                        p.runner_up_sv, p.glr.statistic, p.glr.magnitude));
   const std::uint32_t id = out.decide(d);
   ++counters_.satellites;
+  // Out of the filter from before its onset (the filter's recovery margin) and before this
+  // epoch is fused: which of the two receivers saw it wrong is unknown, so out of both.
+  navbus::FilterCommand c;
+  c.kind(navbus::CMD_EXCLUDE_SATELLITE);
+  c.decision_id(id);
+  c.time_gps_ns(static_cast<std::uint64_t>(time_ns - 1));
+  c.onset_time_gps_ns(d.onset_time_gps_ns());
+  c.sv_id(static_cast<std::uint16_t>(p.sv_id));
+  c.scope(navbus::SCOPE_ALL);
+  out.command(c);
   spdlog::warn(
       "decision {}: sv {} differs between receivers {} and {} by {:.4g} m (+- {:.2g}){}, l {:.4g} "
       ">= h {:.4g}",

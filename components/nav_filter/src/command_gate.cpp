@@ -11,6 +11,9 @@ CommandGate::CommandGate(const FilterConfig& config, bus::StreamCounters& topic_
                          OutcomeSink outcome_sink)
     : vehicle_id_(config.vehicle_id),
       imu_id_(config.imu.id),
+      receiver_id_(config.gnss_observations
+                       ? std::optional<std::uint32_t>(config.gnss_observations->id)
+                       : std::nullopt),
       issuers_(config.command_issuers),
       issuer_identities_(config.issuer_identities),
       max_accel_compensation_mps2_(config.max_accel_compensation_mps2),
@@ -111,6 +114,8 @@ std::optional<std::string> CommandGate::check(const navbus::FilterCommand& c) co
       if (c.axis() > 2) return fmt::format("axis {} outside 0..2", c.axis());
       return std::nullopt;
     case navbus::CMD_COMPENSATE_BIAS:
+      if (c.sensor() == navbus::SOURCE_RECEIVER_CLOCK) return checkReceiverClock(c);
+      [[fallthrough]];
     case navbus::CMD_RELEARN_BIAS: {
       if (auto other = otherImu(c)) return other;
       if (c.sensor() != navbus::SOURCE_ACCELEROMETER && c.sensor() != navbus::SOURCE_GYRO)
@@ -134,6 +139,18 @@ std::optional<std::string> CommandGate::check(const navbus::FilterCommand& c) co
     default:
       return std::nullopt;
   }
+}
+
+std::optional<std::string> CommandGate::checkReceiverClock(const navbus::FilterCommand& c) const {
+  if (!receiver_id_)
+    return fmt::format("sensor_id {}: this filter fuses no receiver's pseudoranges", c.sensor_id());
+  if (c.sensor_id() != *receiver_id_)
+    return fmt::format("sensor_id {} is not this filter's receiver (gnss_observations.id {})",
+                       c.sensor_id(), *receiver_id_);
+  if (!std::isfinite(c.bias())) return fmt::format("bias {} is not finite", c.bias());
+  if (!std::isfinite(c.bias_sigma()) || c.bias_sigma() < 0.0)
+    return fmt::format("bias_sigma {} outside 0..inf", c.bias_sigma());
+  return std::nullopt;
 }
 
 double CommandGate::relearnSigma(const navbus::FilterCommand& c) {

@@ -17,6 +17,10 @@ bool applyEngineCommand(core::NavigationEngine& engine, const navbus::FilterComm
       engine.relearnBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), relearn_sigma);
       return true;
     case navbus::CMD_COMPENSATE_BIAS:
+      if (c.sensor() == navbus::SOURCE_RECEIVER_CLOCK) {  // the receiver checked by the gate
+        engine.compensateReceiverClock(c.bias(), c.bias_sigma());
+        return true;
+      }
       engine.compensateBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias(),
                             c.bias_sigma());
       return true;

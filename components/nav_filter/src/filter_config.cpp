@@ -272,6 +272,7 @@ void parseAuthorities(const YAML::Node& root, FilterConfig& c) {
         .seconds("timeout_s", w.timeout_ns, {0.1, 3600.0})
         .seconds("judgement_wait_s", w.judgement_wait_ns, {0.001, 3600.0})
         .value("judged_from_start", w.judged_from_start)
+        .value("receivers_judged", w.receivers_judged)
         .finish();
     c.fault_monitor = w;
   }
@@ -605,6 +606,11 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   parseStart(root["initial_state"], e);
   parseInputs(root["inputs"], c);
   checkModeAgainstInputs(root, c);
+  if (c.fault_monitor && c.fault_monitor->receivers_judged &&
+      (!c.gnss_observations || c.gnss_observations->period_ns <= 0))
+    throw bus::ConfigError(
+        "configuration fault_monitor.receivers_judged = true needs inputs.gnss_observations "
+        "with its period_s (the epoch after one is held for the receivers' judgement)");
   parseEkf(root["ekf"], e);
   parseFailedAxis(root["failed_axis"], e.tuning);
   parseFusionTuning(root, e.tuning);

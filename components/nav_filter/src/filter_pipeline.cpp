@@ -35,6 +35,9 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   if (monitored)
     s.push_back({kImuJudgementStream, 0, true, true, c.fault_monitor->judgement_wait_ns,
                  c.fault_monitor->judged_from_start});
+  // The judgement of the receivers' epochs (the cross-receiver test), expected from the start.
+  if (monitored && c.fault_monitor->receivers_judged)
+    s.push_back({kGnssJudgementStream, 0, true, true, c.fault_monitor->judgement_wait_ns, true});
   return s;
 }
 
@@ -80,7 +83,9 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
                      &time_reference_),
       star_gate_(bus::topic::kStarTracker, health.stream(bus::topic::kStarTracker),
                  config.time_jump, &time_reference_),
-      commands_(config, health.stream(bus::topic::kFilterCommand), sinks_.command_outcome) {}
+      commands_(config, health.stream(bus::topic::kFilterCommand), sinks_.command_outcome) {
+  receivers_judged_ = config.fault_monitor && config.fault_monitor->receivers_judged;
+}
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
                            FilterInput input) {
@@ -260,6 +265,8 @@ void FilterPipeline::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
   const bus::StreamKindInfo& stream = bus::streamInfo(kind);
   if (stream.merge_rank == bus::kNotMerged) return;
   if (!sequencer_.setActive({stream.merge_rank, id}, false)) return;  // a stream not in use
+  if (kind == bus::StreamKind::kGnssObservations)                     // no next epoch to judge
+    sequencer_.setActive(kGnssJudgementStream, false);
   ended_streams_.insert({stream.merge_rank, id});
   spdlog::info("{} id {} ended (its writer disposed it): no longer waited for", stream.topic, id);
 }
@@ -284,6 +291,7 @@ void FilterPipeline::resumedAfterStall(std::int64_t now_ns, std::int64_t stalled
 void FilterPipeline::flush(std::int64_t now_ns) {
   sequencer_.setActive(kCommandStream, false);  // nothing more will be judged
   sequencer_.setActive(kImuJudgementStream, false);
+  sequencer_.setActive(kGnssJudgementStream, false);
   for (int round = 0; round < 8 && sequencer_.pending() > 0; ++round) {  // a stream a round
     now_ns += config_.sequencer_max_wait_ns;
     pump(now_ns);
@@ -309,6 +317,10 @@ void FilterPipeline::process(StreamId stream, std::int64_t time_ns, const Filter
       publishSolution();
     }
   } else if (const auto* epoch = std::get_if<GnssEpochInput>(&input)) {
+    // The next epoch waits for the receivers' judgement of the time before it: a command
+    // about it (a clock jump, a satellite) then comes before it in the order, as offline.
+    if (receivers_judged_ && !replaying_)
+      sequencer_.owe(kGnssJudgementStream, time_ns + config_.gnss_observations->period_ns - 1);
     if (engine_.addGnssEpoch(epoch->time_ns, epoch->satellites) && !replaying_ &&
         time_ns > diagnosed_up_to_ns_) {
       diagnosed_up_to_ns_ = time_ns;

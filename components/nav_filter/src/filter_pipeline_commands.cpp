@@ -80,6 +80,11 @@ void FilterPipeline::noteJudged(std::int64_t judged_up_to_ns) {
   // The IMU data's own judgement (setImuJudged): its report's imu_judged_up_to_gps_ns.
   if (owe_imu_judgement_ && judgements_.imuJudged() > 0)
     sequencer_.judged(kImuJudgementStream, judgements_.imuJudged());
+  // The receivers' epochs' judgement, while the fused receiver's stream goes on (after its end
+  // no epoch follows to be judged: the stream stays set aside).
+  if (receivers_judged_ && judgements_.gnssJudged() > 0 &&
+      ended_streams_.count({kRankGnssObs, config_.gnss_observations->id}) == 0)
+    sequencer_.judged(kGnssJudgementStream, judgements_.gnssJudged());
 }
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c,

@@ -29,6 +29,8 @@ std::optional<std::int64_t> JudgementTracker::release() {
   const auto judged = static_cast<std::int64_t>(held_->judged_up_to_gps_ns());
   imu_judged_ns_ =
       std::max(imu_judged_ns_, static_cast<std::int64_t>(held_->imu_judged_up_to_gps_ns()));
+  gnss_judged_ns_ =
+      std::max(gnss_judged_ns_, static_cast<std::int64_t>(held_->gnss_judged_up_to_gps_ns()));
   held_.reset();
   return judged;
 }

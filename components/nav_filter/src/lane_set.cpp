@@ -30,7 +30,8 @@ bool isImuCommand(const navbus::FilterCommand& c) {
   switch (c.kind()) {
     case navbus::CMD_FAIL_SENSOR_AXIS:
     case navbus::CMD_RESTORE_SENSOR_AXIS:
-    case navbus::CMD_COMPENSATE_BIAS:
+    case navbus::CMD_COMPENSATE_BIAS:  // a receiver's clock: every lane fuses that receiver
+      return c.sensor() != navbus::SOURCE_RECEIVER_CLOCK;
     case navbus::CMD_RELEARN_BIAS:
       return true;
     case navbus::CMD_EXCLUDE_STREAM:
@@ -155,9 +156,17 @@ void LaneSet::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
 }
 
 void LaneSet::onFaultMonitorProgress(const navbus::FaultMonitorProgress& report) {
-  if (lanes_.size() == 1 || report.vehicle_id() != config_.vehicle_id ||
-      report.imu_judged_up_to_gps_ns() == 0) {
+  if (lanes_.size() == 1 || report.vehicle_id() != config_.vehicle_id) {
     lanes_.front()->onFaultMonitorProgress(report);
+    return;
+  }
+  if (report.imu_judged_up_to_gps_ns() == 0) {
+    // No parity test (yet): the GLR's judgement concerns lane 0, the receivers' every lane.
+    if (report.gnss_judged_up_to_gps_ns() == 0) {
+      lanes_.front()->onFaultMonitorProgress(report);
+    } else {
+      forEach([&](FilterPipeline& l) { l.onFaultMonitorProgress(report); });
+    }
     return;
   }
   // The parity test judges every lane's IMU data: each lane waits for it (lane 0 for it and for

@@ -174,3 +174,32 @@ TEST(PseudorangeErrorStates, DecayAsAGaussMarkovProcessAndKeepTheirStationaryVar
               1e-9 * sigma2);
   EXPECT_NEAR(f.covariance()(free, free), sigma2, 1e-9 * sigma2);
 }
+
+TEST(PseudorangeErrorStates, AReceiverClockShiftedByItsJumpLeavesTheJumpedRangesUnsurprising) {
+  // Given a filter at the truth with clock 0, and the receiver's clock jumping 1 ms (every
+  // pseudorange + 299.8 km): shifted by the jump (IntegratedFilter::shiftClock, the
+  // cross-receiver test's command), its clock estimate is the jump, its clock variance grew by
+  // the jump's sigma^2, and the jumped epoch's innovations are those of an epoch without a
+  // jump; unshifted, every innovation carries the jump.
+  const navbus::core::NavState truth = restingReceiver();
+  const double jump_m = 1e-3 * earth::kSpeedOfLight_mps;
+  auto jumped = satellitesWithRangeError(truth, 0.0);
+  for (auto& s : jumped) s.pseudorange_m += jump_m;
+  navbus::core::IntegratedFilter shifted, unshifted;
+  shifted.initialize(truth, 0.0, 0.0, rangeErrorTuning(), rangeErrorMask());
+  unshifted.initialize(truth, 0.0, 0.0, rangeErrorTuning(), rangeErrorMask());
+  const int clock = layout::kClockBias.index;
+  const double variance_before = shifted.covariance()(clock, clock);
+  shifted.shiftClock(jump_m, 16.0);
+  EXPECT_DOUBLE_EQ(shifted.clockBias(), jump_m);
+  EXPECT_NEAR(shifted.covariance()(clock, clock), variance_before + 256.0, 1e-9);
+  shifted.update(jumped);
+  unshifted.update(jumped);
+  const auto& with = shifted.lastEpoch().innovation;
+  const auto& without = unshifted.lastEpoch().innovation;
+  ASSERT_GT(with.size(), 4);
+  for (Eigen::Index i = 0; i < with.size(); ++i) {
+    EXPECT_LT(std::abs(with[i]), 1e-3) << "row " << i;
+  }
+  EXPECT_GT(std::abs(without[0]), 0.99 * jump_m);
+}

@@ -91,7 +91,8 @@ TEST(ReceiverDetector, AlignsABacklogOfOneReceiverBeforeTheOtherAndNamesAClockJu
   // Given two receivers, when receiver 2's 300 epochs all arrive before receiver 1's (a DDS
   // reader's backlog of one instance), then every time is tested (none incomplete or late);
   // and when receiver 1's clock jumps 1 ms at second 200, the one decision names receiver 1's
-  // clock at that second.
+  // clock at that second, and its command compensates receiver 1's clock by the jump from the
+  // instant before that epoch (so that a filter fuses the epoch after it).
   const fm::FaultManagerConfig config = fm::parseFaultManagerConfig(YAML::Load(kTwoReceivers));
   fm::ReceiverDetector detector(config.receivers);
   Recorder out;
@@ -114,5 +115,17 @@ TEST(ReceiverDetector, AlignsABacklogOfOneReceiverBeforeTheOtherAndNamesAClockJu
   EXPECT_EQ(d.sensor_id(), 1u);
   EXPECT_EQ(d.time_gps_ns(), 1400000200000000000ull);
   EXPECT_NEAR(d.magnitude(), jump, 30.0);
-  EXPECT_TRUE(out.commands.empty());
+  ASSERT_EQ(out.commands.size(), 1u);
+  const navbus::FilterCommand& cmd = out.commands[0];
+  EXPECT_EQ(cmd.kind(), navbus::CMD_COMPENSATE_BIAS);
+  EXPECT_EQ(cmd.sensor(), navbus::SOURCE_RECEIVER_CLOCK);
+  EXPECT_EQ(cmd.sensor_id(), 1u);
+  EXPECT_EQ(cmd.decision_id(), d.decision_id());
+  EXPECT_EQ(cmd.time_gps_ns(), 1400000200000000000ull - 1u);
+  EXPECT_EQ(cmd.onset_time_gps_ns(), 0u) << "applied at its own time, not by restoring";
+  EXPECT_EQ(cmd.bias(), d.magnitude());
+  // Its sigma is the jump's: |v| / sqrt(v^2 / var v); the 3 m ranges give a few metres.
+  EXPECT_GT(cmd.bias_sigma(), 0.5);
+  EXPECT_LT(cmd.bias_sigma(), 30.0);
+  EXPECT_EQ(detector.testedUpToNs(), 1400000299000000000);
 }

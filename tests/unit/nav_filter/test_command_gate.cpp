@@ -1,6 +1,8 @@
 // CommandGate: who may command navbus-filter and what, and the counts it keeps.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "navbus/nav_filter/command_gate.hpp"
 
 namespace nb = navbus;
@@ -77,6 +79,38 @@ TEST(CommandGate, NamesTheFieldAndValueOutOfRange) {
   EXPECT_EQ(gate.check(c).value_or(""), "sv_id 33 outside 1..32");
   c.sv_id(12);
   EXPECT_FALSE(gate.check(c).has_value());
+}
+
+TEST(CommandGate, CompensatesOnlyTheFusedReceiversClockNamingAnother) {
+  // Given a filter fusing receiver 1's pseudoranges, a clock compensation for receiver 1 of
+  // 299.8 km (1 ms) passes (a clock's jump has no IMU compensation limit), one for receiver 2
+  // is refused naming both ids, one not finite is refused naming the field; a filter without
+  // pseudoranges refuses any.
+  nb::bus::StreamCounters topic;
+  nb::nav_filter::FilterConfig config = gateConfig();
+  config.gnss_observations = nb::nav_filter::InputConfig{1, 1'000'000'000};
+  CommandGate gate(config, topic);
+  nb::FilterCommand c = relearn(0.0);
+  c.kind(nb::CMD_COMPENSATE_BIAS);
+  c.sensor(nb::SOURCE_RECEIVER_CLOCK);
+  c.axis(0);
+  c.sensor_id(1);
+  c.bias(299792.458);
+  c.bias_sigma(16.0);
+  EXPECT_FALSE(gate.check(c).has_value()) << gate.check(c).value_or("");
+  c.sensor_id(2);
+  EXPECT_EQ(gate.check(c).value_or(""),
+            "sensor_id 2 is not this filter's receiver (gnss_observations.id 1)");
+  c.sensor_id(1);
+  c.bias(std::nan(""));
+  EXPECT_EQ(gate.check(c).value_or(""), "bias nan is not finite");
+  c.bias(1.0);
+  c.bias_sigma(-1.0);
+  EXPECT_EQ(gate.check(c).value_or(""), "bias_sigma -1 outside 0..inf");
+  CommandGate inertial(gateConfig(), topic);
+  c.bias_sigma(1.0);
+  EXPECT_EQ(inertial.check(c).value_or(""),
+            "sensor_id 1: this filter fuses no receiver's pseudoranges");
 }
 
 TEST(CommandGate, ClampsARelearnSigmaToTheCompensationLimitAndCountsIt) {

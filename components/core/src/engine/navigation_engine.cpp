@@ -834,6 +834,10 @@ void NavigationEngine::compensateBias(bool accelerometer, int axis, double bias,
   status_ |= kStatusBiasCompensated;
 }
 
+void NavigationEngine::compensateReceiverClock(double jump_m, double sigma_m) {
+  if (filter_->initialized()) filter_->shiftClock(jump_m, sigma_m);
+}
+
 void NavigationEngine::failSensorAxis(bool accelerometer, int axis) {
   failed_axes_ |= static_cast<std::uint8_t>(1u << ((accelerometer ? 0 : 3) + axis));
   if (filter_->initialized()) filter_->setAxisFailed(accelerometer, axis, true);

@@ -576,6 +576,11 @@ void IntegratedFilter::resetClock(double bias_m, double drift_mps, double bias_s
   resetState(layout::kClockDrift.index, drift_sigma_mps);
 }
 
+void IntegratedFilter::shiftClock(double jump_m, double sigma_m) {
+  clock_bias_m_ += jump_m;
+  if (sigma_m > 0.0) addVariance(layout::kClockBias.index, sigma_m * sigma_m);
+}
+
 void IntegratedFilter::resetState(int i, double sigma) {
   beginCovarianceJump();  // a fresh state: a zero row of Phi and the prior as process noise
   central_.resetState(i, sigma);

@@ -85,9 +85,7 @@ class FaultPipeline : private FaultOutput {
   const std::optional<DitherDetector>& dither() const { return dither_; }
   /// An observation epoch of any GNSS receiver, for the cross-receiver detector (every epoch,
   /// reliably; none without `receivers:`).
-  void onGnssEpoch(const navbus::GnssObservationEpoch& epoch) {
-    if (receivers_) receivers_->onEpoch(epoch, *this);
-  }
+  void onGnssEpoch(const navbus::GnssObservationEpoch& epoch);
   const std::optional<ReceiverDetector>& receivers() const { return receivers_; }
   /// The parity detector of redundant IMUs, when configured.
   const std::optional<ParityDetector>& parity() const { return parity_; }
@@ -117,9 +115,10 @@ class FaultPipeline : private FaultOutput {
   std::optional<ReceiverDetector> receivers_;
   /// The parity test's progress is reported every this much data time.
   static constexpr std::int64_t kParityReportPeriodNs = 100'000'000;
-  std::int64_t parity_reported_{-1};  ///< data time of the latest report of it
-  std::uint64_t parity_runs_{0};      ///< the parity test's new runs seen
-  navbus::FilterDiagnostics judged_;  ///< the latest diagnostics epoch judged (reports quote it)
+  std::int64_t parity_reported_{-1};     ///< data time of the latest report of it
+  std::uint64_t parity_runs_{0};         ///< the parity test's new runs seen
+  std::int64_t receivers_reported_{-1};  ///< the cross-receiver test's latest reported time
+  navbus::FilterDiagnostics judged_;     ///< the latest diagnostics epoch judged (reports quote it)
   bus::StreamGate diagnostics_gate_;
   std::map<StreamKind, bus::SequenceTracker> trackers_;
   std::map<StreamKind, double> deadline_s_;

@@ -6,9 +6,12 @@
 // (detector "receivers", SOURCE_RECEIVER_CLOCK) naming the receiver; a satellite whose
 // pseudoranges differ between two receivers is a decision (SOURCE_SATELLITE) naming the
 // satellite, ambiguous between the two receivers (both candidates), and the satellite leaves that
-// pair's test and of every receiver's clock test. Decisions only: no command yet (the filter does
-// not wait for this detector's judgement, so a command would reach it at a wall-clock moment: bus
-// and offline would differ).
+// pair's test and of every receiver's clock test. Each decision is followed by its command, at the
+// data time just before the epoch that showed the fault: the receiver's clock compensated by the
+// jump (CMD_COMPENSATE_BIAS, SOURCE_RECEIVER_CLOCK), or the satellite excluded (SCOPE_ALL: a
+// spoofer forges both of its measurements). A filter that waits for this detector's judgement
+// (fault_monitor.receivers_judged, FaultMonitorProgress.gnss_judged_up_to_gps_ns) fuses that
+// epoch after the command, as offline.
 #pragma once
 
 #include <cstdint>
@@ -44,6 +47,8 @@ class ReceiverDetector {
     double max_clock_statistic{0.0}, max_satellite_statistic{0.0};
   };
   const Counters& counters() const { return counters_; }
+  /// Data time up to which every receiver's epochs are tested (and commanded); -1: none yet.
+  std::int64_t testedUpToNs() const { return last_tested_ns_; }
   std::string summary() const;
 
  private:

@@ -58,6 +58,9 @@ class CommandGate {
   bool refuseIfStale(const navbus::FilterCommand& c, std::int64_t first_input_ns);
   /// Why the command's fields cannot be applied (field and value), or nothing.
   std::optional<std::string> check(const navbus::FilterCommand& c) const;
+  /// Why a receiver clock's compensation cannot be applied (another receiver than the fused
+  /// one, a value not finite), or nothing.
+  std::optional<std::string> checkReceiverClock(const navbus::FilterCommand& c) const;
   /// Why an IMU-axis command names another IMU than this filter's (sensor_id), or nothing.
   std::optional<std::string> otherImu(const navbus::FilterCommand& c) const;
   /// A re-learn's bias_sigma, at most the compensation limit (counted and logged when clamped;
@@ -80,7 +83,8 @@ class CommandGate {
   }
 
   std::uint32_t vehicle_id_;
-  std::uint32_t imu_id_;  ///< this filter's IMU (FilterConfig imu.id)
+  std::uint32_t imu_id_;                      ///< this filter's IMU (FilterConfig imu.id)
+  std::optional<std::uint32_t> receiver_id_;  ///< its receiver (gnss_observations.id), if any
   std::vector<std::string> issuers_;
   std::map<std::string, std::string> issuer_identities_;
   double max_accel_compensation_mps2_;

@@ -43,6 +43,11 @@ struct FaultMonitorWatch {
   /// The monitor runs from the start: the output waits for its first judgement too (at most
   /// judgement_wait_ns if it never reports), not only once it has reported.
   bool judged_from_start{false};
+  /// The monitor's cross-receiver test judges the receivers' epochs
+  /// (FaultMonitorProgress.gnss_judged_up_to_gps_ns): an epoch is fused only once the time
+  /// before it is judged, so that a clock jump or a satellite decided there is compensated or
+  /// excluded before it, as offline (needs gnss_observations with its period).
+  bool receivers_judged{false};
 };
 
 /// One IMU of a filter with several (`lanes:`): it runs a lane of its own.

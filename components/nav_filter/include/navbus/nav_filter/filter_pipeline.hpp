@@ -52,6 +52,9 @@ inline constexpr StreamId kCommandStream{kRankCommand, 0};
 /// The fault manager's judgement of the IMU data itself (FaultMonitorProgress
 /// imu_judged_up_to_gps_ns): a judging stream without samples (setImuJudged).
 inline constexpr StreamId kImuJudgementStream{kRankCommand, 1};
+/// The fault manager's judgement of the receivers' epochs (FaultMonitorProgress
+/// gnss_judged_up_to_gps_ns, fault_monitor.receivers_judged): a judging stream without samples.
+inline constexpr StreamId kGnssJudgementStream{kRankCommand, 2};
 
 /// A validated GNSS observation epoch: satellite clock corrections applied.
 struct GnssEpochInput {
@@ -216,6 +219,8 @@ class FilterPipeline {
   void noteJudged(std::int64_t judged_up_to_ns);
   void publishDiagnostics();
   bool owe_imu_judgement_{false};
+  /// fault_monitor.receivers_judged: each epoch's successor waits for the receivers' judgement.
+  bool receivers_judged_{false};
   /// Propagates the low-latency output with an arrived increment and publishes it.
   void publishLowLatency(const core::ImuIncrement& inc);
   bool applyStreamCommand(const navbus::FilterCommand& c);

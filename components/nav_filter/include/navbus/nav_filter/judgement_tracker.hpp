@@ -26,12 +26,16 @@ class JudgementTracker {
   /// starts over too (the commands seen are kept: a report may name one of them).
   void newRun() {
     imu_judged_ns_ = 0;
+    gnss_judged_ns_ = 0;
     held_.reset();
   }
   std::uint64_t reports() const { return reports_; }
   /// How far the released reports say the IMU data is judged (imu_judged_up_to_gps_ns; 0:
   /// no parity test).
   std::int64_t imuJudged() const { return imu_judged_ns_; }
+  /// How far the released reports say the receivers' epochs are judged
+  /// (gnss_judged_up_to_gps_ns; 0: no cross-receiver test).
+  std::int64_t gnssJudged() const { return gnss_judged_ns_; }
   /// Reports that arrived before the command they name (held until it came).
   std::uint64_t heldForCommand() const { return held_for_command_; }
 
@@ -43,6 +47,7 @@ class JudgementTracker {
   std::optional<navbus::FaultMonitorProgress> held_;
   std::uint64_t reports_{0};
   std::int64_t imu_judged_ns_{0};
+  std::int64_t gnss_judged_ns_{0};
   std::uint64_t held_for_command_{0};
 };
 

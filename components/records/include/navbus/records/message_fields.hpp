@@ -286,6 +286,8 @@ IfMessage<M, navbus::FaultMonitorProgress> visitFields(M& m, V& v) {
   v("last_command_id", m.last_command_id());
   v("issuer", m.issuer());
   v("run_id", m.run_id());
+  v("imu_judged_up_to_gps_ns", m.imu_judged_up_to_gps_ns());
+  v("gnss_judged_up_to_gps_ns", m.gnss_judged_up_to_gps_ns());
 }
 template <class M, class V>
 IfMessage<M, navbus::StreamHealth> visitFields(M& m, V& v) {

@@ -196,6 +196,10 @@ class NavigationEngine {
   /// `bias_sigma` [same unit] is the compensation's own uncertainty: added to the bias
   /// variance, so that the filter can still estimate what the compensation missed.
   void compensateBias(bool accelerometer, int axis, double bias, double bias_sigma = 0.0);
+  /// The fused receiver's clock jumped by `jump_m` (c times the step [m]; what its
+  /// pseudoranges gained), known to `sigma_m` [m]: the clock estimate follows (before the
+  /// filter is initialised, the alignment's least-squares clock already does).
+  void compensateReceiverClock(double jump_m, double sigma_m);
   /// A bias step of unknown size: its variance grows by sigma^2 and the filter re-estimates it.
   void relearnBias(bool accelerometer, int axis, double sigma) {
     compensateBias(accelerometer, axis, 0.0, sigma);

@@ -161,6 +161,9 @@ class IntegratedFilter {
   bool modelsFixPositionError() const;
   double clockBias() const { return clock_bias_m_; }
   double clockDrift() const { return clock_drift_mps_; }
+  /// The receiver's clock jumped by `jump_m` (c times the step [m]), known to `sigma_m`: the
+  /// clock bias moves with it and its variance grows by sigma_m^2.
+  void shiftClock(double jump_m, double sigma_m);
   /// The satellites' time-correlated pseudorange errors (tight coupling, when modelled).
   const PseudorangeErrorSlots& pseudorangeErrors() const { return pseudorange_errors_; }
   /// Whether the transition since the last update is kept for the pseudorange epochs'
