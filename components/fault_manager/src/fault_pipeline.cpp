@@ -54,6 +54,17 @@ void FaultPipeline::onImuIncrement(const navbus::ImuIncrement& increment) {
 void FaultPipeline::onGnssEpoch(const navbus::GnssObservationEpoch& epoch) {
   if (!receivers_) return;
   receivers_->onEpoch(epoch, *this);
+  reportReceiversProgress();
+}
+
+void FaultPipeline::receiverGone(StreamKind kind, std::uint32_t sensor_id,
+                                 std::uint64_t last_time_gps_ns) {
+  if (!receivers_ || kind != StreamKind::kGnssObservations) return;
+  receivers_->receiverGone(sensor_id, static_cast<std::int64_t>(last_time_gps_ns), *this);
+  reportReceiversProgress();
+}
+
+void FaultPipeline::reportReceiversProgress() {
   // How far the receivers' epochs are judged, after every time tested (after its commands).
   const std::int64_t tested = receivers_->testedUpToNs();
   if (tested <= receivers_reported_) return;
@@ -121,6 +132,7 @@ void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id,
   if (kind == StreamKind::kImu)
     onStreamEnded(StreamKind::kImuRaw, sensor_id,
                   std::max(end_time_gps_ns, watchdog_.lastTime({kind, sensor_id})));
+  receiverGone(kind, sensor_id, end_time_gps_ns);  // the cross-receiver test: not waited for
   if (!watchdog_.onEnded({kind, sensor_id}, end_time_gps_ns)) return;
   trackers_[kind].reset(sensor_id);
   ++ended_;
@@ -151,6 +163,7 @@ void FaultPipeline::onWatchdogEvent(const WatchdogEvent& e) {
   c.sensor(d.source());
   c.sensor_id(e.key.sensor_id);
   command(c);
+  if (e.lost) receiverGone(e.key.kind, e.key.sensor_id, e.last_time_gps_ns);
 }
 
 void FaultPipeline::onSecondWriter(StreamKind kind, std::uint32_t sensor_id,

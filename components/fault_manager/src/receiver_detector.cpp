@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
@@ -38,6 +39,8 @@ ReceiverDetector::ReceiverDetector(const ReceiverDetectorConfig& config) : confi
     pairs_.emplace_back(config_.glr, baseline);
   }
   pair_times_.resize(pairs_.size());
+  gone_after_ns_.assign(n, std::numeric_limits<std::int64_t>::max());
+  latest_ns_.assign(n, 0);
   spdlog::info(
       "receiver detector: {} receivers (reference {}), clock jumps beyond the chi-square "
       "threshold {:.4g} (P_fa {:.1e} per epoch), shared satellites' differences by a parity GLR "
@@ -84,6 +87,10 @@ void ReceiverDetector::onEpoch(const navbus::GnssObservationEpoch& msg, FaultOut
   }
   ++counters_.epochs;
   const auto time_ns = static_cast<std::int64_t>(msg.time_gps_ns());
+  const auto rx = static_cast<std::size_t>(r);
+  latest_ns_[rx] = std::max(latest_ns_[rx], time_ns);
+  if (time_ns > gone_after_ns_[rx])  // delivers again after its end: waited for again
+    gone_after_ns_[rx] = std::numeric_limits<std::int64_t>::max();
   if (time_ns <= last_tested_ns_) {
     ++counters_.late;
     return;
@@ -100,16 +107,34 @@ void ReceiverDetector::onEpoch(const navbus::GnssObservationEpoch& msg, FaultOut
   drain(out);
 }
 
+void ReceiverDetector::receiverGone(std::uint32_t id, std::int64_t last_time_ns, FaultOutput& out) {
+  const int r = receiverOf(id);
+  if (r < 0) return;
+  const auto rx = static_cast<std::size_t>(r);
+  gone_after_ns_[rx] = std::max(last_time_ns, latest_ns_[rx]);
+  spdlog::info(
+      "receiver detector: receiver {} ended or lost after {:.3f} s: later times are "
+      "tested without it",
+      id, 1e-9 * static_cast<double>(gone_after_ns_[rx]));
+  drain(out);
+}
+
+bool ReceiverDetector::complete(std::int64_t time_ns, const Slot& slot) const {
+  for (std::size_t r = 0; r < slot.receivers.size(); ++r)
+    if (!slot.receivers[r] && time_ns <= gone_after_ns_[r]) return false;
+  return true;
+}
+
 void ReceiverDetector::drain(FaultOutput& out) {
   // Every time up to the latest complete one is settled: the complete ones are tested, the
   // incomplete ones before will not complete (each receiver delivers in time order). Beyond
   // that, the oldest times are dropped while too many wait.
-  const std::size_t n = config_.receiver_ids.size();
   auto last_complete = pending_.end();
   for (auto it = pending_.begin(); it != pending_.end(); ++it)
-    if (it->second.received == n) last_complete = it;
+    if (complete(it->first, it->second)) last_complete = it;
   const auto settle = [&](std::map<std::int64_t, Slot>::iterator it) {
-    if (it->second.received == n) {
+    if (complete(it->first, it->second) && it->second.received >= 2) {
+      if (it->second.received < config_.receiver_ids.size()) ++counters_.without_gone;
       test(it->first, it->second, out);
     } else {
       ++counters_.incomplete;
@@ -131,6 +156,7 @@ void ReceiverDetector::test(std::int64_t time_ns, const Slot& slot, FaultOutput&
   // of every receiver's clock test, whose least-squares clock would otherwise take it for a jump
   // (with four satellites a fix has no redundancy to tell a bad range from a clock step).
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    if (!slot.receivers[0] || !slot.receivers[k + 1]) continue;  // one of them gone
     const core::PairConsistencyResult& p =
         pairs_[k].update(*slot.receivers[0], *slot.receivers[k + 1]);
     std::deque<std::int64_t>& times = pair_times_[k];
@@ -152,6 +178,7 @@ void ReceiverDetector::test(std::int64_t time_ns, const Slot& slot, FaultOutput&
   }
   const double time_s = 1e-9 * static_cast<double>(time_ns);
   for (std::size_t r = 0; r < clocks_.size(); ++r) {
+    if (!slot.receivers[r]) continue;  // gone
     Epoch& consistent = scratch_;
     consistent.clear();
     for (const core::ReceiverSatellite& s : *slot.receivers[r])
@@ -252,10 +279,10 @@ std::string ReceiverDetector::summary() const {
   std::ostringstream s;
   s << "receivers: " << c.tested << " aligned epochs of " << config_.receiver_ids.size()
     << " receivers (" << c.epochs << " epochs, other receivers " << c.other_receivers << ", late "
-    << c.late << ", times incomplete " << c.incomplete << ", satellites left out "
-    << c.satellites_left_out << "), clock jumps " << c.clock_jumps << ", satellites decided "
-    << c.satellites << ", largest statistic clock " << c.max_clock_statistic << " satellites "
-    << c.max_satellite_statistic;
+    << c.late << ", times incomplete " << c.incomplete << ", tested without a receiver gone "
+    << c.without_gone << ", satellites left out " << c.satellites_left_out << "), clock jumps "
+    << c.clock_jumps << ", satellites decided " << c.satellites << ", largest statistic clock "
+    << c.max_clock_statistic << " satellites " << c.max_satellite_statistic;
   return s.str();
 }
 

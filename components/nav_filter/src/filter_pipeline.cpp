@@ -248,6 +248,7 @@ void FilterPipeline::startNewRun() {
   owed_judgement_ns_ = -1;
   judged_up_to_ns_ = -1;
   judgements_.newRun();
+  gnss_judged_passed_ns_ = 0;
   time_reference_.latest_ns = 0;
   for (bus::StreamGate* g : {&gnss_obs_gate_, &gnss_fix_gate_, &star_gate_})
     g->tracker().resetAll();

@@ -81,10 +81,14 @@ void FilterPipeline::noteJudged(std::int64_t judged_up_to_ns) {
   if (owe_imu_judgement_ && judgements_.imuJudged() > 0)
     sequencer_.judged(kImuJudgementStream, judgements_.imuJudged());
   // The receivers' epochs' judgement, while the fused receiver's stream goes on (after its end
-  // no epoch follows to be judged: the stream stays set aside).
-  if (receivers_judged_ && judgements_.gnssJudged() > 0 &&
-      ended_streams_.count({kRankGnssObs, config_.gnss_observations->id}) == 0)
-    sequencer_.judged(kGnssJudgementStream, judgements_.gnssJudged());
+  // no epoch follows to be judged: the stream stays set aside), and only when it went further:
+  // a judge whose wait ran out (a receiver silent, the fault manager stopped) is not waited for
+  // again until it judges more.
+  if (receivers_judged_ && judgements_.gnssJudged() > gnss_judged_passed_ns_ &&
+      ended_streams_.count({kRankGnssObs, config_.gnss_observations->id}) == 0) {
+    gnss_judged_passed_ns_ = judgements_.gnssJudged();
+    sequencer_.judged(kGnssJudgementStream, gnss_judged_passed_ns_);
+  }
 }
 
 void FilterPipeline::onCommand(const navbus::FilterCommand& c,

@@ -129,3 +129,37 @@ TEST(ReceiverDetector, AlignsABacklogOfOneReceiverBeforeTheOtherAndNamesAClockJu
   EXPECT_LT(cmd.bias_sigma(), 30.0);
   EXPECT_EQ(detector.testedUpToNs(), 1400000299000000000);
 }
+
+TEST(ReceiverDetector, AReceiverGoneIsNotWaitedForBeyondItsLastEpochAndIsAgainWhenItReturns) {
+  // Given two receivers, receiver 2 silent after second 99 while receiver 1 goes on: its times
+  // wait for receiver 2 (judged up to 99 s); once receiver 2 is declared gone after 99 s, the
+  // waiting times are settled (one receiver is no pair: untested, counted incomplete) and the
+  // judgement reaches 149 s. When receiver 2 returns at 150 s it is waited for again: every
+  // later time is tested with both, and receiver 1's clock jump at 250 s is named.
+  const fm::FaultManagerConfig config = fm::parseFaultManagerConfig(YAML::Load(kTwoReceivers));
+  fm::ReceiverDetector detector(config.receivers);
+  Recorder out;
+  std::mt19937_64 rng(7);
+  const double jump = 1e-3 * nc::earth::kSpeedOfLight_mps;
+  constexpr std::int64_t kT0 = 1400000000000000000;
+  constexpr std::int64_t kSecond = 1000000000;
+  for (int t = 0; t < 150; ++t) {
+    detector.onEpoch(epoch(1, t, rng), out);
+    if (t < 100) detector.onEpoch(epoch(2, t, rng), out);
+  }
+  EXPECT_EQ(detector.testedUpToNs(), kT0 + 99 * kSecond);
+  detector.receiverGone(2, kT0 + 99 * kSecond, out);
+  EXPECT_EQ(detector.testedUpToNs(), kT0 + 149 * kSecond);
+  EXPECT_EQ(detector.counters().incomplete, 50u);
+  EXPECT_EQ(detector.counters().tested, 100u);
+  for (int t = 150; t < 300; ++t) {
+    detector.onEpoch(epoch(2, t, rng), out);
+    detector.onEpoch(epoch(1, t, rng, t >= 250 ? jump : 0.0), out);
+  }
+  EXPECT_EQ(detector.counters().tested, 250u);
+  EXPECT_EQ(detector.counters().incomplete, 50u);
+  EXPECT_EQ(detector.testedUpToNs(), kT0 + 299 * kSecond);
+  ASSERT_EQ(out.decisions.size(), 1u) << detector.summary();
+  EXPECT_EQ(out.decisions[0].sensor_id(), 1u);
+  EXPECT_EQ(out.decisions[0].time_gps_ns(), static_cast<std::uint64_t>(kT0 + 250 * kSecond));
+}

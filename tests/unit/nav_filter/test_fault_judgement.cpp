@@ -299,3 +299,40 @@ TEST(FaultJudgement, AMonitorThatStopsReportingHoldsTheOutputForItsBudgetOnly) {
   EXPECT_NE(summary.find(timeouts), std::string::npos)
       << "no other stream set aside than at the reference's end of data: " << summary;
 }
+
+TEST(FaultJudgement, AReceiversJudgeThatStopsAdvancingHoldsTheOutputForItsBudgetOnce) {
+  // A filter waiting for the cross-receiver test (fault_monitor.receivers_judged): the fault
+  // manager keeps judging the diagnostics, but its receivers' judgement stops at the third epoch
+  // (a receiver fell silent and the test waits for it). The next epoch is held for the budget,
+  // then the judge is passed over, and not waited for again at every epoch while the reports
+  // carry the same receivers' time; nothing was commanded, so the solutions are the reference's.
+  const std::vector<Frame> all = frames(kFrames);
+  const auto config =
+      tightlyCoupled(40.0,
+                     "fault_monitor: {participant: navbus-fault-manager, judgement_wait_s: 0.5, "
+                     "receivers_judged: true}\n");
+  FilterRun reference(config), bus(config);
+  std::uint64_t gnss_judged_ns = 0;
+  bus.on_diagnostics = [&](const FilterDiagnostics& d) {
+    FaultMonitorProgress p = progress(d, 0);
+    if (bus.diagnostics.size() <= 3) gnss_judged_ns = d.time_gps_ns() + 1'000'000'000;
+    p.gnss_judged_up_to_gps_ns(gnss_judged_ns);
+    bus.pipeline->onFaultMonitorProgress(p);
+  };
+  reference.on_diagnostics = [&](const FilterDiagnostics& d) {
+    FaultMonitorProgress p = progress(d, 0);
+    p.gnss_judged_up_to_gps_ns(d.time_gps_ns() + 1'000'000'000);  // judges every next epoch
+    reference.pipeline->onFaultMonitorProgress(p);
+  };
+  reference.play(all);
+  bus.play(all);
+  expectSameSolutions(reference, bus);
+  const auto passedOver = [](const std::string& summary) {
+    const std::string key = "judgements waited for beyond the budget ";
+    const std::size_t at = summary.find(key);
+    return at == std::string::npos ? -1 : std::stoi(summary.substr(at + key.size()));
+  };
+  EXPECT_EQ(passedOver(bus.pipeline->summary()), 1)
+      << "passed over once, not at every epoch: " << bus.pipeline->summary();
+  EXPECT_EQ(passedOver(reference.pipeline->summary()), 0) << reference.pipeline->summary();
+}

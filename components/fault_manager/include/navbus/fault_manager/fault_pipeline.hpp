@@ -104,6 +104,11 @@ class FaultPipeline : private FaultOutput {
   void command(navbus::FilterCommand& c) override;
   void onWatchdogEvent(const WatchdogEvent& e);
   void reportProgress(const navbus::FilterDiagnostics& judged);
+  /// A progress report when the cross-receiver test has judged further.
+  void reportReceiversProgress();
+  /// A receiver's stream ended or was declared lost after its sample at `last_time_gps_ns`: the
+  /// cross-receiver test stops waiting for it beyond that time (other stream kinds: nothing).
+  void receiverGone(StreamKind kind, std::uint32_t sensor_id, std::uint64_t last_time_gps_ns);
 
   FaultManagerConfig config_;
   bus::HealthCounters& health_;

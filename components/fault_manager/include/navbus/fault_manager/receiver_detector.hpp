@@ -37,12 +37,18 @@ class ReceiverDetector {
   /// receiver). Epochs of other receiver ids are counted and not used; satellites not valid or
   /// not finite are counted and left out.
   void onEpoch(const navbus::GnssObservationEpoch& msg, FaultOutput& out);
+  /// A receiver's stream ended or was declared lost after its epoch at `last_time_ns` (0: the
+  /// latest this detector has): times after it no longer wait for its epochs (the others' are
+  /// tested as they come; a time with fewer than two receivers is settled untested). An epoch of
+  /// it after that time makes it waited for again.
+  void receiverGone(std::uint32_t id, std::int64_t last_time_ns, FaultOutput& out);
 
   struct Counters {
     std::uint64_t epochs{0}, other_receivers{0}, satellites_left_out{0};
-    std::uint64_t late{0};        ///< older than the last time tested (or repeated)
-    std::uint64_t tested{0};      ///< aligned epochs of all receivers tested
-    std::uint64_t incomplete{0};  ///< times dropped: a receiver's epoch missing
+    std::uint64_t late{0};          ///< older than the last time tested (or repeated)
+    std::uint64_t tested{0};        ///< aligned epochs of all receivers tested
+    std::uint64_t incomplete{0};    ///< times dropped: a receiver's epoch missing
+    std::uint64_t without_gone{0};  ///< times tested without a receiver gone (ended or lost)
     std::uint64_t clock_jumps{0}, satellites{0};
     double max_clock_statistic{0.0}, max_satellite_statistic{0.0};
   };
@@ -58,6 +64,8 @@ class ReceiverDetector {
     std::size_t received{0};
   };
   int receiverOf(std::uint32_t id) const;
+  /// Every receiver still waited for at `time_ns` has delivered its epoch of the slot.
+  bool complete(std::int64_t time_ns, const Slot& slot) const;
   Epoch toCore(const navbus::GnssObservationEpoch& msg);
   void drain(FaultOutput& out);
   void test(std::int64_t time_ns, const Slot& slot, FaultOutput& out);
@@ -71,6 +79,9 @@ class ReceiverDetector {
   std::vector<std::deque<std::int64_t>> pair_times_;  ///< per pair: its tested times (onsets)
   std::map<std::int64_t, Slot> pending_;              ///< by time, waiting for every receiver
   std::vector<int> decided_svs_;  ///< satellites decided: out of every receiver's clock test
+  /// Per receiver: ended or lost after this time, not waited for beyond it (max: waited for).
+  std::vector<std::int64_t> gone_after_ns_;
+  std::vector<std::int64_t> latest_ns_;  ///< per receiver: its latest epoch's time
   Epoch scratch_;
   bool printed_detectable_{false};  ///< the first pair's minimum detectable difference, once
   std::int64_t last_tested_ns_{-1};

@@ -221,6 +221,7 @@ class FilterPipeline {
   bool owe_imu_judgement_{false};
   /// fault_monitor.receivers_judged: each epoch's successor waits for the receivers' judgement.
   bool receivers_judged_{false};
+  std::int64_t gnss_judged_passed_ns_{0};  ///< the receivers' judgement handed to the merge
   /// Propagates the low-latency output with an arrived increment and publishes it.
   void publishLowLatency(const core::ImuIncrement& inc);
   bool applyStreamCommand(const navbus::FilterCommand& c);
