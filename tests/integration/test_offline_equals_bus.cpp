@@ -318,6 +318,28 @@ TEST(OfflineEqualsBus, FusedReceiversClockJumpCompensatedAsOffline) {
            true});
 }
 
+// The whole redundant installation (seed000_triplex_dual_receivers.yaml): three lanes, each
+// waiting for both of the fault manager's judgements (the parity test's of the IMU data, the
+// cross-receiver test's of the receivers' epochs), and receiver 1's clock jumping 1 ms at 100 s:
+// the one decision, its command applied in every lane before the jumped epoch, and every
+// published solution the offline run's bit for bit.
+TEST(OfflineEqualsBus, TriplexLanesCompensateTheFusedReceiversClockAsOffline) {
+  runCase({118,
+           "seed000_triplex_dual_receivers.yaml",
+           "filter_triplex_receivers.yaml",
+           "",
+           4,
+           160.0,
+           {"selections made without the parity test's judgement (its wait ran out) 0",
+            "commands applied 1 refused 0"},
+           "fault_manager_triplex_receivers.yaml",
+           1,
+           "faults:\n  - {type: receiver_clock_jump, start_s: 100, magnitude_ms: 1, receiver_id: "
+           "1}\n",
+           "navbus/gnss/observations 1:accepted 2:refused",
+           "navbus/gnss/observations 1:accepted 2:accepted"});
+}
+
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->
 // federated -> adaptive, and a structure that does not apply is refused (the solution keeps the
 // last one).
