@@ -60,6 +60,18 @@ std::optional<Rejection> positiveArray(const std::array<double, N>& a, std::stri
   return std::nullopt;
 }
 
+/// One raw sample's own field names (the caller prefixes its place in the block).
+std::optional<Rejection> validateRawSample(const navbus::ImuRawSample& x,
+                                           const ValidationLimits& l) {
+  if (auto r = finiteArray(x.angular_rate_b_radps(), "angular_rate_b_radps")) return r;
+  if (auto r = finiteArray(x.specific_force_b_mps2(), "specific_force_b_mps2")) return r;
+  if (auto r = range(norm(x.angular_rate_b_radps()), 0.0, l.max_angular_rate_radps,
+                     "|angular_rate_b_radps|"))
+    return r;
+  return range(norm(x.specific_force_b_mps2()), 0.0, l.max_specific_force_mps2,
+               "|specific_force_b_mps2|");
+}
+
 }  // namespace
 
 std::string Rejection::describe() const {
@@ -105,16 +117,10 @@ std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const Validation
                      static_cast<double>(s.sample_period_ns())};
   }
   for (std::size_t i = 0; i < s.samples().size(); ++i) {
-    const auto& x = s.samples()[i];
-    const std::string prefix = indexed("samples", i) + ".";
-    if (auto r = finiteArray(x.angular_rate_b_radps(), prefix + "angular_rate_b_radps")) return r;
-    if (auto r = finiteArray(x.specific_force_b_mps2(), prefix + "specific_force_b_mps2")) return r;
-    if (auto r = range(norm(x.angular_rate_b_radps()), 0.0, l.max_angular_rate_radps,
-                       prefix + "|angular_rate_b_radps|"))
+    if (auto r = validateRawSample(s.samples()[i], l)) {
+      r->field = indexed("samples", i) + "." + r->field;  // its place, only when refused
       return r;
-    if (auto r = range(norm(x.specific_force_b_mps2()), 0.0, l.max_specific_force_mps2,
-                       prefix + "|specific_force_b_mps2|"))
-      return r;
+    }
   }
   return std::nullopt;
 }
@@ -124,35 +130,36 @@ std::optional<Rejection> validate(const navbus::GnssObservationEpoch&, const Val
 }
 
 namespace {
+/// The satellite's own field names (the caller prefixes its place in the epoch on a rejection:
+/// a satellite that passes builds no string).
 std::optional<Rejection> screenSatellite(const navbus::GnssSatelliteMeasurement& m,
-                                         const std::string& p, const ValidationLimits& l) {
+                                         const ValidationLimits& l) {
   if (m.sv_id() < 1 || m.sv_id() > 32) {
-    return Rejection{navbus::REJECT_UNKNOWN_SATELLITE, p + "sv_id", static_cast<double>(m.sv_id())};
+    return Rejection{navbus::REJECT_UNKNOWN_SATELLITE, "sv_id", static_cast<double>(m.sv_id())};
   }
-  if (auto r = finite(m.pseudorange_m(), p + "pseudorange_m")) return r;
-  if (auto r = finite(m.pseudorange_rate_mps(), p + "pseudorange_rate_mps")) return r;
-  if (auto r = finiteArray(m.sat_pos_ecef_m(), p + "sat_pos_ecef_m")) return r;
-  if (auto r = finiteArray(m.sat_vel_ecef_mps(), p + "sat_vel_ecef_mps")) return r;
-  if (auto r = finite(m.sat_clock_correction_m(), p + "sat_clock_correction_m")) return r;
-  if (auto r = finite(m.sat_clock_drift_mps(), p + "sat_clock_drift_mps")) return r;
-  if (auto r = finite(m.cn0_dbhz(), p + "cn0_dbhz")) return r;
-  if (auto r = finite(m.pseudorange_sigma_m(), p + "pseudorange_sigma_m")) return r;
-  if (auto r = finite(m.pseudorange_rate_sigma_mps(), p + "pseudorange_rate_sigma_mps")) return r;
-  if (auto r =
-          range(m.pseudorange_m(), l.min_pseudorange_m, l.max_pseudorange_m, p + "pseudorange_m"))
+  if (auto r = finite(m.pseudorange_m(), "pseudorange_m")) return r;
+  if (auto r = finite(m.pseudorange_rate_mps(), "pseudorange_rate_mps")) return r;
+  if (auto r = finiteArray(m.sat_pos_ecef_m(), "sat_pos_ecef_m")) return r;
+  if (auto r = finiteArray(m.sat_vel_ecef_mps(), "sat_vel_ecef_mps")) return r;
+  if (auto r = finite(m.sat_clock_correction_m(), "sat_clock_correction_m")) return r;
+  if (auto r = finite(m.sat_clock_drift_mps(), "sat_clock_drift_mps")) return r;
+  if (auto r = finite(m.cn0_dbhz(), "cn0_dbhz")) return r;
+  if (auto r = finite(m.pseudorange_sigma_m(), "pseudorange_sigma_m")) return r;
+  if (auto r = finite(m.pseudorange_rate_sigma_mps(), "pseudorange_rate_sigma_mps")) return r;
+  if (auto r = range(m.pseudorange_m(), l.min_pseudorange_m, l.max_pseudorange_m, "pseudorange_m"))
     return r;
   if (auto r = range(std::abs(m.pseudorange_rate_mps()), 0.0, l.max_pseudorange_rate_mps,
-                     p + "pseudorange_rate_mps"))
+                     "pseudorange_rate_mps"))
     return r;
   if (auto r = range(norm(m.sat_pos_ecef_m()), l.min_sat_radius_m, l.max_sat_radius_m,
-                     p + "|sat_pos_ecef_m|"))
+                     "|sat_pos_ecef_m|"))
     return r;
-  if (auto r = range(m.cn0_dbhz(), 0.0, 70.0, p + "cn0_dbhz")) return r;
+  if (auto r = range(m.cn0_dbhz(), 0.0, 70.0, "cn0_dbhz")) return r;
   if (auto r = range(m.pseudorange_sigma_m(), l.min_pseudorange_sigma_m, l.max_pseudorange_sigma_m,
-                     p + "pseudorange_sigma_m"))
+                     "pseudorange_sigma_m"))
     return r;
   if (auto r = range(m.pseudorange_rate_sigma_mps(), l.min_pseudorange_rate_sigma_mps,
-                     l.max_pseudorange_rate_sigma_mps, p + "pseudorange_rate_sigma_mps"))
+                     l.max_pseudorange_rate_sigma_mps, "pseudorange_rate_sigma_mps"))
     return r;
   return std::nullopt;
 }
@@ -163,8 +170,8 @@ std::vector<SatelliteRejection> screenSatellites(const navbus::GnssObservationEp
   std::vector<SatelliteRejection> out;
   const auto& sats = s.satellites();
   for (std::size_t i = 0; i < sats.size(); ++i) {
-    const std::string p = indexed("satellites", i) + ".";
-    if (auto r = screenSatellite(sats[i], p, l)) {
+    if (auto r = screenSatellite(sats[i], l)) {
+      r->field = indexed("satellites", i) + "." + r->field;
       out.push_back({i, *r});
       continue;
     }
@@ -172,8 +179,9 @@ std::vector<SatelliteRejection> screenSatellites(const navbus::GnssObservationEp
       return o.sv_id() == sats[i].sv_id();
     };
     if (std::count_if(sats.begin(), sats.end(), same_id) > 1) {
-      out.push_back({i, Rejection{navbus::REJECT_DUPLICATE_SATELLITE, p + "sv_id",
-                                  static_cast<double>(sats[i].sv_id())}});
+      out.push_back(
+          {i, Rejection{navbus::REJECT_DUPLICATE_SATELLITE, indexed("satellites", i) + ".sv_id",
+                        static_cast<double>(sats[i].sv_id())}});
     }
   }
   return out;

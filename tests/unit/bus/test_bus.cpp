@@ -78,6 +78,31 @@ TEST(Validation, RejectsOutOfRangeAndBadIntervals) {
   EXPECT_EQ(r->value, 0.0);
 }
 
+TEST(Validation, ARawBlockNamesTheSampleAndTheFieldRefused) {
+  // Given a raw block of three good samples, then it passes; when the third one's x rate is NaN,
+  // or the second one's specific force beyond the limit, the rejection names that sample.
+  navbus::ImuRawBlock block;
+  block.sensor_id(1);
+  block.sample_period_ns(416'667);
+  for (int i = 0; i < 3; ++i) {
+    navbus::ImuRawSample x;
+    x.specific_force_b_mps2({0.0, 0.0, -9.81});
+    block.samples().push_back(x);
+  }
+  EXPECT_FALSE(validate(block, ValidationLimits{}));
+  block.samples()[2].angular_rate_b_radps()[0] = std::nan("");
+  auto r = validate(block, ValidationLimits{});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->reason, navbus::REJECT_NOT_FINITE);
+  EXPECT_EQ(r->field, "samples[2].angular_rate_b_radps[0]");
+  block.samples()[2].angular_rate_b_radps()[0] = 0.0;
+  block.samples()[1].specific_force_b_mps2()[2] = -1e6;
+  r = validate(block, ValidationLimits{});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->reason, navbus::REJECT_OUT_OF_RANGE);
+  EXPECT_EQ(r->field, "samples[1].|specific_force_b_mps2|");
+}
+
 TEST(Validation, GnssSatellitesScreenedOneByOne) {
   using navbus::bus::screenSatellites;
   EXPECT_TRUE(screenSatellites(goodEpoch(), ValidationLimits{}).empty());
