@@ -275,8 +275,8 @@ void FilterPipeline::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
 void FilterPipeline::pump(std::int64_t now_ns) {
   last_pump_ns_ = now_ns;
   checkImuWriters(now_ns);
-  sequencer_.release(now_ns, [this](StreamId id, std::int64_t time_ns, const FilterInput& in) {
-    process(id, time_ns, in);
+  sequencer_.release(now_ns, [this](StreamId id, std::int64_t time_ns, FilterInput& in) {
+    process(id, time_ns, std::move(in));
   });
 }
 
@@ -300,13 +300,15 @@ void FilterPipeline::flush(std::int64_t now_ns) {
   engine_.closeSmoothingLog();  // post-processing: the last epoch's updates
 }
 
-void FilterPipeline::process(StreamId stream, std::int64_t time_ns, const FilterInput& input) {
-  if (const auto* cmd = std::get_if<CommandInput>(&input);
+void FilterPipeline::process(StreamId stream, std::int64_t time_ns, FilterInput&& owned) {
+  if (const auto* cmd = std::get_if<CommandInput>(&owned);
       cmd != nullptr && !replaying_ && !cmd->reapply) {
     executeCommand(cmd->command);  // checks, records and applies it (or restores and replays)
     return;
   }
-  history_.record(time_ns, {stream, time_ns, input}, engine_);
+  // Kept by the history (moved, not copied) and processed from there.
+  const FilterInput& input =
+      history_.record(time_ns, {stream, time_ns, std::move(owned)}, engine_).input;
   if (first_input_ns_ < 0 && !std::holds_alternative<CommandInput>(input))
     first_input_ns_ = time_ns;
   if (const auto* inc = std::get_if<core::ImuIncrement>(&input)) {

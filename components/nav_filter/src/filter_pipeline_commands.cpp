@@ -147,7 +147,7 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
                     {kRestoredCommandStream, restored_ns, CommandInput{restored_ns, c}}, engine_);
     applied = applyToEngine(c);
     replaying_ = true;
-    for (const MergedInput& item : replay_) process(item.stream, item.time_ns, item.input);
+    for (MergedInput& item : replay_) process(item.stream, item.time_ns, std::move(item.input));
     replaying_ = false;
     spdlog::warn("command {}: filter restored to {:.3f} s (onset {:.3f} s), {} inputs re-processed",
                  c.command_id(), 1e-9 * static_cast<double>(restored_ns),

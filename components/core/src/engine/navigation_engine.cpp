@@ -44,7 +44,7 @@ NavigationEngine::NavigationEngine(const EngineConfig& config)
     noise_scales_[i].configure(stream);
   }
   process_noise_.configure(config.adaptive_process_noise);
-  used_.reserve(32);
+  used_->reserve(32);
   reset();
 }
 
@@ -553,20 +553,20 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   }
   // Excluded measurements stay in the epoch, monitored only (their innovations go to the
   // diagnostics for the readmission test); the diagnostics carry at most 24 satellites.
-  used_.clear();
+  used_->clear();
   bool any = false;
   for (const auto& s : satellites) {
-    if (used_.size() >= static_cast<std::size_t>(kMaxEpochSatellites)) break;
+    if (used_->size() >= static_cast<std::size_t>(kMaxEpochSatellites)) break;
     SatelliteObservation o = s;
     const auto it = excluded_.find(s.sv_id);
     const std::uint8_t mask = it == excluded_.end() ? 0 : it->second;
     o.use_range = (mask & static_cast<std::uint8_t>(SatelliteScope::kRange)) == 0;
     o.use_rate = (mask & static_cast<std::uint8_t>(SatelliteScope::kRate)) == 0;
     any = any || o.use_range || o.use_rate;
-    used_.push_back(o);
+    used_->push_back(o);
   }
   if (aligning()) {
-    aligner_->addPseudoranges(time_ns, used_);  // excluded satellites are not used there either
+    aligner_->addPseudoranges(time_ns, *used_);  // excluded satellites are not used there either
     if (aligner_->aligned()) startFromAlignment();
     return false;
   }
@@ -579,19 +579,19 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   if (course_check_armed_ &&
       filter_->state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
     const PseudorangeFix pf =
-        pseudorangeFix(time_ns, used_, earth::geodeticToEcef(filter_->state().position));
+        pseudorangeFix(time_ns, *used_, earth::geodeticToEcef(filter_->state().position));
     if (pf.valid) checkHeadingFromCourse(pf.fix.vel_ned_mps, pf.fix.vel_sigma_ned_mps.x());
   }
   const double range_factor = noiseSigmaFactor(NoiseStream::kPseudorange);
   const double rate_factor = noiseSigmaFactor(NoiseStream::kPseudorangeRate);
-  for (SatelliteObservation& o : used_) {
+  for (SatelliteObservation& o : *used_) {
     o.pseudorange_sigma_m *= range_factor;
     o.pseudorange_rate_sigma_mps *= rate_factor;
   }
   // P_Q before the updates (zero when the process noise does not adapt).
   const StateMatrix process_part = filter_->processNoisePart();
   const std::vector<MeasurementReport>& reports =
-      filter_->update(used_, AntennaArm{config_.antenna_lever_arm_b_m, bodyRate()});
+      filter_->update(*used_, AntennaArm{config_.antenna_lever_arm_b_m, bodyRate()});
   for (const auto& rep : reports) {
     counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
     if (!rep.fused) continue;

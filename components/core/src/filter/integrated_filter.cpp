@@ -285,14 +285,15 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
     const std::vector<SatelliteObservation>& sats, const AntennaArm& antenna) {
   ErrorState& es = structure_ == FusionStructure::kFederated ? local_[kGnssLocal] : central_;
   const auto m = static_cast<Eigen::Index>(2 * sats.size());
-  EpochDiagnostics& d = last_epoch_;
+  EpochDiagnostics& d = *last_epoch_;
   d.sv_ids.clear();
   d.is_rate.clear();
   d.used.clear();
   d.test_ratio.clear();
   d.innovation.resize(m);
   d.h.resize(m, kSize);
-  Eigen::VectorXd r(m);
+  Eigen::VectorXd& r = *range_variances_;
+  r.resize(m);
   const std::vector<int>& error_state = pseudorangeErrorStates(sats);
   for (std::size_t i = 0; i < sats.size(); ++i) {
     const auto& sat = sats[i];
@@ -321,7 +322,7 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   d.innovation_cov.diagonal() += r;
   d.phi = phi_since_update_t_.transpose();
   prior_P_ = es.P();
-  std::vector<MeasurementReport>& reports = reports_;
+  std::vector<MeasurementReport>& reports = *reports_;
   reports.clear();
   for (Eigen::Index row = 0; row < m; ++row) {
     ScalarUpdateResult res;
@@ -345,9 +346,9 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
     reports.push_back({d.sv_ids[static_cast<std::size_t>(row)],
                        d.is_rate[static_cast<std::size_t>(row)], fuse, res});
   }
-  applied_gain_.compute(last_epoch_, prior_P_);
+  applied_gain_->compute(d, prior_P_);
   closeUpdate();
-  return reports_;
+  return reports;
 }
 
 bool IntegratedFilter::modelsFixPositionError() const {
@@ -368,12 +369,13 @@ bool IntegratedFilter::modelsPseudorangeErrors() const {
 const std::vector<int>& IntegratedFilter::pseudorangeErrorStates(
     const std::vector<SatelliteObservation>& sats) {
   if (!modelsPseudorangeErrors()) {
-    no_error_states_.assign(sats.size(), -1);
-    return no_error_states_;
+    no_error_states_->assign(sats.size(), -1);
+    return *no_error_states_;
   }
-  epoch_sv_ids_.clear();
-  for (const SatelliteObservation& sat : sats) epoch_sv_ids_.push_back(sat.sv_id);
-  const PseudorangeErrorSlots::Assignment& a = pseudorange_errors_.assign(epoch_sv_ids_);
+  std::vector<int>& sv_ids = *epoch_sv_ids_;
+  sv_ids.clear();
+  for (const SatelliteObservation& sat : sats) sv_ids.push_back(sat.sv_id);
+  const PseudorangeErrorSlots::Assignment& a = pseudorange_errors_.assign(sv_ids);
   for (const int i : a.fresh) resetState(i, tuning_.pseudorange_error_sigma_m);
   return a.state_index;
 }

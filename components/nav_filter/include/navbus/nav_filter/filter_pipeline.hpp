@@ -195,7 +195,7 @@ class FilterPipeline {
   void useGnssFix(const navbus::GnssFix& m);
   void useStarTracker(const navbus::StarTrackerAttitude& m);
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
-  void process(StreamId stream, std::int64_t time_ns, const FilterInput& input);
+  void process(StreamId stream, std::int64_t time_ns, FilterInput&& owned);
   /// A sample whose place in the order was already passed: the engine is restored to before
   /// it (input history) and what followed is merged again with it. False beyond the history.
   bool mergeLate(StreamId id, std::int64_t time_ns, FilterInput& input);

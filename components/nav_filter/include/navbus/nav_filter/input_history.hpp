@@ -38,9 +38,13 @@ class InputHistory {
 
   bool enabled() const { return span_ns_ > 0; }
 
-  /// Called before `engine` processes `item` at data time `time_ns`.
-  void record(std::int64_t time_ns, const Item& item, const core::NavigationEngine& engine) {
-    if (!enabled()) return;
+  /// Called before `engine` processes `item` at data time `time_ns`; returns the item as kept
+  /// (moved in: an epoch's satellites are not copied), which the caller then processes.
+  const Item& record(std::int64_t time_ns, Item&& item, const core::NavigationEngine& engine) {
+    if (!enabled()) {
+      unkept_ = std::move(item);
+      return unkept_;
+    }
     if (snapshots_.empty() || time_ns - snapshots_.back().time_ns >= snapshot_period_ns_) {
       const std::size_t first_item = first_index_ + items_.size();
       // The engine owns heap storage: every snapshot slot the span needs is made at the first
@@ -61,7 +65,8 @@ class InputHistory {
             s.engine = engine;  // copy-assigned: storage reused
           });
     }
-    items_.push_back(item);
+    items_.push_back(std::move(item));
+    const Item& kept = items_.back();
     latest_ns_ = std::max(latest_ns_, time_ns);
     // Forget snapshots (and the items before them) older than the span, keeping one.
     while (snapshots_.size() > 1 && time_ns - snapshots_[1].time_ns >= span_ns_) {
@@ -71,6 +76,7 @@ class InputHistory {
       items_.pop_front();
       ++first_index_;
     }
+    return kept;
   }
 
   /// Restores the engine to the latest snapshot whose state is not later than `onset_ns` and
@@ -134,6 +140,7 @@ class InputHistory {
   // Ring buffers: in the steady state (as many forgotten as recorded) nothing is allocated.
   core::RingBuffer<Snapshot> snapshots_;
   core::RingBuffer<Item> items_;
+  Item unkept_{};               ///< the item being processed when the history is off
   std::size_t first_index_{0};  ///< absolute index of items_.front()
   /// Latest data time of the items recorded (the merge releases in time order, but a command
   /// applied at once is recorded at the engine's time, which may be earlier).

@@ -120,9 +120,10 @@ class InputSequencer {
     s.active = true;
   }
 
-  /// Hands every releasable sample, in order, to consume(id, time_ns, payload).
+  /// Hands every releasable sample, in order, to consume(id, time_ns, payload) (the payload is
+  /// the consumer's: it may move from it).
   void release(std::int64_t wall_now_ns,
-               const std::function<void(StreamId, std::int64_t, const Payload&)>& consume) {
+               const std::function<void(StreamId, std::int64_t, Payload&)>& consume) {
     while (head_ < queue_.size()) {
       const Key key = queue_[head_].first;
       const std::vector<StreamId>& blocking = blockingStreams(key);
@@ -141,7 +142,7 @@ class InputSequencer {
       released_any_ = true;
       // Moved out first: consume may push more samples (a command in answer to this one),
       // which may move the buffer.
-      const Payload payload = std::move(queue_[head_++].second);
+      Payload payload = std::move(queue_[head_++].second);
       consume(key.stream, key.time_ns, payload);
     }
     compact();

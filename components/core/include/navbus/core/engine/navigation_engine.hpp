@@ -31,6 +31,7 @@
 #include "navbus/core/integrity/fix_innovation_log.hpp"
 #include "navbus/core/integrity/protection_level_config.hpp"
 #include "navbus/core/math/indirect.hpp"
+#include "navbus/core/math/scratch.hpp"
 
 namespace navbus::core {
 
@@ -353,8 +354,10 @@ class NavigationEngine {
   EngineMode mode_{EngineMode::kInitializing};
   std::uint32_t status_{0};
   EngineCounters counters_;
-  std::map<int, std::uint8_t> excluded_;    ///< sv -> SatelliteScope bits excluded
-  std::vector<SatelliteObservation> used_;  ///< reused buffer of the satellites fused
+  std::map<int, std::uint8_t> excluded_;  ///< sv -> SatelliteScope bits excluded
+  /// Reused buffer of the satellites fused (each epoch rewrites it: not in the recovery
+  /// history's copies of the engine).
+  Scratch<std::vector<SatelliteObservation>> used_;
   Eigen::Vector3d accel_compensation_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_compensation_{Eigen::Vector3d::Zero()};
   std::uint8_t failed_axes_{0};  ///< bit i: accelerometer i (0-2), gyro i - 3 (3-5)

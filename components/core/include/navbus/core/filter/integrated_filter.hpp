@@ -29,6 +29,7 @@
 #include "navbus/core/ins/imu_correction.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 #include "navbus/core/math/kalman_update.hpp"
+#include "navbus/core/math/scratch.hpp"
 
 namespace navbus::core {
 
@@ -179,7 +180,7 @@ class IntegratedFilter {
   /// That part (zero unless tracked; ErrorState::processNoisePart), and its restart.
   StateMatrix processNoisePart() const { return central_.processNoisePart(); }
   void forgetProcessNoise() { central_.forgetProcessNoise(); }
-  const EpochDiagnostics& lastEpoch() const { return last_epoch_; }
+  const EpochDiagnostics& lastEpoch() const { return *last_epoch_; }
   void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
   /// Records what a fixed-interval smoother needs into `log` (nullptr: nothing recorded, the
   /// default), from the next increment on (rts_smoother.hpp). Not owned.
@@ -230,12 +231,16 @@ class IntegratedFilter {
   StateMatrix phi_since_update_t_{StateMatrix::Identity()};
   bool keep_transition_{true};
   double process_noise_scale_{1.0};  ///< on the inertial process noise (setProcessNoiseScale)
-  EpochDiagnostics last_epoch_;
+  // The latest epoch's outputs and the update's working buffers: each update rewrites them
+  // before it reads them, so the recovery history's copies of the filter leave them out
+  // (Scratch: an engine snapshot copies no epoch's diagnostics, a restore keeps the buffers).
+  Scratch<EpochDiagnostics> last_epoch_;
   StateMatrix prior_P_{StateMatrix::Zero()};  ///< P- of the latest GNSS epoch
-  AppliedGain applied_gain_;                  ///< the diagnostics' K from the sequential updates
-  std::vector<MeasurementReport> reports_;
-  std::vector<int> epoch_sv_ids_;     ///< the satellites of the epoch being processed
-  std::vector<int> no_error_states_;  ///< -1 per satellite: errors not modelled
+  Scratch<AppliedGain> applied_gain_;         ///< the diagnostics' K from the sequential updates
+  Scratch<std::vector<MeasurementReport>> reports_;
+  Scratch<Eigen::VectorXd> range_variances_;   ///< R's diagonal of the epoch being processed
+  Scratch<std::vector<int>> epoch_sv_ids_;     ///< the satellites of the epoch being processed
+  Scratch<std::vector<int>> no_error_states_;  ///< -1 per satellite: errors not modelled
   Eigen::Vector3d accel_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d accel_scale_{Eigen::Vector3d::Zero()};
