@@ -41,6 +41,13 @@ std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoc
 std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& m,
                                                const std::vector<SatelliteRejection>& dropped) {
   std::vector<core::SatelliteObservation> out;
+  toCore(m, dropped, out);
+  return out;
+}
+
+void toCore(const navbus::GnssObservationEpoch& m, const std::vector<SatelliteRejection>& dropped,
+            std::vector<core::SatelliteObservation>& out) {
+  out.clear();
   out.reserve(m.satellites().size());
   for (std::size_t i = 0; i < m.satellites().size(); ++i) {
     const auto& s = m.satellites()[i];
@@ -52,7 +59,6 @@ std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoc
                    s.pseudorange_rate_mps() + s.sat_clock_drift_mps(), s.pseudorange_sigma_m(),
                    s.pseudorange_rate_sigma_mps()});
   }
-  return out;
 }
 
 navbus::ImuIncrement toIdl(const core::ImuIncrement& inc, std::uint32_t sensor_id,

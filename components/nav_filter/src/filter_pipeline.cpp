@@ -85,6 +85,21 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
                  config.time_jump, &time_reference_),
       commands_(config, health.stream(bus::topic::kFilterCommand), sinks_.command_outcome) {
   receivers_judged_ = config.fault_monitor && config.fault_monitor->receivers_judged;
+  spare_satellite_lists_.reserve(kSpareSatelliteLists);
+}
+
+std::vector<core::SatelliteObservation> FilterPipeline::spareSatelliteList() {
+  if (spare_satellite_lists_.empty()) return {};
+  std::vector<core::SatelliteObservation> list = std::move(spare_satellite_lists_.back());
+  spare_satellite_lists_.pop_back();
+  return list;
+}
+
+void FilterPipeline::keepSatelliteList(MergedInput* overwritten) {
+  if (overwritten == nullptr || spare_satellite_lists_.size() >= kSpareSatelliteLists) return;
+  auto* epoch = std::get_if<GnssEpochInput>(&overwritten->input);
+  if (epoch == nullptr || epoch->satellites.capacity() == 0) return;
+  spare_satellite_lists_.push_back(std::move(epoch->satellites));
 }
 
 void FilterPipeline::queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns,
@@ -198,8 +213,9 @@ void FilterPipeline::useGnssObservations(const navbus::GnssObservationEpoch& m) 
     gnss_obs_gate_.rejectElement(d.rejection, m.receiver_id());
   const std::int64_t time_ns =
       static_cast<std::int64_t>(m.time_gps_ns()) + config_.gnss_observations->time_offset_ns;
-  queue(gnss_obs_gate_, {kRankGnssObs, m.receiver_id()}, time_ns,
-        GnssEpochInput{time_ns, bus::toCore(m, dropped)});
+  GnssEpochInput epoch{time_ns, spareSatelliteList()};
+  bus::toCore(m, dropped, epoch.satellites);
+  queue(gnss_obs_gate_, {kRankGnssObs, m.receiver_id()}, time_ns, std::move(epoch));
 }
 
 void FilterPipeline::onGnssFix(const navbus::GnssFix& m) {
@@ -306,6 +322,7 @@ void FilterPipeline::process(StreamId stream, std::int64_t time_ns, FilterInput&
     executeCommand(cmd->command);  // checks, records and applies it (or restores and replays)
     return;
   }
+  keepSatelliteList(history_.overwritten());
   // Kept by the history (moved, not copied) and processed from there.
   const FilterInput& input =
       history_.record(time_ns, {stream, time_ns, std::move(owned)}, engine_).input;

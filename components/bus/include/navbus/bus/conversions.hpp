@@ -39,6 +39,9 @@ std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoc
 /// The same without the satellites screenSatellites() dropped.
 std::vector<core::SatelliteObservation> toCore(const navbus::GnssObservationEpoch& msg,
                                                const std::vector<SatelliteRejection>& dropped);
+/// The same into `out` (cleared first; its storage reused).
+void toCore(const navbus::GnssObservationEpoch& msg, const std::vector<SatelliteRejection>& dropped,
+            std::vector<core::SatelliteObservation>& out);
 
 /// The tightly coupled filter's state layout (core::layout) as the diagnostics declare it.
 void fillStateLayout(navbus::FilterDiagnostics& msg);

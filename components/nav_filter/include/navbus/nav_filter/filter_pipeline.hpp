@@ -195,6 +195,11 @@ class FilterPipeline {
   void useGnssFix(const navbus::GnssFix& m);
   void useStarTracker(const navbus::StarTrackerAttitude& m);
   void queue(bus::StreamGate& gate, StreamId id, std::int64_t time_ns, FilterInput input);
+  /// A pseudorange epoch's satellite list: one the recovery history has forgotten (its storage
+  /// kept, keepSatelliteList), else a new one. In the steady state the epochs allocate nothing.
+  std::vector<core::SatelliteObservation> spareSatelliteList();
+  /// Keeps the satellite list of the input the history is about to overwrite, for a next epoch.
+  void keepSatelliteList(MergedInput* overwritten);
   void process(StreamId stream, std::int64_t time_ns, FilterInput&& owned);
   /// A sample whose place in the order was already passed: the engine is restored to before
   /// it (input history) and what followed is merged again with it. False beyond the history.
@@ -221,6 +226,8 @@ class FilterPipeline {
   bool owe_imu_judgement_{false};
   /// fault_monitor.receivers_judged: each epoch's successor waits for the receivers' judgement.
   bool receivers_judged_{false};
+  static constexpr std::size_t kSpareSatelliteLists = 4;
+  std::vector<std::vector<core::SatelliteObservation>> spare_satellite_lists_;
   std::int64_t gnss_judged_passed_ns_{0};  ///< the receivers' judgement handed to the merge
   /// Propagates the low-latency output with an arrived increment and publishes it.
   void publishLowLatency(const core::ImuIncrement& inc);

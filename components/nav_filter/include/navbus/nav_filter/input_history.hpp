@@ -38,6 +38,10 @@ class InputHistory {
 
   bool enabled() const { return span_ns_ > 0; }
 
+  /// The item the next record() overwrites (one forgotten before), whose storage the caller may
+  /// take for a new input first; nullptr if none.
+  Item* overwritten() { return enabled() ? items_.nextSlot() : &unkept_; }
+
   /// Called before `engine` processes `item` at data time `time_ns`; returns the item as kept
   /// (moved in: an epoch's satellites are not copied), which the caller then processes.
   const Item& record(std::int64_t time_ns, Item&& item, const core::NavigationEngine& engine) {
@@ -127,7 +131,7 @@ class InputHistory {
       engine = s.engine;
       replay.clear();
       const std::size_t from = s.first_item - first_index_;
-      for (std::size_t k = from; k < items_.size(); ++k) replay.push_back(items_[k]);
+      for (std::size_t k = from; k < items_.size(); ++k) replay.push_back(std::move(items_[k]));
       items_.truncate(from);
       snapshots_.truncate(i);
       return true;

@@ -59,6 +59,13 @@ class RingBuffer {
       if (!s) s.emplace(make());
     }
   }
+  /// The object the next push_back assigns to (an element popped or truncated before, whose
+  /// storage the caller may take first), or nullptr when that slot is empty or the buffer grows.
+  T* nextSlot() {
+    if (size_ == slots_.size()) return nullptr;
+    std::optional<T>& s = slots_[slot(size_)];
+    return s ? &*s : nullptr;
+  }
   void pop_front() {
     head_ = slot(1);
     --size_;
