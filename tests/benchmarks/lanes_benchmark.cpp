@@ -13,39 +13,15 @@
 #include <variant>
 #include <vector>
 
+#include "filter_samples.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/lane_set.hpp"
-#include "navbus/sensor_sim/frame_publisher.hpp"
-#include "navbus/sensor_sim/scenario_config.hpp"
-#include "navbus/sim/scenario_source.hpp"
 
 namespace {
 
 using namespace navbus;
-
-using Sample = std::variant<ImuIncrement, GnssObservationEpoch, GnssFix>;
-
-/// The samples the simulator participant would publish, one vector per IMU cycle.
-std::vector<std::vector<Sample>> makeSamples(const sensor_sim::SimConfig& sim, int cycles) {
-  sim::ScenarioSource src(sim.scenario);
-  sensor_sim::SimConfig emitted = sim;
-  emitted.publish_raw = false;
-  emitted.publish_star_tracker = false;
-  sensor_sim::FrameSequence seq;
-  std::vector<std::vector<Sample>> out(static_cast<std::size_t>(cycles));
-  for (auto& cycle : out) {
-    sensor_sim::emitFrame(src.next(), emitted, seq, [&cycle](const auto& s) {
-      using T = std::decay_t<decltype(s)>;
-      if constexpr (std::is_same_v<T, ImuIncrement> || std::is_same_v<T, GnssObservationEpoch> ||
-                    std::is_same_v<T, GnssFix>)
-        cycle.emplace_back(s);
-      return true;
-    });
-  }
-  return out;
-}
 
 nav_filter::FilterConfig filterConfig(const std::string& path) {
   YAML::Node yaml = bus::loadYamlFile(path);
@@ -55,8 +31,9 @@ nav_filter::FilterConfig filterConfig(const std::string& path) {
 
 /// One pass over the samples: seconds spent after `warmup` cycles. `unit_one_only`: the other
 /// units' increments are not fed (a one-IMU filter beside the triplex would refuse them).
-double pass(const nav_filter::FilterConfig& cfg, const std::vector<std::vector<Sample>>& samples,
-            std::size_t warmup, bool unit_one_only, std::uint64_t& solutions) {
+double pass(const nav_filter::FilterConfig& cfg,
+            const std::vector<std::vector<bench::FilterSample>>& samples, std::size_t warmup,
+            bool unit_one_only, std::uint64_t& solutions) {
   bus::HealthCounters health("lanes-benchmark");
   nav_filter::LaneSet lanes(cfg, health,
                             {{[&](const NavigationSolution&) { ++solutions; }, nullptr}, nullptr});
@@ -64,21 +41,10 @@ double pass(const nav_filter::FilterConfig& cfg, const std::vector<std::vector<S
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const auto t0 = std::chrono::steady_clock::now();
     std::int64_t now = 0;
-    for (const Sample& s : samples[k]) {
-      std::visit(
-          [&](const auto& m) {
-            using T = std::decay_t<decltype(m)>;
-            if constexpr (std::is_same_v<T, ImuIncrement>) {
-              if (unit_one_only && m.sensor_id() != cfg.imu.id) return;
-              lanes.onImu(m);
-              now = static_cast<std::int64_t>(m.time_gps_ns());
-            } else if constexpr (std::is_same_v<T, GnssObservationEpoch>) {
-              lanes.onGnssObservations(m);
-            } else {
-              lanes.onGnssFix(m);
-            }
-          },
-          s);
+    for (const bench::FilterSample& s : samples[k]) {
+      const auto* inc = std::get_if<ImuIncrement>(&s);
+      if (unit_one_only && inc != nullptr && inc->sensor_id() != cfg.imu.id) continue;
+      now = std::max(now, bench::feed(lanes, s));
     }
     lanes.pump(now);
     const auto t1 = std::chrono::steady_clock::now();
@@ -102,7 +68,7 @@ int main(int argc, char** argv) {
       sensor_sim::parseSimConfig(bus::loadYamlFile(root + "/sim/scenarios/seed000_triplex.yaml"));
   const nav_filter::FilterConfig one = filterConfig(root + "/config/filter_seed000_tc.yaml");
   const nav_filter::FilterConfig three = filterConfig(root + "/config/filter_triplex.yaml");
-  const auto samples = makeSamples(sim, cycles);
+  const auto samples = bench::filterSamples(sim, cycles);
   // Warm-up: longer than the recovery history, so that its queues are at their steady size.
   const auto warmup = static_cast<std::size_t>(
       std::min<double>(cycles / 2, 1.5 * 1e-9 * static_cast<double>(one.recovery_history_ns) /

@@ -5,47 +5,24 @@
 // it, after a warm-up longer than the recovery history. Prints the time and heap allocations per
 // IMU cycle in the steady state; exits 1 with --require-zero-allocations if any cycle of either
 // case allocated.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "allocation_counter.hpp"
+#include "filter_samples.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
-#include "navbus/sensor_sim/frame_publisher.hpp"
-#include "navbus/sensor_sim/scenario_config.hpp"
-#include "navbus/sim/scenario_source.hpp"
 
 namespace {
 
 using namespace navbus;
-
-using Sample = std::variant<ImuIncrement, GnssObservationEpoch, GnssFix, StarTrackerAttitude>;
-
-/// The samples the simulator participant would publish, one vector per IMU cycle.
-std::vector<std::vector<Sample>> makeSamples(const sensor_sim::SimConfig& sim, int cycles) {
-  sim::ScenarioSource src(sim.scenario);
-  sensor_sim::SimConfig emitted = sim;
-  emitted.publish_raw = false;
-  sensor_sim::FrameSequence seq;
-  std::vector<std::vector<Sample>> out(static_cast<std::size_t>(cycles));
-  for (auto& cycle : out) {
-    sensor_sim::emitFrame(src.next(), emitted, seq, [&cycle](const auto& s) {
-      using T = std::decay_t<decltype(s)>;
-      if constexpr (std::is_same_v<T, ImuIncrement> || std::is_same_v<T, GnssObservationEpoch> ||
-                    std::is_same_v<T, GnssFix> || std::is_same_v<T, StarTrackerAttitude>)
-        cycle.emplace_back(s);
-      return true;
-    });
-  }
-  return out;
-}
 
 /// One case: the scenario's samples through a FilterPipeline with the filter file (the
 /// low-latency output on, no fault monitor); prints its figures and returns the IMU cycles that
@@ -57,7 +34,7 @@ std::uint64_t runCase(const std::string& label, const std::string& scenario,
   filter_yaml["low_latency_output"]["enabled"] = true;
   filter_yaml.remove("fault_monitor");  // no fault manager here: no judgement to wait for
   const nav_filter::FilterConfig cfg = nav_filter::parseFilterConfig(filter_yaml);
-  const auto samples = makeSamples(sim, cycles);
+  const auto samples = bench::filterSamples(sim, cycles);
 
   bus::HealthCounters health("pipeline-benchmark");
   NavigationSolution last, last_fast;
@@ -83,23 +60,7 @@ std::uint64_t runCase(const std::string& label, const std::string& scenario,
     const std::uint64_t before = bench::g_allocations.load();
     const auto t0 = std::chrono::steady_clock::now();
     std::int64_t now = 0;
-    for (const Sample& s : samples[k]) {
-      std::visit(
-          [&](const auto& m) {
-            using T = std::decay_t<decltype(m)>;
-            if constexpr (std::is_same_v<T, ImuIncrement>) {
-              pipeline.onImu(m);
-              now = static_cast<std::int64_t>(m.time_gps_ns());
-            } else if constexpr (std::is_same_v<T, GnssObservationEpoch>) {
-              pipeline.onGnssObservations(m);
-            } else if constexpr (std::is_same_v<T, GnssFix>) {
-              pipeline.onGnssFix(m);
-            } else {
-              pipeline.onStarTracker(m);
-            }
-          },
-          s);
-    }
+    for (const bench::FilterSample& s : samples[k]) now = std::max(now, bench::feed(pipeline, s));
     pipeline.pump(now);
     const auto t1 = std::chrono::steady_clock::now();
     if (k < warmup) continue;
