@@ -111,7 +111,9 @@ void ReceiverDetector::receiverGone(std::uint32_t id, std::int64_t last_time_ns,
   const int r = receiverOf(id);
   if (r < 0) return;
   const auto rx = static_cast<std::size_t>(r);
-  gone_after_ns_[rx] = std::max(last_time_ns, latest_ns_[rx]);
+  const std::int64_t gone_after_ns = std::max(last_time_ns, latest_ns_[rx]);
+  if (gone_after_ns == gone_after_ns_[rx]) return;  // told again (by another reader)
+  gone_after_ns_[rx] = gone_after_ns;
   spdlog::info(
       "receiver detector: receiver {} ended or lost after {:.3f} s: later times are "
       "tested without it",

@@ -606,11 +606,10 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   parseStart(root["initial_state"], e);
   parseInputs(root["inputs"], c);
   checkModeAgainstInputs(root, c);
-  if (c.fault_monitor && c.fault_monitor->receivers_judged &&
-      (!c.gnss_observations || c.gnss_observations->period_ns <= 0))
+  if (c.fault_monitor && c.fault_monitor->receivers_judged && !c.gnss_observations)
     throw bus::ConfigError(
-        "configuration fault_monitor.receivers_judged = true needs inputs.gnss_observations "
-        "with its period_s (the epoch after one is held for the receivers' judgement)");
+        "configuration fault_monitor.receivers_judged = true needs inputs.gnss_observations (the "
+        "epoch after one is held for the receivers' judgement)");
   parseEkf(root["ekf"], e);
   parseFailedAxis(root["failed_axis"], e.tuning);
   parseFusionTuning(root, e.tuning);

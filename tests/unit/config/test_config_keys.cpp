@@ -114,6 +114,21 @@ TEST_F(ConfigKeys, WithoutAnInitialStateTheFilterAlignsAndNeedsAGnssPosition) {
   EXPECT_NE(errorOf(range, filter).find("alignment.course_sigma_deg"), std::string::npos);
 }
 
+TEST_F(ConfigKeys, WaitingForTheReceiversJudgementNeedsTheirEpochs) {
+  // fault_monitor.receivers_judged holds the epoch after one for the fault manager's judgement
+  // (its period is required of every input): a filter without pseudorange epochs is refused
+  // naming the key; config/filter_dual_receivers.yaml passes.
+  const std::string loose = write("loose.yaml", "extends: " + kSrc +
+                                                    "/filter_seed001_lc.yaml\n"
+                                                    "fault_monitor: {receivers_judged: true}\n");
+  EXPECT_NE(errorOf(loose, filter)
+                .find("fault_monitor.receivers_judged = true needs inputs.gnss_observations"),
+            std::string::npos)
+      << errorOf(loose, filter);
+  EXPECT_TRUE(navbus::bus::parseFile(kSrc + "/filter_dual_receivers.yaml", filter)
+                  .fault_monitor->receivers_judged);
+}
+
 TEST_F(ConfigKeys, TypoInAnExtendedFileNamesThatFile) {
   const std::string base =
       write("base.yaml", "extends: " + kSrc + "/fault_manager.yaml\nglr: {thresold: 40}\n");

@@ -149,6 +149,7 @@ TEST(ReceiverDetector, AReceiverGoneIsNotWaitedForBeyondItsLastEpochAndIsAgainWh
   }
   EXPECT_EQ(detector.testedUpToNs(), kT0 + 99 * kSecond);
   detector.receiverGone(2, kT0 + 99 * kSecond, out);
+  detector.receiverGone(2, kT0 + 99 * kSecond, out);  // told again by another reader: no change
   EXPECT_EQ(detector.testedUpToNs(), kT0 + 149 * kSecond);
   EXPECT_EQ(detector.counters().incomplete, 50u);
   EXPECT_EQ(detector.counters().tested, 100u);

@@ -46,7 +46,7 @@ struct FaultMonitorWatch {
   /// The monitor's cross-receiver test judges the receivers' epochs
   /// (FaultMonitorProgress.gnss_judged_up_to_gps_ns): an epoch is fused only once the time
   /// before it is judged, so that a clock jump or a satellite decided there is compensated or
-  /// excluded before it, as offline (needs gnss_observations with its period).
+  /// excluded before it, as offline (needs gnss_observations).
   bool receivers_judged{false};
 };
 
