@@ -340,6 +340,34 @@ TEST(OfflineEqualsBus, TriplexLanesCompensateTheFusedReceiversClockAsOffline) {
            "navbus/gnss/observations 1:accepted 2:accepted"});
 }
 
+// Two parallel units (seed000_dual_parallel.yaml), unit 1's x gyro stepping 10 deg/h at 100 s:
+// the parity test cannot say which unit (one ambiguous decision) and names both as suspects
+// (CMD_RELEARN_BIAS and CMD_SUSPECT_SENSOR_AXIS for each); both lanes re-learn that bias from the
+// onset, and the selection, comparing their estimates at each time, names unit 1 and leaves its
+// lane. The lanes wait for the parity test's judgement, which comes after its commands: the
+// naming and the switch at the same data time on the bus as offline, every published solution
+// bit for bit.
+TEST(OfflineEqualsBus, ParallelLanesNameTheFaultyUnitAsOffline) {
+  runCase(
+      {120,
+       "seed000_dual_parallel.yaml",
+       "filter_dual_parallel.yaml",
+       "",
+       3,
+       160.0,
+       {"lanes: IMU 1 gyro axis x named at", "lanes: switched from IMU 1 to IMU 2", "switches 1,",
+        "selections made without the parity test's judgement (its wait ran out) 0",
+        "suspect units compared 1, named 1,",
+        // lane IMU 1: its re-learn and both suspects (the lanes' commands, answered by lane 0)
+        "commands applied 3 refused 0"},
+       "fault_manager_dual_parallel.yaml",
+       1,
+       "faults:\n  - {type: imu_bias_step, sensor: gyro, axis: x, start_s: 100,\n"
+       "     magnitude_deg_per_h: 10, sensor_id: 1}\n",
+       "navbus/imu/increment_block 1:accepted 2:accepted",
+       "navbus/imu/increment 1:accepted 2:accepted"});
+}
+
 // Run-time switching of the fusion structure by CMD_SELECT_FUSION (seed 001): centralized ->
 // federated -> adaptive, and a structure that does not apply is refused (the solution keeps the
 // last one).

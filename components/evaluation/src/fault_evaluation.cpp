@@ -141,6 +141,35 @@ std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule) {
   return std::nullopt;
 }
 
+namespace {
+/// The first naming of one source after the fault: a decision that is not ambiguous, or the
+/// lanes' choice between two suspects, whichever came first.
+void noteNamed(const OfflineResult& r, const sim::Fault& fault, std::int64_t start_ns,
+               FaultRunOutcome& out) {
+  auto seconds = [start_ns](std::int64_t t_ns) {
+    return 1e-9 * static_cast<double>(t_ns - start_ns);
+  };
+  for (const navbus::FaultDecision& d : r.decisions) {
+    const double t = seconds(static_cast<std::int64_t>(d.time_gps_ns()));
+    if (d.event() != navbus::EVENT_FAULT_DETECTED || d.ambiguous() || t < fault.start_s) continue;
+    out.named_s = t;
+    out.named_correct = matches(fault, d.source(), d.sv_id(), d.axis(), parityUnit(d));
+    break;
+  }
+  for (const OfflineResult::LaneNaming& n : r.lanes_named) {
+    const double t = seconds(n.time_ns);
+    if (t < fault.start_s) continue;
+    if (std::isnan(out.named_s) || t < out.named_s) {
+      out.named_s = t;
+      out.named_correct =
+          matches(fault, n.accelerometer ? navbus::SOURCE_ACCELEROMETER : navbus::SOURCE_GYRO, 0,
+                  n.axis, n.sensor_id);
+    }
+    break;
+  }
+}
+}  // namespace
+
 FaultRunOutcome evaluateRun(const OfflineResult& r, const std::optional<sim::Fault>& fault,
                             std::int64_t start_ns, std::uint64_t seed) {
   FaultRunOutcome out;
@@ -190,8 +219,38 @@ FaultRunOutcome evaluateRun(const OfflineResult& r, const std::optional<sim::Fau
     }
     out.recovery_s = recoveryTime(r.errors, static_cast<std::int64_t>(d.time_gps_ns()));
   }
+  if (fault) noteNamed(r, *fault, start_ns, out);
   return out;
 }
+
+namespace {
+void printNamed(const sim::Fault& fault, const std::vector<FaultRunOutcome>& runs) {
+  int right = 0, wrong = 0, never = 0, within_60 = 0;
+  double sum = 0.0, most = 0.0;
+  for (const FaultRunOutcome& o : runs) {
+    if (!o.detected) continue;
+    if (std::isnan(o.named_s)) {
+      ++never;
+      continue;
+    }
+    if (!o.named_correct) {
+      ++wrong;
+      continue;
+    }
+    ++right;
+    const double after = o.named_s - fault.start_s;
+    sum += after;
+    most = std::max(most, after);
+    within_60 += after <= 60.0 ? 1 : 0;
+  }
+  std::printf(
+      "  named (a decision not ambiguous, or the lanes' choice between two suspects): the faulty "
+      "source in %d runs (within 60 s of the onset in %d; after it %.1f s on average, %.1f s at "
+      "most), another in %d, never in %d\n",
+      right, within_60, right ? sum / right : std::nan(""), right ? most : std::nan(""), wrong,
+      never);
+}
+}  // namespace
 
 void printFaultTable(const std::string& label, const std::optional<sim::Fault>& fault,
                      const std::vector<FaultRunOutcome>& runs, double hours_per_run) {
@@ -255,6 +314,7 @@ void printFaultTable(const std::string& label, const std::optional<sim::Fault>& 
         recovery.empty() ? std::nan("") : recovery[recovery.size() / 2], recovered_10s, detected,
         detected - recovered);
   }
+  if (fault && detected) printNamed(*fault, runs);
   std::printf("  false alarms: %d in %.2f h of data (%.3f per hour)%s\n", false_alarms,
               n * hours_per_run, false_alarms / std::max(n * hours_per_run, 1e-9),
               fault ? " (before the fault)" : "");

@@ -210,6 +210,7 @@ void ParityDetector::report(std::int64_t time_ns, const core::ImuArrayDetection&
     navbus::FaultCandidate second = best;
     second.sensor_id(config_.sensor_ids[static_cast<std::size_t>(det.runner_up_unit)]);
     second.axis(static_cast<std::uint16_t>(det.runner_up_axis));
+    second.magnitude(det.runner_up_magnitude);
     d.candidates().push_back(second);
   }
   const std::uint32_t id = out.decide(d);
@@ -231,8 +232,27 @@ void ParityDetector::report(std::int64_t time_ns, const core::ImuArrayDetection&
   if (!still)
     spdlog::warn("parity detector: the {}s left have no parity: {} detection stops",
                  kindName(det.kind), kindName(det.kind));
-  if (ambiguous || !config_.fail_axes) return;   // which one: the lanes' evidence, not ours
+  if (!config_.fail_axes) return;
   navbus::FilterCommand c = failAxisCommand(d);  // decide() stamped its id
+  if (ambiguous) {
+    // Which one: not ours to say. Both are suspects: each one's lane re-learns that bias from
+    // the onset (its variance grows to the size found), and the filter's lanes compare their
+    // estimates since the onset and leave the one that moved (or that fails its own test).
+    for (const auto kind : {navbus::CMD_RELEARN_BIAS, navbus::CMD_SUSPECT_SENSOR_AXIS}) {
+      c.kind(kind);
+      c.bias(0.0);
+      c.bias_sigma(kind == navbus::CMD_RELEARN_BIAS
+                       ? std::max(std::abs(det.magnitude), 3.0 * det.magnitude_sigma)
+                       : 0.0);
+      for (const navbus::FaultCandidate& candidate : d.candidates()) {
+        c.sensor_id(candidate.sensor_id());
+        c.axis(candidate.axis());
+        out.command(c);
+        ++counters_.commands;
+      }
+    }
+    return;
+  }
   out.command(c);
   ++counters_.commands;
 }

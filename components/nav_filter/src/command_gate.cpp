@@ -101,6 +101,9 @@ std::optional<std::string> CommandGate::otherImu(const navbus::FilterCommand& c)
 
 std::optional<std::string> CommandGate::check(const navbus::FilterCommand& c) const {
   switch (c.kind()) {
+    case navbus::CMD_SUSPECT_SENSOR_AXIS:  // the lanes' (lane_set.hpp), never one filter's
+      return fmt::format("IMU {} as a suspect: this filter has no lanes to compare (lanes:)",
+                         c.sensor_id());
     case navbus::CMD_EXCLUDE_SATELLITE:
     case navbus::CMD_READMIT_SATELLITE:
       if (c.sv_id() < 1 || c.sv_id() > 32) return fmt::format("sv_id {} outside 1..32", c.sv_id());

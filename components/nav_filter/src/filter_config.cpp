@@ -539,9 +539,13 @@ void parseLanes(const YAML::Node& node, FilterConfig& c) {
   r.number("switch_ratio", l.selector.switch_ratio, {0.01, 1.0})
       .integer("confirm_epochs", l.selector.confirm_epochs, {1, 100000})
       .integer("max_pending", l.max_pending, {1, 1000000})
-      .nested({"units"})
+      .nested({"units", "evidence"})
       .finish();
   if (!node) return;
+  bus::KeyReader(node["evidence"], "lanes.evidence")
+      .number("false_decision_probability", l.evidence.false_decision_probability, {1e-15, 0.1})
+      .number("max_wait_s", l.evidence.max_wait_s, {1.0, 3600.0})
+      .finish();
   const YAML::Node list = node["units"];
   if (!list || !list.IsSequence() || list.size() < 2)
     throw bus::ConfigError("configuration lanes.units must list two or more IMUs");

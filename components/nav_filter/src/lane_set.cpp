@@ -4,6 +4,7 @@
 #include <limits>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <Eigen/Geometry>
 
@@ -66,7 +67,10 @@ void setDelta(navbus::NavigationSolution& s, const core::LaneResetDelta& d) {
 }  // namespace
 
 LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks)
-    : config_(config), sinks_(std::move(sinks)), selector_(config.lanes.selector) {
+    : config_(config),
+      sinks_(std::move(sinks)),
+      selector_(config.lanes.selector),
+      suspects_(config.lanes.units, config.lanes.evidence) {
   if (config_.lanes.units.empty()) {
     // One lane: the filter as configured, its solutions straight through.
     lanes_.push_back(std::make_unique<FilterPipeline>(config_, health, sinks_.filter));
@@ -186,6 +190,12 @@ void LaneSet::onCommand(const navbus::FilterCommand& c,
   if (lanes_.size() == 1) return lanes_.front()->onCommand(c, writer_identity);
   if (const auto judged = parity_judgements_.onCommand(c))
     parity_judged_ns_ = std::max(parity_judged_ns_, *judged);
+  if (c.kind() == navbus::CMD_SUSPECT_SENSOR_AXIS) {
+    onSuspect(c, writer_identity);
+    for (std::size_t k = 1; k < lanes_.size(); ++k) lanes_[k]->onCommandElsewhere(c);
+    release(false);
+    return;
+  }
   if (!isImuCommand(c)) {
     forEach([&](FilterPipeline& l) { l.onCommand(c, writer_identity); });
     release(false);
@@ -211,6 +221,44 @@ void LaneSet::onCommand(const navbus::FilterCommand& c,
   for (std::size_t other = 0; other < lanes_.size(); ++other)
     if (other != k) lanes_[other]->onCommandElsewhere(c);
   release(false);
+}
+
+void LaneSet::onSuspect(const navbus::FilterCommand& c,
+                        const std::optional<std::string>& writer_identity) {
+  FilterPipeline& first = *lanes_.front();
+  if (!first.admitLanesCommand(c, writer_identity)) return;
+  const int k = laneOf(c.sensor_id());
+  const bool accel = c.sensor() == navbus::SOURCE_ACCELEROMETER;
+  std::string why;
+  if (k < 0)
+    why = fmt::format("sensor_id {} has no lane (lanes.units)", c.sensor_id());
+  else if (!accel && c.sensor() != navbus::SOURCE_GYRO)
+    why = fmt::format("sensor {} is not an accelerometer or gyro", static_cast<int>(c.sensor()));
+  else if (c.axis() > 2)
+    why = fmt::format("axis {} outside 0..2", c.axis());
+  if (!why.empty()) {
+    first.answerLanesCommand(c, false, navbus::REJECT_OUT_OF_RANGE, why);
+    spdlog::warn("command {} from '{}' refused: {}", c.command_id(), c.issuer(), why);
+    return;
+  }
+  // The onset is where the comparison starts (the decision's time when none is given).
+  const auto onset = static_cast<std::int64_t>(c.onset_time_gps_ns() > 0 ? c.onset_time_gps_ns()
+                                                                         : c.time_gps_ns());
+  const std::string noted = suspects_.onSuspect({c.decision_id(), k, accel, c.axis(), onset});
+  first.answerLanesCommand(c, true, navbus::REJECT_NOT_APPLICABLE, {});
+  spdlog::info("command {} from '{}': {}", c.command_id(), c.issuer(), noted);
+}
+
+void LaneSet::judgeSuspects(std::int64_t time_ns, const std::vector<const Pending*>& at) {
+  suspect_view_.assign(at.size(), nullptr);
+  for (std::size_t k = 0; k < at.size(); ++k)
+    if (at[k]) suspect_view_[k] = &at[k]->solution;
+  const auto named = suspects_.atSelection(time_ns, suspect_view_);
+  if (!named) return;
+  // As a failed axis: unavailable from this data time on (the selection below leaves it).
+  const auto k = static_cast<std::size_t>(named->suspect.lane);
+  excluded_[k] = true;
+  excluded_from_ns_[k] = std::min(excluded_from_ns_[k], time_ns);
 }
 
 void LaneSet::pump(std::int64_t now_ns) {
@@ -275,6 +323,7 @@ void LaneSet::startNewRun(std::uint64_t run) {
   excluded_.assign(n, false);
   excluded_from_ns_.assign(n, std::numeric_limits<std::int64_t>::max());
   parity_judgements_.newRun();
+  suspects_.newRun();
   parity_judged_ns_ = -1;
   held_since_ns_ = -1;
   last_selected_ns_ = -1;
@@ -362,6 +411,9 @@ void LaneSet::select(std::int64_t time_ns) {
     if (!pending_[k].empty() &&
         static_cast<std::int64_t>(pending_[k].front().solution.time_gps_ns()) == time_ns)
       at[k] = &pending_[k].front();
+  }
+  judgeSuspects(time_ns, at);
+  for (std::size_t k = 0; k < pending_.size(); ++k) {
     core::LaneStatus& st = statuses_[k];
     st.available = available(static_cast<int>(k), at[k]);
     st.test_ratio = at[k] ? at[k]->test_ratio : 0.0;
@@ -429,6 +481,7 @@ std::string LaneSet::summary() const {
     << " (its solutions came later " << late_ << ")"
     << ", selections made without the parity test's judgement (its wait ran out) "
     << parity_waits_timed_out_;
+  if (suspects_.counters().questions > 0) s << "; " << suspects_.summary();
   if (run_ > 0)
     s << ", new runs after a source restart " << run_ << " (solutions of earlier runs "
       << solutions_earlier_runs_ << ")";

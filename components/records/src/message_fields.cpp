@@ -165,6 +165,8 @@ const char* enumName(navbus::CommandKind v) {
       return "FAIL_SENSOR_AXIS";
     case navbus::CMD_RESTORE_SENSOR_AXIS:
       return "RESTORE_SENSOR_AXIS";
+    case navbus::CMD_SUSPECT_SENSOR_AXIS:
+      return "SUSPECT_SENSOR_AXIS";
   }
   return "UNKNOWN";
 }

@@ -77,7 +77,7 @@ class CommandCommand final : public Subcommand {
     cli_->add_option("kind", command.kind,
                      "EXCLUDE_SATELLITE, READMIT_SATELLITE, COMPENSATE_BIAS, SELECT_FUSION, "
                      "SELECT_MODE, RESET, EXCLUDE_STREAM, READMIT_STREAM, FAIL_SENSOR_AXIS, "
-                     "RESTORE_SENSOR_AXIS, RELEARN_BIAS")
+                     "RESTORE_SENSOR_AXIS, RELEARN_BIAS, SUSPECT_SENSOR_AXIS")
         ->required();
     cli_->add_option("--vehicle", command.vehicle_id, "vehicle_id of the filter addressed");
     cli_->add_option("--sv", command.sv_id, "GPS PRN (satellite commands)");

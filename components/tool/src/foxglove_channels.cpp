@@ -58,6 +58,9 @@ std::string commandDetail(const navbus::FilterCommand& c) {
     case navbus::CMD_FAIL_SENSOR_AXIS:
     case navbus::CMD_RESTORE_SENSOR_AXIS:
       return fmt::format(" {} axis {}", records::enumName(c.sensor()), axisName(c.axis()));
+    case navbus::CMD_SUSPECT_SENSOR_AXIS:
+      return fmt::format(" IMU {} {} axis {}", c.sensor_id(), records::enumName(c.sensor()),
+                         axisName(c.axis()));
     case navbus::CMD_EXCLUDE_STREAM:
     case navbus::CMD_READMIT_STREAM:
       return fmt::format(" {} {}", records::enumName(c.sensor()), c.sensor_id());

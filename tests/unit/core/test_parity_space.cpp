@@ -162,6 +162,13 @@ TEST(ParityGlr, TwoParallelUnitsDetectButCannotSayWhich) {
   EXPECT_TRUE(r.instrument == 0 || r.instrument == 3) << r.instrument;
   EXPECT_TRUE(r.ambiguous);
   EXPECT_EQ(r.runner_up, r.instrument == 0 ? 3 : 0);
+  // Each candidate with its own size: unit 2's bias on unit 2, its opposite on unit 1 (the
+  // parity residual sees the difference of the two units' x axes).
+  const double bias = 3.0 * g.minimumDetectableBias(3);
+  const double on_unit2 = r.instrument == 3 ? r.magnitude : r.runner_up_magnitude;
+  const double on_unit1 = r.instrument == 0 ? r.magnitude : r.runner_up_magnitude;
+  EXPECT_NEAR(on_unit2, bias, 4.0 * r.magnitude_sigma);
+  EXPECT_NEAR(on_unit1, -on_unit2, 1e-9 * bias);
 }
 
 TEST(ParityGlr, TheMinimumDetectableBiasHasTheDetectionProbabilityItPromises) {

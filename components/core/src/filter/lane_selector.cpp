@@ -17,11 +17,19 @@ LaneResetDelta laneResetDelta(const NavState& from, const NavState& to) {
 }
 
 int LaneSelector::bestAvailable(const std::vector<LaneStatus>& lanes) const {
+  // A lane without a fit yet (its window restarted, e.g. after a re-initialisation: ratio 0)
+  // has shown nothing: it is taken only when no available lane has a fit.
   int best = -1;
+  auto fits = [](const LaneStatus& l) { return l.test_ratio > 0.0; };
   for (int i = 0; i < static_cast<int>(lanes.size()); ++i) {
     const LaneStatus& l = lanes[static_cast<std::size_t>(i)];
     if (!l.available) continue;
-    if (best < 0 || l.test_ratio < lanes[static_cast<std::size_t>(best)].test_ratio) best = i;
+    if (best < 0) {
+      best = i;
+      continue;
+    }
+    const LaneStatus& b = lanes[static_cast<std::size_t>(best)];
+    if ((fits(l) && !fits(b)) || (fits(l) == fits(b) && l.test_ratio < b.test_ratio)) best = i;
   }
   return best;
 }
@@ -57,8 +65,9 @@ const LaneSelection& LaneSelector::update(const std::vector<LaneStatus>& lanes) 
   }
   // Hysteresis: the best lane must beat the selected one clearly, epoch after epoch.
   const double ratio = lanes[static_cast<std::size_t>(current)].test_ratio;
-  const bool better = best != current && lanes[static_cast<std::size_t>(best)].test_ratio <=
-                                             config_.switch_ratio * ratio;
+  const double best_ratio = lanes[static_cast<std::size_t>(best)].test_ratio;
+  const bool better =
+      best != current && best_ratio > 0.0 && best_ratio <= config_.switch_ratio * ratio;
   if (!better) {
     candidate_ = -1;
     candidate_epochs_ = 0;

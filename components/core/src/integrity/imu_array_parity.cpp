@@ -211,6 +211,7 @@ std::optional<ImuArrayDetection> ImuArrayParity::detection(ImuInstrument kind) c
     const int j = c.instrument[static_cast<std::size_t>(r.runner_up)];
     d.runner_up_unit = j / 3;
     d.runner_up_axis = j % 3;
+    d.runner_up_magnitude = r.runner_up_magnitude / interval_s_;
   }
   return d;
 }

@@ -117,6 +117,8 @@ void ParityGlr::evaluate() {
     if (k == j) continue;
     if (space_.signatureCorrelation(j, k) >= config_.ambiguity_correlation) {
       result_.runner_up = k;
+      result_.runner_up_magnitude =
+          f_(k, best_ring) / (samples_[static_cast<std::size_t>(best_ring)] * information_[k]);
       result_.ambiguous = true;
       return;
     }
@@ -128,7 +130,13 @@ void ParityGlr::evaluate() {
     }
   }
   result_.ambiguous = runner_l >= result_.statistic - config_.ambiguity_margin;
-  if (!result_.ambiguous) result_.runner_up = -1;
+  if (!result_.ambiguous) {
+    result_.runner_up = -1;
+    return;
+  }
+  const int k = result_.runner_up;
+  result_.runner_up_magnitude = f_(k, best_ring) / (samples_[static_cast<std::size_t>(best_ring)] *
+                                                    information_[k]);  // eq. 11
 }
 
 }  // namespace navbus::core

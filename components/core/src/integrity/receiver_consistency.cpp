@@ -3,17 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include <boost/math/distributions/chi_squared.hpp>
+#include "navbus/core/math/chi_square.hpp"
 
 namespace navbus::core {
 
 namespace {
-/// The chi-square (1 degree of freedom) value exceeded with probability p.
-double chiSquare1Quantile(double p) {
-  const boost::math::chi_squared_distribution<double> chi2(1.0);
-  return boost::math::quantile(boost::math::complement(chi2, p));
-}
-
 double meanOf(const std::vector<ReceiverSatellite>& sats, double ReceiverSatellite::*field) {
   double sum = 0.0;
   for (const ReceiverSatellite& s : sats) sum += s.*field;
@@ -28,7 +22,7 @@ const ReceiverSatellite* find(const std::vector<ReceiverSatellite>& sats, int sv
 }  // namespace
 
 ReceiverClockMonitor::ReceiverClockMonitor(const ReceiverClockConfig& config)
-    : config_(config), threshold_(chiSquare1Quantile(config.false_alarm_probability)) {}
+    : config_(config), threshold_(chiSquareQuantile(config.false_alarm_probability, 1)) {}
 
 std::optional<ClockJump> ReceiverClockMonitor::update(
     double time_s, const std::vector<ReceiverSatellite>& satellites) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <boost/math/distributions/chi_squared.hpp>
+
 namespace navbus::core {
 
 namespace {
@@ -50,6 +52,11 @@ double chiSquareSignificance(double x, int dof) {
     log_q = std::max(log_q, log_erfc) + std::log1p(std::exp(-std::abs(log_q - log_erfc)));
   }
   return -log_q / std::log(10.0);
+}
+
+double chiSquareQuantile(double p, int dof) {
+  const boost::math::chi_squared_distribution<double> chi2(static_cast<double>(dof));
+  return boost::math::quantile(boost::math::complement(chi2, p));
 }
 
 }  // namespace navbus::core

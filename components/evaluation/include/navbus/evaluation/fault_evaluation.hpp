@@ -34,6 +34,10 @@ struct FaultRunOutcome {
   /// filter's own sigma: the fault-free runs are consistent) and stays there 30 s; NaN: never.
   double recovery_s{std::nan("")};
   std::string decided;  ///< text of the first detection after the fault
+  /// The unit (or receiver, satellite) first named after the fault by a decision that is not
+  /// ambiguous or by the lanes' comparison of two suspects [s from start]; NaN: never.
+  double named_s{std::nan("")};
+  bool named_correct{false};  ///< ... and it was the faulty one
 };
 
 /// Writes the GLR's statistic per accepted epoch (time_gps_ns, statistic, threshold,

@@ -5,8 +5,9 @@
 // isolation becomes a decision (detector "parity") naming the unit in `sensor_id` and its axis,
 // and, when configured, CMD_FAIL_SENSOR_AXIS for that unit and axis; an ambiguous isolation
 // (two instruments whose signatures cannot be told apart, e.g. the same axis of two parallel
-// units) is a decision with both candidates and no command. Either way the instruments decided
-// leave the parity test, which goes on with the others while they have parity.
+// units) is a decision with both candidates and, when configured, CMD_SUSPECT_SENSOR_AXIS for
+// each (the filter's lanes say which: nav_filter suspect_lanes.hpp). Either way the instruments
+// decided leave the parity test, which goes on with the others while they have parity.
 #pragma once
 
 #include <algorithm>

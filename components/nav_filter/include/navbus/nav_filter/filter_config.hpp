@@ -14,6 +14,7 @@
 #include "navbus/core/engine/navigation_engine.hpp"
 #include "navbus/core/filter/lane_selector.hpp"
 #include "navbus/core/ins/imu_mounting.hpp"
+#include "navbus/core/integrity/lane_evidence.hpp"
 #include "navbus/core/math/units.hpp"
 
 namespace navbus::nav_filter {
@@ -65,6 +66,8 @@ struct LaneUnit {
 struct LanesConfig {
   std::vector<LaneUnit> units;  ///< empty: one lane, the `inputs.imu` IMU
   core::LaneSelectorConfig selector;
+  /// Which of two suspect units failed (CMD_SUSPECT_SENSOR_AXIS, suspect_lanes.hpp).
+  core::LaneEvidenceConfig evidence;
   /// Solutions the other lanes may be ahead of a lane that still speaks (one holding for its
   /// fault monitor lags) before it is passed over at those times (unavailable, counted): the
   /// bound on the memory the wait takes. A silent lane is passed over after

@@ -163,6 +163,19 @@ class FilterPipeline {
   void onCommandElsewhere(const navbus::FilterCommand& c) {
     if (const auto judged = judgements_.onCommand(c)) noteJudged(*judged);
   }
+  /// A command the lanes apply themselves (CMD_SUSPECT_SENSOR_AXIS): this lane's judgement
+  /// bookkeeping as for any command; true when it is this vehicle's and its issuer is
+  /// authorized (a refusal is answered and counted here).
+  bool admitLanesCommand(const navbus::FilterCommand& c,
+                         const std::optional<std::string>& writer_identity) {
+    onCommandElsewhere(c);
+    return commands_.addressedToThisVehicle(c) && commands_.authorized(c, writer_identity);
+  }
+  /// The answer to such a command, as this filter's.
+  void answerLanesCommand(const navbus::FilterCommand& c, bool applied, navbus::RejectReason reason,
+                          const std::string& detail) {
+    commands_.report(c, applied, reason, detail);
+  }
   /// Whether a fault monitor is alive (the participant watches its reports): while not,
   /// solutions carry FAULT_NO_FAULT_MONITOR. Changes are logged and counted. (The wait for
   /// its judgement does not follow this: a monitor stopped for longer than its health timeout

@@ -30,6 +30,7 @@
 #include "navbus/core/filter/lane_selector.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/nav_filter/judgement_tracker.hpp"
+#include "navbus/nav_filter/suspect_lanes.hpp"
 
 namespace navbus::nav_filter {
 
@@ -79,6 +80,8 @@ class LaneSet {
   /// The lane whose solutions are published (0 before any selection; config lanes.units order).
   int selectedLane() const { return selectedIndex(); }
   const core::LaneSelection& selection() const { return selector_.last(); }
+  /// The comparison of two suspect units' lanes (CMD_SUSPECT_SENSOR_AXIS) and what it named.
+  const SuspectLanes& suspects() const { return suspects_; }
   std::string summary() const;
 
  private:
@@ -93,6 +96,11 @@ class LaneSet {
     for (auto& lane : lanes_) fn(*lane);
   }
   void onLaneSolution(int k, const navbus::NavigationSolution& s);
+  /// CMD_SUSPECT_SENSOR_AXIS: answered here (lane 0's gate), compared at the selections.
+  void onSuspect(const navbus::FilterCommand& c, const std::optional<std::string>& writer_identity);
+  /// The lanes' evidence at `time_ns` (the lanes' solutions `at`): a suspect unit named is left
+  /// from that time.
+  void judgeSuspects(std::int64_t time_ns, const std::vector<const Pending*>& at);
   /// The IMUs restarted at an earlier time (a lane began its new run `run`): what the earlier
   /// run holds goes out, and the selection starts over as a single filter does (sequence
   /// numbers from 1, the best lane taken without a reset counted, no exclusion, no judgement).
@@ -128,6 +136,8 @@ class LaneSet {
   /// Commands given to one lane (issuer, run, id): that lane answers them.
   std::set<std::tuple<std::string, std::uint64_t, std::uint64_t>> routed_;
   core::LaneSelector selector_;
+  SuspectLanes suspects_;
+  std::vector<const navbus::NavigationSolution*> suspect_view_;  ///< reused at each selection
   std::vector<core::LaneStatus> statuses_;
   std::vector<const Pending*> at_;  ///< each lane's solution at the time being selected
   core::LaneResetDelta last_delta_;

@@ -29,7 +29,8 @@ struct LaneSelectorConfig {
 struct LaneStatus {
   bool available{true};
   /// The lane's innovation test ratio: its normalised innovations squared over their
-  /// threshold (1 = at the gate); smaller fits better.
+  /// threshold (1 = at the gate); smaller fits better; 0: no fit yet (a lane without one is
+  /// never a better fit, and is taken only when no available lane has one).
   double test_ratio{0.0};
   NavState solution;  ///< the lane's estimate at this epoch
 };

@@ -65,6 +65,7 @@ struct ImuArrayDetection {
   double magnitude_sigma{0.0};
   int runner_up_unit{-1};  ///< the instrument that explains the data about as well, or -1
   int runner_up_axis{-1};
+  double runner_up_magnitude{0.0};  ///< the bias were it the runner-up's [its axis]
 };
 
 class ImuArrayParity {

@@ -46,14 +46,15 @@ struct ParityGlrConfig {
 
 struct ParityGlrResult {
   bool detected{false};
-  double statistic{0.0};        ///< largest l over instruments and onsets
-  double threshold{0.0};        ///< h
-  int instrument{-1};           ///< of the largest l
-  double magnitude{0.0};        ///< b^ of that instrument at that onset [measurement units]
-  double magnitude_sigma{0.0};  ///< its standard error, 1 / sqrt(R)
-  int samples_since_onset{0};   ///< N(theta) of that onset
-  int runner_up{-1};            ///< the instrument that explains the data about as well, or -1
-  bool ambiguous{false};        ///< runner_up cannot be told apart from instrument
+  double statistic{0.0};            ///< largest l over instruments and onsets
+  double threshold{0.0};            ///< h
+  int instrument{-1};               ///< of the largest l
+  double magnitude{0.0};            ///< b^ of that instrument at that onset [measurement units]
+  double magnitude_sigma{0.0};      ///< its standard error, 1 / sqrt(R)
+  int samples_since_onset{0};       ///< N(theta) of that onset
+  int runner_up{-1};                ///< the instrument that explains the data about as well, or -1
+  double runner_up_magnitude{0.0};  ///< b^ of runner_up at the same onset (eq. 11)
+  bool ambiguous{false};            ///< runner_up cannot be told apart from instrument
 };
 
 class ParityGlr {

@@ -14,4 +14,8 @@ double chiSquareSurvival(double x, int dof);
 /// statistic: 6 means a one-in-a-million event under the no-fault hypothesis).
 double chiSquareSignificance(double x, int dof);
 
+/// The value a chi-square variable with `dof` >= 1 degrees of freedom exceeds with probability
+/// p in (0, 1) (Boost.Math's inverse of chiSquareSurvival).
+double chiSquareQuantile(double p, int dof);
+
 }  // namespace navbus::core
