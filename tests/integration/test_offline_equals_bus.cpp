@@ -344,9 +344,9 @@ TEST(OfflineEqualsBus, TriplexLanesCompensateTheFusedReceiversClockAsOffline) {
 // the parity test cannot say which unit (one ambiguous decision) and names both as suspects
 // (CMD_RELEARN_BIAS and CMD_SUSPECT_SENSOR_AXIS for each); both lanes re-learn that bias from the
 // onset, and the selection, comparing their estimates at each time, names unit 1 and leaves its
-// lane. The lanes wait for the parity test's judgement, which comes after its commands: the
-// naming and the switch at the same data time on the bus as offline, every published solution
-// bit for bit.
+// lane; the fault manager, reading the lanes' solutions, publishes the decision naming unit 1. The
+// lanes wait for the parity test's judgement, which comes after its commands: the naming and the
+// switch at the same data time on the bus as offline, every published solution bit for bit.
 TEST(OfflineEqualsBus, ParallelLanesNameTheFaultyUnitAsOffline) {
   runCase(
       {120,
@@ -361,7 +361,7 @@ TEST(OfflineEqualsBus, ParallelLanesNameTheFaultyUnitAsOffline) {
         // lane IMU 1: its re-learn and both suspects (the lanes' commands, answered by lane 0)
         "commands applied 3 refused 0"},
        "fault_manager_dual_parallel.yaml",
-       1,
+       2,  // the parity test's (ambiguous) and the fault manager's "lanes" naming unit 1
        "faults:\n  - {type: imu_bias_step, sensor: gyro, axis: x, start_s: 100,\n"
        "     magnitude_deg_per_h: 10, sensor_id: 1}\n",
        "navbus/imu/increment_block 1:accepted 2:accepted",

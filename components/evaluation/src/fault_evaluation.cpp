@@ -17,8 +17,9 @@ bool gnssFault(const sim::Fault& f) {
          f.kind == sim::FaultKind::kReceiverClockJump;
 }
 
-/// `sensor_id`: the unit a parity decision or candidate names, the receiver a "receivers" one
-/// names; 0 for the GLR's, which are about the filter's own IMU (the scenario's, unit 0).
+/// `sensor_id`: the unit a parity (or lanes) decision or candidate names, the receiver a
+/// "receivers" one names; 0 for the GLR's, which are about the filter's own IMU (the scenario's,
+/// unit 0).
 bool matches(const sim::Fault& f, navbus::FaultSource source, int sv_id, int axis,
              std::uint32_t sensor_id) {
   if (f.kind == sim::FaultKind::kReceiverClockJump)
@@ -34,7 +35,9 @@ bool matches(const sim::Fault& f, navbus::FaultSource source, int sv_id, int axi
 }
 
 std::uint32_t parityUnit(const navbus::FaultDecision& d) {
-  return d.detector() == "parity" || d.detector() == "receivers" ? d.sensor_id() : 0;
+  return d.detector() == "parity" || d.detector() == "lanes" || d.detector() == "receivers"
+             ? d.sensor_id()
+             : 0;
 }
 
 double trueMagnitude(const sim::Fault& f) {

@@ -235,8 +235,11 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   if (faults)
     on_outcome = [&](const navbus::FilterCommandOutcome& o) { faults->onCommandOutcome(o); };
   std::function<void(const navbus::LaneSolution&)> on_lane;
-  if (setup.keep_lane_solutions)
-    on_lane = [&](const navbus::LaneSolution& l) { result.lane_solutions.push_back(l); };
+  if (setup.keep_lane_solutions || faults)
+    on_lane = [&](const navbus::LaneSolution& l) {
+      if (setup.keep_lane_solutions) result.lane_solutions.push_back(l);
+      if (faults) faults->onLaneSolution(l);
+    };
   nav_filter::LaneSet pipeline(setup.filter, health,
                                {{on_solution, on_diagnostics, nullptr, on_outcome}, on_lane});
   pipeline_ptr = &pipeline;

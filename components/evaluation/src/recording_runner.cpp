@@ -220,7 +220,11 @@ RecordingResult runRecording(const RecordingSetup& setup, const RecordedSolution
   // One engine's fixes (a lane set would log every lane's into one list).
   if (!lanes) filter_config.engine.fix_innovation_log = &innovation_log;
   std::function<void(const navbus::LaneSolution&)> on_lane;
-  if (lanes) on_lane = [&](const navbus::LaneSolution& l) { result.lane_solutions.push_back(l); };
+  if (lanes)
+    on_lane = [&](const navbus::LaneSolution& l) {
+      result.lane_solutions.push_back(l);
+      if (faults) faults->onLaneSolution(l);  // the lanes' word on two suspect units
+    };
   nav_filter::LaneSet pipeline(filter_config, health,
                                {{[&](const navbus::NavigationSolution& s) {
                                    ++result.solutions;

@@ -53,7 +53,13 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
           participant_.setState(pipeline_.degraded() ? navbus::STATE_DEGRADED
                                                      : navbus::STATE_RUNNING);
       });
-  if (config.parity.enabled) subscribeIncrements();
+  if (config.parity.enabled) {
+    subscribeIncrements();
+    // The lanes' word on two units the parity test cannot tell apart (every lane solution).
+    p.subscribe<navbus::LaneSolutionPubSubType>(
+        topic::kLaneSolution, profile::kSolutionReader,
+        [this](const navbus::LaneSolution& l, const auto&) { pipeline_.onLaneSolution(l); });
+  }
   // The cross-receiver test needs every epoch of every receiver: a reliable reader (the
   // filter's profile for observations).
   if (config.receivers.enabled) {

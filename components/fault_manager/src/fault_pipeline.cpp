@@ -51,6 +51,11 @@ void FaultPipeline::onImuIncrement(const navbus::ImuIncrement& increment) {
   reportProgress(judged_);
 }
 
+void FaultPipeline::onLaneSolution(const navbus::LaneSolution& lane) {
+  if (!parity_ || lane.vehicle_id() != config_.vehicle_id) return;
+  parity_->onLaneSolution(lane, *this);
+}
+
 void FaultPipeline::onGnssEpoch(const navbus::GnssObservationEpoch& epoch) {
   if (!receivers_) return;
   receivers_->onEpoch(epoch, *this);

@@ -235,6 +235,8 @@ void ParityDetector::report(std::int64_t time_ns, const core::ImuArrayDetection&
   if (!config_.fail_axes) return;
   navbus::FilterCommand c = failAxisCommand(d);  // decide() stamped its id
   if (ambiguous) {
+    suspects_[d.decision_id()] = d;
+    if (suspects_.size() > kSuspectsKept) suspects_.erase(suspects_.begin());
     // Which one: not ours to say. Both are suspects: each one's lane re-learns that bias from
     // the onset (its variance grows to the size found), and the filter's lanes compare their
     // estimates since the onset and leave the one that moved (or that fails its own test).
@@ -255,6 +257,35 @@ void ParityDetector::report(std::int64_t time_ns, const core::ImuArrayDetection&
   }
   out.command(c);
   ++counters_.commands;
+}
+
+void ParityDetector::onLaneSolution(const navbus::LaneSolution& lane, FaultOutput& out) {
+  const auto it = suspects_.find(lane.named_faulty_for_decision());
+  if (it == suspects_.end()) return;  // none named, or named already
+  const navbus::FaultDecision ambiguous = it->second;
+  suspects_.erase(it);
+  const auto& c = ambiguous.candidates();
+  const bool first = c[0].sensor_id() == lane.lane_id();
+  if (!first && c[1].sensor_id() != lane.lane_id()) return;  // not a candidate: not this one's
+  navbus::FaultDecision d = ambiguous;
+  const navbus::FaultCandidate& named = c[first ? 0 : 1];
+  d.time_gps_ns(lane.solution().time_gps_ns());
+  d.sensor_id(named.sensor_id());
+  d.axis(named.axis());
+  d.magnitude(named.magnitude());
+  d.ambiguous(false);
+  d.detector("lanes");
+  d.candidates({named, c[first ? 1 : 0]});
+  const std::uint32_t id = out.decide(d);
+  ++counters_.named_by_lanes;
+  const ImuInstrument kind =
+      named.source() == navbus::SOURCE_GYRO ? ImuInstrument::kGyro : ImuInstrument::kAccelerometer;
+  spdlog::warn(
+      "decision {}: the lanes name IMU {} {} axis {} of decision {} at {:.3f} s (their "
+      "estimates since the onset), bias {:.4g} {}",
+      id, named.sensor_id(), kindName(kind), "xyz"[named.axis()], ambiguous.decision_id(),
+      1e-9 * static_cast<double>(lane.solution().time_gps_ns()), readable(kind, named.magnitude()),
+      readableUnit(kind));
 }
 
 std::string ParityDetector::minimumDetectableBiases() const {
@@ -282,9 +313,10 @@ std::string ParityDetector::summary() const {
   std::ostringstream s;
   s << "parity: " << c.samples << " aligned samples of " << array_->units() << " IMUs ("
     << c.increments << " increments), detections " << c.detections << " (ambiguous " << c.ambiguous
-    << ", commands " << c.commands << "), largest statistic gyros " << c.max_statistic[0]
-    << " accelerometers " << c.max_statistic[1] << " (h " << array_->threshold(ImuInstrument::kGyro)
-    << " / " << array_->threshold(ImuInstrument::kAccelerometer) << ")";
+    << ", commands " << c.commands << ", named by the lanes " << c.named_by_lanes
+    << "), largest statistic gyros " << c.max_statistic[0] << " accelerometers "
+    << c.max_statistic[1] << " (h " << array_->threshold(ImuInstrument::kGyro) << " / "
+    << array_->threshold(ImuInstrument::kAccelerometer) << ")";
   if (c.other_sensors + c.invalid + c.wrong_interval + c.late + c.incomplete + c.gaps +
           c.missed_at_start >
       0)

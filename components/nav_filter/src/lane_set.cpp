@@ -113,6 +113,7 @@ LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks 
   pending_.resize(units.size());
   excluded_.assign(units.size(), false);
   excluded_from_ns_.assign(units.size(), std::numeric_limits<std::int64_t>::max());
+  named_for_decision_.assign(units.size(), 0);
   heard_ns_.assign(units.size(), -1);
   previous_.assign(units.size(), std::nullopt);
   statuses_.resize(units.size());
@@ -259,6 +260,7 @@ void LaneSet::judgeSuspects(std::int64_t time_ns, const std::vector<const Pendin
   const auto k = static_cast<std::size_t>(named->suspect.lane);
   excluded_[k] = true;
   excluded_from_ns_[k] = std::min(excluded_from_ns_[k], time_ns);
+  named_for_decision_[k] = named->suspect.decision_id;
 }
 
 void LaneSet::pump(std::int64_t now_ns) {
@@ -322,6 +324,7 @@ void LaneSet::startNewRun(std::uint64_t run) {
   previous_.assign(n, std::nullopt);
   excluded_.assign(n, false);
   excluded_from_ns_.assign(n, std::numeric_limits<std::int64_t>::max());
+  named_for_decision_.assign(n, 0);
   parity_judgements_.newRun();
   suspects_.newRun();
   parity_judged_ns_ = -1;
@@ -465,6 +468,8 @@ void LaneSet::publishLane(std::size_t k, const Pending& p, bool selected) const 
   l.selected(selected);
   l.available(available(static_cast<int>(k), &p));
   l.test_ratio(p.test_ratio);
+  if (static_cast<std::int64_t>(p.solution.time_gps_ns()) >= excluded_from_ns_[k])
+    l.named_faulty_for_decision(named_for_decision_[k]);
   l.solution(p.solution);
   sinks_.lane(l);
 }

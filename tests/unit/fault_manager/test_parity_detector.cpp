@@ -181,3 +181,74 @@ TEST(ParityDetector, ConfigurationErrorsNameTheField) {
   refused(std::string(kTriplexParity) + "  window: 3\n", "window");
   refused("parity: {enabled: true, units: []}\n", "2 to 6");
 }
+
+TEST(ParityDetector, TwoParallelUnitsAreSuspectsUntilTheLanesNameOne) {
+  // Given two parallel units (ids 11, 12) and a 5 deg/h step on unit 12's y gyro, then the
+  // decision is ambiguous between the two y gyros, each candidate with its own magnitude
+  // (opposite), and both are commanded to re-learn that bias and named as suspects (no axis
+  // failed); when a lane solution of unit 12 says the lanes found it the faulty one of that
+  // decision, then one decision "lanes" names unit 12 at that time, once; a lane naming
+  // nothing, or another decision, changes nothing.
+  const fm::FaultManagerConfig config = parityConfig(R"(
+parity:
+  enabled: true
+  imu_rate_hz: 100
+  units:
+    - {sensor_id: 11, mounting_rpy_deg: [0, 0, 0], lever_arm_b_m: [0, 0, 0],
+       gyro_arw_deg_per_sqrth: 0.001, accel_noise_ug_per_sqrthz: 10}
+    - {sensor_id: 12, mounting_rpy_deg: [0, 0, 0], lever_arm_b_m: [0, 0, 0],
+       gyro_arw_deg_per_sqrth: 0.001, accel_noise_ug_per_sqrthz: 10}
+  reference_s: 5
+)");
+  const double step = 5.0 * navbus::units::kDegPerHour;
+  Recorder r;
+  fm::ParityDetector parity(config.parity);
+  for (const auto& m : stillBodyIncrements(config.parity, 1400, 1000, step))
+    parity.onIncrement(m, r);
+  ASSERT_EQ(r.decisions.size(), 1u) << parity.summary();
+  const navbus::FaultDecision d = r.decisions[0];
+  EXPECT_TRUE(d.ambiguous());
+  ASSERT_EQ(d.candidates().size(), 2u);
+  const auto& c = d.candidates();
+  EXPECT_EQ(c[0].sensor_id() + c[1].sensor_id(), 23u);
+  const double on_12 = c[0].sensor_id() == 12 ? c[0].magnitude() : c[1].magnitude();
+  const double on_11 = c[0].sensor_id() == 11 ? c[0].magnitude() : c[1].magnitude();
+  EXPECT_NEAR(on_12, step, 0.2 * step);
+  EXPECT_DOUBLE_EQ(on_11, -on_12);
+  ASSERT_EQ(r.commands.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const navbus::FilterCommand& cmd = r.commands[k];
+    EXPECT_EQ(cmd.kind(), k < 2 ? navbus::CMD_RELEARN_BIAS : navbus::CMD_SUSPECT_SENSOR_AXIS);
+    EXPECT_EQ(cmd.sensor_id(), c[k % 2].sensor_id());
+    EXPECT_EQ(cmd.axis(), 1);
+    EXPECT_EQ(cmd.decision_id(), d.decision_id());
+    EXPECT_EQ(cmd.onset_time_gps_ns(), d.onset_time_gps_ns());
+    if (k < 2) {
+      EXPECT_GE(cmd.bias_sigma(), std::abs(on_12));
+    }
+  }
+  navbus::LaneSolution lane;
+  lane.vehicle_id(1);
+  lane.lane_id(11);
+  lane.solution().time_gps_ns(d.time_gps_ns() + 30'000'000'000ull);
+  parity.onLaneSolution(lane, r);  // names nothing
+  lane.lane_id(12);
+  lane.named_faulty_for_decision(d.decision_id() + 7);
+  parity.onLaneSolution(lane, r);  // another decision's
+  EXPECT_EQ(r.decisions.size(), 1u);
+  lane.named_faulty_for_decision(d.decision_id());
+  parity.onLaneSolution(lane, r);
+  parity.onLaneSolution(lane, r);  // and again: decided once
+  ASSERT_EQ(r.decisions.size(), 2u);
+  const navbus::FaultDecision& named = r.decisions[1];
+  EXPECT_EQ(named.detector(), "lanes");
+  EXPECT_FALSE(named.ambiguous());
+  EXPECT_EQ(named.sensor_id(), 12u);
+  EXPECT_EQ(named.axis(), 1);
+  EXPECT_EQ(named.time_gps_ns(), lane.solution().time_gps_ns());
+  EXPECT_EQ(named.onset_time_gps_ns(), d.onset_time_gps_ns());
+  EXPECT_DOUBLE_EQ(named.magnitude(), on_12);
+  EXPECT_EQ(named.candidates()[1].sensor_id(), 11u);
+  EXPECT_EQ(r.commands.size(), 4u);  // the lanes acted already: nothing to command
+  EXPECT_EQ(parity.counters().named_by_lanes, 1u);
+}

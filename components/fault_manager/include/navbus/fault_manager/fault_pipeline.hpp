@@ -76,6 +76,9 @@ class FaultPipeline : private FaultOutput {
   /// A navigation-rate increment of any IMU unit, for the parity detector (every increment,
   /// a fast-pacing block's elements one by one).
   void onImuIncrement(const navbus::ImuIncrement& increment);
+  /// A filter lane's solution (navbus/nav/lane_solution), for the parity detector: the lanes'
+  /// naming of an ambiguous decision's faulty unit becomes a decision. Other vehicles ignored.
+  void onLaneSolution(const navbus::LaneSolution& lane);
   /// A unit's increments ended as announced (the parity reader got its dispose after its last
   /// sample): once every unit has, the parity test's progress is reported to the end.
   void onParityUnitEnded(std::uint32_t sensor_id);

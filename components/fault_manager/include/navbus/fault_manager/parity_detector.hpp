@@ -17,7 +17,9 @@
 #include <optional>
 #include <string>
 
+#include <navbus_idl/Fault.h>
 #include <navbus_idl/Imu.h>
+#include <navbus_idl/Navigation.h>
 
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/integrity/imu_array_parity.hpp"
@@ -43,13 +45,18 @@ class ParityDetector {
     std::uint64_t incomplete{0};  ///< times dropped: a unit's increment lost, or a unit silent
     std::uint64_t gaps{0};        ///< breaks in the aligned times: the tests restarted
     std::uint64_t detections{0}, ambiguous{0}, commands{0};
-    std::uint64_t new_runs{0};  ///< the units' source restarted at an earlier time
+    std::uint64_t named_by_lanes{0};  ///< ambiguous decisions whose unit the lanes named
+    std::uint64_t new_runs{0};        ///< the units' source restarted at an earlier time
     /// Increments before each unit's first one taken in a run, by its sequence numbers (which
     /// start at 1): the reader joined after the unit's stream began.
     std::uint64_t missed_at_start{0};
     std::array<double, core::kImuInstrumentKinds> max_statistic{};
   };
   const Counters& counters() const { return counters_; }
+  /// A filter lane's solution (navbus/nav/lane_solution): once the lanes name the faulty one
+  /// of an ambiguous decision's two candidates (named_faulty_for_decision), a decision
+  /// (detector "lanes") names that unit, at that solution's time. Once per decision.
+  void onLaneSolution(const navbus::LaneSolution& lane, FaultOutput& out);
   /// The unit's increments ended as announced; true once every unit's have.
   bool onUnitEnded(std::uint32_t sensor_id);
   /// Every time up to this one is tested, or dropped (-1: none yet).
@@ -97,6 +104,9 @@ class ParityDetector {
   std::array<std::uint64_t, core::ImuArrayParity::kMaxUnits> latest_seq_{};  ///< per unit
   core::ImuArrayParity::Result latest_;
   Counters counters_;
+  /// Ambiguous decisions by id, until the lanes name one of their candidates (the latest few).
+  std::map<std::uint32_t, navbus::FaultDecision> suspects_;
+  static constexpr std::size_t kSuspectsKept = 16;
 };
 
 }  // namespace navbus::fault_manager

@@ -127,6 +127,8 @@ class LaneSet {
   std::vector<bool> excluded_;  ///< the lane's IMU axis was failed by a command
   /// ... from this data time on (the command's): unavailable at the times since
   std::vector<std::int64_t> excluded_from_ns_;
+  /// The decision whose suspects the lanes' comparison found this lane's unit faulty (0: none).
+  std::vector<std::uint32_t> named_for_decision_;
   JudgementTracker parity_judgements_;  ///< the parity test's progress, with its commands
   bool parity_reported_{false};
   std::int64_t parity_judged_ns_{-1};

@@ -125,6 +125,7 @@ IfMessage<M, navbus::LaneSolution> visitFields(M& m, V& v) {
   v("selected", m.selected());
   v("available", m.available());
   v("test_ratio", m.test_ratio());
+  v("named_faulty_for_decision", m.named_faulty_for_decision());
   auto& s = m.solution();
   v("seq", s.seq());
   v("time_gps_ns", s.time_gps_ns());
