@@ -64,6 +64,19 @@ bool FaultSchedule::any(FaultKind kind, double t) const {
                      [&](const Fault& f) { return f.kind == kind && active(f, t); });
 }
 
+bool FaultSchedule::gnssOut(double t) const {
+  return std::any_of(faults_.begin(), faults_.end(), [&](const Fault& f) {
+    return f.kind == FaultKind::kGnssOutage && f.receiver < 0 && active(f, t);
+  });
+}
+
+bool FaultSchedule::receiverOut(double t, int receiver) const {
+  return std::any_of(faults_.begin(), faults_.end(), [&](const Fault& f) {
+    return f.kind == FaultKind::kGnssOutage && (f.receiver < 0 || f.receiver == receiver) &&
+           active(f, t);
+  });
+}
+
 const char* faultKindName(FaultKind kind) {
   switch (kind) {
     case FaultKind::kImuBiasStep:

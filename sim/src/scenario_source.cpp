@@ -61,7 +61,10 @@ void ScenarioSource::observeExtraReceivers(std::int64_t t_ns, const Eigen::Vecto
   const Eigen::Matrix3d C_b_e = C_n_e * f.truth.q_b_to_n.toRotationMatrix();
   const Eigen::Vector3d v_e = C_n_e * f.truth.vel_ned_mps;  // the body's (w x r left out)
   f.extra_gnss.resize(extra_receivers_.size());
+  f.extra_gnss_silent.assign(extra_receivers_.size(), false);
+  f.has_extra_gnss = !extra_receivers_.empty();
   for (std::size_t k = 0; k < extra_receivers_.size(); ++k) {
+    f.extra_gnss_silent[k] = config_.faults.receiverOut(t_s, static_cast<int>(k) + 1);
     ExtraReceiver& rx = extra_receivers_[k];
     const Eigen::Vector3d antenna_e = r_e + C_b_e * config_.extra_receivers[k].antenna_b_m;
     f.extra_gnss[k] = rx.model.observe(t_ns, config_.start_time_ns, antenna_e, v_e, rx.rng);
@@ -218,7 +221,9 @@ void ScenarioSource::next(SensorFrame& f) {
   const double t_s = t0 + T;
   if (config_.gnss_every_n_increments > 0 && index_ % config_.gnss_every_n_increments == 0 &&
       !config_.faults.gnssOut(t_s)) {
-    f.has_gnss = true;
+    // A receiver out on its own is observed all the same (its noise sequence goes on), and its
+    // epoch left unsent.
+    f.has_gnss = !config_.faults.receiverOut(t_s, 0);
     const Eigen::Vector3d r_e = earth::geodeticToEcef(f.truth.position);
     const Eigen::Matrix3d C_n_e =
         earth::C_n_e(f.truth.position.latitude_rad, f.truth.position.longitude_rad);

@@ -43,6 +43,10 @@ struct Case {
   /// reaches the filter and the fault manager together, and the filter has gone on to its time
   /// before the fault manager could judge it (default: as fast as the readers take it).
   bool realtime{false};
+  /// The watchdog's decisions (a stream silent for seconds of wall time) exist on the bus only:
+  /// left out of the comparison, and this many of them expected.
+  std::size_t watchdog_decisions{0};
+  std::vector<std::string> fm_log_lacks{};  ///< lines the fault manager's log must not contain
 };
 
 /// Checks `expected` (Case::filter_sensors) against the input of a health report.
@@ -136,16 +140,24 @@ void runCase(const Case& c) {
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(c.domain, "offline-equals-bus"), shutdown);
   std::vector<std::string> rows;
+  std::size_t flagged_gnss_lost = 0;
   me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution,
                                              bus::profile::kSolutionReader,
                                              [&](const NavigationSolution& s, const auto&) {
                                                if (s.mode() != MODE_INERTIAL_LOST)
                                                  rows.push_back(records::csvRows(s).at(0));
+                                               if (s.active_fault_flags() & FAULT_GNSS_STREAM_LOST)
+                                                 ++flagged_gnss_lost;
                                              });
   std::vector<std::string> decisions;
+  std::size_t watchdog_decisions = 0;
   me.subscribe<FaultDecisionPubSubType>(
       bus::topic::kFaultDecision, bus::profile::kDecisionReader,
       [&](const FaultDecision& d, const auto&) {
+        if (d.detector() == "watchdog") {
+          ++watchdog_decisions;
+          return;
+        }
         decisions.push_back(withoutRunId(records::csvRows(d).at(0)));
       });
   Health filter_health, fm_health;
@@ -189,6 +201,7 @@ void runCase(const Case& c) {
   EXPECT_EQ(differing, 0u);
   std::printf("%s: %zu solutions, bus and offline bit-identical (17-digit CSV rows): %s\n",
               c.scenario.c_str(), rows.size(), differing == 0 ? "yes" : "NO");
+  EXPECT_EQ(flagged_gnss_lost, 0u) << "solutions flagged FAULT_GNSS_STREAM_LOST";
   // The last solutions came without a bounded wait: the announced end released them.
   const std::string log = test::readFile(dir / "filter.log");
   EXPECT_NE(log.find("navbus/imu/increment id 1 ended (its writer disposed it)"), std::string::npos)
@@ -196,11 +209,15 @@ void runCase(const Case& c) {
   EXPECT_NE(log.find("sequencer timeouts 0,"), std::string::npos) << log;
   for (const std::string& line : c.filter_log_says)
     EXPECT_NE(log.find(line), std::string::npos) << line;
+  const std::string fm_log = test::readFile(dir / "fm.log");
+  for (const std::string& line : c.fm_log_lacks)
+    EXPECT_EQ(fm_log.find(line), std::string::npos) << line << "\n" << fm_log;
   if (!c.fault_manager.empty()) {
     // The fault manager's decisions (the parity test's on the units' increments, taken from
     // the bus in whatever order the units' samples arrive) are the offline run's, field for field.
     EXPECT_EQ(expected_decisions.size(), c.decisions) << test::readFile(dir / "offline.log");
     EXPECT_EQ(decisions, expected_decisions) << test::readFile(dir / "fm.log");
+    EXPECT_EQ(watchdog_decisions, c.watchdog_decisions) << test::readFile(dir / "fm.log");
     std::printf("%zu decisions, bus and offline identical: %s\n", decisions.size(),
                 decisions == expected_decisions ? "yes" : "NO");
   }
@@ -316,6 +333,33 @@ TEST(OfflineEqualsBus, FusedReceiversClockJumpCompensatedAsOffline) {
            "navbus/gnss/observations 1:accepted 2:refused",
            "navbus/gnss/observations 1:accepted 2:accepted",
            true});
+}
+
+// A redundant receiver falls silent (seed000_dual_receivers.yaml, receiver 2 out from 10 s to
+// 16 s, data in real time): the fault manager's watchdog declares its epochs LOST after 2 s and
+// RESTORED when they return (two decisions on the bus only, wall-time judgements); the
+// cross-receiver test goes on without it, so the filter, which waits for that test's judgement
+// of each of its receiver's epochs, is not held beyond its budget; the filter does not fuse
+// receiver 2, so its loss is not the filter's (no solution flagged FAULT_GNSS_STREAM_LOST, the
+// exclusion refused as not its stream, and the fault manager not DEGRADED by that refusal).
+// Every solution is the offline run's bit for bit.
+TEST(OfflineEqualsBus, ASilentRedundantReceiverHoldsNothingAndFlagsNothing) {
+  Case c{121,
+         "seed000_dual_receivers.yaml",
+         "filter_dual_receivers.yaml",
+         "",
+         3,
+         24.0,
+         {"judgements waited for beyond the budget 0", "is not a stream of this filter"},
+         "fault_manager_dual_receivers.yaml",
+         0,
+         "faults:\n  - {type: gnss_outage, start_s: 10, duration_s: 6, receiver_id: 2}\n",
+         "navbus/gnss/observations 1:accepted 2:refused",
+         "navbus/gnss/observations 1:accepted 2:accepted",
+         true};
+  c.watchdog_decisions = 2;
+  c.fm_log_lacks = {"health DEGRADED"};
+  runCase(c);
 }
 
 // The whole redundant installation (seed000_triplex_dual_receivers.yaml): three lanes, each

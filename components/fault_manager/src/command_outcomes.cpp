@@ -15,6 +15,10 @@ bool CommandOutcomes::onOutcome(const navbus::FilterCommandOutcome& o) {
       ++refused_;
       break;
   }
+  if (notItsStream(o)) {
+    ++not_its_streams_;
+    return true;  // nothing of the filter's is left uncured
+  }
   // Outcomes may come out of order (a command merged late answers after a later one): the
   // latest command decides.
   if (o.command_id() >= latest_command_id_) {
@@ -22,6 +26,11 @@ bool CommandOutcomes::onOutcome(const navbus::FilterCommandOutcome& o) {
     degraded_ = o.outcome() != navbus::OUTCOME_APPLIED;
   }
   return true;
+}
+
+bool CommandOutcomes::notItsStream(const navbus::FilterCommandOutcome& o) {
+  return o.outcome() == navbus::OUTCOME_REFUSED && o.reason() == navbus::REJECT_UNEXPECTED_SOURCE &&
+         (o.kind() == navbus::CMD_EXCLUDE_STREAM || o.kind() == navbus::CMD_READMIT_STREAM);
 }
 
 }  // namespace navbus::fault_manager

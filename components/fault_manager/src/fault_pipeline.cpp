@@ -243,6 +243,11 @@ void FaultPipeline::command(navbus::FilterCommand& c) {
 
 void FaultPipeline::onCommandOutcome(const navbus::FilterCommandOutcome& o) {
   if (!outcomes_.onOutcome(o) || o.outcome() == navbus::OUTCOME_APPLIED) return;
+  if (CommandOutcomes::notItsStream(o)) {
+    spdlog::info("command {} (kind {}): the filter does not fuse that stream ({})", o.command_id(),
+                 static_cast<int>(o.kind()), o.detail());
+    return;
+  }
   spdlog::warn("command {} (kind {}) {} by the filter: {}{}", o.command_id(),
                static_cast<int>(o.kind()),
                o.outcome() == navbus::OUTCOME_CLAMPED ? "clamped" : "refused", o.detail(),
@@ -259,8 +264,10 @@ std::string FaultPipeline::summary() const {
       << " (judged by their writers only), liveliness losses after a stall that were stale "
       << watchdog_.staleLivelinessEvents() << ", streams ended as announced " << ended_
       << ", commands published " << commands() << " (the filter applied " << outcomes_.applied()
-      << ", clamped " << outcomes_.clamped() << ", refused " << outcomes_.refused() << ")"
-      << "; " << glr_.summary();
+      << ", clamped " << outcomes_.clamped() << ", refused " << outcomes_.refused();
+  if (outcomes_.notItsStreams() > 0)
+    out << " (streams it does not fuse: " << outcomes_.notItsStreams() << ")";
+  out << "); " << glr_.summary();
   if (dither_) out << "; " << dither_->summary();
   if (parity_) out << "; " << parity_->summary();
   if (receivers_) out << "; " << receivers_->summary();

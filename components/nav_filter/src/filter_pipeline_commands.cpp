@@ -24,7 +24,12 @@ void FilterPipeline::onDecision(const navbus::FaultDecision& d) {
 }
 
 bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
-  const std::optional<std::uint32_t> flag = SolutionFlags::streamFlag(c, config_.imu.id);
+  auto idOf = [](const std::optional<InputConfig>& input) {
+    return input ? std::optional<std::uint32_t>(input->id) : std::nullopt;
+  };
+  const std::optional<std::uint32_t> flag =
+      SolutionFlags::streamFlag(c, {config_.imu.id, idOf(config_.gnss_observations),
+                                    idOf(config_.gnss_fix), idOf(config_.star_tracker)});
   if (!flag) return false;
   flags_.applyStreamCommand(c, *flag);
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM && *flag == navbus::FAULT_IMU_STREAM_LOST) {

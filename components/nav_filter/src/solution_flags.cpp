@@ -11,17 +11,24 @@ constexpr std::uint32_t kStreamLostFlags =
 }  // namespace
 
 std::optional<std::uint32_t> SolutionFlags::streamFlag(const navbus::FilterCommand& c,
-                                                       std::uint32_t imu_id) {
+                                                       const InputIds& ids) {
+  const auto is = [&c](const std::optional<std::uint32_t>& id) {
+    return id && *id == c.sensor_id();
+  };
   switch (c.sensor()) {
     case navbus::SOURCE_IMU_STREAM:
-      if (c.sensor_id() != imu_id) return std::nullopt;
+      if (c.sensor_id() != ids.imu) return std::nullopt;
       return navbus::FAULT_IMU_STREAM_LOST;
     case navbus::SOURCE_IMU_RAW_STREAM:
       return navbus::FAULT_RAW_IMU_LOST;
     case navbus::SOURCE_GNSS_OBS_STREAM:
+      if (!is(ids.gnss_observations)) return std::nullopt;
+      return navbus::FAULT_GNSS_STREAM_LOST;
     case navbus::SOURCE_GNSS_FIX_STREAM:
+      if (!is(ids.gnss_fix)) return std::nullopt;
       return navbus::FAULT_GNSS_STREAM_LOST;
     case navbus::SOURCE_ST_STREAM:
+      if (!is(ids.star_tracker)) return std::nullopt;
       return navbus::FAULT_ST_STREAM_LOST;
     default:
       return std::nullopt;

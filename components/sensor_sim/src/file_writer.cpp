@@ -124,13 +124,15 @@ void FileWriter::write(const sim::SensorFrame& f) {
   }
   ++counts_.raw;
   writeUnits(f);
+  for (std::size_t k = 0; f.has_extra_gnss && k < f.extra_gnss.size() && k < receiver_ids_.size();
+       ++k) {
+    if (f.extra_gnss_silent[k]) continue;  // that receiver is out
+    writeSatellites(receivers_, std::to_string(receiver_ids_[k]) + ",", f.extra_gnss[k]);
+    ++counts_.receiver_epochs;
+  }
   if (f.has_gnss) {
     writeSatellites(gnss_, "", f.gnss);
     ++counts_.gnss_epochs;
-    for (std::size_t k = 0; k < f.extra_gnss.size() && k < receiver_ids_.size(); ++k) {
-      writeSatellites(receivers_, std::to_string(receiver_ids_[k]) + ",", f.extra_gnss[k]);
-      ++counts_.receiver_epochs;
-    }
     const auto& x = f.fix;
     fix_ << x.time_ns << "," << (x.valid ? 1 : 0) << "," << num(x.position.latitude_rad) << ","
          << num(x.position.longitude_rad) << "," << num(x.position.height_m) << ","

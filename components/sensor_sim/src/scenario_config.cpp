@@ -159,6 +159,8 @@ void checkFaultKeys(const YAML::Node& n, const std::string& where, const std::st
     checkKeys(n, where, {"sv_id", "magnitude_m", "receiver_id"}, kFaultCommonKeys);
   else if (type == "receiver_clock_jump")
     checkKeys(n, where, {"magnitude_ms", "receiver_id"}, kFaultCommonKeys);
+  else if (type == "gnss_outage")
+    checkKeys(n, where, {"receiver_id"}, kFaultCommonKeys);
   else if (type == "gnss_position_pulse")
     checkKeys(n, where, {"north_m", "east_m", "down_m"}, kFaultCommonKeys);
   else if (type == "sensor_stuck")
@@ -299,6 +301,9 @@ sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::ui
       f.sensor_id = imu_ids[static_cast<std::size_t>(f.unit)];
     } else if (type == "gnss_outage") {
       f.kind = sim::FaultKind::kGnssOutage;
+      // One receiver's (receiver_id), or every receiver's.
+      f.receiver = n["receiver_id"] ? faultReceiver(n, where, receiver_ids) : -1;
+      if (f.receiver >= 0) f.receiver_id = receiver_ids[static_cast<std::size_t>(f.receiver)];
     } else if (type == "star_tracker_outage") {
       f.kind = sim::FaultKind::kStarTrackerOutage;
     } else if (type == "star_tracker_bias") {

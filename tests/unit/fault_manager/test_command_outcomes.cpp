@@ -42,3 +42,21 @@ TEST(CommandOutcomes, OtherIssuersAndEarlierRunsAreNotThisFaultManagers) {
   EXPECT_FALSE(outcomes.degraded());
   EXPECT_EQ(outcomes.refused(), 0u);
 }
+
+TEST(CommandOutcomes, AStreamTheFilterDoesNotFuseIsNoDegradation) {
+  // A redundant receiver's epochs declared lost: the filter refuses the exclusion as not its
+  // stream (it fuses the other receiver). Nothing of the filter's is uncured: counted, not
+  // DEGRADED; any other refusal still is.
+  CommandOutcomes outcomes("fault-manager", 5);
+  navbus::FilterCommandOutcome o = outcome(1, navbus::OUTCOME_REFUSED);
+  o.kind(navbus::CMD_EXCLUDE_STREAM);
+  o.reason(navbus::REJECT_UNEXPECTED_SOURCE);
+  EXPECT_TRUE(outcomes.onOutcome(o));
+  EXPECT_FALSE(outcomes.degraded());
+  EXPECT_EQ(outcomes.refused(), 1u);
+  EXPECT_EQ(outcomes.notItsStreams(), 1u);
+  o.command_id(2);
+  o.kind(navbus::CMD_FAIL_SENSOR_AXIS);  // another IMU's axis: a fault left uncured
+  EXPECT_TRUE(outcomes.onOutcome(o));
+  EXPECT_TRUE(outcomes.degraded());
+}

@@ -21,6 +21,8 @@
 #include <map>
 #include <variant>
 
+#include "navbus/nav_filter/solution_flags.hpp"
+
 using namespace navbus;
 
 TEST(FilterPipelineCommands, StaleCommandOfAnEarlierRunIsRefused) {
@@ -632,4 +634,30 @@ TEST(FilterPipelineOrder, AStreamStartingAfterAnotherGivesTheSameSolutionsInAnyA
     EXPECT_EQ(a.vel_ned_mps(), b.vel_ned_mps()) << i;
     EXPECT_EQ(a.q_b_to_n(), b.q_b_to_n()) << i;
   }
+}
+
+TEST(SolutionFlags, AStreamLostIsThisFiltersOnlyWhenItFusesThatStream) {
+  // Given a filter fusing IMU 1 and receiver 1's epochs (a second receiver, 2, on the bus for
+  // the fault manager's cross-receiver test), when the fault manager declares receiver 2's
+  // epochs lost, then that is not this filter's loss (measured before: its solutions carried
+  // FAULT_GNSS_STREAM_LOST and its health said DEGRADED for the 5 s receiver 2 was silent);
+  // receiver 1's is, and a fix stream only where fixes are fused.
+  using Ids = nav_filter::SolutionFlags::InputIds;
+  const Ids ids{1, 1u, std::nullopt, std::nullopt};
+  FilterCommand c;
+  c.kind(CMD_EXCLUDE_STREAM);
+  c.sensor(SOURCE_GNSS_OBS_STREAM);
+  c.sensor_id(2);
+  EXPECT_FALSE(nav_filter::SolutionFlags::streamFlag(c, ids));
+  c.sensor_id(1);
+  EXPECT_EQ(nav_filter::SolutionFlags::streamFlag(c, ids), FAULT_GNSS_STREAM_LOST);
+  c.sensor(SOURCE_GNSS_FIX_STREAM);
+  EXPECT_FALSE(nav_filter::SolutionFlags::streamFlag(c, ids));
+  EXPECT_EQ(nav_filter::SolutionFlags::streamFlag(c, Ids{1, std::nullopt, 1u, std::nullopt}),
+            FAULT_GNSS_STREAM_LOST);
+  c.sensor(SOURCE_ST_STREAM);
+  EXPECT_FALSE(nav_filter::SolutionFlags::streamFlag(c, ids));
+  c.sensor(SOURCE_IMU_STREAM);
+  c.sensor_id(2);
+  EXPECT_FALSE(nav_filter::SolutionFlags::streamFlag(c, ids));
 }

@@ -219,3 +219,59 @@ TEST(Scenarios, StarTrackerOutageAndBiasFaults) {
     }
   }
 }
+
+TEST(Scenarios, AnOutageAddressedToOneReceiverSilencesThatReceiverOnly) {
+  // Given the dual-receiver aircraft with receiver 2 out from 20 s to 30 s, then receiver 2 has
+  // no epoch in that time and receiver 1 (its epochs and fixes) every one, bit for bit those of
+  // the run without the outage (the silent receiver is observed all the same: nothing else
+  // moves); an outage naming no receiver still silences all. An unknown receiver is refused
+  // naming the field.
+  auto c = load("seed000_dual_receivers.yaml");
+  const auto clean = c;
+  navbus::sim::Fault out;
+  out.kind = navbus::sim::FaultKind::kGnssOutage;
+  out.start_s = 20.0;
+  out.end_s = 30.0;
+  out.receiver = 1;  // the first further receiver (id 2)
+  std::vector<navbus::sim::Fault> faults = c.faults.faults();
+  faults.push_back(out);
+  c.faults = navbus::sim::FaultSchedule(faults);
+  ScenarioSource a(clean), b(c);
+  int silent = 0, epochs = 0;
+  for (int k = 0; k < 100 * 40; ++k) {
+    const SensorFrame fa = a.next(), fb = b.next();
+    ASSERT_EQ(fa.has_gnss, fb.has_gnss);
+    if (!fa.has_gnss) continue;
+    ++epochs;
+    const double t = seconds(c, fb.time_ns);
+    ASSERT_TRUE(fb.has_extra_gnss);
+    EXPECT_EQ(fb.extra_gnss_silent.at(0), t >= 20.0 && t < 30.0) << t;
+    silent += fb.extra_gnss_silent.at(0) ? 1 : 0;
+    ASSERT_EQ(fa.gnss.satellites.size(), fb.gnss.satellites.size());
+    for (std::size_t i = 0; i < fa.gnss.satellites.size(); ++i)
+      EXPECT_EQ(fa.gnss.satellites[i].pseudorange_m, fb.gnss.satellites[i].pseudorange_m);
+    EXPECT_EQ(fa.extra_gnss.at(0).satellites.size(), fb.extra_gnss.at(0).satellites.size());
+  }
+  EXPECT_EQ(epochs, 40);
+  EXPECT_EQ(silent, 10);
+  EXPECT_FALSE(c.faults.receiverOut(25.0, 0));
+  EXPECT_TRUE(c.faults.receiverOut(25.0, 1));
+  EXPECT_FALSE(c.faults.gnssOut(25.0));
+  out.receiver = -1;  // every receiver's
+  EXPECT_TRUE(navbus::sim::FaultSchedule({out}).receiverOut(25.0, 0));
+  EXPECT_TRUE(navbus::sim::FaultSchedule({out}).gnssOut(25.0));
+  YAML::Node root = navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) +
+                                              "/seed000_dual_receivers.yaml");
+  root["faults"] = YAML::Load("[{type: gnss_outage, start_s: 20, duration_s: 10, receiver_id: 9}]");
+  try {
+    navbus::sensor_sim::parseSimConfig(root);
+    FAIL() << "an outage of an unknown receiver was accepted";
+  } catch (const navbus::bus::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("faults[0].receiver_id = 9"), std::string::npos)
+        << e.what();
+  }
+  root["faults"] = YAML::Load("[{type: gnss_outage, start_s: 20, duration_s: 10, receiver_id: 2}]");
+  const auto parsed = navbus::sensor_sim::parseSimConfig(root).scenario;
+  EXPECT_TRUE(parsed.faults.receiverOut(25.0, 1));
+  EXPECT_FALSE(parsed.faults.receiverOut(25.0, 0));
+}

@@ -17,7 +17,7 @@ enum class FaultKind {
   kPseudorangeRamp,    ///< seed 000 table 3: slope [m/s] from start, saturating at `saturation`
   kGnssPositionPulse,  ///< seed 001: a position error [m, NED] on the fixes while active
   kSensorStuck,        ///< seed 003: an axis output frozen at its value at the start
-  kGnssOutage,         ///< seed 004: no GNSS epochs or fixes while active
+  kGnssOutage,         ///< seed 004: no GNSS epochs or fixes while active (of one receiver, or all)
   kStarTrackerOutage,  ///< no star-tracker solution while active
   kStarTrackerBias,    ///< a star-tracker attitude bias [rad, body] while active
   kPseudorangeStep,   ///< one satellite's pseudoranges of one receiver offset by `magnitude` [m] (a
@@ -37,8 +37,8 @@ struct Fault {
   /// IMU faults: the unit (0: the scenario's IMU; k: ScenarioConfig::extra_imus[k - 1]).
   int unit{0};
   std::uint32_t sensor_id{0};  ///< IMU faults: the unit's sensor id (ImuIncrement.sensor_id)
-  /// Pseudorange and clock faults: the receiver (0: the scenario's; k:
-  /// ScenarioConfig::extra_receivers[k - 1]).
+  /// Pseudorange and clock faults, and an outage of one receiver: the receiver (0: the
+  /// scenario's; k: ScenarioConfig::extra_receivers[k - 1]); an outage of every receiver: -1.
   int receiver{0};
   std::uint32_t receiver_id{0};  ///< ... its receiver id (GnssObservationEpoch.receiver_id)
   int sv_id{0};
@@ -69,7 +69,10 @@ class FaultSchedule {
   /// receiver's clock jumps.
   double pseudorangeError(int sv_id, double t, int receiver = 0) const;
   Eigen::Vector3d positionPulse(double t) const;
-  bool gnssOut(double t) const { return any(FaultKind::kGnssOutage, t); }
+  /// Every receiver is out at t.
+  bool gnssOut(double t) const;
+  /// Receiver `receiver` (0: the scenario's) is out at t: its own outage or every receiver's.
+  bool receiverOut(double t, int receiver) const;
   bool starTrackerOut(double t) const { return any(FaultKind::kStarTrackerOutage, t); }
   Eigen::Vector3d starTrackerBias(double t) const;
   const std::vector<Fault>& faults() const { return faults_; }

@@ -75,11 +75,15 @@ struct SensorFrame {
   RawImuBlock raw;
   /// The further IMU units, in ScenarioConfig::extra_imus order (unit k + 1 at index k).
   std::vector<UnitImuIncrement> extra_imus;
-  bool has_gnss{false};
+  bool has_gnss{false};  ///< the scenario's receiver has an epoch (and a fix) at this time
   GnssEpoch gnss;
   GnssFixSample fix;
-  /// With has_gnss: the further receivers' epochs (ScenarioConfig::extra_receivers order).
+  /// The further receivers' epochs at the scenario receiver's epoch times
+  /// (ScenarioConfig::extra_receivers order), with those of a receiver out marked silent.
   std::vector<GnssEpoch> extra_gnss;
+  std::vector<bool> extra_gnss_silent;  ///< per further receiver: out at this time
+  /// The further receivers' epochs hold this time (whatever the scenario's receiver does).
+  bool has_extra_gnss{false};
   bool has_star_tracker{false};
   StarTrackerSample star_tracker;
   core::NavState truth;

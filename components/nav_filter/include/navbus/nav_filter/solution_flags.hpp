@@ -14,10 +14,16 @@ namespace navbus::nav_filter {
 
 class SolutionFlags {
  public:
-  /// The stream-lost flag a stream command concerns (the IMU stream only with the filter's
-  /// `imu_id`); nullopt for a source that is not a stream of this filter.
+  /// The ids of the streams this filter fuses (nullopt: it has no such input).
+  struct InputIds {
+    std::uint32_t imu{0};
+    std::optional<std::uint32_t> gnss_observations, gnss_fix, star_tracker;
+  };
+  /// The stream-lost flag a stream command concerns, only for a stream this filter fuses (its
+  /// IMU, its receiver's epochs or fixes, its star tracker: another receiver of a redundant
+  /// installation falling silent is not this filter's loss); nullopt for any other.
   static std::optional<std::uint32_t> streamFlag(const navbus::FilterCommand& c,
-                                                 std::uint32_t imu_id);
+                                                 const InputIds& ids);
   /// Sets (CMD_EXCLUDE_STREAM) or clears (CMD_READMIT_STREAM) `flag`, logged.
   void applyStreamCommand(const navbus::FilterCommand& c, std::uint32_t flag);
   /// Whether a fault monitor is alive; changes are logged and losses counted.

@@ -83,10 +83,14 @@ bool emitFrame(const sim::SensorFrame& f, const SimConfig& c, FrameSequence& seq
     ++seq.gnss_epochs;
     if (!emit(toIdl(f.fix, c.gnss_receiver_id, seq.gnss_fixes + 1))) return false;
     ++seq.gnss_fixes;
-    // The further receivers' epochs (no fixes of their own), each under its receiver id.
+  }
+  if (c.publish_gnss && f.has_extra_gnss) {
+    // The further receivers' epochs (no fixes of their own), each under its receiver id; none
+    // of a receiver that is out.
     const std::size_t receivers = std::min(f.extra_gnss.size(), c.extra_gnss_receiver_ids.size());
     if (seq.extra_gnss.size() < receivers) seq.extra_gnss.resize(receivers, 0);
     for (std::size_t k = 0; k < receivers; ++k) {
+      if (f.extra_gnss_silent[k]) continue;
       if (!emit(toIdl(f.extra_gnss[k], c.extra_gnss_receiver_ids[k], seq.extra_gnss[k] + 1)))
         return false;
       ++seq.extra_gnss[k];
