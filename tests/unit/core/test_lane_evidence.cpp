@@ -86,3 +86,20 @@ TEST(ChiSquare, TheQuantileInvertsTheSurvival) {
       EXPECT_NEAR(nc::chiSquareSurvival(nc::chiSquareQuantile(p, dof), dof) / p, 1.0, 1e-6);
   }
 }
+
+TEST(LaneEvidence, ALaneFailingItsOwnTestSinceTheOnsetIsNamedNotOneThatFailedBefore) {
+  // Neither estimate moves. Lane 1 was already failing its consistency test at the reference:
+  // that says nothing about this fault (not named, however long); lane 0 failing from a time
+  // after the onset while lane 1 holds is named then.
+  nc::LaneEvidenceTest test(nc::LaneEvidenceConfig{});
+  const double sigma = 0.3 * kDegPerHour;
+  test.open(0, {{{0.0, sigma, true}, {0.0, sigma, false}}});
+  for (int k = 1; k <= 100; ++k)
+    ASSERT_FALSE(test.update(k * kSecondNs / 10, {{{0.0, sigma, true}, {0.0, sigma, false}}}));
+  test.open(0, {{{0.0, sigma, true}, {0.0, sigma, true}}});
+  EXPECT_FALSE(test.update(kSecondNs, {{{0.0, sigma, true}, {0.0, sigma, true}}}));
+  const auto d = test.update(2 * kSecondNs, {{{0.0, sigma, false}, {0.0, sigma, true}}});
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->candidate, 0);
+  EXPECT_EQ(d->kind, nc::LaneEvidenceKind::kLaneInconsistent);
+}

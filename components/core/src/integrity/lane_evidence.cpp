@@ -30,9 +30,14 @@ std::optional<LaneEvidenceDecision> LaneEvidenceTest::update(
   const double lambda = 0.5 * (normalised[0] - normalised[1]);  // eq. 2
   latest_ = std::abs(lambda);
   const bool bias_moved = latest_ >= threshold_;
-  if (bias_moved || now[0].consistent != now[1].consistent) {
+  // A lane that fails its own test since the onset (it held at the reference) while the other
+  // holds: a lane already failing before the onset says nothing about this fault.
+  auto failedSince = [&](std::size_t i) {
+    return reference_[i].consistent && !now[i].consistent && now[1 - i].consistent;
+  };
+  if (bias_moved || failedSince(0) || failedSince(1)) {
     open_ = false;
-    const std::size_t k = bias_moved ? (lambda > 0.0 ? 0 : 1) : (now[0].consistent ? 1 : 0);
+    const std::size_t k = bias_moved ? (lambda > 0.0 ? 0 : 1) : (failedSince(0) ? 0 : 1);
     return LaneEvidenceDecision{
         static_cast<int>(k),
         bias_moved ? LaneEvidenceKind::kBiasMoved : LaneEvidenceKind::kLaneInconsistent,

@@ -24,8 +24,8 @@
 // moved its estimate by 0.01 deg/h in 50 s) and drift away instead, until its own consistency
 // test (consistency_monitor.hpp: the windowed NIS beyond its chi-square bound) fails. The lanes
 // share every aiding measurement, so a fault in neither fails both or none: when one candidate's
-// lane has failed its test since the onset and the other's has not, the failed one is named
-// (each lane's test has its own false-alarm probability).
+// lane fails its test at a time after the onset (having held at the reference) while the
+// other's holds, the failed one is named (each lane's test has its own false-alarm probability).
 //
 // A test that has not decided within `max_wait_s` of the onset gives up (the ambiguity stays).
 // Pure math.
