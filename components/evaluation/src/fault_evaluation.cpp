@@ -145,30 +145,18 @@ std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule) {
 }
 
 namespace {
-/// The first naming of one source after the fault: a decision that is not ambiguous, or the
-/// lanes' choice between two suspects, whichever came first.
+/// The first naming of one source after the fault: a decision that is not ambiguous (the
+/// parity test's, or the fault manager's "lanes" decision when the lanes chose between two
+/// suspects).
 void noteNamed(const OfflineResult& r, const sim::Fault& fault, std::int64_t start_ns,
                FaultRunOutcome& out) {
-  auto seconds = [start_ns](std::int64_t t_ns) {
-    return 1e-9 * static_cast<double>(t_ns - start_ns);
-  };
   for (const navbus::FaultDecision& d : r.decisions) {
-    const double t = seconds(static_cast<std::int64_t>(d.time_gps_ns()));
+    const double t =
+        1e-9 * static_cast<double>(static_cast<std::int64_t>(d.time_gps_ns()) - start_ns);
     if (d.event() != navbus::EVENT_FAULT_DETECTED || d.ambiguous() || t < fault.start_s) continue;
     out.named_s = t;
     out.named_correct = matches(fault, d.source(), d.sv_id(), d.axis(), parityUnit(d));
-    break;
-  }
-  for (const OfflineResult::LaneNaming& n : r.lanes_named) {
-    const double t = seconds(n.time_ns);
-    if (t < fault.start_s) continue;
-    if (std::isnan(out.named_s) || t < out.named_s) {
-      out.named_s = t;
-      out.named_correct =
-          matches(fault, n.accelerometer ? navbus::SOURCE_ACCELEROMETER : navbus::SOURCE_GYRO, 0,
-                  n.axis, n.sensor_id);
-    }
-    break;
+    return;
   }
 }
 }  // namespace
@@ -247,9 +235,9 @@ void printNamed(const sim::Fault& fault, const std::vector<FaultRunOutcome>& run
     within_60 += after <= 60.0 ? 1 : 0;
   }
   std::printf(
-      "  named (a decision not ambiguous, or the lanes' choice between two suspects): the faulty "
-      "source in %d runs (within 60 s of the onset in %d; after it %.1f s on average, %.1f s at "
-      "most), another in %d, never in %d\n",
+      "  named (the first decision not ambiguous, the lanes' between two suspects included): the "
+      "faulty source in %d runs (within 60 s of the onset in %d; after it %.1f s on average, "
+      "%.1f s at most), another in %d, never in %d\n",
       right, within_60, right ? sum / right : std::nan(""), right ? most : std::nan(""), wrong,
       never);
 }

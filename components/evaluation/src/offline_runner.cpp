@@ -288,10 +288,6 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
   // End of data: whatever waits for a stream that will not speak again is released.
   pipeline.flush(sim.scenario.start_time_ns + total * period_ns);
   result.summary = pipeline.summary();
-  for (const auto& n : pipeline.suspects().named())
-    result.lanes_named.push_back(
-        {n.time_ns, setup.filter.lanes.units[static_cast<std::size_t>(n.suspect.lane)].sensor_id,
-         n.suspect.accelerometer, n.suspect.axis});
   if (const bus::StreamCounters* imu = health.find(bus::topic::kImuIncrement))
     result.imu_rejected = imu->rejected;
   if (const bus::StreamCounters* gnss = health.find(bus::topic::kGnssObservations))

@@ -263,10 +263,10 @@ void ParityDetector::onLaneSolution(const navbus::LaneSolution& lane, FaultOutpu
   const auto it = suspects_.find(lane.named_faulty_for_decision());
   if (it == suspects_.end()) return;  // none named, or named already
   const navbus::FaultDecision ambiguous = it->second;
-  suspects_.erase(it);
   const auto& c = ambiguous.candidates();
   const bool first = c[0].sensor_id() == lane.lane_id();
   if (!first && c[1].sensor_id() != lane.lane_id()) return;  // not a candidate: not this one's
+  suspects_.erase(it);
   navbus::FaultDecision d = ambiguous;
   const navbus::FaultCandidate& named = c[first ? 0 : 1];
   d.time_gps_ns(lane.solution().time_gps_ns());

@@ -18,7 +18,7 @@ const char* instrumentName(bool accelerometer) {
 
 SuspectLanes::SuspectLanes(const std::vector<LaneUnit>& units,
                            const core::LaneEvidenceConfig& config)
-    : units_(units), test_(config), history_(units.size()) {}
+    : units_(units), test_(config), history_(units.size(), History(kHistory)) {}
 
 std::string SuspectLanes::onSuspect(const Suspect& s) {
   if (!first_ || first_->decision_id != s.decision_id || first_->lane == s.lane) {
@@ -41,8 +41,8 @@ std::optional<SuspectLanes::Named> SuspectLanes::atSelection(
     std::int64_t time_ns, const std::vector<const navbus::NavigationSolution*>& at) {
   for (std::size_t k = 0; k < at.size(); ++k) {
     if (!at[k]) continue;
+    if (history_[k].size() == kHistory) history_[k].pop_front();  // full: the oldest goes
     history_[k].push_back(inUnitAxes(k, *at[k]));
-    if (history_[k].size() > kHistory) history_[k].pop_front();
   }
   if (!question_) return std::nullopt;
   Question& q = *question_;
@@ -137,13 +137,13 @@ std::optional<std::array<core::LaneBiasEstimate, 2>> SuspectLanes::referenceFrom
   const std::int64_t onset = q.suspects[0].onset_ns;
   if (ha.back().time_ns < onset) return std::nullopt;  // the selection will pass the onset
   // The latest time both lanes kept before the onset.
-  for (auto ia = ha.rbegin(); ia != ha.rend(); ++ia) {
-    if (ia->time_ns >= onset) continue;
-    for (auto ib = hb.rbegin(); ib != hb.rend(); ++ib) {
-      if (ib->time_ns == ia->time_ns)
-        return std::array<core::LaneBiasEstimate, 2>{instrument(*ia, q.suspects[0]),
-                                                     instrument(*ib, q.suspects[1])};
-      if (ib->time_ns < ia->time_ns) break;
+  for (std::size_t ia = ha.size(); ia-- > 0;) {
+    if (ha[ia].time_ns >= onset) continue;
+    for (std::size_t ib = hb.size(); ib-- > 0;) {
+      if (hb[ib].time_ns == ha[ia].time_ns)
+        return std::array<core::LaneBiasEstimate, 2>{instrument(ha[ia], q.suspects[0]),
+                                                     instrument(hb[ib], q.suspects[1])};
+      if (hb[ib].time_ns < ha[ia].time_ns) break;
     }
   }
   ++counters_.old_onset;  // before everything kept: the oldest common time stands for it

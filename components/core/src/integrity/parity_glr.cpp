@@ -105,9 +105,12 @@ void ParityGlr::evaluate() {
   }
   if (best_ring < 0) return;
   const int j = result_.instrument;
-  const double r = samples_[static_cast<std::size_t>(best_ring)] * information_[j];  // eq. 10
+  const double samples = samples_[static_cast<std::size_t>(best_ring)];
+  const double r = samples * information_[j];  // eq. 10
+  // b^ of instrument i at that onset (eq. 11).
+  auto magnitude = [&](int i) { return f_(i, best_ring) / (samples * information_[i]); };
   result_.detected = result_.statistic >= threshold_;
-  result_.magnitude = f_(j, best_ring) / r;  // eq. 11
+  result_.magnitude = magnitude(j);
   result_.magnitude_sigma = 1.0 / std::sqrt(r);
   result_.samples_since_onset = samples_[static_cast<std::size_t>(best_ring)];
   // Runner-up at the same onset: a collinear signature first (no data can tell them apart),
@@ -117,13 +120,11 @@ void ParityGlr::evaluate() {
     if (k == j) continue;
     if (space_.signatureCorrelation(j, k) >= config_.ambiguity_correlation) {
       result_.runner_up = k;
-      result_.runner_up_magnitude =
-          f_(k, best_ring) / (samples_[static_cast<std::size_t>(best_ring)] * information_[k]);
+      result_.runner_up_magnitude = magnitude(k);
       result_.ambiguous = true;
       return;
     }
-    const double l = f_(k, best_ring) * f_(k, best_ring) /
-                     (2.0 * samples_[static_cast<std::size_t>(best_ring)] * information_[k]);
+    const double l = f_(k, best_ring) * f_(k, best_ring) / (2.0 * samples * information_[k]);
     if (l > runner_l) {
       runner_l = l;
       result_.runner_up = k;
@@ -134,9 +135,7 @@ void ParityGlr::evaluate() {
     result_.runner_up = -1;
     return;
   }
-  const int k = result_.runner_up;
-  result_.runner_up_magnitude = f_(k, best_ring) / (samples_[static_cast<std::size_t>(best_ring)] *
-                                                    information_[k]);  // eq. 11
+  result_.runner_up_magnitude = magnitude(result_.runner_up);
 }
 
 }  // namespace navbus::core

@@ -35,7 +35,8 @@ struct FaultRunOutcome {
   double recovery_s{std::nan("")};
   std::string decided;  ///< text of the first detection after the fault
   /// The unit (or receiver, satellite) first named after the fault by a decision that is not
-  /// ambiguous or by the lanes' comparison of two suspects [s from start]; NaN: never.
+  /// ambiguous (the lanes' "lanes" decision between two suspects included) [s from start];
+  /// NaN: never.
   double named_s{std::nan("")};
   bool named_correct{false};  ///< ... and it was the faulty one
 };

@@ -70,14 +70,6 @@ struct OfflineResult {
   /// scored against the truth.
   std::uint64_t solutions_without_engine_state{0};
   std::vector<navbus::LaneSolution> lane_solutions;  ///< with keep_lane_solutions
-  /// Units the lanes named between two suspects (CMD_SUSPECT_SENSOR_AXIS), in order.
-  struct LaneNaming {
-    std::int64_t time_ns{0};
-    std::uint32_t sensor_id{0};
-    bool accelerometer{false};
-    int axis{0};
-  };
-  std::vector<LaneNaming> lanes_named;
   /// The fault manager's parity test (redundant IMUs), every 100 ms of data: the largest
   /// statistic of each kind over those samples and the thresholds.
   struct ParityEpoch {

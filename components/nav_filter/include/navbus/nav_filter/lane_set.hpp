@@ -80,8 +80,6 @@ class LaneSet {
   /// The lane whose solutions are published (0 before any selection; config lanes.units order).
   int selectedLane() const { return selectedIndex(); }
   const core::LaneSelection& selection() const { return selector_.last(); }
-  /// The comparison of two suspect units' lanes (CMD_SUSPECT_SENSOR_AXIS) and what it named.
-  const SuspectLanes& suspects() const { return suspects_; }
   std::string summary() const;
 
  private:

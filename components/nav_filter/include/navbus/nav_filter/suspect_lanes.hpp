@@ -11,7 +11,6 @@
 
 #include <array>
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,6 +18,7 @@
 #include <navbus_idl/Navigation.h>
 
 #include "navbus/core/integrity/lane_evidence.hpp"
+#include "navbus/core/math/ring_buffer.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 
 namespace navbus::nav_filter {
@@ -61,7 +61,6 @@ class SuspectLanes {
     std::uint64_t old_onset{0};   ///< onsets before the history kept: its oldest time used
   };
   const Counters& counters() const { return counters_; }
-  const std::vector<Named>& named() const { return named_; }
   std::string summary() const;
 
  private:
@@ -80,6 +79,8 @@ class SuspectLanes {
   };
   /// Selected times kept per lane, for a reference before an onset the selection has passed.
   static constexpr std::size_t kHistory = 256;
+  /// A lane's kept times: a ring of fixed size (a deque allocated a block every 3 selections).
+  using History = core::RingBuffer<Estimates>;
 
   Estimates inUnitAxes(std::size_t lane, const navbus::NavigationSolution& s) const;
   static core::LaneBiasEstimate instrument(const Estimates& e, const Suspect& s);
@@ -88,7 +89,7 @@ class SuspectLanes {
 
   std::vector<LaneUnit> units_;
   core::LaneEvidenceTest test_;
-  std::vector<std::deque<Estimates>> history_;  ///< per lane, at selected times
+  std::vector<History> history_;  ///< per lane, at selected times
   std::optional<Suspect> first_;  ///< a decision's first candidate, waiting for its second
   std::optional<Question> question_;
   std::vector<Named> named_;
