@@ -227,3 +227,23 @@ TEST(LoadedLanes, TriplexLanesThroughASwitchWithStopsAndCpuHogsEqualOffline) {
        {"lanes: switched from IMU 1 to IMU", "switches 1,",
         "selections made without the parity test's judgement (its wait ran out) 0"}});
 }
+
+// Two parallel units in two lanes (config/filter_dual_parallel.yaml): unit 1's x gyro steps
+// 10 deg/h at 100 s, the parity test names both units as suspects, and the lanes, comparing their
+// bias estimates, name unit 1 and leave its lane; the filter is stopped twice and the fault
+// manager once, two busy loops beside them. The published solutions, every lane's own and both
+// decisions (the parity test's and the lanes') equal offline's.
+TEST(LoadedLanes, ParallelLanesNameTheFaultyUnitWithStopsAndCpuHogsAsOffline) {
+  run({122,
+       "seed000_dual_parallel",
+       240,
+       2,
+       1,
+       2,
+       "filter_dual_parallel",
+       "fault_manager_dual_parallel",
+       "faults:\n  - {type: imu_bias_step, sensor: gyro, axis: x, start_s: 100,\n"
+       "     magnitude_deg_per_h: 10, sensor_id: 1}\n",
+       {"lanes: IMU 1 gyro axis x named at", "lanes: switched from IMU 1 to IMU 2", "switches 1,",
+        "selections made without the parity test's judgement (its wait ran out) 0"}});
+}
