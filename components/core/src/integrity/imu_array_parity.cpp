@@ -6,54 +6,16 @@
 
 namespace navbus::core {
 
-namespace {
-
-constexpr double kRotationTolerance = 1e-6;  ///< |C C^T - I| and |det C - 1| of a mounting
-
-std::string unitField(std::size_t u, const char* field) {
-  return "IMU array unit " + std::to_string(u) + ": " + field;
-}
-
-}  // namespace
-
 std::optional<ImuArrayParity> ImuArrayParity::make(const std::vector<ImuArrayUnit>& units,
                                                    double interval_s,
                                                    const ImuArrayParityConfig& config,
                                                    std::string& error) {
-  if (units.size() < 2 || units.size() > static_cast<std::size_t>(kMaxUnits)) {
-    error = "IMU array: " + std::to_string(units.size()) + " units; it must have 2 to " +
-            std::to_string(kMaxUnits);
-    return std::nullopt;
-  }
-  if (!(interval_s > 0.0) || !std::isfinite(interval_s)) {
-    error = "IMU array: sample interval " + std::to_string(interval_s) + " s is not positive";
-    return std::nullopt;
-  }
+  if (!checkImuArray(units, interval_s, kMaxUnits, error)) return std::nullopt;
   if (config.reference_samples < 1 || !(config.reference_time_constant_samples >= 0.0)) {
     error = "IMU array: reference_samples " + std::to_string(config.reference_samples) +
             " must be >= 1 and the reference time constant " +
             std::to_string(config.reference_time_constant_samples) + " >= 0";
     return std::nullopt;
-  }
-  for (std::size_t u = 0; u < units.size(); ++u) {
-    const ImuArrayUnit& unit = units[u];
-    const Eigen::Matrix3d& c = unit.c_u_b;
-    if (!c.allFinite() ||
-        (c * c.transpose() - Eigen::Matrix3d::Identity()).norm() > kRotationTolerance ||
-        std::abs(c.determinant() - 1.0) > kRotationTolerance) {
-      error = unitField(u, "the mounting is not a rotation");
-      return std::nullopt;
-    }
-    if (!unit.lever_arm_b_m.allFinite()) {
-      error = unitField(u, "lever_arm_b_m is not finite");
-      return std::nullopt;
-    }
-    if (!(unit.gyro_sigma_rad > 0.0) || !(unit.accel_sigma_mps > 0.0)) {
-      error = unitField(u, "the gyro and accelerometer noise must be positive (gyro ") +
-              std::to_string(unit.gyro_sigma_rad) + " rad, accelerometer " +
-              std::to_string(unit.accel_sigma_mps) + " m/s per sample)";
-      return std::nullopt;
-    }
   }
   ImuArrayParity array(units, interval_s, config);
   for (int k = 0; k < kImuInstrumentKinds; ++k) {
@@ -164,8 +126,7 @@ void ImuArrayParity::fillAccelerometer(const std::array<ImuIncrement, kMaxUnits>
   for (int r = 0; r < c.rows; ++r) {
     const int i = c.instrument[static_cast<std::size_t>(r)];
     const ImuArrayUnit& unit = units_[static_cast<std::size_t>(i / 3)];
-    const Eigen::Vector3d& arm = unit.lever_arm_b_m;
-    const Eigen::Vector3d arm_f_b = w_dot.cross(arm) + w.cross(w.cross(arm));
+    const Eigen::Vector3d arm_f_b = leverArmSpecificForce(w, w_dot, unit.lever_arm_b_m);
     c.m[r] = increments[static_cast<std::size_t>(i / 3)].delta_vel_b_mps[i % 3] -
              unit.c_u_b.row(i % 3).dot(arm_f_b) * interval_s_;
   }

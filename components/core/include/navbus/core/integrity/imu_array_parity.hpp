@@ -30,19 +30,12 @@
 
 #include <Eigen/Core>
 
+#include "navbus/core/ins/imu_array.hpp"
 #include "navbus/core/ins/strapdown.hpp"
 #include "navbus/core/integrity/parity_glr.hpp"
 #include "navbus/core/integrity/parity_space.hpp"
 
 namespace navbus::core {
-
-/// One IMU of the array.
-struct ImuArrayUnit {
-  Eigen::Matrix3d c_u_b{Eigen::Matrix3d::Identity()};      ///< body -> unit axes
-  Eigen::Vector3d lever_arm_b_m{Eigen::Vector3d::Zero()};  ///< place from the body origin
-  double gyro_sigma_rad{0.0};   ///< white noise of one angle increment (ARW sqrt(dt)) [rad]
-  double accel_sigma_mps{0.0};  ///< white noise of one velocity increment (VRW sqrt(dt)) [m/s]
-};
 
 struct ImuArrayParityConfig {
   ParityGlrConfig glr;
@@ -50,9 +43,6 @@ struct ImuArrayParityConfig {
   /// Tracking of the parity mean afterwards [samples]; 0 freezes it.
   double reference_time_constant_samples{180000.0};
 };
-
-enum class ImuInstrument { kGyro = 0, kAccelerometer = 1 };
-inline constexpr int kImuInstrumentKinds = 2;
 
 /// A detection in the array of one kind: the instrument named by its unit (index into the
 /// units given to make()) and its axis in that unit's frame.
