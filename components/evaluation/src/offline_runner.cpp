@@ -79,6 +79,38 @@ Truth laneTruth(const Truth& t, const nav_filter::LaneUnit& unit,
   return out;
 }
 
+/// The truth as the least-squares lane's engine estimates it: the biases its combination carries
+/// (E b of every unit's biases, in each unit's axes), at the body origin.
+Truth combinedTruth(const Truth& t, const nav_filter::LaneSet& lanes,
+                    const sensor_sim::SimConfig& sim) {
+  Truth out = t;
+  std::array<Eigen::Vector3d, core::ImuArrayCombination::kMaxUnits> accel{}, gyro{};
+  const auto& ids = sim.extra_imu_sensor_ids;
+  const core::ImuArrayCombination& c = lanes.combined()->combination();
+  for (int u = 0; u < c.units(); ++u) {
+    const nav_filter::LaneUnit& unit = lanes.laneUnit(u);
+    const auto i = static_cast<std::size_t>(u);
+    accel[i] = unit.c_b_u.transpose() * t.accel_bias_b_mps2;  // the scenario's IMU: body axes
+    gyro[i] = unit.c_b_u.transpose() * t.gyro_bias_b_radps;
+    for (std::size_t k = 0; k < ids.size() && k < t.unit_biases_u.size(); ++k) {
+      if (ids[k] != unit.sensor_id) continue;
+      accel[i] = t.unit_biases_u[k].first;
+      gyro[i] = t.unit_biases_u[k].second;
+    }
+  }
+  out.accel_bias_b_mps2 = c.combinedBias(core::ImuInstrument::kAccelerometer, accel);
+  out.gyro_bias_b_radps = c.combinedBias(core::ImuInstrument::kGyro, gyro);
+  return out;
+}
+
+/// The truth as the selected lane's engine estimates it.
+Truth selectedLaneTruth(const Truth& t, const nav_filter::LaneSet& lanes,
+                        const sensor_sim::SimConfig& sim) {
+  const int k = lanes.selectedLane();
+  if (lanes.combined() && k == lanes.lanes() - 1) return combinedTruth(t, lanes, sim);
+  return laneTruth(t, lanes.laneUnit(k), sim);
+}
+
 /// NEES of one 3-state block of the error (estimate minus truth) against its covariance
 /// block; NaN when the filter does not estimate the block.
 double blockNees(const core::StateMatrix& P, const core::StateMask& active,
@@ -185,9 +217,7 @@ OfflineResult runOffline(const OfflineSetup& setup, const SolutionHook& hook) {
     const auto& units = setup.filter.lanes.units;
     // One lane: the frame's truth as it is (no copy per solution).
     std::optional<Truth> lane_truth;
-    if (!units.empty())
-      lane_truth = laneTruth(truths.front(),
-                             units[static_cast<std::size_t>(pipeline_ptr->selectedLane())], sim);
+    if (!units.empty()) lane_truth = selectedLaneTruth(truths.front(), *pipeline_ptr, sim);
     const Truth& truth = lane_truth ? *lane_truth : truths.front();
     // With lanes, the selection waits for the slowest lane: the selected lane's engine may have
     // moved on (its covariance at this time is gone). Scored from the message then (at the body

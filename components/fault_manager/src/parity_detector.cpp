@@ -39,7 +39,10 @@ navbus::FaultSource source(ImuInstrument k) {
 }  // namespace
 
 ParityDetector::ParityDetector(const ParityDetectorConfig& config)
-    : config_(config), period_ns_(std::llround(1e9 / config.imu_rate_hz)) {
+    : config_(config),
+      period_ns_(std::llround(1e9 / config.imu_rate_hz)),
+      aligner_(static_cast<int>(config.units.size()),
+               static_cast<std::size_t>(config.alignment_depth)) {
   makeArray();
   spdlog::info("parity detector: {} IMU units, {}", config_.units.size(),
                minimumDetectableBiases());
@@ -71,25 +74,14 @@ void ParityDetector::onIncrement(const navbus::ImuIncrement& msg, FaultOutput& o
   const auto u = static_cast<std::size_t>(unit);
   // A unit's reliable reader delivers its writer's increments in order: time and sequence both
   // going back is a new run of its source, not a late sample.
-  if (msg.seq() < latest_seq_[u] && time_ns < latest_ns_[u]) startNewRun();
+  if (msg.seq() < latest_seq_[u] && time_ns < aligner_.latestNs(unit)) startNewRun();
   if (latest_seq_[u] == 0 && msg.seq() > 1) noteMissedStart(msg);
   latest_seq_[u] = msg.seq();
-  if (time_ns <= std::max(last_tested_ns_, late_before_ns_)) {
-    ++counters_.late;
+  if (aligner_.add(unit, bus::toCore(msg)) != bus::ImuUnitAligner::Added::kTaken) {
+    ++counters_.late;  // at or before a time already tested or dropped, or the same unit twice
     return;
   }
   ++counters_.increments;
-  Slot& slot = pending_[time_ns];
-  const std::uint32_t bit = 1u << static_cast<unsigned>(unit);
-  if (slot.mask & bit) {
-    ++counters_.late;  // the same unit twice at one time
-    return;
-  }
-  slot.mask |= bit;
-  ++slot.received;
-  slot.units[static_cast<std::size_t>(unit)] = bus::toCore(msg);
-  latest_ns_[static_cast<std::size_t>(unit)] =
-      std::max(latest_ns_[static_cast<std::size_t>(unit)], time_ns);
   drain(out);
 }
 
@@ -111,11 +103,9 @@ void ParityDetector::makeArray() {
 
 void ParityDetector::startNewRun() {
   makeArray();  // as configured (it was made so once: it cannot fail now)
-  pending_.clear();
+  aligner_.clear();
   ended_units_ = 0;
   last_tested_ns_ = -1;
-  late_before_ns_ = -1;
-  latest_ns_.fill(0);
   latest_seq_.fill(0);
   latest_ = {};
   ++counters_.new_runs;
@@ -131,48 +121,28 @@ bool ParityDetector::onUnitEnded(std::uint32_t sensor_id) {
   return ended_units_ == (1u << static_cast<unsigned>(array_->units())) - 1u;
 }
 
-bool ParityDetector::lost(std::int64_t time_ns, const Slot& slot) const {
-  // Each unit's increments come in time order (a reliable reader per unit instance; the units'
-  // instances are taken in any order between them): a unit that delivered a later time never
-  // delivers this one.
-  for (int u = 0; u < array_->units(); ++u) {
-    if (slot.mask & (1u << static_cast<unsigned>(u))) continue;
-    if (latest_ns_[static_cast<std::size_t>(u)] <= time_ns) return false;
-  }
-  return true;
-}
-
 void ParityDetector::drain(FaultOutput& out) {
-  const int units = array_->units();
-  while (!pending_.empty()) {
-    auto oldest = pending_.begin();
-    if (oldest->second.received < units) {
-      // Wait for the missing unit's increment until it has passed that time, or a silent unit
-      // holds alignment_depth times waiting.
-      if (!lost(oldest->first, oldest->second) &&
-          static_cast<int>(pending_.size()) <= config_.alignment_depth)
-        return;
+  while (const std::optional<bus::ImuUnitAligner::Sample> sample = aligner_.next()) {
+    if (!aligner_.complete(*sample)) {
+      // A unit's increment lost, or a silent unit held alignment_depth times waiting.
       ++counters_.incomplete;
       array_->restart();  // the window's sums need consecutive samples
       last_tested_ns_ = -1;
-      late_before_ns_ = oldest->first;
-      pending_.erase(oldest);
       continue;
     }
-    test(oldest->first, oldest->second, out);
-    pending_.erase(oldest);
+    test(sample->time_ns, sample->units, out);
   }
 }
 
-void ParityDetector::test(std::int64_t time_ns, const Slot& slot, FaultOutput& out) {
+void ParityDetector::test(std::int64_t time_ns, const bus::ImuUnitAligner::Increments& units,
+                          FaultOutput& out) {
   if (last_tested_ns_ >= 0 && time_ns - last_tested_ns_ != period_ns_) {
     ++counters_.gaps;  // the window's sums need consecutive samples
     array_->restart();
   }
   last_tested_ns_ = time_ns;
-  late_before_ns_ = time_ns;
   ++counters_.samples;
-  latest_ = array_->update(slot.units);
+  latest_ = array_->update(units);
   for (int k = 0; k < core::kImuInstrumentKinds; ++k) {
     const auto i = static_cast<std::size_t>(k);
     counters_.max_statistic[i] = std::max(counters_.max_statistic[i], latest_.statistic[i]);

@@ -532,6 +532,25 @@ void parseGeometry(const YAML::Node& node, FilterConfig& c) {
     bus::checkRange(lever[i], -100.0, 100.0, "geometry.antenna_lever_arm_b_m");
   c.engine.antenna_lever_arm_b_m = lever;
 }
+/// The lane on the least-squares combination of the units (LanesConfig::least_squares_lane_id).
+void parseLeastSquaresLane(const YAML::Node& node, LanesConfig& l) {
+  if (!node) return;
+  std::uint32_t lane_id = 0;
+  bool preferred = false;
+  bus::KeyReader(node, "lanes.least_squares")
+      .value("lane_id", lane_id)
+      .value("preferred", preferred)
+      .integer("alignment_depth", l.least_squares_alignment_depth, {1, 100000})
+      .finish();
+  if (!node["lane_id"])
+    throw bus::ConfigError("configuration lanes.least_squares.lane_id is missing");
+  if (lane_id == 0)
+    throw bus::ConfigError(
+        "configuration lanes.least_squares.lane_id 0: 0 names the filter's own IMU in commands");
+  l.least_squares_lane_id = lane_id;
+  l.least_squares_preferred = preferred;
+}
+
 /// Redundant IMUs: one lane per unit (LanesConfig).
 void parseLanes(const YAML::Node& node, FilterConfig& c) {
   bus::KeyReader r(node, "lanes");
@@ -539,9 +558,10 @@ void parseLanes(const YAML::Node& node, FilterConfig& c) {
   r.number("switch_ratio", l.selector.switch_ratio, {0.01, 1.0})
       .integer("confirm_epochs", l.selector.confirm_epochs, {1, 100000})
       .integer("max_pending", l.max_pending, {1, 1000000})
-      .nested({"units", "evidence"})
+      .nested({"units", "evidence", "least_squares"})
       .finish();
   if (!node) return;
+  parseLeastSquaresLane(node["least_squares"], l);
   bus::KeyReader(node["evidence"], "lanes.evidence")
       .number("false_decision_probability", l.evidence.false_decision_probability, {1e-15, 0.1})
       .number("max_wait_s", l.evidence.max_wait_s, {1.0, 3600.0})
@@ -573,6 +593,14 @@ void parseLanes(const YAML::Node& node, FilterConfig& c) {
         "configuration lanes.units[0].sensor_id {} must be inputs.imu's id {} (the first lane is "
         "the filter's own IMU: its diagnostics feed the fault manager's GLR)",
         l.units.front().sensor_id, c.imu.id));
+  if (l.least_squares_lane_id) {
+    for (const LaneUnit& u : l.units)
+      if (u.sensor_id == *l.least_squares_lane_id)
+        throw bus::ConfigError(fmt::format(
+            "configuration lanes.least_squares.lane_id {} is a unit's sensor_id (lanes.units): "
+            "the combination's lane needs an id of its own",
+            *l.least_squares_lane_id));
+  }
 }
 
 }  // namespace

@@ -120,6 +120,14 @@ void FilterPipeline::onCommand(const navbus::FilterCommand& c,
           c.command_id(), c.issuer(), static_cast<int>(c.sensor()), c.sensor_id());
     return;
   }
+  enterCommand(c);
+}
+
+void FilterPipeline::addOwnCommand(const navbus::FilterCommand& c) {
+  enterCommand(c);
+}
+
+void FilterPipeline::enterCommand(const navbus::FilterCommand& c) {
   const auto time_ns = static_cast<std::int64_t>(c.time_gps_ns());
   if (time_ns > 0) {
     FilterInput input = CommandInput{time_ns, c};

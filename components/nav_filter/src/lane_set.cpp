@@ -27,6 +27,19 @@ FilterConfig laneConfig(const FilterConfig& base, const LaneUnit& unit, bool fir
   return c;
 }
 
+/// The configuration with the selection's preferred lane: the least-squares lane (after the
+/// units' lanes) when `lanes.least_squares.preferred`.
+FilterConfig withPreferredLane(FilterConfig c) {
+  if (c.lanes.least_squares_lane_id && c.lanes.least_squares_preferred)
+    c.lanes.selector.preferred = static_cast<int>(c.lanes.units.size());
+  return c;
+}
+
+core::ImuInstrument instrument(const navbus::FilterCommand& c) {
+  return c.sensor() == navbus::SOURCE_ACCELEROMETER ? core::ImuInstrument::kAccelerometer
+                                                    : core::ImuInstrument::kGyro;
+}
+
 bool isImuCommand(const navbus::FilterCommand& c) {
   switch (c.kind()) {
     case navbus::CMD_FAIL_SENSOR_AXIS:
@@ -67,9 +80,9 @@ void setDelta(navbus::NavigationSolution& s, const core::LaneResetDelta& d) {
 }  // namespace
 
 LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks sinks)
-    : config_(config),
+    : config_(withPreferredLane(config)),
       sinks_(std::move(sinks)),
-      selector_(config.lanes.selector),
+      selector_(config_.lanes.selector),
       suspects_(config.lanes.units, config.lanes.evidence) {
   if (config_.lanes.units.empty()) {
     // One lane: the filter as configured, its solutions straight through.
@@ -101,7 +114,9 @@ LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks 
     // lane is fed is counted once, by the first.
     lanes_.push_back(
         std::make_unique<FilterPipeline>(laneConfig(config_, units[k], first), h, health, s));
+    lane_units_.push_back(units[k]);
   }
+  if (config_.lanes.least_squares_lane_id) addLeastSquaresLane();
   // A fault manager started with the filter (fault_monitor.judged_from_start) judges the
   // lanes' IMU data from the first sample: every lane and the selection wait for it from the
   // start, not only once it has reported (a replay as fast as the readers take would otherwise
@@ -110,13 +125,83 @@ LaneSet::LaneSet(const FilterConfig& config, bus::HealthCounters& health, Sinks 
     forEach([](FilterPipeline& l) { l.setImuJudged(); });
     parity_reported_ = true;
   }
-  pending_.resize(units.size());
-  excluded_.assign(units.size(), false);
-  excluded_from_ns_.assign(units.size(), std::numeric_limits<std::int64_t>::max());
-  named_for_decision_.assign(units.size(), 0);
-  heard_ns_.assign(units.size(), -1);
-  previous_.assign(units.size(), std::nullopt);
-  statuses_.resize(units.size());
+  const std::size_t n = lanes_.size();
+  pending_.resize(n);
+  excluded_.assign(n, false);
+  excluded_from_ns_.assign(n, std::numeric_limits<std::int64_t>::max());
+  named_for_decision_.assign(n, 0);
+  heard_ns_.assign(n, -1);
+  previous_.assign(n, std::nullopt);
+  statuses_.resize(n);
+}
+
+void LaneSet::addLeastSquaresLane() {
+  combined_.emplace(config_);
+  const std::size_t k = lanes_.size();
+  FilterPipeline::Sinks s;
+  s.solution = [this, k](const navbus::NavigationSolution& sol) {
+    onLaneSolution(static_cast<int>(k), sol);
+  };
+  // Its own re-learns are answered to no one; a command routed to it alone, to its issuer.
+  s.command_outcome = [this](const navbus::FilterCommandOutcome& o) {
+    if (routed_.erase({o.issuer().to_string(), o.run_id(), o.command_id()}) > 0 &&
+        sinks_.filter.command_outcome)
+      sinks_.filter.command_outcome(o);
+  };
+  const std::uint32_t id = *config_.lanes.least_squares_lane_id;
+  // Its IMU is no sensor of the bus: counted in its own health only.
+  lane_health_.push_back(
+      std::make_unique<bus::HealthCounters>("lane " + std::to_string(id) + " (least squares)"));
+  lanes_.push_back(std::make_unique<FilterPipeline>(combined_->laneConfig(), *lane_health_.back(),
+                                                    *lane_health_.back(), s));
+  LaneUnit unit;  // body axes, at the body origin
+  unit.sensor_id = id;
+  lane_units_.push_back(unit);
+}
+
+void LaneSet::feedCombined(bool all) {
+  // Not again from within: the lane's solutions select, which may come back here.
+  if (!combined_ || feeding_) return;
+  feeding_ = true;
+  // A time is combined once the parity test has judged it and its commands are in (a failed
+  // axis leaves the combination at its decision's time, on the bus as offline).
+  const std::int64_t judged =
+      parity_reported_ ? parity_judged_ns_ : std::numeric_limits<std::int64_t>::max();
+  const std::size_t k = lanes_.size() - 1;
+  FilterPipeline& lane = *lanes_[k];
+  while (std::optional<CombinedImu::Output> out = combined_->next(judged, all)) {
+    const auto t = static_cast<std::int64_t>(out->increment.time_gps_ns());
+    for (const core::ImuInstrument kind :
+         {core::ImuInstrument::kGyro, core::ImuInstrument::kAccelerometer}) {
+      if (!out->relearn[static_cast<std::size_t>(kind)]) continue;
+      for (int axis = 0; axis < 3; ++axis) lane.addOwnCommand(relearnCommand(kind, axis, t));
+    }
+    if (out->unusable) {
+      excluded_[k] = true;
+      excluded_from_ns_[k] = std::min(excluded_from_ns_[k], t);
+    }
+    lane.onImu(out->increment);
+  }
+  feeding_ = false;
+}
+
+navbus::FilterCommand LaneSet::relearnCommand(core::ImuInstrument kind, int axis,
+                                              std::int64_t time_ns) {
+  // The combination's bias changed with its weights by E' b' - E b: each instrument's bias
+  // within its prior, so the lane re-learns within that prior.
+  const core::FilterTuning& t = config_.engine.tuning;
+  const bool gyro = kind == core::ImuInstrument::kGyro;
+  navbus::FilterCommand c;
+  c.command_id(++own_commands_);
+  c.vehicle_id(config_.vehicle_id);
+  c.kind(navbus::CMD_RELEARN_BIAS);
+  c.time_gps_ns(static_cast<std::uint64_t>(time_ns));
+  c.sensor(gyro ? navbus::SOURCE_GYRO : navbus::SOURCE_ACCELEROMETER);
+  c.sensor_id(*config_.lanes.least_squares_lane_id);
+  c.axis(static_cast<std::uint16_t>(axis));
+  c.bias_sigma(gyro ? t.gyro_bias_sigma_radps : t.accel_bias_sigma_mps2);
+  c.issuer("lanes");
+  return c;
 }
 
 int LaneSet::laneOf(std::uint32_t sensor_id) const {
@@ -128,13 +213,22 @@ int LaneSet::laneOf(std::uint32_t sensor_id) const {
 
 void LaneSet::onImu(const navbus::ImuIncrement& msg) {
   // Another IMU's increment goes to lane 0, which refuses it as an unexpected source (counted).
-  const int k = std::max(laneOf(msg.sensor_id()), 0);
-  lanes_[static_cast<std::size_t>(k)]->onImu(msg);
+  const int unit = laneOf(msg.sensor_id());
+  lanes_[static_cast<std::size_t>(std::max(unit, 0))]->onImu(msg);
+  if (combined_ && unit >= 0) {
+    combined_->onIncrement(unit, msg);
+    feedCombined(false);
+  }
 }
 
 void LaneSet::onImuBlock(const navbus::ImuIncrementBlock& msg) {
-  const int k = std::max(laneOf(msg.sensor_id()), 0);
-  lanes_[static_cast<std::size_t>(k)]->onImuBlock(msg);
+  const int unit = laneOf(msg.sensor_id());
+  lanes_[static_cast<std::size_t>(std::max(unit, 0))]->onImuBlock(msg);
+  if (combined_ && unit >= 0 && msg.increments().size() > 0) {
+    for (const navbus::ImuIncrement& inc : msg.increments())
+      if (inc.sensor_id() == msg.sensor_id()) combined_->onIncrement(unit, inc);
+    feedCombined(false);
+  }
 }
 
 void LaneSet::onGnssObservations(const navbus::GnssObservationEpoch& msg) {
@@ -158,6 +252,10 @@ void LaneSet::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
   // falls silent). Another IMU's end goes to lane 0, which logs it as not in use.
   const int k = laneOf(id);
   lanes_[static_cast<std::size_t>(std::max(k, 0))]->onStreamEnded(kind, id);
+  if (combined_ && k >= 0) {
+    combined_->unitEnded(k);
+    feedCombined(false);
+  }
 }
 
 void LaneSet::onFaultMonitorProgress(const navbus::FaultMonitorProgress& report) {
@@ -183,6 +281,7 @@ void LaneSet::onFaultMonitorProgress(const navbus::FaultMonitorProgress& report)
   parity.judged_up_to_gps_ns(report.imu_judged_up_to_gps_ns());
   if (const auto judged = parity_judgements_.onProgress(parity))
     parity_judged_ns_ = std::max(parity_judged_ns_, *judged);
+  feedCombined(false);
   release(false);
 }
 
@@ -194,11 +293,13 @@ void LaneSet::onCommand(const navbus::FilterCommand& c,
   if (c.kind() == navbus::CMD_SUSPECT_SENSOR_AXIS) {
     onSuspect(c, writer_identity);
     for (std::size_t k = 1; k < lanes_.size(); ++k) lanes_[k]->onCommandElsewhere(c);
+    feedCombined(false);
     release(false);
     return;
   }
   if (!isImuCommand(c)) {
     forEach([&](FilterPipeline& l) { l.onCommand(c, writer_identity); });
+    feedCombined(false);
     release(false);
     return;
   }
@@ -214,6 +315,9 @@ void LaneSet::onCommand(const navbus::FilterCommand& c,
     const bool out = c.kind() == navbus::CMD_FAIL_SENSOR_AXIS;
     const bool back = c.kind() == navbus::CMD_RESTORE_SENSOR_AXIS;
     if (out || back) excluded_[k] = out;
+    if (out && combined_)
+      combined_->exclude(instrument(c), named, c.axis(),
+                         static_cast<std::int64_t>(c.time_gps_ns()));
     // Data time, not arrival: the lane is unavailable from the decision's time on.
     if (out) excluded_from_ns_[k] = static_cast<std::int64_t>(c.time_gps_ns());
     if (back) excluded_from_ns_[k] = std::numeric_limits<std::int64_t>::max();
@@ -221,6 +325,7 @@ void LaneSet::onCommand(const navbus::FilterCommand& c,
   lanes_[k]->onCommand(c, writer_identity);
   for (std::size_t other = 0; other < lanes_.size(); ++other)
     if (other != k) lanes_[other]->onCommandElsewhere(c);
+  feedCombined(false);
   release(false);
 }
 
@@ -246,13 +351,17 @@ void LaneSet::onSuspect(const navbus::FilterCommand& c,
   const auto onset = static_cast<std::int64_t>(c.onset_time_gps_ns() > 0 ? c.onset_time_gps_ns()
                                                                          : c.time_gps_ns());
   const std::string noted = suspects_.onSuspect({c.decision_id(), k, accel, c.axis(), onset});
+  // Either may be the faulty one: both leave the combination at the decision's time.
+  if (combined_)
+    combined_->exclude(instrument(c), k, c.axis(), static_cast<std::int64_t>(c.time_gps_ns()));
   first.answerLanesCommand(c, true, navbus::REJECT_NOT_APPLICABLE, {});
   spdlog::info("command {} from '{}': {}", c.command_id(), c.issuer(), noted);
 }
 
 void LaneSet::judgeSuspects(std::int64_t time_ns, const std::vector<const Pending*>& at) {
-  suspect_view_.assign(at.size(), nullptr);
-  for (std::size_t k = 0; k < at.size(); ++k)
+  // The units' lanes (the least-squares lane is no unit's: it has no part in the comparison).
+  suspect_view_.assign(config_.lanes.units.size(), nullptr);
+  for (std::size_t k = 0; k < suspect_view_.size(); ++k)
     if (at[k]) suspect_view_[k] = &at[k]->solution;
   const auto named = suspects_.atSelection(time_ns, suspect_view_);
   if (!named) return;
@@ -264,6 +373,7 @@ void LaneSet::judgeSuspects(std::int64_t time_ns, const std::vector<const Pendin
 }
 
 void LaneSet::pump(std::int64_t now_ns) {
+  feedCombined(false);
   now_ns_ = now_ns;
   for (std::int64_t& heard : heard_ns_)
     if (heard < 0) heard = now_ns;  // a lane's silence counts from the first turn
@@ -280,6 +390,7 @@ void LaneSet::setWritersAlive(bus::StreamKind kind, bool alive, std::int64_t now
 }
 
 void LaneSet::flush(std::int64_t now_ns) {
+  feedCombined(true);
   forEach([&](FilterPipeline& l) { l.flush(now_ns); });
   if (lanes_.size() > 1) release(true);
 }
@@ -294,9 +405,13 @@ void LaneSet::setFaultMonitorAlive(bool alive) {
 
 void LaneSet::onLaneSolution(int k, const navbus::NavigationSolution& s) {
   const auto i = static_cast<std::size_t>(k);
+  // A lane's silence counts from the first solution of any lane: before it, every lane waits
+  // alike (for the fault manager's first judgement; judged_from_start).
+  if (!any_heard_) heard_ns_.assign(heard_ns_.size(), now_ns_);
+  any_heard_ = true;
   heard_ns_[i] = now_ns_;
   // The lane's fit as it stands at this solution (the engine moves on before the selection).
-  Pending p{atBodyOrigin(s, config_.lanes.units[i].lever_arm_b_m),
+  Pending p{atBodyOrigin(s, lane_units_[i].lever_arm_b_m),
             lanes_[i]->engine().consistency().windowNisPerRow()};
   // A source restart reaches the lanes one by one: the first lane in a new run starts the
   // selection over; a lane still flushing the earlier run is heard out unselected.
@@ -436,8 +551,8 @@ void LaneSet::select(std::int64_t time_ns) {
     spdlog::warn(
         "lanes: switched from IMU {} to IMU {} at {:.3f} s ({}), reset {}: position "
         "{:.3f} m, velocity {:.4f} m/s, attitude {:.3g} mrad",
-        config_.lanes.units[static_cast<std::size_t>(sel.previous_lane)].sensor_id,
-        config_.lanes.units[static_cast<std::size_t>(sel.lane)].sensor_id,
+        lane_units_[static_cast<std::size_t>(sel.previous_lane)].sensor_id,
+        lane_units_[static_cast<std::size_t>(sel.lane)].sensor_id,
         1e-9 * static_cast<double>(time_ns),
         sel.reason == core::LaneSwitchReason::kUnavailable ? "the lane became unavailable"
                                                            : "a clearly better fit",
@@ -464,7 +579,7 @@ void LaneSet::publishLane(std::size_t k, const Pending& p, bool selected) const 
   if (!sinks_.lane) return;
   navbus::LaneSolution l;
   l.vehicle_id(config_.vehicle_id);
-  l.lane_id(config_.lanes.units[k].sensor_id);
+  l.lane_id(lane_units_[k].sensor_id);
   l.selected(selected);
   l.available(available(static_cast<int>(k), &p));
   l.test_ratio(p.test_ratio);
@@ -479,7 +594,7 @@ std::string LaneSet::summary() const {
   std::ostringstream s;
   const core::LaneSelection& sel = selector_.last();
   s << "lanes: " << lanes_.size() << ", selected IMU "
-    << (sel.lane >= 0 ? config_.lanes.units[static_cast<std::size_t>(sel.lane)].sensor_id : 0)
+    << (sel.lane >= 0 ? lane_units_[static_cast<std::size_t>(sel.lane)].sensor_id : 0)
     << ", switches " << sel.reset_count << ", solutions published " << seq_
     << ", times selected without a lane (silent beyond the sequencer's and the judgement's waits, "
     << "or " << config_.lanes.max_pending << " solutions behind) " << passed_over_
@@ -491,8 +606,9 @@ std::string LaneSet::summary() const {
     s << ", new runs after a source restart " << run_ << " (solutions of earlier runs "
       << solutions_earlier_runs_ << ")";
   for (std::size_t k = 0; k < lanes_.size(); ++k)
-    s << (k == 0 ? "; " : "\n") << "lane IMU " << config_.lanes.units[k].sensor_id
+    s << (k == 0 ? "; " : "\n") << "lane IMU " << lane_units_[k].sensor_id
       << (excluded_[k] ? " (excluded)" : "") << ": " << lanes_[k]->summary();
+  if (combined_) s << "\n" << combined_->summary();
   return s.str();
 }
 

@@ -390,3 +390,24 @@ TEST_F(ConfigKeys, TheFixPositionErrorBelongsToLooseCouplingWithBothSigmas) {
   EXPECT_NE(no_v.find("ekf.fix_position_error_sigma_v_m (0 m) must be positive"), std::string::npos)
       << no_v;
 }
+
+TEST_F(ConfigKeys, TheLeastSquaresLaneNeedsAnIdOfItsOwn) {
+  const auto with = [&](const std::string& name, const std::string& block) {
+    return write(name, "extends: " + kSrc +
+                           "/filter_triplex.yaml\nlanes:\n  least_squares: " + block + "\n");
+  };
+  const auto c = navbus::bus::parseFile(with("ok.yaml", "{lane_id: 9, preferred: true}"), filter);
+  ASSERT_TRUE(c.lanes.least_squares_lane_id.has_value());
+  EXPECT_EQ(*c.lanes.least_squares_lane_id, 9u);
+  EXPECT_TRUE(c.lanes.least_squares_preferred);
+  EXPECT_EQ(c.lanes.units.size(), 3u) << "the units stay as the file it extends gives them";
+  const std::string unit = errorOf(with("unit.yaml", "{lane_id: 2}"), filter);
+  EXPECT_NE(unit.find("lanes.least_squares.lane_id 2 is a unit's sensor_id"), std::string::npos)
+      << unit;
+  const std::string missing = errorOf(with("missing.yaml", "{preferred: true}"), filter);
+  EXPECT_NE(missing.find("lanes.least_squares.lane_id is missing"), std::string::npos) << missing;
+  const std::string zero = errorOf(with("zero.yaml", "{lane_id: 0}"), filter);
+  EXPECT_NE(zero.find("lanes.least_squares.lane_id 0"), std::string::npos) << zero;
+  const std::string typo = with("typo.yaml", "{lane_id: 9, prefered: true}");
+  EXPECT_TRUE(names(errorOf(typo, filter), "lanes.least_squares.prefered", typo));
+}

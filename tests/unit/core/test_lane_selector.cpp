@@ -121,3 +121,20 @@ TEST(LaneSelector, ALaneWithoutAFitYetIsNeverABetterOne) {
   l[2].available = false;  // nothing with a fit left: the one without is better than none
   EXPECT_EQ(sel.update(l).lane, 1);
 }
+
+TEST(LaneSelector, APreferredLaneIsTakenFirstAndWhenTheSelectedOneIsLeft) {
+  nc::LaneSelectorConfig config;
+  config.preferred = 2;
+  config.confirm_epochs = 3;
+  nc::LaneSelector sel(config);
+  EXPECT_EQ(sel.update(lanes(0.4, 0.2, 0.9)).lane, 2) << "preferred, though not the best fit";
+  // Hysteresis as for any lane: a clearly better one for 3 epochs in a row is taken.
+  for (int k = 0; k < 3; ++k) sel.update(lanes(0.4, 0.2, 0.9));
+  EXPECT_EQ(sel.last().lane, 1);
+  EXPECT_EQ(sel.last().reason, nc::LaneSwitchReason::kBetterFit);
+  auto l = lanes(0.4, 0.2, 0.9);
+  l[1].available = false;
+  EXPECT_EQ(sel.update(l).lane, 2) << "back to the preferred lane, not to lane 0 (0.4)";
+  l[2].available = false;
+  EXPECT_EQ(sel.update(l).lane, 0) << "the preferred lane unavailable: the best available";
+}

@@ -34,6 +34,14 @@ int LaneSelector::bestAvailable(const std::vector<LaneStatus>& lanes) const {
   return best;
 }
 
+int LaneSelector::preferredOr(int best, const std::vector<LaneStatus>& lanes) const {
+  const int p = config_.preferred;
+  return p >= 0 && p < static_cast<int>(lanes.size()) &&
+                 lanes[static_cast<std::size_t>(p)].available
+             ? p
+             : best;
+}
+
 void LaneSelector::switchTo(int lane, LaneSwitchReason reason,
                             const std::vector<LaneStatus>& lanes) {
   const int from = selection_.lane;
@@ -56,11 +64,11 @@ const LaneSelection& LaneSelector::update(const std::vector<LaneStatus>& lanes) 
   const int current = selection_.lane;
   const int best = bestAvailable(lanes);
   if (current < 0 || current >= static_cast<int>(lanes.size())) {
-    if (best >= 0) switchTo(best, LaneSwitchReason::kFirst, lanes);
+    if (best >= 0) switchTo(preferredOr(best, lanes), LaneSwitchReason::kFirst, lanes);
     return selection_;
   }
   if (!lanes[static_cast<std::size_t>(current)].available) {
-    switchTo(best, LaneSwitchReason::kUnavailable, lanes);
+    switchTo(preferredOr(best, lanes), LaneSwitchReason::kUnavailable, lanes);
     return selection_;
   }
   // Hysteresis: the best lane must beat the selected one clearly, epoch after epoch.

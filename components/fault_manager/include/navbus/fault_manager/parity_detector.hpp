@@ -21,6 +21,7 @@
 #include <navbus_idl/Imu.h>
 #include <navbus_idl/Navigation.h>
 
+#include "navbus/bus/imu_alignment.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/integrity/imu_array_parity.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
@@ -60,7 +61,7 @@ class ParityDetector {
   /// The unit's increments ended as announced; true once every unit's have.
   bool onUnitEnded(std::uint32_t sensor_id);
   /// Every time up to this one is tested, or dropped (-1: none yet).
-  std::int64_t testedUpToNs() const { return std::max(last_tested_ns_, late_before_ns_); }
+  std::int64_t testedUpToNs() const { return aligner_.releasedNs(); }
   const core::ImuArrayParity& array() const { return *array_; }
   /// The largest statistic of the latest aligned sample, per kind (0 while learning).
   const core::ImuArrayParity::Result& latest() const { return latest_; }
@@ -69,15 +70,8 @@ class ParityDetector {
   std::string summary() const;
 
  private:
-  struct Slot {
-    std::array<core::ImuIncrement, core::ImuArrayParity::kMaxUnits> units{};
-    int received{0};
-    std::uint32_t mask{0};
-  };
   /// Index of a sensor id among the units, or -1.
   int unitOf(std::uint32_t sensor_id) const;
-  /// A unit missing at that time has delivered a later one: it will not come.
-  bool lost(std::int64_t time_ns, const Slot& slot) const;
   /// Tests the complete slots in time order; drops the oldest when a missing unit's increment
   /// is lost or too many times wait.
   void drain(FaultOutput& out);
@@ -89,18 +83,16 @@ class ParityDetector {
   void startNewRun();
   /// Counts (and says) the increments a unit sent before the first one taken in this run.
   void noteMissedStart(const navbus::ImuIncrement& first);
-  void test(std::int64_t time_ns, const Slot& slot, FaultOutput& out);
+  void test(std::int64_t time_ns, const bus::ImuUnitAligner::Increments& units, FaultOutput& out);
   void report(std::int64_t time_ns, const core::ImuArrayDetection& d, FaultOutput& out);
 
   ParityDetectorConfig config_;
   std::optional<core::ImuArrayParity> array_;
   std::int64_t period_ns_;
   bus::ValidationLimits limits_;
-  std::map<std::int64_t, Slot> pending_;  ///< by time, waiting for every unit
-  std::uint32_t ended_units_{0};          ///< bit per unit whose increments ended
-  std::int64_t last_tested_ns_{-1};       ///< -1: the next time tested starts a new window
-  std::int64_t late_before_ns_{-1};       ///< increments at or before this time come too late
-  std::array<std::int64_t, core::ImuArrayParity::kMaxUnits> latest_ns_{};    ///< per unit
+  bus::ImuUnitAligner aligner_;      ///< the units' increments by time, waiting for every unit
+  std::uint32_t ended_units_{0};     ///< bit per unit whose increments ended
+  std::int64_t last_tested_ns_{-1};  ///< -1: the next time tested starts a new window
   std::array<std::uint64_t, core::ImuArrayParity::kMaxUnits> latest_seq_{};  ///< per unit
   core::ImuArrayParity::Result latest_;
   Counters counters_;

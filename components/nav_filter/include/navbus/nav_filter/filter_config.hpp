@@ -73,6 +73,15 @@ struct LanesConfig {
   /// bound on the memory the wait takes. A silent lane is passed over after
   /// sequencer_max_wait_s of running time.
   std::size_t max_pending{100000};
+  /// `least_squares`: a further lane on the least-squares combination of every unit's
+  /// instruments (combined_imu.hpp), with this lane id (its solutions' lane_id; not a unit's
+  /// sensor_id); none when empty.
+  std::optional<std::uint32_t> least_squares_lane_id;
+  /// Times the combination holds waiting for a silent unit before it combines without it.
+  int least_squares_alignment_depth{1000};
+  /// The selection starts on the least-squares lane and, when the lane it follows is left,
+  /// goes back to it while it is available (LaneSelectorConfig::preferred).
+  bool least_squares_preferred{false};
 };
 
 struct FilterConfig {

@@ -158,6 +158,10 @@ class FilterPipeline {
   /// FaultMonitorWatch::judgement_wait_ns), so that a command answering it acts where offline
   /// it does, before the next solution is published.
   void onFaultMonitorProgress(const navbus::FaultMonitorProgress& report);
+  /// A command of the lanes themselves (the least-squares lane's re-learn where its combination
+  /// changed, lane_set.hpp): no issuer to authorize; it enters the deterministic order at its
+  /// data time as any engine command.
+  void addOwnCommand(const navbus::FilterCommand& c);
   /// A command given to another lane (lane_set.hpp): not this filter's to apply, but a report
   /// naming it may count now (a judgement waits for every command it names).
   void onCommandElsewhere(const navbus::FilterCommand& c) {
@@ -220,6 +224,8 @@ class FilterPipeline {
   /// Counts a restore to before a fault's onset (or one the history could not reach).
   bool countRecovery(bool restored);
   bool applyToEngine(const navbus::FilterCommand& c);
+  /// An engine command into the merge at its data time (late: by rewinding, or at once).
+  void enterCommand(const navbus::FilterCommand& c);
   void executeCommand(const navbus::FilterCommand& c);
   /// The IMU source restarted at an earlier time (a restarted simulator replaying its
   /// scenario): what is held of the old run is processed, then the filter starts over as at

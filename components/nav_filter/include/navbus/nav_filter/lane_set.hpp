@@ -28,6 +28,7 @@
 #include <navbus_idl/Navigation.h>
 
 #include "navbus/core/filter/lane_selector.hpp"
+#include "navbus/nav_filter/combined_imu.hpp"
 #include "navbus/nav_filter/filter_pipeline.hpp"
 #include "navbus/nav_filter/judgement_tracker.hpp"
 #include "navbus/nav_filter/suspect_lanes.hpp"
@@ -80,6 +81,10 @@ class LaneSet {
   /// The lane whose solutions are published (0 before any selection; config lanes.units order).
   int selectedLane() const { return selectedIndex(); }
   const core::LaneSelection& selection() const { return selector_.last(); }
+  /// Each lane's unit (lanes.units order; the least-squares lane last: body axes, body origin).
+  const LaneUnit& laneUnit(int k) const { return lane_units_[static_cast<std::size_t>(k)]; }
+  /// The least-squares lane's combination (lanes.least_squares), or null.
+  const CombinedImu* combined() const { return combined_ ? &*combined_ : nullptr; }
   std::string summary() const;
 
  private:
@@ -89,6 +94,12 @@ class LaneSet {
   };
   int selectedIndex() const { return selector_.last().lane < 0 ? 0 : selector_.last().lane; }
   int laneOf(std::uint32_t sensor_id) const;
+  /// The lane on the least-squares combination, after the units' lanes.
+  void addLeastSquaresLane();
+  /// Gives that lane the combined increments released (at most to the parity test's judgement;
+  /// `all`: everything, the data ended), with its re-learns where the combination changed.
+  void feedCombined(bool all);
+  navbus::FilterCommand relearnCommand(core::ImuInstrument kind, int axis, std::int64_t time_ns);
   template <class Fn>
   void forEach(Fn&& fn) {
     for (auto& lane : lanes_) fn(*lane);
@@ -121,6 +132,10 @@ class LaneSet {
   std::vector<std::unique_ptr<bus::HealthCounters>>
       lane_health_;  ///< lanes 1..: what every lane is fed, counted once (by lane 0)
   std::vector<std::unique_ptr<FilterPipeline>> lanes_;
+  std::vector<LaneUnit> lane_units_;  ///< each lane's IMU (the least-squares lane: its own id)
+  std::optional<CombinedImu> combined_;
+  std::uint64_t own_commands_{0};  ///< the least-squares lane's re-learns
+  bool feeding_{false};            ///< within feedCombined()
   std::vector<std::deque<Pending>> pending_;
   std::vector<bool> excluded_;  ///< the lane's IMU axis was failed by a command
   /// ... from this data time on (the command's): unavailable at the times since
@@ -150,6 +165,7 @@ class LaneSet {
   std::uint64_t run_{0};  ///< the lanes' run being selected (FilterPipeline::newRuns())
   std::uint64_t solutions_earlier_runs_{0};
   std::vector<std::int64_t> heard_ns_;  ///< per lane: running time of its latest solution
+  bool any_heard_{false};               ///< a lane has published a solution
 };
 
 }  // namespace navbus::nav_filter

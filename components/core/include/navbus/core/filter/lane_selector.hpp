@@ -23,6 +23,9 @@ struct LaneSelectorConfig {
   double switch_ratio{0.5};
   /// ... for this many consecutive epochs before the selector switches to it.
   int confirm_epochs{5};
+  /// A lane taken first, and whenever the selected lane is left as unavailable, while it is
+  /// available itself (the least-squares lane of all instruments); -1: none.
+  int preferred{-1};
 };
 
 /// One lane at one epoch, as the selector sees it.
@@ -64,6 +67,8 @@ class LaneSelector {
 
  private:
   int bestAvailable(const std::vector<LaneStatus>& lanes) const;
+  /// The preferred lane when it is available, else `best`.
+  int preferredOr(int best, const std::vector<LaneStatus>& lanes) const;
   void switchTo(int lane, LaneSwitchReason reason, const std::vector<LaneStatus>& lanes);
 
   LaneSelectorConfig config_;
