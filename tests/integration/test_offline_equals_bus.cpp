@@ -292,6 +292,30 @@ TEST(OfflineEqualsBus, TriplexLanesSwitchWhereOfflineTheyDo) {
            "navbus/imu/increment 1:accepted 2:accepted 3:accepted"});
 }
 
+// The triplex with a fourth lane on the least-squares combination of all three units, preferred
+// (config/filter_triplex_least_squares.yaml), and a 10 deg/h step on unit 2's x gyro at 100 s:
+// the combination waits for the parity test's judgement of each time, so the failed gyro leaves
+// it at the decision's data time and the lane re-learns there, on the bus as offline; that lane
+// is published throughout (no switch), every solution bit for bit.
+TEST(OfflineEqualsBus, TriplexLanesWithALeastSquaresLaneLeaveTheFailedGyroAsOffline) {
+  runCase({123,
+           "seed000_triplex.yaml",
+           "filter_triplex_least_squares.yaml",
+           "",
+           3,
+           200.0,
+           {"least-squares lane 9: 20000 combined increments of 3 units (60000 taken), "
+            "instruments taken out 1",
+            "selected IMU 9, switches 0,",
+            "selections made without the parity test's judgement (its wait ran out) 0"},
+           "fault_manager_triplex.yaml",
+           1,
+           "faults:\n  - {type: imu_bias_step, sensor: gyro, axis: x, start_s: 100,\n"
+           "     magnitude_deg_per_h: 10, sensor_id: 2}\n",
+           "navbus/imu/increment_block 1:accepted 2:accepted 3:accepted",
+           "navbus/imu/increment 1:accepted 2:accepted 3:accepted"});
+}
+
 // Two GNSS receivers (seed000_dual_receivers.yaml: receiver 2 beside the filter's receiver 1)
 // with the fault manager's cross-receiver test: the simulator publishes receiver 2's epochs under
 // its id, the filter refuses them (counted), the fault manager reads both reliably, and receiver
