@@ -86,7 +86,7 @@ Truth combinedTruth(const Truth& t, const nav_filter::LaneSet& lanes,
   Truth out = t;
   std::array<Eigen::Vector3d, core::ImuArrayCombination::kMaxUnits> accel{}, gyro{};
   const auto& ids = sim.extra_imu_sensor_ids;
-  const core::ImuArrayCombination& c = lanes.combined()->combination();
+  const core::ImuArrayCombination& c = lanes.combined()->combinationAt(t.state.time_ns);
   for (int u = 0; u < c.units(); ++u) {
     const nav_filter::LaneUnit& unit = lanes.laneUnit(u);
     const auto i = static_cast<std::size_t>(u);

@@ -79,6 +79,15 @@ void CombinedImu::makeCombination() {
   combination_ =
       core::ImuArrayCombination::make(units_, 1e-9 * static_cast<double>(period_ns_), error);
   if (!combination_) throw bus::ConfigError("configuration lanes.least_squares: " + error);
+  initial_ = combination_;
+  changes_.clear();
+}
+
+const core::ImuArrayCombination& CombinedImu::combinationAt(std::int64_t time_ns) const {
+  const core::ImuArrayCombination* c = &*initial_;
+  for (const auto& [from_ns, changed] : changes_)
+    if (from_ns <= time_ns) c = &changed;
+  return *c;
 }
 
 void CombinedImu::onIncrement(int unit, const navbus::ImuIncrement& msg) {
@@ -128,6 +137,7 @@ void CombinedImu::applyExclusions(std::int64_t time_ns, Output& out) {
     const bool already = it->axis >= 0 && !combination_->included(it->kind, it->unit, it->axis);
     if (out_now) {
       ++counters_.excluded;
+      changes_.emplace_back(time_ns, *combination_);
       for (const ImuInstrument k : kKinds)
         if (it->axis < 0 || k == it->kind) out.relearn[static_cast<std::size_t>(k)] = true;
     } else if (!already && usable_) {

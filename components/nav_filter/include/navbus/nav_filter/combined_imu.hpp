@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <navbus_idl/Imu.h>
@@ -69,6 +70,9 @@ class CombinedImu {
   const Counters& counters() const { return counters_; }
   /// The combination as it stands (its included instruments, its weights).
   const core::ImuArrayCombination& combination() const { return *combination_; }
+  /// The combination the increment at `time_ns` of this run was made with (the data time of
+  /// each change is kept: the selection, behind the combination, is scored with its own).
+  const core::ImuArrayCombination& combinationAt(std::int64_t time_ns) const;
   bool usable() const { return usable_; }
   std::string summary() const;
 
@@ -89,6 +93,9 @@ class CombinedImu {
   std::int64_t period_ns_;
   FilterConfig lane_config_;
   std::optional<core::ImuArrayCombination> combination_;
+  /// Each change of this run: from that data time on, the combination as it became.
+  std::vector<std::pair<std::int64_t, core::ImuArrayCombination>> changes_;
+  std::optional<core::ImuArrayCombination> initial_;  ///< as configured
   bus::ImuUnitAligner aligner_;
   bus::ValidationLimits limits_;
   std::vector<Exclusion> exclusions_;  ///< waiting for their time, in arrival order
