@@ -27,6 +27,24 @@ evaluation::OfflineResult run(const YAML::Node& scenario, double duration_s) {
   return evaluation::runOffline(s);
 }
 
+/// A triplex scenario `file` through the filter `filter` (in lanes) and the parity test of
+/// config/fault_manager_triplex.yaml, keeping every lane's solutions.
+evaluation::OfflineSetup triplexLanes(const std::string& file, const std::string& filter,
+                                      double duration_s) {
+  const std::string config = navbus::test_paths::configDir();
+  evaluation::OfflineSetup s;
+  s.sim = navbus::sensor_sim::parseSimConfig(
+      navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) + "/" + file));
+  s.filter =
+      navbus::nav_filter::parseFilterConfig(navbus::bus::loadYamlFile(config + "/" + filter));
+  s.filter.engine.initial_state = evaluation::initialTruth(s.sim.scenario);
+  s.fault_manager = navbus::fault_manager::parseFaultManagerConfig(
+      navbus::bus::loadYamlFile(config + "/fault_manager_triplex.yaml"));
+  s.duration_s = duration_s;
+  s.keep_lane_solutions = true;
+  return s;
+}
+
 }  // namespace
 
 TEST(RedundantUnits, AOneImuFilterRefusesTheFurtherUnitsCountedAndUnchanged) {
@@ -133,17 +151,8 @@ TEST(RedundantUnits, LanesLeaveTheFailedUnitAndPublishTheJumpTheyMake) {
   // the new lane's solution minus lane 1's at the last time lane 1 was published, to 1 mm and
   // 1 mm/s (the published jump is that plus the new lane's motion over the step, to 1 mm), and
   // stay on every later solution with the counter; before the switch, lane 1 with zero deltas.
-  const std::string dir = navbus::test_paths::scenarioDir();
-  evaluation::OfflineSetup s;
-  s.sim = navbus::sensor_sim::parseSimConfig(
-      navbus::bus::loadYamlFile(dir + "/seed000_triplex_gyro_ramp.yaml"));
-  s.filter = navbus::nav_filter::parseFilterConfig(navbus::bus::loadYamlFile(
-      std::string(navbus::test_paths::configDir()) + "/filter_triplex.yaml"));
-  s.filter.engine.initial_state = evaluation::initialTruth(s.sim.scenario);
-  s.fault_manager = navbus::fault_manager::parseFaultManagerConfig(navbus::bus::loadYamlFile(
-      std::string(navbus::test_paths::configDir()) + "/fault_manager_triplex.yaml"));
-  s.duration_s = 900.0;
-  s.keep_lane_solutions = true;
+  const evaluation::OfflineSetup s =
+      triplexLanes("seed000_triplex_gyro_ramp.yaml", "filter_triplex.yaml", 900.0);
   std::vector<navbus::NavigationSolution> published;
   const evaluation::OfflineResult r =
       evaluation::runOffline(s, [&](const navbus::NavigationSolution& sol, const auto&,
@@ -294,17 +303,8 @@ TEST(RedundantUnits, TheLeastSquaresLaneLeavesTheFailedInstrumentOutAndStaysHone
   // the failed gyro leaves the combination at the decision, and the lane, scored against the
   // biases its combination carries (E b), is consistent after it: it re-learned the gyro bias
   // whose weights changed.
-  const std::string dir = navbus::test_paths::scenarioDir();
-  evaluation::OfflineSetup s;
-  s.sim = navbus::sensor_sim::parseSimConfig(
-      navbus::bus::loadYamlFile(dir + "/seed000_triplex_gyro_step.yaml"));
-  s.filter = navbus::nav_filter::parseFilterConfig(navbus::bus::loadYamlFile(
-      std::string(navbus::test_paths::configDir()) + "/filter_triplex_least_squares.yaml"));
-  s.filter.engine.initial_state = evaluation::initialTruth(s.sim.scenario);
-  s.fault_manager = navbus::fault_manager::parseFaultManagerConfig(navbus::bus::loadYamlFile(
-      std::string(navbus::test_paths::configDir()) + "/fault_manager_triplex.yaml"));
-  s.duration_s = 700.0;
-  s.keep_lane_solutions = true;
+  const evaluation::OfflineSetup s =
+      triplexLanes("seed000_triplex_gyro_step.yaml", "filter_triplex_least_squares.yaml", 700.0);
   std::vector<navbus::NavigationSolution> published;
   const evaluation::OfflineResult r =
       evaluation::runOffline(s, [&](const navbus::NavigationSolution& sol, const auto&,
