@@ -1,17 +1,32 @@
 #include "navbus/bus/imu_alignment.hpp"
 
+#include <algorithm>
+
 namespace navbus::bus {
 
 ImuUnitAligner::Added ImuUnitAligner::add(int unit, const core::ImuIncrement& inc) {
   if (inc.time_ns <= released_ns_) return Added::kLate;
-  Sample& s = pending_[inc.time_ns];
-  if (s.present & bit(unit)) return Added::kRepeated;
-  s.time_ns = inc.time_ns;
-  s.present |= bit(unit);
-  s.units[static_cast<std::size_t>(unit)] = inc;
-  auto& latest = latest_ns_[static_cast<std::size_t>(unit)];
-  if (inc.time_ns > latest) latest = inc.time_ns;
+  const auto u = static_cast<std::size_t>(unit);
+  if (inc.time_ns <= latest_ns_[u]) return Added::kRepeated;
+  queues_[u].push_back(inc);
+  latest_ns_[u] = inc.time_ns;
   return Added::kTaken;
+}
+
+std::int64_t ImuUnitAligner::oldest(std::uint32_t& present) const {
+  std::int64_t t = -1;
+  present = 0;
+  for (int u = 0; u < units_; ++u) {
+    const auto& q = queues_[static_cast<std::size_t>(u)];
+    if (q.empty()) continue;
+    const std::int64_t front = q.front().time_ns;
+    if (t < 0 || front < t) {
+      t = front;
+      present = 0;
+    }
+    if (front == t) present |= bit(u);
+  }
+  return t;
 }
 
 bool ImuUnitAligner::lost(std::int64_t time_ns, std::uint32_t present) const {
@@ -22,30 +37,43 @@ bool ImuUnitAligner::lost(std::int64_t time_ns, std::uint32_t present) const {
   return true;
 }
 
+std::size_t ImuUnitAligner::waiting() const {
+  std::size_t most = 0;
+  for (const auto& q : queues_) most = std::max(most, q.size());
+  return most;
+}
+
 std::optional<ImuUnitAligner::Sample> ImuUnitAligner::next(std::int64_t up_to_ns) {
-  if (pending_.empty()) return std::nullopt;
-  const auto oldest = pending_.begin();
-  if (oldest->first > up_to_ns) return std::nullopt;
-  if (oldest->second.present != all() && !lost(oldest->first, oldest->second.present) &&
-      pending_.size() <= depth_)
-    return std::nullopt;
-  return take(oldest);
+  std::uint32_t present = 0;
+  const std::int64_t t = oldest(present);
+  if (t < 0 || t > up_to_ns) return std::nullopt;
+  if (present != all() && !lost(t, present) && waiting() <= depth_) return std::nullopt;
+  return take(t, present);
 }
 
 std::optional<ImuUnitAligner::Sample> ImuUnitAligner::flushNext() {
-  if (pending_.empty()) return std::nullopt;
-  return take(pending_.begin());
+  std::uint32_t present = 0;
+  const std::int64_t t = oldest(present);
+  if (t < 0) return std::nullopt;
+  return take(t, present);
 }
 
-ImuUnitAligner::Sample ImuUnitAligner::take(std::map<std::int64_t, Sample>::iterator it) {
-  Sample s = it->second;
-  released_ns_ = it->first;
-  pending_.erase(it);
+ImuUnitAligner::Sample ImuUnitAligner::take(std::int64_t time_ns, std::uint32_t present) {
+  Sample s;
+  s.time_ns = time_ns;
+  s.present = present;
+  for (int u = 0; u < units_; ++u) {
+    if ((present & bit(u)) == 0) continue;
+    auto& q = queues_[static_cast<std::size_t>(u)];
+    s.units[static_cast<std::size_t>(u)] = q.front();
+    q.pop_front();
+  }
+  released_ns_ = time_ns;
   return s;
 }
 
 void ImuUnitAligner::clear() {
-  pending_.clear();
+  for (auto& q : queues_) q.clear();
   latest_ns_.fill(0);
   ended_ = 0;
   released_ns_ = -1;

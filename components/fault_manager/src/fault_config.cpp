@@ -160,7 +160,7 @@ void parseParity(const YAML::Node& n, ParityDetectorConfig& d) {
   a.reference_time_constant_samples = tau_s * d.imu_rate_hz;
   d.alignment_depth =
       static_cast<int>(bus::checkRange(bus::get<double>(n, w, "alignment_depth", d.alignment_depth),
-                                       1.0, 1e5, "parity.alignment_depth"));
+                                       1.0, 1e7, "parity.alignment_depth"));
   const YAML::Node act = n["actions"];
   checkKeys(act, "parity.actions", {"axis"});
   const auto axis = bus::get<std::string>(act, "parity.actions", "axis", "fail");

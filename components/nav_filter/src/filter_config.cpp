@@ -540,7 +540,7 @@ void parseLeastSquaresLane(const YAML::Node& node, LanesConfig& l) {
   bus::KeyReader(node, "lanes.least_squares")
       .value("lane_id", lane_id)
       .value("preferred", preferred)
-      .integer("alignment_depth", l.least_squares_alignment_depth, {1, 100000})
+      .integer("alignment_depth", l.least_squares_alignment_depth, {1, 10000000})
       .finish();
   if (!node["lane_id"])
     throw bus::ConfigError("configuration lanes.least_squares.lane_id is missing");

@@ -1,15 +1,18 @@
 // The increments of several IMU units aligned by their time (the fault manager's parity test,
 // the filter's least-squares lane). Each unit's increments come in time order (one reliable
-// reader instance per unit); the units' instances come in any order between them. A time is
-// released when every unit has delivered it, or when a unit missing there has delivered a later
-// time (it never will), or an ended unit is missing, or more than `depth` times wait (a silent
-// unit): then incomplete, with the units present. Pure logic.
+// reader instance per unit); the units' instances come in any order between them: a reader hands
+// out one unit's whole backlog before the next's (up to its history per instance: 5000 blocks of
+// up to 64 increments, qos/navbus_qos.xml). A time is released when every unit has delivered it,
+// or when a unit missing there has delivered a later time (it never will), or has ended, or one
+// unit holds more than `depth` increments waiting (the missing one is silent): then incomplete,
+// with the units present. Each unit's increments wait in a queue of their own (64 bytes each).
+// Pure logic.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <limits>
-#include <map>
 #include <optional>
 
 #include "navbus/core/ins/strapdown.hpp"
@@ -19,6 +22,9 @@ namespace navbus::bus {
 class ImuUnitAligner {
  public:
   static constexpr int kMaxUnits = 6;
+  /// Increments a reader may hand out of one unit before another's: its history per instance
+  /// (5000 samples) of the largest blocks (64 increments).
+  static constexpr std::size_t kReaderBacklog = 5000 * 64;
   using Increments = std::array<core::ImuIncrement, kMaxUnits>;
 
   struct Sample {
@@ -30,8 +36,8 @@ class ImuUnitAligner {
   ImuUnitAligner(int units, std::size_t depth) : units_(units), depth_(depth) {}
 
   enum class Added { kTaken, kLate, kRepeated };
-  /// Unit u's increment: kLate at or before the latest time released, kRepeated when that unit
-  /// already gave this time.
+  /// Unit u's increment: kLate at or before the latest time released, kRepeated at or before
+  /// that unit's latest (a repeated time, or one out of order).
   Added add(int unit, const core::ImuIncrement& inc);
   /// The oldest waiting time, taken out, once it is complete or will not be (see above); and
   /// only at or before `up_to_ns`.
@@ -45,7 +51,8 @@ class ImuUnitAligner {
   void clear();
   /// The latest time released (-1: none).
   std::int64_t releasedNs() const { return released_ns_; }
-  std::size_t waiting() const { return pending_.size(); }
+  /// The most increments one unit holds waiting.
+  std::size_t waiting() const;
   /// The latest time unit u delivered (0: none yet).
   std::int64_t latestNs(int unit) const { return latest_ns_[static_cast<std::size_t>(unit)]; }
   bool complete(const Sample& s) const { return s.present == all(); }
@@ -53,13 +60,15 @@ class ImuUnitAligner {
  private:
   static std::uint32_t bit(int unit) { return 1u << static_cast<unsigned>(unit); }
   std::uint32_t all() const { return (1u << static_cast<unsigned>(units_)) - 1u; }
+  /// The oldest time any unit holds (-1: none), and the units that hold it.
+  std::int64_t oldest(std::uint32_t& present) const;
   /// A unit missing at that time will not deliver it.
   bool lost(std::int64_t time_ns, std::uint32_t present) const;
-  Sample take(std::map<std::int64_t, Sample>::iterator it);
+  Sample take(std::int64_t time_ns, std::uint32_t present);
 
   int units_;
   std::size_t depth_;
-  std::map<std::int64_t, Sample> pending_;
+  std::array<std::deque<core::ImuIncrement>, kMaxUnits> queues_{};
   std::array<std::int64_t, kMaxUnits> latest_ns_{};
   std::uint32_t ended_{0};
   std::int64_t released_ns_{-1};

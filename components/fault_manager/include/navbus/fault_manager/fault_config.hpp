@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "navbus/bus/imu_alignment.hpp"
 #include "navbus/core/integrity/dither_monitor.hpp"
 #include "navbus/core/integrity/glr.hpp"
 #include "navbus/core/integrity/imu_array_parity.hpp"
@@ -48,12 +49,12 @@ struct ParityDetectorConfig {
   std::vector<core::ImuArrayUnit> units;  ///< same order
   core::ImuArrayParityConfig array;
   bool fail_axes{true};  ///< command CMD_FAIL_SENSOR_AXIS (unit, axis) for an isolated instrument
-  /// Times waiting for a unit's increment (units are received in any order between them: a DDS
-  /// reader hands out one instance's backlog, up to its history's max_samples (20000 for the
-  /// sensor reader profile), before the next's; a unit that has passed a time without its
-  /// increment lost it). Beyond this many, a silent unit holds up the others: the oldest time is
-  /// dropped, counted, and the tests restart. About 450 bytes a time.
-  int alignment_depth{20000};
+  /// Increments one unit may hold waiting for another's (units are received in any order
+  /// between them: a DDS reader hands out one instance's backlog, up to its history per instance
+  /// of blocks, before the next's; a unit that has passed a time without its increment lost it).
+  /// Beyond this many, the missing unit is silent: the oldest time is dropped, counted, and the
+  /// tests restart. 64 bytes an increment (bus/imu_alignment.hpp).
+  int alignment_depth{static_cast<int>(bus::ImuUnitAligner::kReaderBacklog)};
 };
 
 /// The cross-receiver test of redundant GNSS receivers (receiver_detector.hpp): the receivers on

@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "navbus/bus/imu_alignment.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/bus/validation.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
@@ -77,8 +78,10 @@ struct LanesConfig {
   /// instruments (combined_imu.hpp), with this lane id (its solutions' lane_id; not a unit's
   /// sensor_id); none when empty.
   std::optional<std::uint32_t> least_squares_lane_id;
-  /// Times the combination holds waiting for a silent unit before it combines without it.
-  int least_squares_alignment_depth{1000};
+  /// Increments one unit may hold waiting for another's before the combination goes on without
+  /// the missing one (a reader hands out one unit's backlog before the next's: its history per
+  /// instance; bus/imu_alignment.hpp).
+  int least_squares_alignment_depth{static_cast<int>(bus::ImuUnitAligner::kReaderBacklog)};
   /// The selection starts on the least-squares lane and, when the lane it follows is left,
   /// goes back to it while it is available (LaneSelectorConfig::preferred).
   bool least_squares_preferred{false};
