@@ -247,3 +247,25 @@ TEST(LoadedLanes, ParallelLanesNameTheFaultyUnitWithStopsAndCpuHogsAsOffline) {
        {"lanes: IMU 1 gyro axis x named at", "lanes: switched from IMU 1 to IMU 2", "switches 1,",
         "selections made without the parity test's judgement (its wait ran out) 0"}});
 }
+
+// The triplex with a fourth lane on the least-squares combination of all three units, preferred
+// (config/filter_triplex_least_squares.yaml): unit 2's x gyro steps 10 deg/h at 100 s, the parity
+// decision takes it out of the combination at its time and that lane re-learns there; the filter
+// is stopped twice (its readers then hand out one unit's backlog before the next's, which the
+// combination waits through) and the fault manager once, two busy loops beside them. The
+// published solutions, every lane's own (the combined lane's included) and the decision equal
+// offline's.
+TEST(LoadedLanes, ALeastSquaresLaneWithStopsAndCpuHogsCombinesAsOffline) {
+  run({124,
+       "seed000_triplex",
+       240,
+       2,
+       1,
+       2,
+       "filter_triplex_least_squares",
+       "fault_manager_triplex",
+       "faults:\n  - {type: imu_bias_step, sensor: gyro, axis: x, start_s: 100,\n"
+       "     magnitude_deg_per_h: 10, sensor_id: 2}\n",
+       {"instruments taken out 1", "selected IMU 9, switches 0,",
+        "selections made without the parity test's judgement (its wait ran out) 0"}});
+}

@@ -60,6 +60,10 @@ CombinedImu::CombinedImu(const FilterConfig& config)
   c.imu.id = lane_id_;
   c.imu_mounting.sensor_to_body = Eigen::Matrix3d::Identity();
   c.low_latency_output = false;
+  // Its increments come once the parity test has judged their time (lane_set.hpp): the merge
+  // waits for them as long as for that judgement, beyond its usual wait.
+  if (c.fault_monitor)
+    c.imu.max_wait_ns = c.sequencer_max_wait_ns + c.fault_monitor->judgement_wait_ns;
   core::FilterTuning& t = c.engine.tuning;
   const double gyro = noiseFactor(*combination_, ImuInstrument::kGyro, units_[0].gyro_sigma_rad);
   const double accel =

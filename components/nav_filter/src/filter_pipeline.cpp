@@ -19,7 +19,7 @@ namespace {
 
 std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const FilterConfig& c) {
   std::vector<InputSequencer<FilterInput>::ExpectedStream> s;
-  s.push_back({{kRankImu, c.imu.id}, c.imu.period_ns});
+  s.push_back({{kRankImu, c.imu.id}, c.imu.period_ns, false, false, c.imu.max_wait_ns});
   if (c.gnss_observations)
     s.push_back({{kRankGnssObs, c.gnss_observations->id}, c.gnss_observations->period_ns});
   if (c.gnss_fix) s.push_back({{kRankGnssFix, c.gnss_fix->id}, c.gnss_fix->period_ns});

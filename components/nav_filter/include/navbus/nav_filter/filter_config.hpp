@@ -29,6 +29,10 @@ struct InputConfig {
   /// gnss_fix only: the fix's velocity is valid at its (offset) time plus this [ns], negative
   /// for a receiver whose velocity lags its position (navbus calibrate time-offset).
   std::int64_t velocity_time_offset_ns{0};
+  /// How long the stream may hold the ordered merge back before it is set aside [running ns]
+  /// (0: sequencer_max_wait_s). Not a configuration key: the least-squares lane's IMU, which
+  /// its lane set releases only once the fault manager has judged it, waits for that too.
+  std::int64_t max_wait_ns{0};
 };
 
 /// The fault manager whose health reports (navbus/health) show that faults are monitored.
