@@ -165,8 +165,24 @@ void LaneSet::feedCombined(bool all) {
   feeding_ = true;
   // A time is combined once the parity test has judged it and its commands are in (a failed
   // axis leaves the combination at its decision's time, on the bus as offline).
-  const std::int64_t judged =
+  std::int64_t judged =
       parity_reported_ ? parity_judged_ns_ : std::numeric_limits<std::int64_t>::max();
+  // A judgement later than its wait (the fault manager's first report comes with its first
+  // diagnostics, after the filter's alignment; a stopped fault manager) is not waited for
+  // longer, as the lanes' merges do not: counted. A command about a time already combined then
+  // takes its instrument out from the next time combined (offline, from its own).
+  if (combined_->heldBeyond(judged)) {
+    const std::int64_t wait_ns =
+        config_.fault_monitor ? config_.fault_monitor->judgement_wait_ns : 0;
+    if (combined_held_since_ns_ < 0) combined_held_since_ns_ = now_ns_;
+    if (all || now_ns_ - combined_held_since_ns_ >= wait_ns) {
+      if (!all) ++combined_unjudged_;
+      judged = std::numeric_limits<std::int64_t>::max();
+      combined_held_since_ns_ = -1;
+    }
+  } else {
+    combined_held_since_ns_ = -1;
+  }
   const std::size_t k = lanes_.size() - 1;
   FilterPipeline& lane = *lanes_[k];
   while (std::optional<CombinedImu::Output> out = combined_->next(judged, all)) {
@@ -608,7 +624,10 @@ std::string LaneSet::summary() const {
   for (std::size_t k = 0; k < lanes_.size(); ++k)
     s << (k == 0 ? "; " : "\n") << "lane IMU " << lane_units_[k].sensor_id
       << (excluded_[k] ? " (excluded)" : "") << ": " << lanes_[k]->summary();
-  if (combined_) s << "\n" << combined_->summary();
+  if (combined_)
+    s << "\n"
+      << combined_->summary() << ", combined beyond the parity test's judgement (its wait ran out) "
+      << combined_unjudged_;
   return s.str();
 }
 

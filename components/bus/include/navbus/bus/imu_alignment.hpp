@@ -51,6 +51,11 @@ class ImuUnitAligner {
   void clear();
   /// The latest time released (-1: none).
   std::int64_t releasedNs() const { return released_ns_; }
+  /// The oldest time waiting (-1: none).
+  std::int64_t oldestNs() const {
+    std::uint32_t present = 0;
+    return oldest(present);
+  }
   /// The most increments one unit holds waiting.
   std::size_t waiting() const;
   /// The latest time unit u delivered (0: none yet).

@@ -57,6 +57,11 @@ class CombinedImu {
   /// The next combined increment, once its time is complete (or will not be) and at or before
   /// `judged_ns`; `all`: whatever still waits (the data ended).
   std::optional<Output> next(std::int64_t judged_ns, bool all = false);
+  /// A time waits beyond `judged_ns` (for the judgement, not for a unit).
+  bool heldBeyond(std::int64_t judged_ns) const {
+    const std::int64_t t = aligner_.oldestNs();
+    return t >= 0 && t > judged_ns;
+  }
 
   struct Counters {
     std::uint64_t increments{0};  ///< units' increments taken

@@ -136,6 +136,9 @@ class LaneSet {
   std::optional<CombinedImu> combined_;
   std::uint64_t own_commands_{0};  ///< the least-squares lane's re-learns
   bool feeding_{false};            ///< within feedCombined()
+  /// Running time the combination began to hold a complete time for the judgement (-1: none).
+  std::int64_t combined_held_since_ns_{-1};
+  std::uint64_t combined_unjudged_{0};  ///< times it went on without the judgement
   std::vector<std::deque<Pending>> pending_;
   std::vector<bool> excluded_;  ///< the lane's IMU axis was failed by a command
   /// ... from this data time on (the command's): unavailable at the times since
