@@ -73,12 +73,9 @@ class CombinedImu {
     std::uint64_t new_runs{0};
   };
   const Counters& counters() const { return counters_; }
-  /// The combination as it stands (its included instruments, its weights).
-  const core::ImuArrayCombination& combination() const { return *combination_; }
   /// The combination the increment at `time_ns` of this run was made with (the data time of
   /// each change is kept: the selection, behind the combination, is scored with its own).
   const core::ImuArrayCombination& combinationAt(std::int64_t time_ns) const;
-  bool usable() const { return usable_; }
   std::string summary() const;
 
  private:
