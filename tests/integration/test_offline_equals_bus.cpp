@@ -418,6 +418,32 @@ TEST(OfflineEqualsBus, TriplexLanesCompensateTheFusedReceiversClockAsOffline) {
            "navbus/gnss/observations 1:accepted 2:accepted"});
 }
 
+// Every lane fed every receiver (config/filter_triplex_receivers_fused.yaml): three lanes, each
+// fusing both receivers' epochs of a time as one stacked update (receiver 2 with its own clock
+// states, started from its first epoch), and receiver 2's clock jumping 1 ms at 100 s: the one
+// decision, its command applied to receiver 2's clock in every lane before the jumped epoch (a
+// filter fusing receiver 1 alone refuses it), both receivers accepted, and every published
+// solution the offline run's bit for bit.
+TEST(OfflineEqualsBus, TriplexLanesFuseBothReceiversAndCompensateEitherClockAsOffline) {
+  runCase({125,
+           "seed000_triplex_dual_receivers.yaml",
+           "filter_triplex_receivers_fused.yaml",
+           "",
+           4,
+           160.0,
+           {"selections made without the parity test's judgement (its wait ran out) 0",
+            "further receivers' clocks started 1,",
+            // refusals not counted: the watchdog's end-of-data exclusions may be refused as
+            // "ended as announced"
+            "commands applied 1 refused "},
+           "fault_manager_triplex_receivers.yaml",
+           1,
+           "faults:\n  - {type: receiver_clock_jump, start_s: 100, magnitude_ms: 1, receiver_id: "
+           "2}\n",
+           "navbus/gnss/observations 1:accepted 2:accepted",
+           "navbus/gnss/observations 1:accepted 2:accepted"});
+}
+
 // Two parallel units (seed000_dual_parallel.yaml), unit 1's x gyro stepping 10 deg/h at 100 s:
 // the parity test cannot say which unit (one ambiguous decision) and names both as suspects
 // (CMD_RELEARN_BIAS and CMD_SUSPECT_SENSOR_AXIS for each); both lanes re-learn that bias from the

@@ -115,6 +115,8 @@ constexpr LayoutEntry kStateLayout[] = {
     {"clock_bias", core::layout::kClockBias, "m"},
     {"clock_drift", core::layout::kClockDrift, "m/s"},
     {"pseudorange_error", core::layout::kPseudorangeError, "m"},
+    {"clock2_bias", core::layout::kSecondClockBias, "m"},
+    {"clock2_drift", core::layout::kSecondClockDrift, "m/s"},
     {"accel_scale", core::layout::kAccelScale, "1"},
     {"gyro_scale", core::layout::kGyroScale, "1"}};
 }  // namespace
@@ -133,7 +135,8 @@ void fillStateLayout(navbus::FilterDiagnostics& msg) {
 }
 
 navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t vehicle_id,
-                                std::uint64_t seq, std::int64_t time_ns) {
+                                std::uint64_t seq, std::int64_t time_ns,
+                                const FusedReceiverIds& receiver_ids) {
   navbus::FilterDiagnostics msg;
   msg.vehicle_id(vehicle_id);
   msg.seq(seq);
@@ -146,6 +149,8 @@ navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t v
     row.kind(d.is_rate[r] ? navbus::MEAS_PSEUDORANGE_RATE : navbus::MEAS_PSEUDORANGE);
     row.sv_id(static_cast<std::uint16_t>(d.sv_ids[r]));
     row.used(d.used[r]);
+    const int receiver = r < d.receivers.size() ? d.receivers[r] : 0;
+    row.receiver_id(receiver_ids[static_cast<std::size_t>(receiver)]);
     msg.rows().push_back(row);
     msg.innovation().push_back(d.innovation[static_cast<Eigen::Index>(r)]);
     msg.test_ratio().push_back(d.test_ratio[r]);

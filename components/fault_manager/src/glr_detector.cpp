@@ -179,6 +179,17 @@ void GlrDetector::report(const core::GlrResult& r, FaultOutput& out) {
   glr_.reset();
 }
 
+void GlrDetector::keepOut(int sv_id) {
+  const bool kept =
+      std::any_of(quarantine_.begin(), quarantine_.end(), [sv_id](const Quarantine& q) {
+        return q.permanent && q.covers(sv_id, false) && q.covers(sv_id, true);
+      });
+  if (kept) return;
+  glr_.setQuarantined(sv_id, true);
+  quarantine_.push_back({sv_id, navbus::SCOPE_ALL, -1, true});
+  glr_.reset();
+}
+
 void GlrDetector::escalate(const core::GlrResult& r, navbus::FilterCommand c, FaultOutput& out) {
   ++counters_.escalated;
   spdlog::warn(

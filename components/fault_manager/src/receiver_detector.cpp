@@ -205,7 +205,7 @@ void ReceiverDetector::reportClock(std::int64_t time_ns, std::size_t r, const co
   d.threshold(j.threshold);
   d.magnitude(j.magnitude_m);
   d.onset_time_gps_ns(static_cast<std::uint64_t>(time_ns));  // since the epoch before
-  d.detector("receivers");
+  d.detector(kDetectorName);
   d.candidates().push_back(candidate(navbus::SOURCE_RECEIVER_CLOCK, config_.receiver_ids[r], 0,
                                      j.statistic, j.magnitude_m));
   const std::uint32_t id = out.decide(d);
@@ -246,7 +246,7 @@ void ReceiverDetector::reportSatellite(std::int64_t time_ns, std::size_t r,
       static_cast<std::uint64_t>(since > 0 ? times[times.size() - since] : time_ns));
   // Two receivers cannot say which of them measured the satellite wrong.
   d.ambiguous(true);
-  d.detector("receivers");
+  d.detector(kDetectorName);
   for (const std::size_t receiver : {std::size_t{0}, r})
     d.candidates().push_back(candidate(navbus::SOURCE_SATELLITE, config_.receiver_ids[receiver],
                                        p.sv_id, p.glr.statistic, p.glr.magnitude));

@@ -14,6 +14,7 @@ CommandGate::CommandGate(const FilterConfig& config, bus::StreamCounters& topic_
       receiver_id_(config.gnss_observations
                        ? std::optional<std::uint32_t>(config.gnss_observations->id)
                        : std::nullopt),
+      second_receiver_id_(config.second_gnss_receiver_id),
       issuers_(config.command_issuers),
       issuer_identities_(config.issuer_identities),
       max_accel_compensation_mps2_(config.max_accel_compensation_mps2),
@@ -147,9 +148,12 @@ std::optional<std::string> CommandGate::check(const navbus::FilterCommand& c) co
 std::optional<std::string> CommandGate::checkReceiverClock(const navbus::FilterCommand& c) const {
   if (!receiver_id_)
     return fmt::format("sensor_id {}: this filter fuses no receiver's pseudoranges", c.sensor_id());
-  if (c.sensor_id() != *receiver_id_)
-    return fmt::format("sensor_id {} is not this filter's receiver (gnss_observations.id {})",
-                       c.sensor_id(), *receiver_id_);
+  if (c.sensor_id() != *receiver_id_ &&
+      c.sensor_id() != second_receiver_id_.value_or(*receiver_id_))
+    return fmt::format(
+        "sensor_id {} is not a receiver this filter fuses (gnss_observations.id {}{})",
+        c.sensor_id(), *receiver_id_,
+        second_receiver_id_ ? fmt::format(", second_id {}", *second_receiver_id_) : "");
   if (!std::isfinite(c.bias())) return fmt::format("bias {} is not finite", c.bias());
   if (!std::isfinite(c.bias_sigma()) || c.bias_sigma() < 0.0)
     return fmt::format("bias_sigma {} outside 0..inf", c.bias_sigma());

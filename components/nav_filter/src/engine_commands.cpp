@@ -6,6 +6,11 @@ namespace navbus::nav_filter {
 
 bool applyEngineCommand(core::NavigationEngine& engine, const navbus::FilterCommand& c,
                         double relearn_sigma) {
+  return applyEngineCommand(engine, c, relearn_sigma, 0);
+}
+
+bool applyEngineCommand(core::NavigationEngine& engine, const navbus::FilterCommand& c,
+                        double relearn_sigma, int receiver) {
   switch (c.kind()) {
     case navbus::CMD_EXCLUDE_SATELLITE:
       engine.excludeSatellite(c.sv_id(), toCore(c.scope()));
@@ -18,7 +23,7 @@ bool applyEngineCommand(core::NavigationEngine& engine, const navbus::FilterComm
       return true;
     case navbus::CMD_COMPENSATE_BIAS:
       if (c.sensor() == navbus::SOURCE_RECEIVER_CLOCK) {  // the receiver checked by the gate
-        engine.compensateReceiverClock(c.bias(), c.bias_sigma());
+        engine.compensateReceiverClock(c.bias(), c.bias_sigma(), receiver);
         return true;
       }
       engine.compensateBias(c.sensor() == navbus::SOURCE_ACCELEROMETER, c.axis(), c.bias(),

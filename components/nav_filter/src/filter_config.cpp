@@ -45,6 +45,8 @@ std::optional<InputConfig> input(const YAML::Node& inputs, const std::string& ke
   const std::string where = "inputs." + key;
   if (key == "gnss_fix") {
     bus::checkKeys(n, where, {"id", "period_s", "time_offset_s", "velocity_time_offset_s"});
+  } else if (key == "gnss_observations") {
+    bus::checkKeys(n, where, {"id", "period_s", "time_offset_s", "second_id"});
   } else {
     bus::checkKeys(n, where, {"id", "period_s", "time_offset_s"});
   }
@@ -302,6 +304,15 @@ void parseInputs(const YAML::Node& inputs, FilterConfig& c) {
   c.imu = *input(inputs, "imu", true);
   c.engine.imu_period_s = 1e-9 * static_cast<double>(c.imu.period_ns);
   c.gnss_observations = input(inputs, "gnss_observations", false);
+  if (c.gnss_observations && inputs["gnss_observations"]["second_id"]) {
+    const auto second = bus::require<std::uint32_t>(inputs["gnss_observations"],
+                                                    "inputs.gnss_observations", "second_id");
+    if (second == c.gnss_observations->id)
+      throw bus::ConfigError("configuration inputs.gnss_observations.second_id = " +
+                             std::to_string(second) + " is the first receiver's id as well");
+    c.second_gnss_receiver_id = second;
+    c.engine.fused_receivers = 2;
+  }
   c.gnss_fix = input(inputs, "gnss_fix", false);
   // The engine brings a lagging fix velocity forward through its velocity history.
   const std::int64_t reach_ns = (core::VelocityHistory::kLength - 2) * c.imu.period_ns;
@@ -320,6 +331,12 @@ void checkModeAgainstInputs(const YAML::Node& root, const FilterConfig& c) {
   const core::EngineConfig& e = c.engine;
   if (e.aiding == core::AidingMode::kTightlyCoupled && !c.gnss_observations) {
     throw bus::ConfigError("configuration mode = tightly_coupled needs inputs.gnss_observations");
+  }
+  if (c.second_gnss_receiver_id && e.aiding != core::AidingMode::kTightlyCoupled) {
+    throw bus::ConfigError(
+        "configuration inputs.gnss_observations.second_id = " +
+        std::to_string(*c.second_gnss_receiver_id) +
+        " needs mode = tightly_coupled (a second receiver's pseudoranges are fused only there)");
   }
   if ((e.aiding == core::AidingMode::kLooselyCoupled ||
        e.aiding == core::AidingMode::kMultiDimensional) &&
@@ -521,7 +538,8 @@ void parseMultiDimensional(const YAML::Node& node, core::MdfConfig& m) {
 /// The vehicle's geometry: how the IMU sits in the body, where the GNSS antenna is.
 void parseGeometry(const YAML::Node& node, FilterConfig& c) {
   bus::KeyReader r(node, "geometry");
-  r.nested({"imu_mounting_rpy_deg", "antenna_lever_arm_b_m"}).finish();
+  r.nested({"imu_mounting_rpy_deg", "antenna_lever_arm_b_m", "second_antenna_lever_arm_b_m"})
+      .finish();
   if (!node) return;
   const Eigen::Vector3d rpy = bus::getVector3(node, "geometry", "imu_mounting_rpy_deg", 1.0);
   for (int i = 0; i < 3; ++i)
@@ -531,6 +549,11 @@ void parseGeometry(const YAML::Node& node, FilterConfig& c) {
   for (int i = 0; i < 3; ++i)
     bus::checkRange(lever[i], -100.0, 100.0, "geometry.antenna_lever_arm_b_m");
   c.engine.antenna_lever_arm_b_m = lever;
+  const Eigen::Vector3d second =
+      bus::getVector3(node, "geometry", "second_antenna_lever_arm_b_m", 1.0);
+  for (int i = 0; i < 3; ++i)
+    bus::checkRange(second[i], -100.0, 100.0, "geometry.second_antenna_lever_arm_b_m");
+  c.engine.second_antenna_lever_arm_b_m = second;
 }
 /// The lane on the least-squares combination of the units (LanesConfig::least_squares_lane_id).
 void parseLeastSquaresLane(const YAML::Node& node, LanesConfig& l) {

@@ -22,6 +22,8 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   s.push_back({{kRankImu, c.imu.id}, c.imu.period_ns, false, false, c.imu.max_wait_ns});
   if (c.gnss_observations)
     s.push_back({{kRankGnssObs, c.gnss_observations->id}, c.gnss_observations->period_ns});
+  if (c.second_gnss_receiver_id)
+    s.push_back({{kRankGnssObs, *c.second_gnss_receiver_id}, c.gnss_observations->period_ns});
   if (c.gnss_fix) s.push_back({{kRankGnssFix, c.gnss_fix->id}, c.gnss_fix->period_ns});
   if (c.star_tracker)
     s.push_back({{kRankStarTracker, c.star_tracker->id}, c.star_tracker->period_ns});
@@ -53,6 +55,7 @@ std::size_t historyItems(const FilterConfig& c) {
   };
   add(c.imu);
   add(c.gnss_observations);
+  if (c.second_gnss_receiver_id) add(c.gnss_observations);
   add(c.gnss_fix);
   add(c.star_tracker);
   return static_cast<std::size_t>(1.25 * per_ns * static_cast<double>(c.recovery_history_ns)) + 16;
@@ -282,9 +285,9 @@ void FilterPipeline::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
   const bus::StreamKindInfo& stream = bus::streamInfo(kind);
   if (stream.merge_rank == bus::kNotMerged) return;
   if (!sequencer_.setActive({stream.merge_rank, id}, false)) return;  // a stream not in use
-  if (kind == bus::StreamKind::kGnssObservations)                     // no next epoch to judge
-    sequencer_.setActive(kGnssJudgementStream, false);
   ended_streams_.insert({stream.merge_rank, id});
+  if (kind == bus::StreamKind::kGnssObservations && fusedReceiverEnded())  // no next epoch
+    sequencer_.setActive(kGnssJudgementStream, false);                     // to judge
   spdlog::info("{} id {} ended (its writer disposed it): no longer waited for", stream.topic, id);
 }
 
@@ -313,6 +316,7 @@ void FilterPipeline::flush(std::int64_t now_ns) {
     now_ns += config_.sequencer_max_wait_ns;
     pump(now_ns);
   }
+  fuseHeldEpoch();              // a receiver's epoch whose companion never came
   engine_.closeSmoothingLog();  // post-processing: the last epoch's updates
 }
 
@@ -321,6 +325,13 @@ void FilterPipeline::process(StreamId stream, std::int64_t time_ns, FilterInput&
       cmd != nullptr && !replaying_ && !cmd->reapply) {
     executeCommand(cmd->command);  // checks, records and applies it (or restores and replays)
     return;
+  }
+  // Epochs of several receivers held for one stacked update: fused before anything that does
+  // not join them (the IMU's next increment at the latest).
+  if (engine_.hasHeldEpoch()) {
+    const auto* next = std::get_if<GnssEpochInput>(&owned);
+    if (next == nullptr || !engine_.joinsHeldEpoch(time_ns, receiverIndex(stream.sensor_id)))
+      fuseHeldEpoch();
   }
   keepSatelliteList(history_.overwritten());
   // Kept by the history (moved, not copied) and processed from there.
@@ -341,10 +352,11 @@ void FilterPipeline::process(StreamId stream, std::int64_t time_ns, FilterInput&
     // about it (a clock jump, a satellite) then comes before it in the order, as offline.
     if (receivers_judged_ && !replaying_)
       sequencer_.owe(kGnssJudgementStream, time_ns + config_.gnss_observations->period_ns - 1);
-    if (engine_.addGnssEpoch(epoch->time_ns, epoch->satellites) && !replaying_ &&
-        time_ns > diagnosed_up_to_ns_) {
-      diagnosed_up_to_ns_ = time_ns;
-      publishDiagnostics();
+    if (config_.second_gnss_receiver_id) {
+      engine_.holdGnssEpoch(epoch->time_ns, epoch->satellites, receiverIndex(stream.sensor_id));
+      if (engine_.heldEpochComplete()) fuseHeldEpoch();
+    } else if (engine_.addGnssEpoch(epoch->time_ns, epoch->satellites)) {
+      diagnoseEpoch(time_ns);
     }
   } else if (const auto* fix = std::get_if<core::GnssFixMeasurement>(&input)) {
     engine_.addGnssFix(*fix);
@@ -353,6 +365,29 @@ void FilterPipeline::process(StreamId stream, std::int64_t time_ns, FilterInput&
   } else if (const auto* cmd = std::get_if<CommandInput>(&input)) {
     applyToEngine(cmd->command);  // re-processed after a rollback: checked when it first came
   }
+}
+
+int FilterPipeline::receiverIndex(std::uint32_t receiver_id) const {
+  return config_.second_gnss_receiver_id && receiver_id == *config_.second_gnss_receiver_id ? 1 : 0;
+}
+
+bool FilterPipeline::fusedReceiverEnded() const {
+  if (!config_.gnss_observations) return true;
+  const bool first = ended_streams_.count({kRankGnssObs, config_.gnss_observations->id}) > 0;
+  if (!config_.second_gnss_receiver_id) return first;
+  return first && ended_streams_.count({kRankGnssObs, *config_.second_gnss_receiver_id}) > 0;
+}
+
+void FilterPipeline::fuseHeldEpoch() {
+  if (!engine_.hasHeldEpoch()) return;
+  const std::int64_t time_ns = engine_.heldEpochTime();
+  if (engine_.fuseHeldEpoch()) diagnoseEpoch(time_ns);
+}
+
+void FilterPipeline::diagnoseEpoch(std::int64_t time_ns) {
+  if (replaying_ || time_ns <= diagnosed_up_to_ns_) return;  // each epoch once, also after a rewind
+  diagnosed_up_to_ns_ = time_ns;
+  publishDiagnostics();
 }
 
 bool FilterPipeline::mergeLate(StreamId id, std::int64_t time_ns, FilterInput& input) {
@@ -374,8 +409,12 @@ void FilterPipeline::publishDiagnostics() {
   if (!sinks_.diagnostics) return;
   owed_judgement_ns_ = engine_.state().time_ns;
   sequencer_.owe(kCommandStream, owed_judgement_ns_);  // a command may answer it
-  navbus::FilterDiagnostics msg = bus::toIdl(engine_.lastEpoch(), config_.vehicle_id,
-                                             ++diagnostics_seq_, engine_.state().time_ns);
+  const bus::FusedReceiverIds receivers{
+      config_.gnss_observations ? config_.gnss_observations->id : 0U,
+      config_.second_gnss_receiver_id.value_or(0U)};
+  navbus::FilterDiagnostics msg =
+      bus::toIdl(engine_.lastEpoch(), config_.vehicle_id, ++diagnostics_seq_,
+                 engine_.state().time_ns, receivers);
   appendNoiseScales(engine_, msg);
   sinks_.diagnostics(msg);
 }

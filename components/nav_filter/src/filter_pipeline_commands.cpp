@@ -27,9 +27,9 @@ bool FilterPipeline::applyStreamCommand(const navbus::FilterCommand& c) {
   auto idOf = [](const std::optional<InputConfig>& input) {
     return input ? std::optional<std::uint32_t>(input->id) : std::nullopt;
   };
-  const std::optional<std::uint32_t> flag =
-      SolutionFlags::streamFlag(c, {config_.imu.id, idOf(config_.gnss_observations),
-                                    idOf(config_.gnss_fix), idOf(config_.star_tracker)});
+  const std::optional<std::uint32_t> flag = SolutionFlags::streamFlag(
+      c, {config_.imu.id, idOf(config_.gnss_observations), idOf(config_.gnss_fix),
+          idOf(config_.star_tracker), config_.second_gnss_receiver_id});
   if (!flag) return false;
   flags_.applyStreamCommand(c, *flag);
   if (c.kind() == navbus::CMD_EXCLUDE_STREAM && *flag == navbus::FAULT_IMU_STREAM_LOST) {
@@ -90,7 +90,7 @@ void FilterPipeline::noteJudged(std::int64_t judged_up_to_ns) {
   // a judge whose wait ran out (a receiver silent, the fault manager stopped) is not waited for
   // again until it judges more.
   if (receivers_judged_ && judgements_.gnssJudged() > gnss_judged_passed_ns_ &&
-      ended_streams_.count({kRankGnssObs, config_.gnss_observations->id}) == 0) {
+      !fusedReceiverEnded()) {
     gnss_judged_passed_ns_ = judgements_.gnssJudged();
     sequencer_.judged(kGnssJudgementStream, gnss_judged_passed_ns_);
   }
@@ -184,6 +184,6 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
 bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {
   const double relearn_sigma =
       c.kind() == navbus::CMD_RELEARN_BIAS ? commands_.relearnSigma(c) : 0.0;
-  return applyEngineCommand(engine_, c, relearn_sigma);
+  return applyEngineCommand(engine_, c, relearn_sigma, receiverIndex(c.sensor_id()));
 }
 }  // namespace navbus::nav_filter

@@ -23,6 +23,8 @@ FilterConfig laneConfig(const FilterConfig& base, const LaneUnit& unit, bool fir
   c.imu.id = unit.sensor_id;
   c.imu_mounting.sensor_to_body = unit.c_b_u;
   c.engine.antenna_lever_arm_b_m = base.engine.antenna_lever_arm_b_m - unit.lever_arm_b_m;
+  c.engine.second_antenna_lever_arm_b_m =
+      base.engine.second_antenna_lever_arm_b_m - unit.lever_arm_b_m;
   if (!first) c.low_latency_output = false;
   return c;
 }

@@ -30,11 +30,13 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
       << ", star-tracker attitudes fused " << n.star_fused << ", ZUPTs " << n.zero_velocity_updates
       << ", NHC updates " << n.nonholonomic_updates
       << ", pseudoranges without an error state (every state taken) "
-      << v.engine.pseudorangesWithoutErrorState() << ", rows gated " << n.rows_gated
-      << ", stage switches " << n.stage_switches << ", decisions seen " << p.decisions_seen
-      << ", commands applied " << k.applied << " refused " << k.refused << " (unauthorized issuer "
-      << k.unauthorized << ", issuer not the writer's identity " << k.impersonated << ", stale "
-      << k.stale << ") late " << k.late << ", re-learn sigmas clamped to the compensation limit "
+      << v.engine.pseudorangesWithoutErrorState() << ", satellites beyond an epoch's capacity "
+      << n.epoch_satellites_dropped << ", further receivers' clocks started "
+      << n.receiver_clocks_started << ", rows gated " << n.rows_gated << ", stage switches "
+      << n.stage_switches << ", decisions seen " << p.decisions_seen << ", commands applied "
+      << k.applied << " refused " << k.refused << " (unauthorized issuer " << k.unauthorized
+      << ", issuer not the writer's identity " << k.impersonated << ", stale " << k.stale
+      << ") late " << k.late << ", re-learn sigmas clamped to the compensation limit "
       << k.relearn_clamped << ", sequencer timeouts " << v.sequencer_timeouts << ", pending "
       << v.pending << ", recoveries from onset " << p.onset_recoveries << " (onset beyond history "
       << p.onset_beyond_history << ")"

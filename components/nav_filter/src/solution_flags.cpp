@@ -1,5 +1,7 @@
 #include "navbus/nav_filter/solution_flags.hpp"
 
+#include <algorithm>
+
 #include <spdlog/spdlog.h>
 
 namespace navbus::nav_filter {
@@ -22,7 +24,7 @@ std::optional<std::uint32_t> SolutionFlags::streamFlag(const navbus::FilterComma
     case navbus::SOURCE_IMU_RAW_STREAM:
       return navbus::FAULT_RAW_IMU_LOST;
     case navbus::SOURCE_GNSS_OBS_STREAM:
-      if (!is(ids.gnss_observations)) return std::nullopt;
+      if (!is(ids.gnss_observations) && !is(ids.second_gnss_observations)) return std::nullopt;
       return navbus::FAULT_GNSS_STREAM_LOST;
     case navbus::SOURCE_GNSS_FIX_STREAM:
       if (!is(ids.gnss_fix)) return std::nullopt;
@@ -37,11 +39,14 @@ std::optional<std::uint32_t> SolutionFlags::streamFlag(const navbus::FilterComma
 
 void SolutionFlags::applyStreamCommand(const navbus::FilterCommand& c, std::uint32_t flag) {
   const bool lost = c.kind() == navbus::CMD_EXCLUDE_STREAM;
-  if (lost) {
-    stream_flags_ |= flag;
-  } else {
-    stream_flags_ &= ~flag;
-  }
+  const int source = static_cast<int>(c.sensor());
+  lost_.erase(std::remove_if(
+                  lost_.begin(), lost_.end(),
+                  [&](const LostStream& l) { return l.source == source && l.id == c.sensor_id(); }),
+              lost_.end());
+  if (lost) lost_.push_back({source, c.sensor_id(), flag});
+  stream_flags_ = 0;
+  for (const LostStream& l : lost_) stream_flags_ |= l.flag;
   spdlog::log(lost ? spdlog::level::warn : spdlog::level::info,
               "stream source {} id {} {}; flags 0x{:x}", static_cast<int>(c.sensor()),
               c.sensor_id(), lost ? "lost" : "restored", stream_flags_);

@@ -84,8 +84,8 @@ TEST(CommandGate, NamesTheFieldAndValueOutOfRange) {
 TEST(CommandGate, CompensatesOnlyTheFusedReceiversClockNamingAnother) {
   // Given a filter fusing receiver 1's pseudoranges, a clock compensation for receiver 1 of
   // 299.8 km (1 ms) passes (a clock's jump has no IMU compensation limit), one for receiver 2
-  // is refused naming both ids, one not finite is refused naming the field; a filter without
-  // pseudoranges refuses any.
+  // is refused naming both ids (taken when the filter fuses receiver 2 too), one not finite is
+  // refused naming the field; a filter without pseudoranges refuses any.
   nb::bus::StreamCounters topic;
   nb::nav_filter::FilterConfig config = gateConfig();
   config.gnss_observations = nb::nav_filter::InputConfig{1, 1'000'000'000};
@@ -100,7 +100,15 @@ TEST(CommandGate, CompensatesOnlyTheFusedReceiversClockNamingAnother) {
   EXPECT_FALSE(gate.check(c).has_value()) << gate.check(c).value_or("");
   c.sensor_id(2);
   EXPECT_EQ(gate.check(c).value_or(""),
-            "sensor_id 2 is not this filter's receiver (gnss_observations.id 1)");
+            "sensor_id 2 is not a receiver this filter fuses (gnss_observations.id 1)");
+  // A filter fusing receiver 2 as well takes it, and still refuses receiver 3.
+  config.second_gnss_receiver_id = 2;
+  CommandGate both(config, topic);
+  EXPECT_FALSE(both.check(c).has_value()) << both.check(c).value_or("");
+  c.sensor_id(3);
+  EXPECT_EQ(
+      both.check(c).value_or(""),
+      "sensor_id 3 is not a receiver this filter fuses (gnss_observations.id 1, second_id 2)");
   c.sensor_id(1);
   c.bias(std::nan(""));
   EXPECT_EQ(gate.check(c).value_or(""), "bias nan is not finite");

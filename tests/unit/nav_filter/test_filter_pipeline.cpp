@@ -643,7 +643,7 @@ TEST(SolutionFlags, AStreamLostIsThisFiltersOnlyWhenItFusesThatStream) {
   // FAULT_GNSS_STREAM_LOST and its health said DEGRADED for the 5 s receiver 2 was silent);
   // receiver 1's is, and a fix stream only where fixes are fused.
   using Ids = nav_filter::SolutionFlags::InputIds;
-  const Ids ids{1, 1u, std::nullopt, std::nullopt};
+  const Ids ids{1, 1u, std::nullopt, std::nullopt, std::nullopt};
   FilterCommand c;
   c.kind(CMD_EXCLUDE_STREAM);
   c.sensor(SOURCE_GNSS_OBS_STREAM);
@@ -653,11 +653,36 @@ TEST(SolutionFlags, AStreamLostIsThisFiltersOnlyWhenItFusesThatStream) {
   EXPECT_EQ(nav_filter::SolutionFlags::streamFlag(c, ids), FAULT_GNSS_STREAM_LOST);
   c.sensor(SOURCE_GNSS_FIX_STREAM);
   EXPECT_FALSE(nav_filter::SolutionFlags::streamFlag(c, ids));
-  EXPECT_EQ(nav_filter::SolutionFlags::streamFlag(c, Ids{1, std::nullopt, 1u, std::nullopt}),
+  EXPECT_EQ(nav_filter::SolutionFlags::streamFlag(
+                c, Ids{1, std::nullopt, 1u, std::nullopt, std::nullopt}),
             FAULT_GNSS_STREAM_LOST);
   c.sensor(SOURCE_ST_STREAM);
   EXPECT_FALSE(nav_filter::SolutionFlags::streamFlag(c, ids));
   c.sensor(SOURCE_IMU_STREAM);
   c.sensor_id(2);
   EXPECT_FALSE(nav_filter::SolutionFlags::streamFlag(c, ids));
+}
+
+TEST(SolutionFlags, TwoFusedReceiversShareTheFlagWhileEitherIsLost) {
+  // Given a filter fusing receivers 1 and 2, when both are declared lost and receiver 1 comes
+  // back, then the flag stays until receiver 2 is back too.
+  const nav_filter::SolutionFlags::InputIds ids{1, 1u, std::nullopt, std::nullopt, 2u};
+  nav_filter::SolutionFlags flags;
+  FilterCommand c;
+  c.sensor(SOURCE_GNSS_OBS_STREAM);
+  for (const std::uint32_t id : {1u, 2u}) {
+    c.kind(CMD_EXCLUDE_STREAM);
+    c.sensor_id(id);
+    const auto flag = nav_filter::SolutionFlags::streamFlag(c, ids);
+    ASSERT_EQ(flag, FAULT_GNSS_STREAM_LOST);
+    flags.applyStreamCommand(c, *flag);
+  }
+  c.kind(CMD_READMIT_STREAM);
+  c.sensor_id(1);
+  flags.applyStreamCommand(c, FAULT_GNSS_STREAM_LOST);
+  EXPECT_EQ(flags.flags() & FAULT_GNSS_STREAM_LOST, FAULT_GNSS_STREAM_LOST);
+  EXPECT_TRUE(flags.degraded());
+  c.sensor_id(2);
+  flags.applyStreamCommand(c, FAULT_GNSS_STREAM_LOST);
+  EXPECT_EQ(flags.flags() & FAULT_GNSS_STREAM_LOST, 0u);
 }

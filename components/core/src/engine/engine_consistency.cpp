@@ -54,8 +54,8 @@ void NavigationEngine::askReinitialisation() {
 }
 
 bool NavigationEngine::reinitialiseFromPseudoranges(std::int64_t time_ns) {
-  const PseudorangeFix pf =
-      pseudorangeFix(time_ns, *used_, earth::geodeticToEcef(filter_->state().position));
+  const PseudorangeFix pf = pseudorangeFix(time_ns, firstReceiverObservations(),
+                                           earth::geodeticToEcef(filter_->state().position));
   if (!pf.valid) return false;
   filter_->resetNavigation(pf.fix);
   filter_->resetClock(pf.clock_bias_m, pf.clock_drift_mps, pf.clock_bias_sigma_m,

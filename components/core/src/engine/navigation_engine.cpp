@@ -45,6 +45,8 @@ NavigationEngine::NavigationEngine(const EngineConfig& config)
   }
   process_noise_.configure(config.adaptive_process_noise);
   used_->reserve(32);
+  first_receiver_->reserve(32);
+  held_.satellites.reserve(static_cast<std::size_t>(kMaxEpochSatellites));
   reset();
 }
 
@@ -87,11 +89,11 @@ Eigen::Vector3d NavigationEngine::mountingMisalignment() const {
 bool NavigationEngine::modelsMountingMisalignment() const {
   return filter_->modelsMountingMisalignment();
 }
-double NavigationEngine::clockBias() const {
-  return filter_->clockBias();
+double NavigationEngine::clockBias(int receiver) const {
+  return filter_->clockBias(receiver);
 }
-double NavigationEngine::clockDrift() const {
-  return filter_->clockDrift();
+double NavigationEngine::clockDrift(int receiver) const {
+  return filter_->clockDrift(receiver);
 }
 FusionStructure NavigationEngine::fusion() const {
   return filter_->structure();
@@ -159,6 +161,7 @@ StateMask NavigationEngine::baseMask() const {
   if (config_.aiding == AidingMode::kTightlyCoupled ||
       config_.aiding == AidingMode::kInertialOnly) {
     m |= maskOf({kClockBias, kClockDrift});
+    if (config_.fused_receivers > 1) m |= maskOf({kSecondClockBias, kSecondClockDrift});
     if (config_.tuning.pseudorange_error_sigma_m > 0.0) m |= maskOf({kPseudorangeError});
     return m;
   }
@@ -279,6 +282,7 @@ void NavigationEngine::start(const NavState& state, double clock_bias_m, double 
   velocity_history_.clear();
   filter_->initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
                       config_.fusion, initial_covariance);
+  clocks_started_ = 1;  // a further receiver's clock starts with its next epoch
   // The GLRs' Phi between epochs: the fault manager's (pseudoranges) and the protection
   // levels' own on fixes.
   filter_->keepTransitionSinceUpdate(config_.aiding == AidingMode::kTightlyCoupled ||
@@ -554,22 +558,29 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   // Excluded measurements stay in the epoch, monitored only (their innovations go to the
   // diagnostics for the readmission test); the diagnostics carry at most 24 satellites.
   used_->clear();
-  bool any = false;
   for (const auto& s : satellites) {
-    if (used_->size() >= static_cast<std::size_t>(kMaxEpochSatellites)) break;
+    if (used_->size() >= static_cast<std::size_t>(kMaxEpochSatellites)) {
+      ++counters_.epoch_satellites_dropped;
+      continue;
+    }
+    if (s.receiver >= config_.fused_receivers) continue;  // not a fused receiver's
     SatelliteObservation o = s;
     const auto it = excluded_.find(s.sv_id);
     const std::uint8_t mask = it == excluded_.end() ? 0 : it->second;
     o.use_range = (mask & static_cast<std::uint8_t>(SatelliteScope::kRange)) == 0;
     o.use_rate = (mask & static_cast<std::uint8_t>(SatelliteScope::kRate)) == 0;
-    any = any || o.use_range || o.use_rate;
     used_->push_back(o);
   }
   if (aligning()) {
-    aligner_->addPseudoranges(time_ns, *used_);  // excluded satellites are not used there either
+    // Excluded satellites are not used there either.
+    aligner_->addPseudoranges(time_ns, firstReceiverObservations());
     if (aligner_->aligned()) startFromAlignment();
     return false;
   }
+  startReceiverClocks();
+  const bool any = std::any_of(used_->begin(), used_->end(), [](const SatelliteObservation& o) {
+    return o.use_range || o.use_rate;
+  });
   if (!any) return false;
   if ((status_ & kStatusReinitialising) != 0) {
     reinitialiseFromPseudoranges(time_ns);
@@ -578,8 +589,8 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   if (course_check_armed_) floorBeforeCourseCheck();
   if (course_check_armed_ &&
       filter_->state().vel_ned_mps.head<2>().norm() >= config_.alignment.course_min_speed_mps) {
-    const PseudorangeFix pf =
-        pseudorangeFix(time_ns, *used_, earth::geodeticToEcef(filter_->state().position));
+    const PseudorangeFix pf = pseudorangeFix(time_ns, firstReceiverObservations(),
+                                             earth::geodeticToEcef(filter_->state().position));
     if (pf.valid) checkHeadingFromCourse(pf.fix.vel_ned_mps, pf.fix.vel_sigma_ned_mps.x());
   }
   const double range_factor = noiseSigmaFactor(NoiseStream::kPseudorange);
@@ -590,8 +601,9 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   }
   // P_Q before the updates (zero when the process noise does not adapt).
   const StateMatrix process_part = filter_->processNoisePart();
-  const std::vector<MeasurementReport>& reports =
-      filter_->update(*used_, AntennaArm{config_.antenna_lever_arm_b_m, bodyRate()});
+  const AntennaArms antennas{AntennaArm{config_.antenna_lever_arm_b_m, bodyRate()},
+                             AntennaArm{config_.second_antenna_lever_arm_b_m, bodyRate()}};
+  const std::vector<MeasurementReport>& reports = filter_->update(*used_, antennas);
   for (const auto& rep : reports) {
     counters_.rows_gated += rep.fused && !rep.result.accepted ? 1 : 0;
     if (!rep.fused) continue;
@@ -608,6 +620,73 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   mode_ = aidedMode();
   if (config_.integrity.enabled) integrity_->onEpoch(time_ns, filter_->lastEpoch());
   return true;
+}
+
+const std::vector<SatelliteObservation>& NavigationEngine::firstReceiverObservations() {
+  if (config_.fused_receivers <= 1) return *used_;
+  first_receiver_->clear();
+  for (const SatelliteObservation& o : *used_)
+    if (o.receiver == 0) first_receiver_->push_back(o);
+  return *first_receiver_;
+}
+
+void NavigationEngine::startReceiverClocks() {
+  for (int r = 1; r < config_.fused_receivers; ++r) {
+    const auto bit = static_cast<std::uint8_t>(1u << r);
+    if ((clocks_started_ & bit) != 0) continue;
+    // c*b and c*f: the mean of the receiver's range and rate residuals from the filter's
+    // position and velocity, with the tuning's initial sigmas (what the position's error adds
+    // is far inside them); the epoch that started the clock is not fused.
+    const AntennaArm arm{config_.second_antenna_lever_arm_b_m, bodyRate()};
+    double bias_m = 0.0, drift_mps = 0.0;
+    int n = 0;
+    for (const SatelliteObservation& o : *used_) {
+      if (o.receiver != r) continue;
+      const RangePrediction p = predictRange(filter_->state(), 0.0, 0.0, o, arm);
+      bias_m += o.pseudorange_m - p.pseudorange_m;
+      drift_mps += o.pseudorange_rate_mps - p.pseudorange_rate_mps;
+      ++n;
+    }
+    if (n == 0) continue;
+    filter_->resetClock(bias_m / n, drift_mps / n, config_.tuning.clock_bias_sigma_m,
+                        config_.tuning.clock_drift_sigma_mps, r);
+    clocks_started_ |= bit;
+    ++counters_.receiver_clocks_started;
+    used_->erase(std::remove_if(used_->begin(), used_->end(),
+                                [r](const SatelliteObservation& o) { return o.receiver == r; }),
+                 used_->end());
+  }
+}
+
+bool NavigationEngine::holdGnssEpoch(std::int64_t time_ns,
+                                     const std::vector<SatelliteObservation>& satellites,
+                                     int receiver) {
+  if (hasHeldEpoch() && !joinsHeldEpoch(time_ns, receiver)) return false;
+  held_.time_ns = time_ns;
+  held_.receivers |= static_cast<std::uint8_t>(1u << receiver);
+  for (const SatelliteObservation& o : satellites) {
+    held_.satellites.push_back(o);
+    held_.satellites.back().receiver = receiver;
+  }
+  return true;
+}
+
+bool NavigationEngine::joinsHeldEpoch(std::int64_t time_ns, int receiver) const {
+  return receiver >= 0 && receiver < config_.fused_receivers &&
+         (!hasHeldEpoch() ||
+          (time_ns == held_.time_ns && (held_.receivers & (1u << receiver)) == 0));
+}
+
+bool NavigationEngine::heldEpochComplete() const {
+  return held_.receivers == (1u << config_.fused_receivers) - 1u;
+}
+
+bool NavigationEngine::fuseHeldEpoch() {
+  if (!hasHeldEpoch()) return false;
+  const bool fused = addGnssEpoch(held_.time_ns, held_.satellites);
+  held_.receivers = 0;
+  held_.satellites.clear();
+  return fused;
 }
 
 ProtectionLevels NavigationEngine::protectionLevels() const {
@@ -834,8 +913,9 @@ void NavigationEngine::compensateBias(bool accelerometer, int axis, double bias,
   status_ |= kStatusBiasCompensated;
 }
 
-void NavigationEngine::compensateReceiverClock(double jump_m, double sigma_m) {
-  if (filter_->initialized()) filter_->shiftClock(jump_m, sigma_m);
+void NavigationEngine::compensateReceiverClock(double jump_m, double sigma_m, int receiver) {
+  if (receiver < 0 || receiver >= config_.fused_receivers) return;
+  if (filter_->initialized()) filter_->shiftClock(jump_m, sigma_m, receiver);
 }
 
 void NavigationEngine::failSensorAxis(bool accelerometer, int axis) {

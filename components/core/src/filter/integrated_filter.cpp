@@ -40,8 +40,10 @@ StateVector IntegratedFilter::initialSigma(const FilterTuning& tuning) {
   if (tuning.mounting_misalignment_sigma_rad > 0.0)
     frame_sigma = tuning.mounting_misalignment_sigma_rad;
   sigma.segment<3>(kStarTrackerBias.index).setConstant(frame_sigma);
-  sigma[kClockBias.index] = tuning.clock_bias_sigma_m;
-  sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
+  for (int r = 0; r < kMaxFusedReceivers; ++r) {
+    sigma[clockBiasOf(r).index] = tuning.clock_bias_sigma_m;
+    sigma[clockDriftOf(r).index] = tuning.clock_drift_sigma_mps;
+  }
   sigma.segment<kPseudorangeError.dof>(kPseudorangeError.index)
       .setConstant(tuning.pseudorange_error_sigma_m > 0.0 ? tuning.pseudorange_error_sigma_m : 1.0);
   if (tuning.fix_position_error_sigma_h_m > 0.0 && !(tuning.pseudorange_error_sigma_m > 0.0))
@@ -65,8 +67,8 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   tuning_ = tuning;
   ins_ = StrapdownNed(tuning.gravity);
   ins_.initialize(state);
-  clock_bias_m_ = clock_bias_m;
-  clock_drift_mps_ = clock_drift_mps;
+  clock_bias_m_ = {clock_bias_m};  // a further receiver's clock starts with its first epoch
+  clock_drift_mps_ = {clock_drift_mps};
   accel_bias_.setZero();
   gyro_bias_.setZero();
   accel_scale_.setZero();
@@ -115,7 +117,8 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
       errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, inc.delta_angle_b_rad / dt, at_state),
       dt);
   ins_.propagate(inc, at_state);
-  clock_bias_m_ += clock_drift_mps_ * dt;
+  for (std::size_t r = 0; r < clock_bias_m_.size(); ++r)
+    clock_bias_m_[r] += clock_drift_mps_[r] * dt;
   if (suspend_filter) {
     smoothing_.continues = false;  // the covariance stood still: nothing to smooth across
     return;
@@ -130,8 +133,10 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
       .setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt * q_scale);
   q.segment<3>(kAtt.index)
       .setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt * q_scale);
-  q[kClockBias.index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
-  q[kClockDrift.index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
+  for (int r = 0; r < kMaxFusedReceivers; ++r) {  // every receiver's oscillator alike
+    q[clockBiasOf(r).index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
+    q[clockDriftOf(r).index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
+  }
   if (modelsMountingMisalignment()) {
     // Random constants with a random walk (layout::kMountingMisalignment).
     q.segment<3>(kMountingMisalignment.index)
@@ -283,11 +288,19 @@ InnovationWindow<3>* IntegratedFilter::window(AidingKind kind) {
 
 const std::vector<MeasurementReport>& IntegratedFilter::update(
     const std::vector<SatelliteObservation>& sats, const AntennaArm& antenna) {
+  AntennaArms antennas;
+  antennas.fill(antenna);
+  return update(sats, antennas);
+}
+
+const std::vector<MeasurementReport>& IntegratedFilter::update(
+    const std::vector<SatelliteObservation>& sats, const AntennaArms& antennas) {
   ErrorState& es = structure_ == FusionStructure::kFederated ? local_[kGnssLocal] : central_;
   const auto m = static_cast<Eigen::Index>(2 * sats.size());
   EpochDiagnostics& d = *last_epoch_;
   d.sv_ids.clear();
   d.is_rate.clear();
+  d.receivers.clear();
   d.used.clear();
   d.test_ratio.clear();
   d.innovation.resize(m);
@@ -297,8 +310,9 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   const std::vector<int>& error_state = pseudorangeErrorStates(sats);
   for (std::size_t i = 0; i < sats.size(); ++i) {
     const auto& sat = sats[i];
+    const std::size_t rx = slot(sat.receiver);
     const RangePrediction p =
-        predictRange(ins_.state(), clock_bias_m_, clock_drift_mps_, sat, antenna);
+        predictRange(ins_.state(), clock_bias_m_[rx], clock_drift_mps_[rx], sat, antennas[rx]);
     const auto row = static_cast<Eigen::Index>(2 * i);
     // Innovations in the error-state form z = H dx + v: predicted minus measured (seed 000 eq. 5).
     d.innovation[row] = p.pseudorange_m - sat.pseudorange_m;
@@ -315,6 +329,7 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
     r[row + 1] = sat.pseudorange_rate_sigma_mps * sat.pseudorange_rate_sigma_mps;
     d.sv_ids.insert(d.sv_ids.end(), {sat.sv_id, sat.sv_id});
     d.is_rate.insert(d.is_rate.end(), {false, true});
+    d.receivers.insert(d.receivers.end(), {sat.receiver, sat.receiver});
   }
   // Batch view from the prior covariance, published for the GLR; the update itself is
   // sequential (exact for the diagonal R) so that each row can be gated on its own.
@@ -439,8 +454,10 @@ void IntegratedFilter::feedback(const StateVector& dx) {
   accel_scale_ -= dx.segment<3>(kAccelScale.index);
   gyro_scale_ -= dx.segment<3>(kGyroScale.index);
   star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);  // or the mounting's (same block)
-  clock_bias_m_ -= dx[kClockBias.index];
-  clock_drift_mps_ -= dx[kClockDrift.index];
+  for (int r = 0; r < kMaxFusedReceivers; ++r) {
+    clock_bias_m_[slot(r)] -= dx[clockBiasOf(r).index];
+    clock_drift_mps_[slot(r)] -= dx[clockDriftOf(r).index];
+  }
   if (modelsFixPositionError()) {
     fix_position_error_ned_m_ -= dx.segment<3>(kFixPositionError.index);
   } else {
@@ -571,16 +588,16 @@ void IntegratedFilter::resetNavigation(const GnssFixMeasurement& fix) {
 }
 
 void IntegratedFilter::resetClock(double bias_m, double drift_mps, double bias_sigma_m,
-                                  double drift_sigma_mps) {
-  clock_bias_m_ = bias_m;
-  clock_drift_mps_ = drift_mps;
-  resetState(layout::kClockBias.index, bias_sigma_m);
-  resetState(layout::kClockDrift.index, drift_sigma_mps);
+                                  double drift_sigma_mps, int receiver) {
+  clock_bias_m_[slot(receiver)] = bias_m;
+  clock_drift_mps_[slot(receiver)] = drift_mps;
+  resetState(layout::clockBiasOf(receiver).index, bias_sigma_m);
+  resetState(layout::clockDriftOf(receiver).index, drift_sigma_mps);
 }
 
-void IntegratedFilter::shiftClock(double jump_m, double sigma_m) {
-  clock_bias_m_ += jump_m;
-  if (sigma_m > 0.0) addVariance(layout::kClockBias.index, sigma_m * sigma_m);
+void IntegratedFilter::shiftClock(double jump_m, double sigma_m, int receiver) {
+  clock_bias_m_[slot(receiver)] += jump_m;
+  if (sigma_m > 0.0) addVariance(layout::clockBiasOf(receiver).index, sigma_m * sigma_m);
 }
 
 void IntegratedFilter::resetState(int i, double sigma) {

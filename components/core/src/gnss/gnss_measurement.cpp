@@ -26,10 +26,10 @@ RangePrediction predictRange(const NavState& ins, double clock_bias_m, double cl
   p.h_range.block<1, 3>(0, kPos.index) = -p.los_ned.transpose();
   // A tilt error moves the estimated antenna about the IMU by -phi x a = [a x] phi.
   p.h_range.block<1, 3>(0, kAtt.index) = -p.los_ned.transpose() * skew(arm_ned_m);
-  p.h_range(0, kClockBias.index) = 1.0;
+  p.h_range(0, clockBiasOf(sat.receiver).index) = 1.0;
   p.h_rate.block<1, 3>(0, kVel.index) = -p.los_ned.transpose();
   p.h_rate.block<1, 3>(0, kAtt.index) = -p.los_ned.transpose() * skew(arm_vel_ned_mps);
-  p.h_rate(0, kClockDrift.index) = 1.0;
+  p.h_rate(0, clockDriftOf(sat.receiver).index) = 1.0;
   return p;
 }
 

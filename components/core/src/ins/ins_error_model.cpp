@@ -75,6 +75,7 @@ StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
   F.block<3, 3>(kAtt.index, kGyroBias.index) = C_b_n;
   F.block<3, 3>(kAtt.index, kGyroScale.index) = C_b_n * w_ib_b.asDiagonal();
   F(kClockBias.index, kClockDrift.index) = 1.0;
+  F(kSecondClockBias.index, kSecondClockDrift.index) = 1.0;
   return F;
 }
 

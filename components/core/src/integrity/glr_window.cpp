@@ -105,9 +105,13 @@ bool GlrWindow::accepts(const GlrEpoch& e) const {
       e.innovation_cov.rows() != e.rows || e.innovation_cov.cols() != e.rows ||
       e.h.rows() != e.rows || e.k.cols() != e.rows)
     return false;
+  std::array<std::array<int, 2>, 33> rows_of_sv{};  // range and rate rows per PRN
   for (int r = 0; r < e.rows; ++r) {
     const int sv = e.sv_id[static_cast<std::size_t>(r)];
     if (sv < 1 || sv > 32) return false;
+    int& n =
+        rows_of_sv[static_cast<std::size_t>(sv)][e.is_rate[static_cast<std::size_t>(r)] ? 1 : 0];
+    if (++n > layout::kMaxFusedReceivers) return false;
   }
   // H must stay on the support (the pseudorange and rate model of the layout).
   if (!e.h.middleCols<kSupportTail.index - kSupportHead.end()>(kSupportHead.end()).isZero(0.0))
@@ -148,9 +152,9 @@ int GlrWindow::slotOf(int sv_id) const {
 void GlrWindow::assignSlots(const GlrEpoch& e) {
   for (int s = 0; s < slots_used_; ++s) {
     Slot& slot = slots_[static_cast<std::size_t>(s)];
-    slot.prev_range_row = slot.range_row;
-    slot.prev_rate_row = slot.rate_row;
-    slot.range_row = slot.rate_row = -1;
+    slot.prev_range = slot.range;
+    slot.prev_rate = slot.rate;
+    slot.range = slot.rate = Rows{};
   }
   for (int r = 0; r < e.rows; ++r) {
     const int sv = e.sv_id[static_cast<std::size_t>(r)];
@@ -174,7 +178,8 @@ void GlrWindow::assignSlots(const GlrEpoch& e) {
     }
     Slot& s = slots_[static_cast<std::size_t>(slot)];
     s.last_seen = epochs_;
-    (e.is_rate[static_cast<std::size_t>(r)] ? s.rate_row : s.range_row) = r;
+    Rows& rows = e.is_rate[static_cast<std::size_t>(r)] ? s.rate : s.range;
+    rows.row[static_cast<std::size_t>(rows.count++)] = r;  // accepts() bounds the count
   }
 }
 
@@ -269,10 +274,11 @@ void GlrWindow::propagate() {
   const bool range = config_.range_steps || config_.range_ramps;
   for (int s = 0; s < slots_used_; ++s) {
     const Slot& slot = slots_[static_cast<std::size_t>(s)];
-    if (slot.prev_range_row >= 0 && range)
-      subtractInput(muColumn(s, kRangeStep), slot.prev_range_row);
-    if (slot.prev_rate_row >= 0 && config_.rate_steps)
-      subtractInput(muColumn(s, kRateStep), slot.prev_rate_row);
+    // A satellite's fault entered each receiver's row of it.
+    if (range)
+      for (const int row : slot.prev_range) subtractInput(muColumn(s, kRangeStep), row);
+    if (config_.rate_steps)
+      for (const int row : slot.prev_rate) subtractInput(muColumn(s, kRateStep), row);
   }
 }
 
@@ -386,15 +392,25 @@ void GlrWindow::accumulateSatellite(int s) {
   const int window = config_.window;
   const int n = support_count_;
   // Direct inputs d (doc: inputs table) and the rows they enter; an absent row has d = 0.
-  const int rr = slot.range_row, tr = slot.rate_row;
-  const double d_step = rr >= 0 ? kStepInput : 0.0;
-  const double d_rate = tr >= 0 && config_.rate_steps ? kStepInput : 0.0;
-  const Vector u_range = rr >= 0 ? Vector(u_.row(rr).transpose()) : Vector::Zero(n);
-  const Vector u_rate = tr >= 0 ? Vector(u_.row(tr).transpose()) : Vector::Zero(n);
-  const double w_range = rr >= 0 ? w_[rr] : 0.0, w_rate = tr >= 0 ? w_[tr] : 0.0;
-  const double v_rr = rr >= 0 ? vInv(rr, rr) : 0.0;
-  const double v_rt = rr >= 0 && tr >= 0 ? vInv(rr, tr) : 0.0;
-  const double v_tt = tr >= 0 ? vInv(tr, tr) : 0.0;
+  // With several receivers' rows of the satellite, d enters each: its terms below are sums
+  // over those rows (U D = sum of U's rows, D^T V^-1 D = sum of the block's entries).
+  const Rows& range_rows = slot.range;
+  const Rows& rate_rows = slot.rate;
+  const double d_step = range_rows.any() ? kStepInput : 0.0;
+  const double d_rate = rate_rows.any() && config_.rate_steps ? kStepInput : 0.0;
+  Vector u_range = Vector::Zero(n), u_rate = Vector::Zero(n);
+  double w_range = 0.0, w_rate = 0.0, v_rr = 0.0, v_rt = 0.0, v_tt = 0.0;
+  for (const int i : range_rows) {
+    u_range += u_.row(i).transpose();
+    w_range += w_[i];
+    for (const int j : range_rows) v_rr += vInv(i, j);
+    for (const int j : rate_rows) v_rt += vInv(i, j);
+  }
+  for (const int i : rate_rows) {
+    u_rate += u_.row(i).transpose();
+    w_rate += w_[i];
+    for (const int j : rate_rows) v_tt += vInv(i, j);
+  }
   // Disabled hypotheses add nothing (their columns may still carry a ramp's steps).
   const double on_step = config_.range_steps ? 1.0 : 0.0;
   const double on_ramp = config_.range_ramps ? 1.0 : 0.0;
@@ -471,13 +487,13 @@ void GlrWindow::positionSignatures(std::vector<PositionSignature>& out) const {
   const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxRows> k_pos =
       prev_k_.middleRows<3>(kPosRow);
   const Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kSupport> kh = k_pos * h_support_;
-  const auto after = [&](int column, double d, int row) {
+  const auto after = [&](int column, double d, const Rows& rows) {
     Eigen::Vector3d p = -kh * mu_.col(column).head(support_count_);
     for (int i = 0; i < 3; ++i) {
       const int live_row = row_of_[static_cast<std::size_t>(kPosRow + i)];
       if (live_row >= 0) p[i] += mu_(live_row, column);
     }
-    if (row >= 0) p -= d * k_pos.col(row);
+    for (const int row : rows) p -= d * k_pos.col(row);
     return p;
   };
   if (config_.imu_steps) {
@@ -486,7 +502,7 @@ void GlrWindow::positionSignatures(std::vector<PositionSignature>& out) const {
       const OnsetView o = onset(age);
       for (int j = 0; j < kImuDirections; ++j) {
         const GlrHypothesis h{j < 3 ? GlrFault::kAccelStep : GlrFault::kGyroStep, j % 3, 0};
-        out.push_back({h, age, after(firstColumn(j) + ring, 0.0, -1), o.r_imu(j, j)});
+        out.push_back({h, age, after(firstColumn(j) + ring, 0.0, Rows{}), o.r_imu(j, j)});
       }
     }
   }
@@ -502,7 +518,7 @@ void GlrWindow::positionSignatures(std::vector<PositionSignature>& out) const {
       const int ring = onsetIndex(age);
       const OnsetView o = onset(age);
       const Eigen::Matrix3d r = o.rSat(s);
-      const Eigen::Vector3d step = after(step_first + ring, kStepInput, slot.range_row);
+      const Eigen::Vector3d step = after(step_first + ring, kStepInput, slot.range);
       ramp += spacing_s_[ring] * step;
       if (config_.range_steps)
         out.push_back(
@@ -513,7 +529,7 @@ void GlrWindow::positionSignatures(std::vector<PositionSignature>& out) const {
       if (config_.rate_steps)
         out.push_back({{GlrFault::kRateStep, 0, slot.sv_id},
                        age,
-                       after(rate_first + ring, kStepInput, slot.rate_row),
+                       after(rate_first + ring, kStepInput, slot.rate),
                        r(kRateStep, kRateStep)});
     }
   }

@@ -46,9 +46,14 @@ void toCore(const navbus::GnssObservationEpoch& msg, const std::vector<Satellite
 /// The tightly coupled filter's state layout (core::layout) as the diagnostics declare it.
 void fillStateLayout(navbus::FilterDiagnostics& msg);
 
-/// A GNSS epoch's diagnostics over core::layout as the message (matrices row-major).
+/// The bus ids of a filter's fused receivers, in receiver order (0: none).
+using FusedReceiverIds = std::array<std::uint32_t, core::layout::kMaxFusedReceivers>;
+
+/// A GNSS epoch's diagnostics over core::layout as the message (matrices row-major); each
+/// pseudorange row names its receiver by `receiver_ids`.
 navbus::FilterDiagnostics toIdl(const core::EpochDiagnostics& d, std::uint32_t vehicle_id,
-                                std::uint64_t seq, std::int64_t time_ns);
+                                std::uint64_t seq, std::int64_t time_ns,
+                                const FusedReceiverIds& receiver_ids = {});
 
 /// A validated diagnostics sample (validate() passed) as the GLR's epoch; a rejection when
 /// its state layout is not core::layout's or it has more rows than the GLR supports.

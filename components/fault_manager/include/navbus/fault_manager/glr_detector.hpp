@@ -40,6 +40,12 @@ class GlrDetector {
   /// when the sample does not describe the tightly coupled filter the GLR models.
   bool onDiagnostics(const navbus::FilterDiagnostics& msg, FaultOutput& out);
 
+  /// Another detector (the cross-receiver test) had the filter exclude `sv_id` for good: its
+  /// rows, monitored in the diagnostics, leave the GLR's epochs from here (as its own
+  /// exclusions' do, without a readmission: that is the other detector's), and the statistics
+  /// restart (the filter reconfigured).
+  void keepOut(int sv_id);
+
   struct Counters {
     std::uint64_t epochs{0}, refused{0}, restarts{0};
     std::uint64_t detections{0}, satellites_excluded{0}, biases_compensated{0};

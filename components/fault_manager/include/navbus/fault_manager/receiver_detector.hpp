@@ -31,6 +31,8 @@ namespace navbus::fault_manager {
 
 class ReceiverDetector {
  public:
+  /// FaultDecision.detector of its decisions.
+  static constexpr const char* kDetectorName = "receivers";
   explicit ReceiverDetector(const ReceiverDetectorConfig& config);
 
   /// One receiver's epoch as received (any receiver, any order between them; in time order per

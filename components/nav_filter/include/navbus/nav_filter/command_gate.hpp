@@ -85,6 +85,7 @@ class CommandGate {
   std::uint32_t vehicle_id_;
   std::uint32_t imu_id_;                      ///< this filter's IMU (FilterConfig imu.id)
   std::optional<std::uint32_t> receiver_id_;  ///< its receiver (gnss_observations.id), if any
+  std::optional<std::uint32_t> second_receiver_id_;  ///< a second fused receiver (second_id)
   std::vector<std::string> issuers_;
   std::map<std::string, std::string> issuer_identities_;
   double max_accel_compensation_mps2_;

@@ -15,6 +15,9 @@ namespace navbus::nav_filter {
 /// the configured aiding does not have). `relearn_sigma`: the gate's sigma of a
 /// CMD_RELEARN_BIAS (CommandGate::relearnSigma), unused otherwise.
 bool applyEngineCommand(core::NavigationEngine& engine, const navbus::FilterCommand& c,
+                        double relearn_sigma, int receiver);
+/// The same for a filter with one receiver.
+bool applyEngineCommand(core::NavigationEngine& engine, const navbus::FilterCommand& c,
                         double relearn_sigma);
 /// The command answers a fault with an estimated onset (exclude a satellite, compensate or
 /// re-learn a bias, fail an axis): the filter restores to before the onset and re-processes.

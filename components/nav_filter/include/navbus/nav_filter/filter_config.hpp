@@ -96,6 +96,11 @@ struct FilterConfig {
   std::uint32_t vehicle_id{1};
   InputConfig imu{1, 10'000'000};
   std::optional<InputConfig> gnss_observations;
+  /// A second receiver whose pseudoranges the filter fuses beside gnss_observations.id's
+  /// (inputs.gnss_observations.second_id; same period and time offset; its antenna
+  /// geometry.second_antenna_lever_arm_b_m, its own clock states). Its epoch and the first's of
+  /// the same time are fused as one stacked update.
+  std::optional<std::uint32_t> second_gnss_receiver_id;
   std::optional<InputConfig> gnss_fix;
   std::optional<InputConfig> star_tracker;
   std::int64_t sequencer_max_wait_ns{500'000'000};

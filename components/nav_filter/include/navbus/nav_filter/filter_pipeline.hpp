@@ -218,6 +218,14 @@ class FilterPipeline {
   /// Keeps the satellite list of the input the history is about to overwrite, for a next epoch.
   void keepSatelliteList(MergedInput* overwritten);
   void process(StreamId stream, std::int64_t time_ns, FilterInput&& owned);
+  /// The fused receiver index of a receiver id (0: gnss_observations.id, 1: second_id).
+  int receiverIndex(std::uint32_t receiver_id) const;
+  /// Every fused receiver's observation stream has ended.
+  bool fusedReceiverEnded() const;
+  /// Fuses the receivers' epochs the engine holds as one (several fused receivers).
+  void fuseHeldEpoch();
+  /// A fused epoch's diagnostics out, each epoch time once (not while replaying).
+  void diagnoseEpoch(std::int64_t time_ns);
   /// A sample whose place in the order was already passed: the engine is restored to before
   /// it (input history) and what followed is merged again with it. False beyond the history.
   bool mergeLate(StreamId id, std::int64_t time_ns, FilterInput& input);

@@ -133,6 +133,13 @@ struct EngineConfig {
   /// The GNSS antenna's offset from the IMU [m, body axes]: fixes and pseudoranges are of the
   /// antenna.
   Eigen::Vector3d antenna_lever_arm_b_m{Eigen::Vector3d::Zero()};
+  /// GNSS receivers whose pseudoranges are fused, 1 or layout::kMaxFusedReceivers (tightly
+  /// coupled): the second has its own clock states (layout::kSecondClockBias, started from its
+  /// first epoch) and its own antenna; the first alone serves the alignment, the
+  /// re-initialisation and the course check.
+  int fused_receivers{1};
+  /// The second fused receiver's antenna offset from the IMU [m, body axes].
+  Eigen::Vector3d second_antenna_lever_arm_b_m{Eigen::Vector3d::Zero()};
   /// Post-processing: where the filter records what the fixed-interval smoother needs
   /// (rts_smoother.hpp); nullptr (the default, and always on the bus): nothing recorded.
   /// Not owned; must outlive every engine made from this configuration.
@@ -167,6 +174,11 @@ struct EngineCounters {
   InnovationStatistics fix_position_nis, fix_velocity_nis;
   /// Fix velocities older than the velocity history reaches (compared as they are).
   std::uint64_t fix_velocities_beyond_history{0};
+  /// Satellites beyond the kMaxEpochSatellites an epoch (all receivers' together) can hold:
+  /// left out of it.
+  std::uint64_t epoch_satellites_dropped{0};
+  /// Further receivers' clocks started from their first epoch (that epoch is not fused).
+  std::uint64_t receiver_clocks_started{0};
 };
 
 class NavigationEngine {
@@ -186,6 +198,20 @@ class NavigationEngine {
   /// Fuses a pseudorange epoch of time `time_ns` (tightly coupled mode); true when fused
   /// (diagnostics ready). While aligning, the epoch goes to the aligner.
   bool addGnssEpoch(std::int64_t time_ns, const std::vector<SatelliteObservation>& satellites);
+  /// Several fused receivers (EngineConfig::fused_receivers): receiver `receiver`'s epoch of
+  /// `time_ns` is held until the caller fuses the held epochs as one (fuseHeldEpoch): once
+  /// every fused receiver's epoch of that time is in (heldEpochComplete), or before any input
+  /// that is not one of them. Returns false (nothing held) when an epoch of another time or
+  /// of the same receiver is held: fuse that first.
+  bool holdGnssEpoch(std::int64_t time_ns, const std::vector<SatelliteObservation>& satellites,
+                     int receiver);
+  bool heldEpochComplete() const;
+  /// Whether an epoch is held, and whether `receiver`'s epoch of `time_ns` would join it.
+  bool hasHeldEpoch() const { return held_.receivers != 0; }
+  std::int64_t heldEpochTime() const { return held_.time_ns; }
+  bool joinsHeldEpoch(std::int64_t time_ns, int receiver) const;
+  /// Fuses the held epochs as one stacked epoch (addGnssEpoch); false when nothing was fused.
+  bool fuseHeldEpoch();
   void addGnssFix(const GnssFixMeasurement& fix);
   void addStarAttitude(const StarAttitudeMeasurement& st);
 
@@ -197,10 +223,10 @@ class NavigationEngine {
   /// `bias_sigma` [same unit] is the compensation's own uncertainty: added to the bias
   /// variance, so that the filter can still estimate what the compensation missed.
   void compensateBias(bool accelerometer, int axis, double bias, double bias_sigma = 0.0);
-  /// The fused receiver's clock jumped by `jump_m` (c times the step [m]; what its
-  /// pseudoranges gained), known to `sigma_m` [m]: the clock estimate follows (before the
+  /// A fused receiver's clock (0: the first) jumped by `jump_m` (c times the step [m]; what
+  /// its pseudoranges gained), known to `sigma_m` [m]: the clock estimate follows (before the
   /// filter is initialised, the alignment's least-squares clock already does).
-  void compensateReceiverClock(double jump_m, double sigma_m);
+  void compensateReceiverClock(double jump_m, double sigma_m, int receiver = 0);
   /// A bias step of unknown size: its variance grows by sigma^2 and the filter re-estimates it.
   void relearnBias(bool accelerometer, int axis, double sigma) {
     compensateBias(accelerometer, axis, 0.0, sigma);
@@ -236,8 +262,8 @@ class NavigationEngine {
   /// (IntegratedFilter::mountingMisalignment; its sigmas: covariance(), kMountingMisalignment).
   Eigen::Vector3d mountingMisalignment() const;
   bool modelsMountingMisalignment() const;
-  double clockBias() const;   ///< receiver clock bias c*b [m]
-  double clockDrift() const;  ///< receiver clock drift c*f [m/s]
+  double clockBias(int receiver = 0) const;   ///< a fused receiver's clock bias c*b [m]
+  double clockDrift(int receiver = 0) const;  ///< a fused receiver's clock drift c*f [m/s]
   EngineMode mode() const {
     return (status_ & kStatusReinitialising) != 0 ? EngineMode::kReinitialising : mode_;
   }
@@ -358,6 +384,23 @@ class NavigationEngine {
   /// Reused buffer of the satellites fused (each epoch rewrites it: not in the recovery
   /// history's copies of the engine).
   Scratch<std::vector<SatelliteObservation>> used_;
+  /// The first receiver's satellites of used_ (alignment, re-initialisation, course check).
+  Scratch<std::vector<SatelliteObservation>> first_receiver_;
+  /// The fused receivers' epochs of one time, waiting to be fused as one (holdGnssEpoch).
+  struct HeldEpoch {
+    std::int64_t time_ns{0};
+    std::uint8_t receivers{0};  ///< bit r: receiver r's epoch is in
+    std::vector<SatelliteObservation> satellites;
+  };
+  HeldEpoch held_;
+  /// Bit r: fused receiver r's clock has been started since the filter was (receiver 0's
+  /// with the filter itself).
+  std::uint8_t clocks_started_{1};
+  /// used_ with the first receiver's satellites only (used_ itself when there is one).
+  const std::vector<SatelliteObservation>& firstReceiverObservations();
+  /// Starts each further receiver's clock from its first epoch in used_, whose satellites then
+  /// leave this epoch.
+  void startReceiverClocks();
   Eigen::Vector3d accel_compensation_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d gyro_compensation_{Eigen::Vector3d::Zero()};
   std::uint8_t failed_axes_{0};  ///< bit i: accelerometer i (0-2), gyro i - 3 (3-5)

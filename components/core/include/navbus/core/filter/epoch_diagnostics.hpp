@@ -19,6 +19,7 @@ namespace navbus::core {
 struct EpochDiagnostics {
   std::vector<int> sv_ids;         ///< per row
   std::vector<bool> is_rate;       ///< per row
+  std::vector<int> receivers;      ///< per row: the fused receiver (0: the first), 0 if none
   std::vector<bool> used;          ///< per row: fused (false: gated, or monitored only)
   Eigen::VectorXd innovation;      ///< predicted minus measured, m rows
   Eigen::MatrixXd innovation_cov;  ///< V = H P- H^T + R, m x m

@@ -50,7 +50,8 @@ class IntegratedFilter {
   /// pseudorange errors), which only the GNSS local filter observes.
   static constexpr int kFusedStates = layout::kClockBias.index;
   static_assert(layout::kClockDrift.end() == layout::kPseudorangeError.index &&
-                    layout::kPseudorangeError.end() == layout::kSize,
+                    layout::kPseudorangeError.end() == layout::kSecondClockBias.index &&
+                    layout::kSecondClockDrift.end() == layout::kSize,
                 "the receiver's states must trail the layout");
 
   /// Starts from `state` with the tuning's initial sigmas (initialSigma).
@@ -75,6 +76,10 @@ class IntegratedFilter {
   /// The ranges are predicted at the antenna, `antenna` away from the IMU.
   const std::vector<MeasurementReport>& update(const std::vector<SatelliteObservation>& sats,
                                                const AntennaArm& antenna = {});
+  /// The same for the stacked epoch of several receivers: each satellite's rows take the clock
+  /// states and the antenna of its receiver (SatelliteObservation::receiver).
+  const std::vector<MeasurementReport>& update(const std::vector<SatelliteObservation>& sats,
+                                               const AntennaArms& antennas);
   /// Processes an aiding measurement, one decorrelated row at a time.
   template <int M>
   std::array<ScalarUpdateResult, M> update(const AidingMeasurement<M>& m, AidingKind kind);
@@ -99,8 +104,10 @@ class IntegratedFilter {
   /// rest: what the filter knew of them no longer holds). Attitude, biases and clock keep
   /// theirs.
   void resetNavigation(const GnssFixMeasurement& fix);
-  /// The same for the receiver clock (bias [m], drift [m/s] and their sigmas).
-  void resetClock(double bias_m, double drift_mps, double bias_sigma_m, double drift_sigma_mps);
+  /// The same for a receiver's clock (bias [m], drift [m/s] and their sigmas; receiver 0 the
+  /// first fused one).
+  void resetClock(double bias_m, double drift_mps, double bias_sigma_m, double drift_sigma_mps,
+                  int receiver = 0);
   /// The GNSS course against the INS course (NavigationEngine::checkHeadingFromCourse):
   ///   z = course_gnss - course_ins = -u_c . e_v / speed + noise,
   /// u_c the unit vector across the track: the cross-track velocity error, which the velocity
@@ -160,11 +167,12 @@ class IntegratedFilter {
   /// The fix's position error is a state (tuning sigma positive, block active, no pseudorange
   /// errors sharing the block).
   bool modelsFixPositionError() const;
-  double clockBias() const { return clock_bias_m_; }
-  double clockDrift() const { return clock_drift_mps_; }
-  /// The receiver's clock jumped by `jump_m` (c times the step [m]), known to `sigma_m`: the
+  /// A fused receiver's clock bias c*b [m] and drift c*f [m/s] (receiver 0: the first).
+  double clockBias(int receiver = 0) const { return clock_bias_m_[slot(receiver)]; }
+  double clockDrift(int receiver = 0) const { return clock_drift_mps_[slot(receiver)]; }
+  /// A receiver's clock jumped by `jump_m` (c times the step [m]), known to `sigma_m`: the
   /// clock bias moves with it and its variance grows by sigma_m^2.
-  void shiftClock(double jump_m, double sigma_m);
+  void shiftClock(double jump_m, double sigma_m, int receiver = 0);
   /// The satellites' time-correlated pseudorange errors (tight coupling, when modelled).
   const PseudorangeErrorSlots& pseudorangeErrors() const { return pseudorange_errors_; }
   /// Whether the transition since the last update is kept for the pseudorange epochs'
@@ -248,8 +256,10 @@ class IntegratedFilter {
   /// The star tracker's bias, or a land vehicle's mounting misalignment (the block's estimate).
   Eigen::Vector3d star_tracker_bias_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d fix_position_error_ned_m_{Eigen::Vector3d::Zero()};
-  double clock_bias_m_{0.0};
-  double clock_drift_mps_{0.0};
+  static std::size_t slot(int receiver) { return static_cast<std::size_t>(receiver); }
+  /// Each fused receiver's clock (layout::clockBiasOf / clockDriftOf its states).
+  std::array<double, layout::kMaxFusedReceivers> clock_bias_m_{};
+  std::array<double, layout::kMaxFusedReceivers> clock_drift_mps_{};
   PseudorangeErrorSlots pseudorange_errors_;
   /// What the next smoothing record gathers since the last one.
   struct SmoothingPending {

@@ -3,6 +3,8 @@
 // over the error vector of state_layout.hpp.
 #pragma once
 
+#include <array>
+
 #include <Eigen/Core>
 
 #include "navbus/core/ins/state_layout.hpp"
@@ -26,6 +28,9 @@ struct SatelliteObservation {
   double pseudorange_rate_sigma_mps{0.1};
   bool use_range{true};  ///< false: the pseudorange is excluded (monitored, not fused)
   bool use_rate{true};   ///< false: the pseudorange rate is excluded
+  /// Which fused receiver measured it (0: the first; its clock states are
+  /// layout::clockBiasOf(receiver) and clockDriftOf(receiver)).
+  int receiver{0};
 };
 
 struct RangePrediction {
@@ -42,13 +47,16 @@ struct AntennaArm {
   Eigen::Vector3d lever_arm_b_m{Eigen::Vector3d::Zero()};
   Eigen::Vector3d rate_nb_b_radps{Eigen::Vector3d::Zero()};
 };
+/// Each fused receiver's antenna, in receiver order.
+using AntennaArms = std::array<AntennaArm, layout::kMaxFusedReceivers>;
 
 /// Predicts the measurements of `sat` at the antenna from the INS state and the clock
 /// estimates. With error = estimate - truth, a predicted-minus-measured innovation
 /// z = H dx + noise, where (seed 000 eq. 5, l = line of sight in NED, a = C_b_n lever the
 /// antenna's offset in NED, b = C_b_n (w_nb x lever) its velocity about the IMU)
 ///   H_range: -l^T on the position error, -l^T [a x] on the attitude error, 1 on the clock bias;
-///   H_rate:  -l^T on the velocity error, -l^T [b x] on the attitude error, 1 on the drift.
+///   H_rate:  -l^T on the velocity error, -l^T [b x] on the attitude error, 1 on the drift
+/// (the clock states of the satellite's receiver, and its clock estimates passed in).
 /// The attitude columns follow
 /// from C_b_n,est = (I - [phi x]) C_b_n, as in the loosely coupled rows
 /// (aiding_measurements.hpp). The rate's dependence on position through l is neglected, as in

@@ -38,7 +38,21 @@ inline constexpr StateBlock kGyroScale{21, 3};
 inline constexpr StateBlock kClockBias{24, 1};
 inline constexpr StateBlock kClockDrift{25, 1};
 inline constexpr StateBlock kPseudorangeError{26, 12};
-inline constexpr int kSize = 38;
+/// A second fused GNSS receiver's clock bias c*b [m] and drift c*f [m/s] (its own oscillator;
+/// the first receiver's are kClockBias and kClockDrift). Last, so that the receivers' states
+/// (clocks and pseudorange errors) stay one trailing run.
+inline constexpr StateBlock kSecondClockBias{38, 1};
+inline constexpr StateBlock kSecondClockDrift{39, 1};
+inline constexpr int kSize = 40;
+/// Receivers whose pseudoranges one filter fuses, each with its own clock states.
+inline constexpr int kMaxFusedReceivers = 2;
+/// The clock bias and drift states of fused receiver `index` (0: the first).
+constexpr StateBlock clockBiasOf(int index) {
+  return index == 0 ? kClockBias : kSecondClockBias;
+}
+constexpr StateBlock clockDriftOf(int index) {
+  return index == 0 ? kClockDrift : kSecondClockDrift;
+}
 /// Loose coupling has no pseudoranges: there the first three states of the receiver's error
 /// block are the GNSS fix's position error [m, NED, first-order Gauss-Markov; estimate minus
 /// truth]. The aiding mode says which meaning the block has; the two are never active together
@@ -61,7 +75,10 @@ static_assert(kPos.end() == kVel.index && kVel.end() == kAtt.index &&
                   kStarTrackerBias.end() == kAccelScale.index &&
                   kAccelScale.end() == kGyroScale.index && kGyroScale.end() == kClockBias.index &&
                   kClockBias.end() == kClockDrift.index &&
-                  kClockDrift.end() == kPseudorangeError.index && kPseudorangeError.end() == kSize,
+                  kClockDrift.end() == kPseudorangeError.index &&
+                  kPseudorangeError.end() == kSecondClockBias.index &&
+                  kSecondClockBias.end() == kSecondClockDrift.index &&
+                  kSecondClockDrift.end() == kSize,
               "the layout's blocks must tile the state vector");
 static_assert(kFixPositionError.end() <= kPseudorangeError.end(),
               "the fix's position error shares the receiver's error block");

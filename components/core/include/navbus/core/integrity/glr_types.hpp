@@ -29,19 +29,19 @@ inline constexpr int kMaxPropagated = kImuDirections + 2 * kMaxSatellites;
 inline constexpr int kMaxWindow = 100;  ///< largest configurable window M [epochs]
 /// The states pseudorange and rate rows measure: position, velocity and attitude (the first
 /// nine; attitude through the antenna's lever arm, gnss_measurement.hpp), the clock bias and
-/// drift and the satellites' time-correlated pseudorange errors (the trailing ones, when the
-/// filter models them). f and R see a signature only through H, so they are accumulated on
-/// these states; an epoch whose H reaches others is refused.
+/// drift, the satellites' time-correlated pseudorange errors and a second receiver's clock
+/// (the trailing ones, when the filter models them). f and R see a signature only through H, so
+/// they are accumulated on these states; an epoch whose H reaches others is refused.
 inline constexpr StateBlock kSupportHead{layout::kPos.index,
                                          layout::kPos.dof + layout::kVel.dof + layout::kAtt.dof};
-inline constexpr StateBlock kSupportTail{
-    layout::kClockBias.index,
-    layout::kClockBias.dof + layout::kClockDrift.dof + layout::kPseudorangeError.dof};
+inline constexpr StateBlock kSupportTail{layout::kClockBias.index,
+                                         layout::kSize - layout::kClockBias.index};
 inline constexpr int kSupport = kSupportHead.dof + kSupportTail.dof;
 static_assert(kSupportHead.index == 0 && layout::kVel.index == layout::kPos.end() &&
                   layout::kAtt.index == layout::kVel.end() &&
                   layout::kClockDrift.index == layout::kClockBias.end() &&
                   layout::kPseudorangeError.index == layout::kClockDrift.end() &&
+                  layout::kSecondClockBias.index == layout::kPseudorangeError.end() &&
                   kSupportTail.end() == kStates,
               "the GLR's support is position, velocity, attitude (leading) and the receiver's "
               "clock and pseudorange errors (trailing)");

@@ -34,12 +34,21 @@ class GlrWindow {
                                                glr::kSatDirections * glr::kSatDirections * slot);
     }
   };
+  /// A satellite's rows of one kind in an epoch: one per fused receiver that tracks it (a
+  /// fault of the satellite enters each of them).
+  struct Rows {
+    std::array<int, layout::kMaxFusedReceivers> row{};
+    int count{0};
+    bool any() const { return count > 0; }
+    const int* begin() const { return row.data(); }
+    const int* end() const { return row.data() + count; }
+  };
   /// A satellite's place in f, R and the signatures.
   struct Slot {
     int sv_id{0};
     std::uint64_t last_seen{0};
-    int range_row{-1}, rate_row{-1};            ///< rows this epoch, -1 if absent
-    int prev_range_row{-1}, prev_rate_row{-1};  ///< rows at the previous epoch
+    Rows range, rate;            ///< rows this epoch (none if absent)
+    Rows prev_range, prev_rate;  ///< rows at the previous epoch
     bool quarantined{false};
   };
   /// What a fault of unit magnitude along one direction, begun at one onset in the window,
@@ -59,8 +68,9 @@ class GlrWindow {
   void configure(const GlrConfig& config);
   /// Forgets every onset and the previous epoch; quarantines stay.
   void reset();
-  /// Whether the epoch can be processed: sizes, satellites 1..32, H on the support, finite
-  /// values, and a time after the previous epoch's.
+  /// Whether the epoch can be processed: sizes, satellites 1..32 with at most one range and one
+  /// rate row per fused receiver, H on the support, finite values, and a time after the
+  /// previous epoch's.
   bool accepts(const GlrEpoch& e) const;
   /// Processes an epoch that accepts() took: propagates every signature, starts the onset at
   /// this epoch and adds this epoch's terms to f and R. Returns false (nothing changed) when
