@@ -86,6 +86,31 @@ TEST(PseudorangeErrorSlots, SatellitesTakeFreeStatesAndGiveThemUpWhenTheyGo) {
   EXPECT_EQ(slots.unmodelled(), 3u);
 }
 
+TEST(PseudorangeErrorSlots, ASecondReceiversClockLeavesTheLastTwoStatesAlone) {
+  // Given slots beside a second receiver's clock, when more satellites than states come, then
+  // none takes layout::kSecondClockBias or kSecondClockDrift (two more are left unmodelled), a
+  // same satellite of both receivers takes one state, and a correction of the clock's states
+  // changes no satellite's estimate.
+  PseudorangeErrorSlots slots;
+  slots.leaveStatesToSecondClock(true);
+  EXPECT_EQ(slots.slotsInUse(), PseudorangeErrorSlots::kSlots - 2);
+  std::vector<int> many;
+  for (int sv = 1; sv <= PseudorangeErrorSlots::kSlots; ++sv) many.push_back(sv);
+  many.push_back(1);  // the second receiver's satellite 1
+  const auto& a = slots.assign(many);
+  EXPECT_EQ(std::count(a.state_index.begin(), a.state_index.end(), -1), 2);
+  for (const int state : a.state_index) {
+    EXPECT_NE(state, layout::kSecondClockBias.index);
+    EXPECT_NE(state, layout::kSecondClockDrift.index);
+  }
+  EXPECT_EQ(a.state_index.front(), a.state_index.back());
+  PseudorangeErrorSlots::Errors dx = PseudorangeErrorSlots::Errors::Zero();
+  dx.tail<2>().setConstant(5.0);
+  slots.correct(dx);
+  for (int i = 0; i < PseudorangeErrorSlots::kSlots; ++i)
+    EXPECT_EQ(slots.estimate(layout::kPseudorangeError.index + i), 0.0);
+}
+
 TEST(PseudorangeErrorStates, EachSatellitesRangeRowReachesItsOwnStateOnly) {
   // An 8 m error on one satellite gives its state an estimate; in the next epoch each
   // satellite's range row has 1 in its own state's column of H and 0 in the others', and the

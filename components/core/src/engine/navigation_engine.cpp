@@ -282,6 +282,7 @@ void NavigationEngine::start(const NavState& state, double clock_bias_m, double 
   velocity_history_.clear();
   filter_->initialize(state, clock_bias_m, clock_drift_mps, config_.tuning, baseMask(),
                       config_.fusion, initial_covariance);
+  filter_->modelSecondReceiverClock(config_.fused_receivers > 1);
   clocks_started_ = 1;  // a further receiver's clock starts with its next epoch
   // The GLRs' Phi between epochs: the fault manager's (pseudoranges) and the protection
   // levels' own on fixes.
@@ -559,11 +560,11 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
   // diagnostics for the readmission test); the diagnostics carry at most 24 satellites.
   used_->clear();
   for (const auto& s : satellites) {
+    if (s.receiver >= config_.fused_receivers) continue;  // not a fused receiver's
     if (used_->size() >= static_cast<std::size_t>(kMaxEpochSatellites)) {
       ++counters_.epoch_satellites_dropped;
       continue;
     }
-    if (s.receiver >= config_.fused_receivers) continue;  // not a fused receiver's
     SatelliteObservation o = s;
     const auto it = excluded_.find(s.sv_id);
     const std::uint8_t mask = it == excluded_.end() ? 0 : it->second;
@@ -636,19 +637,25 @@ void NavigationEngine::startReceiverClocks() {
     if ((clocks_started_ & bit) != 0) continue;
     // c*b and c*f: the mean of the receiver's range and rate residuals from the filter's
     // position and velocity, with the tuning's initial sigmas (what the position's error adds
-    // is far inside them); the epoch that started the clock is not fused.
+    // is far inside them), excluded measurements left out; the epoch that started the clock is
+    // not fused.
     const AntennaArm arm{config_.second_antenna_lever_arm_b_m, bodyRate()};
     double bias_m = 0.0, drift_mps = 0.0;
-    int n = 0;
+    int ranges = 0, rates = 0;
     for (const SatelliteObservation& o : *used_) {
       if (o.receiver != r) continue;
       const RangePrediction p = predictRange(filter_->state(), 0.0, 0.0, o, arm);
-      bias_m += o.pseudorange_m - p.pseudorange_m;
-      drift_mps += o.pseudorange_rate_mps - p.pseudorange_rate_mps;
-      ++n;
+      if (o.use_range) {
+        bias_m += o.pseudorange_m - p.pseudorange_m;
+        ++ranges;
+      }
+      if (o.use_rate) {
+        drift_mps += o.pseudorange_rate_mps - p.pseudorange_rate_mps;
+        ++rates;
+      }
     }
-    if (n == 0) continue;
-    filter_->resetClock(bias_m / n, drift_mps / n, config_.tuning.clock_bias_sigma_m,
+    if (ranges == 0 || rates == 0) continue;
+    filter_->resetClock(bias_m / ranges, drift_mps / rates, config_.tuning.clock_bias_sigma_m,
                         config_.tuning.clock_drift_sigma_mps, r);
     clocks_started_ |= bit;
     ++counters_.receiver_clocks_started;

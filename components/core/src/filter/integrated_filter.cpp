@@ -40,10 +40,10 @@ StateVector IntegratedFilter::initialSigma(const FilterTuning& tuning) {
   if (tuning.mounting_misalignment_sigma_rad > 0.0)
     frame_sigma = tuning.mounting_misalignment_sigma_rad;
   sigma.segment<3>(kStarTrackerBias.index).setConstant(frame_sigma);
-  for (int r = 0; r < kMaxFusedReceivers; ++r) {
-    sigma[clockBiasOf(r).index] = tuning.clock_bias_sigma_m;
-    sigma[clockDriftOf(r).index] = tuning.clock_drift_sigma_mps;
-  }
+  // A second receiver's clock (the pseudorange-error block's last states) is started from its
+  // first epoch with these sigmas (NavigationEngine): until then it is not measured.
+  sigma[kClockBias.index] = tuning.clock_bias_sigma_m;
+  sigma[kClockDrift.index] = tuning.clock_drift_sigma_mps;
   sigma.segment<kPseudorangeError.dof>(kPseudorangeError.index)
       .setConstant(tuning.pseudorange_error_sigma_m > 0.0 ? tuning.pseudorange_error_sigma_m : 1.0);
   if (tuning.fix_position_error_sigma_h_m > 0.0 && !(tuning.pseudorange_error_sigma_m > 0.0))
@@ -75,7 +75,7 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
   gyro_scale_.setZero();
   star_tracker_bias_.setZero();
   fix_position_error_ned_m_.setZero();
-  pseudorange_errors_.clear();
+  modelSecondReceiverClock(false);  // every satellite forgotten; a second clock is set after
   central_.initialize(initial_covariance, active);
   const Eigen::Vector3d floor_pos = Eigen::Vector3d::Constant(tuning.adaptive_floor_position_m);
   windows_[0].configure(tuning.adaptive_window, floor_pos);
@@ -133,10 +133,8 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
       .setConstant(std::pow(tuning_.accel_noise_mps2_per_sqrthz, 2) * dt * q_scale);
   q.segment<3>(kAtt.index)
       .setConstant(std::pow(tuning_.gyro_noise_radps_per_sqrthz, 2) * dt * q_scale);
-  for (int r = 0; r < kMaxFusedReceivers; ++r) {  // every receiver's oscillator alike
-    q[clockBiasOf(r).index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
-    q[clockDriftOf(r).index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
-  }
+  q[kClockBias.index] = std::pow(tuning_.clock_bias_noise_m_per_sqrts, 2) * dt;
+  q[kClockDrift.index] = std::pow(tuning_.clock_drift_noise_mps_per_sqrts, 2) * dt;
   if (modelsMountingMisalignment()) {
     // Random constants with a random walk (layout::kMountingMisalignment).
     q.segment<3>(kMountingMisalignment.index)
@@ -159,7 +157,8 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
     const double decay = std::exp(-dt / tuning_.pseudorange_error_correlation_time_s);
     const double sigma = tuning_.pseudorange_error_sigma_m;
     pseudorange_errors_.decay(decay);
-    for (int i = kPseudorangeError.index; i < kPseudorangeError.end(); ++i) {
+    const int end = kPseudorangeError.index + pseudorange_errors_.slotsInUse();
+    for (int i = kPseudorangeError.index; i < end; ++i) {
       Phi(i, i) = decay;
       q[i] = sigma * sigma * (1.0 - decay * decay);
     }
@@ -176,6 +175,13 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
       Phi(kFixPositionError.index + i, kFixPositionError.index + i) = decay;
       q[kFixPositionError.index + i] = sigma[i] * sigma[i] * (1.0 - decay * decay);
     }
+  }
+  if (second_clock_) {
+    // The second receiver's oscillator: the first's random walks (seed 000 eq. 3).
+    q[kSecondClockBias.index] = q[kClockBias.index];
+    q[kSecondClockDrift.index] = q[kClockDrift.index];
+  } else {
+    Phi(kSecondClockBias.index, kSecondClockDrift.index) = 0.0;  // pseudorange-error states
   }
   for (int a = 0; a < 3; ++a) {
     q[kAccelBias.index + a] = std::pow(axis_failed_[static_cast<std::size_t>(a)]
@@ -454,7 +460,7 @@ void IntegratedFilter::feedback(const StateVector& dx) {
   accel_scale_ -= dx.segment<3>(kAccelScale.index);
   gyro_scale_ -= dx.segment<3>(kGyroScale.index);
   star_tracker_bias_ -= dx.segment<3>(kStarTrackerBias.index);  // or the mounting's (same block)
-  for (int r = 0; r < kMaxFusedReceivers; ++r) {
+  for (int r = 0; r < (second_clock_ ? 2 : 1); ++r) {
     clock_bias_m_[slot(r)] -= dx[clockBiasOf(r).index];
     clock_drift_mps_[slot(r)] -= dx[clockDriftOf(r).index];
   }
@@ -593,6 +599,11 @@ void IntegratedFilter::resetClock(double bias_m, double drift_mps, double bias_s
   clock_drift_mps_[slot(receiver)] = drift_mps;
   resetState(layout::clockBiasOf(receiver).index, bias_sigma_m);
   resetState(layout::clockDriftOf(receiver).index, drift_sigma_mps);
+}
+
+void IntegratedFilter::modelSecondReceiverClock(bool on) {
+  second_clock_ = on;
+  pseudorange_errors_.leaveStatesToSecondClock(on);
 }
 
 void IntegratedFilter::shiftClock(double jump_m, double sigma_m, int receiver) {

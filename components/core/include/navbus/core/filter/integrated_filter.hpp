@@ -50,8 +50,7 @@ class IntegratedFilter {
   /// pseudorange errors), which only the GNSS local filter observes.
   static constexpr int kFusedStates = layout::kClockBias.index;
   static_assert(layout::kClockDrift.end() == layout::kPseudorangeError.index &&
-                    layout::kPseudorangeError.end() == layout::kSecondClockBias.index &&
-                    layout::kSecondClockDrift.end() == layout::kSize,
+                    layout::kPseudorangeError.end() == layout::kSize,
                 "the receiver's states must trail the layout");
 
   /// Starts from `state` with the tuning's initial sigmas (initialSigma).
@@ -173,6 +172,9 @@ class IntegratedFilter {
   /// A receiver's clock jumped by `jump_m` (c times the step [m]), known to `sigma_m`: the
   /// clock bias moves with it and its variance grows by sigma_m^2.
   void shiftClock(double jump_m, double sigma_m, int receiver = 0);
+  /// A second fused receiver's clock is modelled (layout::kSecondClockBias: the last two
+  /// pseudorange-error states, left to it); call after initialize().
+  void modelSecondReceiverClock(bool on);
   /// The satellites' time-correlated pseudorange errors (tight coupling, when modelled).
   const PseudorangeErrorSlots& pseudorangeErrors() const { return pseudorange_errors_; }
   /// Whether the transition since the last update is kept for the pseudorange epochs'
@@ -260,6 +262,7 @@ class IntegratedFilter {
   /// Each fused receiver's clock (layout::clockBiasOf / clockDriftOf its states).
   std::array<double, layout::kMaxFusedReceivers> clock_bias_m_{};
   std::array<double, layout::kMaxFusedReceivers> clock_drift_mps_{};
+  bool second_clock_{false};  ///< modelSecondReceiverClock
   PseudorangeErrorSlots pseudorange_errors_;
   /// What the next smoothing record gathers since the last one.
   struct SmoothingPending {

@@ -42,6 +42,11 @@ class PseudorangeErrorSlots {
 
   /// Forgets every satellite (a new run; unmodelled() keeps counting).
   void clear();
+  /// A second receiver's clock takes the last two states (layout::kSecondClockBias): the
+  /// satellites get the others only. Forgets every satellite.
+  void leaveStatesToSecondClock(bool leave);
+  /// States the satellites can take (kSlots, or kSlots - 2 beside a second receiver's clock).
+  int slotsInUse() const { return slots_in_use_; }
   /// Releases the states of satellites not in `sv_ids`, then gives a state to each new one.
   /// Allocation-free after the first epochs (the vectors keep their capacity).
   const Assignment& assign(const std::vector<int>& sv_ids);
@@ -51,7 +56,7 @@ class PseudorangeErrorSlots {
   /// e = decay e: the expected value of the Gauss-Markov process one step on.
   void decay(double factor) { errors_m_ *= factor; }
   /// The error state dx (estimate minus truth) is removed from the estimates.
-  void correct(const Errors& dx) { errors_m_ -= dx; }
+  void correct(const Errors& dx) { errors_m_.head(slots_in_use_) -= dx.head(slots_in_use_); }
 
   /// Satellite epochs whose pseudorange found no free state, since construction.
   std::uint64_t unmodelled() const { return unmodelled_; }
@@ -69,6 +74,7 @@ class PseudorangeErrorSlots {
     return a;
   }
   Errors errors_m_{Errors::Zero()};
+  int slots_in_use_{kSlots};
   Assignment assignment_;
   std::uint64_t unmodelled_{0};
 };

@@ -38,12 +38,15 @@ inline constexpr StateBlock kGyroScale{21, 3};
 inline constexpr StateBlock kClockBias{24, 1};
 inline constexpr StateBlock kClockDrift{25, 1};
 inline constexpr StateBlock kPseudorangeError{26, 12};
-/// A second fused GNSS receiver's clock bias c*b [m] and drift c*f [m/s] (its own oscillator;
-/// the first receiver's are kClockBias and kClockDrift). Last, so that the receivers' states
-/// (clocks and pseudorange errors) stay one trailing run.
-inline constexpr StateBlock kSecondClockBias{38, 1};
-inline constexpr StateBlock kSecondClockDrift{39, 1};
-inline constexpr int kSize = 40;
+inline constexpr int kSize = 38;
+/// A filter fusing two GNSS receivers: the second receiver's clock bias c*b [m] and drift c*f
+/// [m/s] (its own oscillator; the first's are kClockBias and kClockDrift) take the last two
+/// states of the pseudorange-error block, whose time-correlated errors such a filter models for
+/// at most kPseudorangeError.dof - 2 satellites (pseudorange_error_slots.hpp). Shared rather than
+/// appended: two more states cost every filter, one receiver or two, 14-21 % of its IMU cycle
+/// (measured: docs/results.md), for what only the second receiver's filter uses.
+inline constexpr StateBlock kSecondClockBias{kPseudorangeError.end() - 2, 1};
+inline constexpr StateBlock kSecondClockDrift{kPseudorangeError.end() - 1, 1};
 /// Receivers whose pseudoranges one filter fuses, each with its own clock states.
 inline constexpr int kMaxFusedReceivers = 2;
 /// The clock bias and drift states of fused receiver `index` (0: the first).
@@ -75,13 +78,14 @@ static_assert(kPos.end() == kVel.index && kVel.end() == kAtt.index &&
                   kStarTrackerBias.end() == kAccelScale.index &&
                   kAccelScale.end() == kGyroScale.index && kGyroScale.end() == kClockBias.index &&
                   kClockBias.end() == kClockDrift.index &&
-                  kClockDrift.end() == kPseudorangeError.index &&
-                  kPseudorangeError.end() == kSecondClockBias.index &&
-                  kSecondClockBias.end() == kSecondClockDrift.index &&
-                  kSecondClockDrift.end() == kSize,
+                  kClockDrift.end() == kPseudorangeError.index && kPseudorangeError.end() == kSize,
               "the layout's blocks must tile the state vector");
 static_assert(kFixPositionError.end() <= kPseudorangeError.end(),
               "the fix's position error shares the receiver's error block");
+static_assert(kSecondClockBias.end() == kSecondClockDrift.index &&
+                  kSecondClockDrift.end() == kPseudorangeError.end() &&
+                  kSecondClockBias.index >= kFixPositionError.end(),
+              "a second receiver's clock shares the pseudorange-error block's last states");
 }  // namespace layout
 
 /// Which states of the layout a filter estimates (the others are inactive, error_state.hpp).

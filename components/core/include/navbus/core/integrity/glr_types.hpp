@@ -41,7 +41,6 @@ static_assert(kSupportHead.index == 0 && layout::kVel.index == layout::kPos.end(
                   layout::kAtt.index == layout::kVel.end() &&
                   layout::kClockDrift.index == layout::kClockBias.end() &&
                   layout::kPseudorangeError.index == layout::kClockDrift.end() &&
-                  layout::kSecondClockBias.index == layout::kPseudorangeError.end() &&
                   kSupportTail.end() == kStates,
               "the GLR's support is position, velocity, attitude (leading) and the receiver's "
               "clock and pseudorange errors (trailing)");
