@@ -18,6 +18,26 @@ Eigen::Vector3d FaultSchedule::imuBias(double t, SensorKind sensor, int unit) co
   return b;
 }
 
+Eigen::Vector3d FaultSchedule::scaleError(double t, SensorKind sensor, int unit) const {
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (const auto& f : faults_) {
+    if (f.kind == FaultKind::kImuScaleFactorStep && f.sensor == sensor && f.unit == unit &&
+        active(f, t))
+      s[f.axis] += f.magnitude;
+  }
+  return s;
+}
+
+Eigen::Vector3d FaultSchedule::noiseFactor(double t, SensorKind sensor, int unit) const {
+  Eigen::Vector3d k = Eigen::Vector3d::Ones();
+  for (const auto& f : faults_) {
+    if (f.kind == FaultKind::kImuNoiseIncrease && f.sensor == sensor && f.unit == unit &&
+        active(f, t))
+      k[f.axis] *= f.magnitude;
+  }
+  return k;
+}
+
 std::optional<double> FaultSchedule::stuckSince(SensorKind sensor, int axis, double t,
                                                 int unit) const {
   for (const auto& f : faults_) {
@@ -35,6 +55,8 @@ double FaultSchedule::pseudorangeError(int sv_id, double t, int receiver) const 
     if (f.kind == FaultKind::kReceiverClockJump) e += f.magnitude;
     if (f.sv_id != sv_id) continue;
     if (f.kind == FaultKind::kPseudorangeStep) e += f.magnitude;
+    if (f.kind == FaultKind::kGnssMultipath)
+      e += f.magnitude * std::sin(2.0 * M_PI * (t - f.start_s) / f.period_s);
     if (f.kind != FaultKind::kPseudorangeRamp) continue;
     const double ramp = f.slope * (t - f.start_s);
     // Saturation keeps the sign of the slope (seed 000: 12.5 m/s saturating at 125 m after 10 s).
@@ -97,6 +119,12 @@ const char* faultKindName(FaultKind kind) {
       return "pseudorange_step";
     case FaultKind::kReceiverClockJump:
       return "receiver_clock_jump";
+    case FaultKind::kImuScaleFactorStep:
+      return "imu_scale_factor_step";
+    case FaultKind::kImuNoiseIncrease:
+      return "imu_noise_increase";
+    case FaultKind::kGnssMultipath:
+      return "gnss_multipath";
     case FaultKind::kStarTrackerBias:
       return "star_tracker_bias";
   }

@@ -36,7 +36,8 @@ ScenarioSource::ScenarioSource(const ScenarioConfig& c)
       constellation_(c.constellation),
       receiver_(c.gnss, constellation_),
       star_(c.star_tracker, c.seed * 4 + 3),
-      rng_(c.seed * 4) {
+      rng_(c.seed * 4),
+      fault_rng_(c.seed * 4 + 6) {
   // Each further unit's noise from a stream of its own (a step of the golden-ratio constant
   // apart from the others'), derived from the one scenario seed.
   for (std::size_t k = 0; k < c.extra_imus.size(); ++k)
@@ -91,6 +92,27 @@ Eigen::Vector3d ScenarioSource::frozen(UnitOutputs& unit, int unit_index, Sensor
   return out;
 }
 
+void ScenarioSource::applyAxisFaults(const PerfectIncrement& input, const ImuSpec& spec, int unit,
+                                     double t, double dt, PerfectIncrement& sensed) {
+  const FaultSchedule& faults = config_.faults;
+  sensed.delta_vel_b_mps +=
+      faults.scaleError(t, SensorKind::kAccelerometer, unit).cwiseProduct(input.delta_vel_b_mps);
+  sensed.delta_angle_b_rad +=
+      faults.scaleError(t, SensorKind::kGyro, unit).cwiseProduct(input.delta_angle_b_rad);
+  // White noise of density k N: the specified N's share is in `sensed`, the rest added here
+  // (an increment's white noise over dt has sigma N sqrt(dt)).
+  std::normal_distribution<double> unit_normal(0.0, 1.0);
+  const auto addNoise = [&](SensorKind sensor, double density, Eigen::Vector3d& delta) {
+    const Eigen::Vector3d k = faults.noiseFactor(t, sensor, unit);
+    for (int a = 0; a < 3; ++a) {
+      if (k[a] <= 1.0) continue;
+      delta[a] += density * std::sqrt((k[a] * k[a] - 1.0) * dt) * unit_normal(fault_rng_);
+    }
+  };
+  addNoise(SensorKind::kAccelerometer, spec.accel.random_walk, sensed.delta_vel_b_mps);
+  addNoise(SensorKind::kGyro, spec.gyro.random_walk, sensed.delta_angle_b_rad);
+}
+
 void ScenarioSource::senseExtraUnit(int k, const PerfectIncrement& perfect,
                                     const Eigen::Vector3d& f_b,
                                     const Eigen::Vector3d& vibration_f_b,
@@ -112,6 +134,7 @@ void ScenarioSource::senseExtraUnit(int k, const PerfectIncrement& perfect,
   at_unit.delta_angle_b_rad = spec.c_u_b * perfect.delta_angle_b_rad;
   at_unit.delta_vel_b_mps = spec.c_u_b * (perfect.delta_vel_b_mps + arm_f * dt);
   PerfectIncrement sensed = u.model.apply(at_unit, spec.c_u_b * (f_b + arm_f), dt);
+  applyAxisFaults(at_unit, spec.imu, unit, t, dt, sensed);
   sensed.delta_vel_b_mps += config_.faults.accelBias(t, unit) * dt;
   sensed.delta_angle_b_rad += config_.faults.gyroBias(t, unit) * dt;
   sensed.delta_vel_b_mps += spec.c_u_b * vibration_f_b * dt;
@@ -174,6 +197,7 @@ void ScenarioSource::next(SensorFrame& f) {
     const PerfectIncrement perfect = trajectory_->advance(dt);
     const Eigen::Vector3d f_b = trajectory_->specificForceBody();
     PerfectIncrement sensed = imu_.apply(perfect, f_b, dt);
+    applyAxisFaults(perfect, config_.imu, 0, t, dt, sensed);
     sensed.delta_vel_b_mps += config_.faults.accelBias(t) * dt;
     sensed.delta_angle_b_rad += config_.faults.gyroBias(t) * dt;
     Eigen::Vector3d f_vib = Eigen::Vector3d::Zero(), w_vib = Eigen::Vector3d::Zero();

@@ -14,7 +14,7 @@ namespace {
 
 bool gnssFault(const sim::Fault& f) {
   return f.kind == sim::FaultKind::kPseudorangeRamp || f.kind == sim::FaultKind::kPseudorangeStep ||
-         f.kind == sim::FaultKind::kReceiverClockJump;
+         f.kind == sim::FaultKind::kReceiverClockJump || f.kind == sim::FaultKind::kGnssMultipath;
 }
 
 /// `sensor_id`: the unit a parity (or lanes) decision or candidate names, the receiver a
@@ -24,7 +24,8 @@ bool matches(const sim::Fault& f, navbus::FaultSource source, int sv_id, int axi
              std::uint32_t sensor_id) {
   if (f.kind == sim::FaultKind::kReceiverClockJump)
     return source == navbus::SOURCE_RECEIVER_CLOCK && sensor_id == f.receiver_id;
-  if (f.kind == sim::FaultKind::kPseudorangeRamp || f.kind == sim::FaultKind::kPseudorangeStep) {
+  if (f.kind == sim::FaultKind::kPseudorangeRamp || f.kind == sim::FaultKind::kPseudorangeStep ||
+      f.kind == sim::FaultKind::kGnssMultipath) {
     return source == navbus::SOURCE_SATELLITE && sv_id == f.sv_id;
   }
   const navbus::FaultSource want = f.sensor == sim::SensorKind::kAccelerometer
@@ -138,7 +139,8 @@ bool writeParityCsv(const std::string& path, const std::vector<OfflineResult::Pa
 std::optional<sim::Fault> detectableFault(const sim::FaultSchedule& schedule) {
   for (const sim::Fault& f : schedule.faults()) {
     if (f.kind == sim::FaultKind::kImuBiasStep || f.kind == sim::FaultKind::kImuBiasRamp ||
-        gnssFault(f))
+        f.kind == sim::FaultKind::kImuScaleFactorStep ||
+        f.kind == sim::FaultKind::kImuNoiseIncrease || gnssFault(f))
       return f;
   }
   return std::nullopt;
@@ -201,7 +203,12 @@ FaultRunOutcome evaluateRun(const OfflineResult& r, const std::optional<sim::Fau
     // shape is not scored, nor is its magnitude.
     const bool ramp = fault->kind == sim::FaultKind::kPseudorangeRamp;
     out.shape_correct = !ramp || d.shape() == navbus::SHAPE_RAMP;
-    if (!out.shape_correct || fault->kind == sim::FaultKind::kImuBiasRamp)
+    // A scale-factor step or a noise increase is decided as the bias it looks like: no
+    // magnitude of the same kind to compare.
+    if (!out.shape_correct || fault->kind == sim::FaultKind::kImuBiasRamp ||
+        fault->kind == sim::FaultKind::kImuScaleFactorStep ||
+        fault->kind == sim::FaultKind::kImuNoiseIncrease ||
+        fault->kind == sim::FaultKind::kGnssMultipath)
       out.magnitude_error = std::nan("");
     for (const navbus::FilterCommand& c : r.commands) {
       if (c.decision_id() == d.decision_id() && c.kind() == navbus::CMD_COMPENSATE_BIAS &&

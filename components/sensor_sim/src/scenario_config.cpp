@@ -165,6 +165,12 @@ void checkFaultKeys(const YAML::Node& n, const std::string& where, const std::st
     checkKeys(n, where, {"north_m", "east_m", "down_m"}, kFaultCommonKeys);
   else if (type == "sensor_stuck")
     checkKeys(n, where, {"sensor", "axis"}, kImuFaultKeys);
+  else if (type == "imu_scale_factor_step")
+    checkKeys(n, where, {"sensor", "axis", "magnitude_ppm"}, kImuFaultKeys);
+  else if (type == "imu_noise_increase")
+    checkKeys(n, where, {"sensor", "axis", "factor"}, kImuFaultKeys);
+  else if (type == "gnss_multipath")
+    checkKeys(n, where, {"sv_id", "amplitude_m", "period_s", "receiver_id"}, kFaultCommonKeys);
   else if (type == "star_tracker_bias")
     checkKeys(n, where, {"bias_arcsec"}, kFaultCommonKeys);
   else
@@ -299,6 +305,28 @@ sim::FaultSchedule parseFaults(const YAML::Node& list, const std::vector<std::ui
       f.axis = axisIndex(n, where);
       f.unit = faultUnit(n, where, imu_ids);
       f.sensor_id = imu_ids[static_cast<std::size_t>(f.unit)];
+    } else if (type == "imu_scale_factor_step" || type == "imu_noise_increase") {
+      const bool scale = type == "imu_scale_factor_step";
+      f.kind = scale ? sim::FaultKind::kImuScaleFactorStep : sim::FaultKind::kImuNoiseIncrease;
+      f.sensor = sensorKind(n, where);
+      f.axis = axisIndex(n, where);
+      f.unit = faultUnit(n, where, imu_ids);
+      f.sensor_id = imu_ids[static_cast<std::size_t>(f.unit)];
+      f.magnitude =
+          scale ? checkRange(bus::require<double>(n, where, "magnitude_ppm"), -1e5, 1e5,
+                             where + ".magnitude_ppm") *
+                      1e-6
+                : checkRange(bus::require<double>(n, where, "factor"), 1.0, 1e4, where + ".factor");
+    } else if (type == "gnss_multipath") {
+      f.kind = sim::FaultKind::kGnssMultipath;
+      f.receiver = faultReceiver(n, where, receiver_ids);
+      f.receiver_id = receiver_ids[static_cast<std::size_t>(f.receiver)];
+      f.sv_id = static_cast<int>(
+          checkRange(bus::require<int>(n, where, "sv_id"), 1, 32, where + ".sv_id"));
+      f.magnitude = checkRange(bus::require<double>(n, where, "amplitude_m"), 0.0, 1e4,
+                               where + ".amplitude_m");
+      f.period_s =
+          checkRange(bus::require<double>(n, where, "period_s"), 0.1, 1e5, where + ".period_s");
     } else if (type == "gnss_outage") {
       f.kind = sim::FaultKind::kGnssOutage;
       // One receiver's (receiver_id), or every receiver's.

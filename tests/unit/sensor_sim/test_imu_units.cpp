@@ -170,6 +170,72 @@ TEST(ImuUnits, ABiasRampGrowsAtItsSlopeUpToItsSaturation) {
   EXPECT_EQ(faults.gyroBias(100.0, 0).z(), 0.0);  // the scenario's own IMU is not faulty
 }
 
+TEST(ImuUnits, AScaleFactorStepReachesItsUnitsAxisOnly) {
+  // Given the drive with a perfect primary IMU and two perfect units (sensors 2 and 3 as the
+  // primary), when sensor 2's z gyro reads 1000 ppm long from 20 s, then its z increments are
+  // 1.001 times the primary's after 20 s and equal before, its x axis and sensor 3 unchanged.
+  YAML::Node root = perfectDrive();
+  root["imu_units"].push_back(unit(2, {0, 0, 0}, {0, 0, 0}));
+  root["imu_units"].push_back(unit(3, {0, 0, 0}, {0, 0, 0}));
+  YAML::Node scale = imuFault("imu_scale_factor_step", 20.0, "gyro", "z", 2);
+  scale["magnitude_ppm"] = 1000.0;
+  root["faults"].push_back(scale);
+  const auto c = parse(root);
+  ScenarioSource src(c.scenario);
+  int turning = 0;
+  for (int k = 0; k < 6000; ++k) {
+    const SensorFrame f = src.next();
+    const double t = 1e-9 * static_cast<double>(f.time_ns - c.scenario.start_time_ns);
+    const double T = f.increment.interval_s;
+    if (std::abs(t - 20.0) <= 2.0 * T) continue;  // the frames around the onset
+    const Eigen::Vector3d& primary = f.increment.delta_angle_b_rad;
+    const Eigen::Vector3d& faulty = f.extra_imus[0].increment.delta_angle_b_rad;
+    EXPECT_NEAR(faulty.z(), (t < 20.0 ? 1.0 : 1.001) * primary.z(), 1e-15) << "t = " << t;
+    EXPECT_EQ(faulty.x(), primary.x());
+    EXPECT_EQ(f.extra_imus[1].increment.delta_angle_b_rad, primary);
+    turning += t > 20.0 && std::abs(primary.z()) > 1e-4 ? 1 : 0;
+  }
+  EXPECT_GT(turning, 50);  // the check saw the scale factor at work
+}
+
+TEST(ImuUnits, ANoiseIncreaseMultipliesTheAxisNoiseAndLeavesTheRestBitForBit) {
+  // Given the drive's own IMU grade on two units (sensors 2 and 3), when sensor 3's x gyro's
+  // white noise density is multiplied by 4 from 0 s, then the spread of its x increments about
+  // sensor 2's grows about 4-fold against the y axis's (sqrt((16 + 1) / 2) = 2.9 of the
+  // difference's), sensor 2 and the primary are bit for bit the fault-free run's.
+  YAML::Node root = scenarioYaml();
+  root["vibration"] = YAML::Node(YAML::NodeType::Map);
+  root["vibration"]["enabled"] = false;
+  root["imu_units"].push_back(unit(2, {0, 0, 0}, {0, 0, 0}));
+  root["imu_units"].push_back(unit(3, {0, 0, 0}, {0, 0, 0}));
+  root["faults"] = YAML::Node(YAML::NodeType::Sequence);
+  const auto clean = parse(root);
+  YAML::Node noise = imuFault("imu_noise_increase", 0.0, "gyro", "x", 3);
+  noise["factor"] = 4.0;
+  root["faults"].push_back(noise);
+  const auto faulty = parse(root);
+  ScenarioSource a(clean.scenario), b(faulty.scenario);
+  // Successive differences of the units' difference: the biases (constant over a step) cancel.
+  double sum_x = 0.0, sum_y = 0.0;
+  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+  const int n = 20000;
+  for (int k = 0; k < n; ++k) {
+    const SensorFrame fa = a.next(), fb = b.next();
+    ASSERT_EQ(fa.increment.delta_angle_b_rad, fb.increment.delta_angle_b_rad);
+    ASSERT_EQ(fa.extra_imus[0].increment.delta_angle_b_rad,
+              fb.extra_imus[0].increment.delta_angle_b_rad);
+    const Eigen::Vector3d d =
+        fb.extra_imus[1].increment.delta_angle_b_rad - fb.extra_imus[0].increment.delta_angle_b_rad;
+    if (k > 0) {
+      sum_x += std::pow(d.x() - previous.x(), 2);
+      sum_y += std::pow(d.y() - previous.y(), 2);
+    }
+    previous = d;
+  }
+  const double ratio = std::sqrt(sum_x / sum_y);
+  EXPECT_NEAR(ratio, std::sqrt((16.0 + 1.0) / 2.0), 0.1 * std::sqrt(17.0 / 2.0)) << ratio;
+}
+
 TEST(ImuUnits, RefusesIdsItCannotPlaceNamingThem) {
   YAML::Node duplicate = perfectDrive();
   duplicate["ids"]["imu"] = 5;

@@ -275,3 +275,37 @@ TEST(Scenarios, AnOutageAddressedToOneReceiverSilencesThatReceiverOnly) {
   EXPECT_TRUE(parsed.faults.receiverOut(25.0, 1));
   EXPECT_FALSE(parsed.faults.receiverOut(25.0, 0));
 }
+
+TEST(Scenarios, MultipathOnOneReceiversSatelliteFollowsItsSineAndNothingElse) {
+  // Given the dual-receiver aircraft with a 5 m multipath of period 60 s on satellite 13 of
+  // receiver 2 from 100 s, then receiver 2's satellite 13 pseudorange error is 5 sin(2 pi (t -
+  // 100) / 60) m while active (2.5 m at 105 s, 5 m at 115 s, 0 before 100 s), and receiver 1's
+  // and receiver 2's other satellites get none.
+  YAML::Node root = navbus::bus::loadYamlFile(std::string(navbus::test_paths::scenarioDir()) +
+                                              "/seed000_dual_receivers.yaml");
+  YAML::Node f;
+  f["type"] = "gnss_multipath";
+  f["start_s"] = 100.0;
+  f["sv_id"] = 13;
+  f["receiver_id"] = 2;
+  f["amplitude_m"] = 5.0;
+  f["period_s"] = 60.0;
+  root["faults"] = YAML::Node(YAML::NodeType::Sequence);
+  root["faults"].push_back(f);
+  const navbus::sim::FaultSchedule faults =
+      navbus::sensor_sim::parseSimConfig(root).scenario.faults;
+  EXPECT_EQ(faults.pseudorangeError(13, 99.0, 1), 0.0);
+  EXPECT_NEAR(faults.pseudorangeError(13, 105.0, 1), 2.5, 1e-12);
+  EXPECT_NEAR(faults.pseudorangeError(13, 115.0, 1), 5.0, 1e-12);
+  EXPECT_EQ(faults.pseudorangeError(13, 115.0, 0), 0.0);
+  EXPECT_EQ(faults.pseudorangeError(12, 115.0, 1), 0.0);
+  // A period that would divide by zero is refused naming the field.
+  f["period_s"] = 0.0;
+  root["faults"][0] = f;
+  try {
+    navbus::sensor_sim::parseSimConfig(root);
+    FAIL() << "a zero period was taken";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("faults[0].period_s"), std::string::npos) << e.what();
+  }
+}

@@ -20,10 +20,14 @@ enum class FaultKind {
   kGnssOutage,         ///< seed 004: no GNSS epochs or fixes while active (of one receiver, or all)
   kStarTrackerOutage,  ///< no star-tracker solution while active
   kStarTrackerBias,    ///< a star-tracker attitude bias [rad, body] while active
-  kPseudorangeStep,   ///< one satellite's pseudoranges of one receiver offset by `magnitude` [m] (a
-                      ///< spoofed satellite)
-  kReceiverClockJump  ///< a receiver's clock steps: every pseudorange of it + `magnitude` [m] = c *
-                      ///< the jump
+  kPseudorangeStep,  ///< one satellite's pseudoranges of one receiver offset by `magnitude` [m] (a
+                     ///< spoofed satellite)
+  kReceiverClockJump,   ///< a receiver's clock steps: every pseudorange of it + `magnitude` [m] =
+                        ///< c * the jump
+  kImuScaleFactorStep,  ///< one axis of a unit reads (1 + `magnitude`) times its input from start
+  kImuNoiseIncrease,    ///< one axis of a unit: its white noise density times `magnitude` (>= 1)
+  kGnssMultipath        ///< one satellite of one receiver: + `magnitude` sin(2 pi (t - start) /
+                        ///< `period_s`) [m]
 };
 
 enum class SensorKind { kAccelerometer, kGyro };
@@ -48,6 +52,7 @@ struct Fault {
   /// Ramps: the size they stop growing at, 0: none [m | m/s^2 | rad/s]
   double saturation{0.0};
   Eigen::Vector3d vector{Eigen::Vector3d::Zero()};  ///< position pulse [m, NED] or ST bias [rad]
+  double period_s{0.0};  ///< multipath: the period of the reflected path's phase [s]
 };
 
 class FaultSchedule {
@@ -63,6 +68,11 @@ class FaultSchedule {
   Eigen::Vector3d gyroBias(double t, int unit = 0) const {
     return imuBias(t, SensorKind::kGyro, unit);
   }
+  /// Scale-factor errors [1, the unit's axes] of a unit at t: an axis reads (1 + s) times its
+  /// input.
+  Eigen::Vector3d scaleError(double t, SensorKind sensor, int unit = 0) const;
+  /// Factor on each axis's white-noise density of a unit at t (1: as specified).
+  Eigen::Vector3d noiseFactor(double t, SensorKind sensor, int unit = 0) const;
   /// Axes frozen at t: the start time of the stuck fault per axis, or nothing.
   std::optional<double> stuckSince(SensorKind sensor, int axis, double t, int unit = 0) const;
   /// Error added to a satellite's pseudorange of a receiver at t [m]: ramps, steps and the

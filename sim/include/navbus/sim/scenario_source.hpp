@@ -97,6 +97,10 @@ class ScenarioSource {
   };
   Eigen::Vector3d frozen(UnitOutputs& unit, int unit_index, SensorKind sensor,
                          const Eigen::Vector3d& rate, double t);
+  /// The scale-factor and noise faults of unit `unit` (spec `spec`) on one raw sample: `input`
+  /// the true increments in the unit's axes, `sensed` its output so far.
+  void applyAxisFaults(const PerfectIncrement& input, const ImuSpec& spec, int unit, double t,
+                       double dt, PerfectIncrement& sensed);
   /// One raw sample of extra unit k, added to its increment in `f`.
   void senseExtraUnit(int k, const PerfectIncrement& perfect, const Eigen::Vector3d& f_b,
                       const Eigen::Vector3d& vibration_f_b, const Eigen::Vector3d& vibration_w_b,
@@ -120,6 +124,9 @@ class ScenarioSource {
   StarTrackerModel star_;
   Eigen::Vector3d star_bias_b_rad_{Eigen::Vector3d::Zero()};  ///< at the latest tracker sample
   std::mt19937_64 rng_;
+  /// The added noise of noise-increase faults (drawn only while one is active, so that every
+  /// other stream is the same with or without the fault).
+  std::mt19937_64 fault_rng_;
   std::int64_t index_{0};
   UnitOutputs outputs_;  ///< the scenario's IMU (unit 0)
   std::vector<ExtraUnit> extra_;
