@@ -255,6 +255,25 @@ TEST(LoadedLanes, ParallelLanesNameTheFaultyUnitWithStopsAndCpuHogsAsOffline) {
 // combination waits through) and the fault manager once, two busy loops beside them. The
 // published solutions, every lane's own (the combined lane's included) and the decision equal
 // offline's.
+// Every lane fed both receivers (config/filter_triplex_receivers_fused.yaml): receiver 2's clock
+// jumps 1 ms at 100 s, the cross-receiver test decides it and the command shifts receiver 2's
+// clock in every lane before the jumped epoch; the filter is stopped twice and the fault manager
+// once, two busy loops beside them. The published solutions, every lane's own and the decision
+// equal offline's (both receivers' epochs of a time held and fused as one on the bus as offline).
+TEST(LoadedLanes, LanesFusingBothReceiversWithStopsAndCpuHogsCompensateAsOffline) {
+  run({126,
+       "seed000_triplex_dual_receivers",
+       240,
+       2,
+       1,
+       2,
+       "filter_triplex_receivers_fused",
+       "fault_manager_triplex_receivers",
+       "faults:\n  - {type: receiver_clock_jump, start_s: 100, magnitude_ms: 1, receiver_id: 2}\n",
+       {"further receivers' clocks started 1,", "commands applied 1 refused ",
+        "selections made without the parity test's judgement (its wait ran out) 0"}});
+}
+
 TEST(LoadedLanes, ALeastSquaresLaneWithStopsAndCpuHogsCombinesAsOffline) {
   run({124,
        "seed000_triplex",
