@@ -169,11 +169,14 @@ void parseGlrStatistics(const YAML::Node& g, const std::string& w, core::GlrConf
                                 w + ".rank_tolerance");
   const YAML::Node h = g ? g["hypotheses"] : YAML::Node();
   const std::string wh = w + ".hypotheses";
-  checkKeys(h, wh, {"imu_steps", "range_steps", "range_ramps", "rate_steps"});
+  checkKeys(h, wh,
+            {"imu_steps", "range_steps", "range_ramps", "rate_steps", "per_receiver_satellites"});
   m.imu_steps = get<bool>(h, wh, "imu_steps", m.imu_steps);
   m.range_steps = get<bool>(h, wh, "range_steps", m.range_steps);
   m.range_ramps = get<bool>(h, wh, "range_ramps", m.range_ramps);
   m.rate_steps = get<bool>(h, wh, "rate_steps", m.rate_steps);
+  m.per_receiver_satellites =
+      get<bool>(h, wh, "per_receiver_satellites", m.per_receiver_satellites);
 }
 
 }  // namespace navbus::bus

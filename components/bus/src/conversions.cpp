@@ -202,6 +202,7 @@ std::optional<Rejection> toGlrEpoch(const navbus::FilterDiagnostics& msg, core::
     const auto ur = static_cast<std::size_t>(r);
     out.sv_id[ur] = msg.rows()[ur].sv_id();
     out.is_rate[ur] = msg.rows()[ur].kind() == navbus::MEAS_PSEUDORANGE_RATE;
+    out.receiver[ur] = msg.rows()[ur].receiver_id();
     out.innovation[r] = msg.innovation()[ur];
     for (Eigen::Index c = 0; c < rows; ++c)
       out.innovation_cov(r, c) = msg.innovation_cov()[ur * m + static_cast<std::size_t>(c)];

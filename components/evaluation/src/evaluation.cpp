@@ -1,15 +1,12 @@
 #include "navbus/evaluation/evaluation.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
-#include <mutex>
-#include <thread>
 
 #include <spdlog/spdlog.h>
 #include <boost/math/distributions/chi_squared.hpp>
@@ -20,6 +17,7 @@
 #include "navbus/evaluation/fault_evaluation.hpp"
 #include "navbus/evaluation/integrity_evaluation.hpp"
 #include "navbus/evaluation/offline_runner.hpp"
+#include "navbus/evaluation/parallel_runs.hpp"
 #include "navbus/fault_manager/fault_config.hpp"
 #include "navbus/records/formatters.hpp"
 
@@ -51,6 +49,10 @@ void checkIntegrityDetector(const nav_filter::FilterConfig& filter,
   differ("hypotheses.range_steps", a.range_steps, b.range_steps);
   differ("hypotheses.range_ramps", a.range_ramps, b.range_ramps);
   differ("hypotheses.rate_steps", a.rate_steps, b.rate_steps);
+  // Only a filter fusing two receivers gives the GLR rows of several receivers.
+  if (filter.second_gnss_receiver_id)
+    differ("hypotheses.per_receiver_satellites", a.per_receiver_satellites,
+           b.per_receiver_satellites);
 }
 
 /// `filter_yaml` is the filter file's content (the Monte Carlo overrides some keys);
@@ -463,31 +465,6 @@ std::vector<OfflineSetup> monteCarloSetups(const MonteCarloOptions& o, const Var
   return setups;
 }
 
-/// Runs: in parallel (one per core unless --threads), results in seed order.
-std::vector<OfflineResult> runAll(const std::vector<OfflineSetup>& setups, int threads_wanted,
-                                  const std::string& label) {
-  const int runs = static_cast<int>(setups.size());
-  std::vector<OfflineResult> results(setups.size());
-  std::atomic<int> next{0}, done{0};
-  std::mutex progress;
-  auto worker = [&] {
-    for (int i = next++; i < runs; i = next++) {
-      results[static_cast<std::size_t>(i)] = runOffline(setups[static_cast<std::size_t>(i)]);
-      const std::lock_guard<std::mutex> lock(progress);
-      std::fprintf(stderr, "\r[%s] run %d/%d", label.c_str(), ++done, runs);
-      std::fflush(stderr);
-    }
-  };
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const int threads = std::min(runs, threads_wanted > 0 ? threads_wanted : static_cast<int>(hw));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  std::fprintf(stderr, "\n");
-  return results;
-}
-
 /// Tallies of one configuration over its runs: each tally takes every run (add), the report
 /// prints them. A new tally (a lane's, say) is a member here and a line in add().
 struct Tallies {
@@ -644,7 +621,7 @@ int runMonteCarloCommand(const MonteCarloOptions& o) {
   std::vector<Tallies> rows;
   for (const Variant& v : variants) {
     const std::vector<OfflineSetup> setups = monteCarloSetups(o, v);
-    const std::vector<OfflineResult> results = runAll(setups, o.threads, v.label);
+    const std::vector<OfflineResult> results = runInParallel(setups, o.threads, v.label);
     Tallies& row = rows.emplace_back();
     row.label = v.label;
     for (std::size_t i = 0; i < setups.size(); ++i)

@@ -34,6 +34,8 @@ navbus::FaultCandidate toIdl(const core::GlrCandidate& c) {
   out.sv_id(static_cast<std::uint16_t>(c.hypothesis.sv_id));
   out.axis(static_cast<std::uint16_t>(c.hypothesis.isImu() ? c.hypothesis.axis : 0));
   out.shape(toShape(c.hypothesis.fault));
+  if (!c.hypothesis.isImu() && c.hypothesis.receiver != core::GlrHypothesis::kEveryReceiver)
+    out.sensor_id(static_cast<std::uint32_t>(c.hypothesis.receiver));  // one receiver's rows
   out.statistic(c.statistic);
   out.magnitude(c.magnitude);
   return out;
@@ -50,6 +52,8 @@ std::string describe(const core::GlrCandidate& c) {
       << axisName(c.hypothesis.axis) << " step";
   } else {
     s << "sv " << c.hypothesis.sv_id << " " << core::glrFaultName(c.hypothesis.fault);
+    if (c.hypothesis.receiver != core::GlrHypothesis::kEveryReceiver)
+      s << " at receiver " << c.hypothesis.receiver;
   }
   s << " (l* " << c.statistic << ", magnitude " << c.magnitude << ")";
   return s.str();
@@ -107,6 +111,7 @@ navbus::FaultDecision GlrDetector::decision(const core::GlrResult& r) const {
   const navbus::FaultCandidate isolated = toIdl(best);  // the decision names candidate 0
   d.source(isolated.source());
   d.sv_id(isolated.sv_id());
+  d.sensor_id(isolated.sensor_id());
   d.axis(isolated.axis());
   d.shape(isolated.shape());
   d.test_statistic(r.statistic);
@@ -296,6 +301,7 @@ void GlrDetector::removeQuarantinedRows() {
     const int r = keep[static_cast<std::size_t>(i)];
     e.sv_id[static_cast<std::size_t>(i)] = e.sv_id[static_cast<std::size_t>(r)];
     e.is_rate[static_cast<std::size_t>(i)] = e.is_rate[static_cast<std::size_t>(r)];
+    e.receiver[static_cast<std::size_t>(i)] = e.receiver[static_cast<std::size_t>(r)];
     e.innovation[i] = e.innovation[r];
     e.h.row(i) = e.h.row(r);
     e.k.col(i) = e.k.col(r);

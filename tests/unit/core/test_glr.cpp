@@ -31,7 +31,6 @@ namespace {
 constexpr int kSats = 4;
 constexpr int kRows = 2 * kSats;
 constexpr std::int64_t kSecond = 1'000'000'000;
-const int kSvIds[kSats] = {3, 6, 9, 13};
 
 /// A linear system with the filter's state layout: random but fixed Phi (biases and clock as random
 /// constants / random walk), pseudorange-like and rate-like rows, a Kalman filter's gains.
@@ -141,17 +140,34 @@ int biasState(const GlrHypothesis& h) {
          h.axis;
 }
 
-int rowOf(const GlrHypothesis& h) {
-  for (int s = 0; s < kSats; ++s)
-    if (kSvIds[s] == h.sv_id) return 2 * s + (h.fault == GlrFault::kRateStep ? 1 : 0);
-  return -1;
+/// Who measures each of the loop's kSats lines of sight: a satellite and a receiver. By default
+/// four satellites of one receiver; two receivers each tracking two satellites give a fused
+/// filter's stacked epoch (the toy loop's lines of sight differ between the receivers' rows of
+/// a satellite, which the GLR's algebra does not mind).
+struct RowLabels {
+  int sv_id[kSats];
+  std::int64_t receiver[kSats];
+};
+constexpr RowLabels kOneReceiver{{3, 6, 9, 13}, {0, 0, 0, 0}};
+constexpr RowLabels kTwoReceivers{{6, 6, 13, 13}, {1, 2, 1, 2}};
+
+/// The rows a measurement fault enters: its satellite's range or rate row at its receiver, or
+/// at every receiver.
+std::vector<int> rowsOf(const GlrHypothesis& h, const RowLabels& labels) {
+  std::vector<int> rows;
+  for (int s = 0; s < kSats; ++s) {
+    if (labels.sv_id[s] != h.sv_id) continue;
+    if (h.receiver != GlrHypothesis::kEveryReceiver && labels.receiver[s] != h.receiver) continue;
+    rows.push_back(2 * s + (h.fault == GlrFault::kRateStep ? 1 : 0));
+  }
+  return rows;
 }
 
 /// Simulates `epochs` epochs of the closed loop: truth error dx (estimate minus truth),
 /// innovations eps = H dx + v - (measurement fault), correction dx -= K eps. With `noise` false
 /// the run is the deterministic response to the fault alone: its innovations are the signature.
 LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& faults, bool noise,
-                 LoopShape shape = {}) {
+                 LoopShape shape = {}, const RowLabels& labels = kOneReceiver) {
   ClosedLoop loop(seed, shape);
   std::mt19937_64 rng(seed * 7 + 1);
   std::normal_distribution<double> n(0.0, noise ? 1.0 : 0.0);
@@ -179,7 +195,8 @@ LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& fault
       const double value = f.h.fault == GlrFault::kRangeRamp
                                ? f.magnitude * static_cast<double>(k - f.onset_epoch + 1)
                                : f.magnitude;
-      eps[rowOf(f.h)] -= value;  // predicted minus measured: a long range lowers it
+      for (const int row : rowsOf(f.h, labels))
+        eps[row] -= value;  // predicted minus measured: a long range lowers it
     }
     dx -= loop.k() * eps;
     run.corrected.push_back(dx);
@@ -187,9 +204,12 @@ LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& fault
     e.time_ns = (k + 1) * kSecond;
     e.rows = kRows;
     for (int s = 0; s < kSats; ++s) {
-      e.sv_id[static_cast<std::size_t>(2 * s)] = kSvIds[s];
-      e.sv_id[static_cast<std::size_t>(2 * s + 1)] = kSvIds[s];
-      e.is_rate[static_cast<std::size_t>(2 * s + 1)] = true;
+      for (int kind = 0; kind < 2; ++kind) {
+        const auto row = static_cast<std::size_t>(2 * s + kind);
+        e.sv_id[row] = labels.sv_id[s];
+        e.receiver[row] = labels.receiver[s];
+        e.is_rate[row] = kind == 1;
+      }
     }
     e.innovation = eps;
     e.innovation_cov = loop.v();
@@ -206,8 +226,9 @@ LoopRun simulate(std::uint64_t seed, int epochs, const std::vector<Fault>& fault
 /// signature (noise-free faulty run with unit magnitude).
 nc::GlrMonitor::DirectionSums bruteForce(std::uint64_t seed, const LoopRun& data,
                                          const GlrHypothesis& h, int onset, int k,
-                                         LoopShape shape = {}) {
-  const LoopRun sig = simulate(seed, k + 1, {{h, onset, 1.0}}, false, shape);
+                                         LoopShape shape = {},
+                                         const RowLabels& labels = kOneReceiver) {
+  const LoopRun sig = simulate(seed, k + 1, {{h, onset, 1.0}}, false, shape, labels);
   nc::GlrMonitor::DirectionSums out;
   for (int i = onset; i <= k; ++i) {
     const Eigen::MatrixXd v_inv = data.epochs[static_cast<std::size_t>(i)].innovation_cov.inverse();
@@ -298,6 +319,78 @@ TEST(Glr, SignatureSumsHoldWhenTheLoopReachesANewStateAndTheAttitude) {
             << nc::glrFaultName(h.fault) << " axis " << h.axis << " sv " << h.sv_id << " age "
             << age;
       }
+    }
+  }
+}
+
+TEST(Glr, OneReceiversRowsOfASatelliteAreAHypothesisOfTheirOwn) {
+  // Given a fused filter's epochs (satellites 6 and 13 each at receivers 1 and 2) with
+  // receiver 2's range of sv 13 stepping 3 m at epoch 16 (multipath, a spoofed channel), when
+  // the monitor processes them with per-receiver hypotheses, then f and R of every direction
+  // of the satellite's own fault (both receivers' rows) and of each receiver's rows alone equal
+  // the brute-force regression, for every onset in the window.
+  const std::uint64_t seed = 31;
+  const GlrHypothesis faulty{GlrFault::kRangeStep, 0, 13, 2};
+  const LoopRun run = simulate(seed, 30, {{faulty, 16, 3.0}}, true, {}, kTwoReceivers);
+  nc::GlrConfig cfg;
+  cfg.window = 10;
+  cfg.per_receiver_satellites = true;
+  nc::GlrMonitor glr(cfg);
+  for (const auto& e : run.epochs) ASSERT_TRUE(glr.update(e).valid);
+  const int k = 29;
+  const GlrHypothesis hyps[] = {{GlrFault::kRangeStep, 0, 13, GlrHypothesis::kEveryReceiver},
+                                {GlrFault::kRangeStep, 0, 13, 1},
+                                {GlrFault::kRangeStep, 0, 13, 2},
+                                {GlrFault::kRangeRamp, 0, 6, 2},
+                                {GlrFault::kRateStep, 0, 6, 1},
+                                {GlrFault::kRateStep, 0, 13, GlrHypothesis::kEveryReceiver},
+                                {GlrFault::kGyroStep, 1, 0}};
+  for (int age = 0; age < glr.onsetCount(); ++age) {
+    for (const auto& h : hyps) {
+      const auto got = glr.directionSums(age, h);
+      const auto want = bruteForce(seed, run, h, k - age, k, {}, kTwoReceivers);
+      if (!h.isImu()) {
+        ASSERT_GT(want.r, 0.0) << "sv " << h.sv_id << " receiver " << h.receiver;
+      }
+      EXPECT_NEAR(got.r, want.r, 1e-7 * std::max(1.0, std::abs(want.r)))
+          << nc::glrFaultName(h.fault) << " sv " << h.sv_id << " receiver " << h.receiver << " age "
+          << age;
+      EXPECT_NEAR(got.f, want.f, 1e-7 * std::max(1.0, std::abs(want.f)))
+          << nc::glrFaultName(h.fault) << " sv " << h.sv_id << " receiver " << h.receiver << " age "
+          << age;
+    }
+  }
+}
+
+TEST(Glr, AFaultInOneReceiversRowsIsIsolatedToThatReceiver) {
+  // Given the fused epochs with receiver 2's range of sv 13 stepping 40 m at epoch 20, when
+  // the monitor detects it, then it names sv 13 at receiver 2, one candidate per satellite;
+  // without per-receiver hypotheses it can only name the satellite (every receiver's rows).
+  const LoopRun run =
+      simulate(21, 30, {{{GlrFault::kRangeStep, 0, 13, 2}, 20, 40.0}}, true, {}, kTwoReceivers);
+  for (const bool per_receiver : {true, false}) {
+    nc::GlrConfig cfg;
+    cfg.per_receiver_satellites = per_receiver;
+    nc::GlrMonitor glr(cfg);
+    nc::GlrResult detection;
+    for (const auto& e : run.epochs) {
+      const nc::GlrResult& r = glr.update(e);
+      if (r.detected && !detection.detected) detection = r;
+    }
+    ASSERT_TRUE(detection.detected) << "per receiver " << per_receiver;
+    ASSERT_EQ(detection.source, nc::GlrSourceClass::kSatellite) << "per receiver " << per_receiver;
+    const GlrHypothesis& best = detection.candidates[0].hypothesis;
+    EXPECT_EQ(best.sv_id, 13);
+    EXPECT_EQ(best.receiver, per_receiver ? 2 : GlrHypothesis::kEveryReceiver);
+    for (int i = 1; i < detection.candidate_count; ++i)
+      EXPECT_NE(detection.candidates[static_cast<std::size_t>(i)].hypothesis.sv_id, 13)
+          << "one candidate per satellite";
+    if (per_receiver) {
+      // The one receiver's direction explains the data far better than both receivers' rows.
+      const int age = detection.onset_epochs_ago;
+      const auto one = glr.directionSums(age, best);
+      const auto both = glr.directionSums(age, {GlrFault::kRangeStep, 0, 13});
+      EXPECT_GT(0.5 * one.f * one.f / one.r, 0.5 * both.f * both.f / both.r + 10.0);
     }
   }
 }

@@ -117,7 +117,7 @@ GlrMonitor::DirectionSums GlrMonitor::directionSums(int age, const GlrHypothesis
     const int j = (h.fault == GlrFault::kAccelStep ? 0 : 3) + std::clamp(h.axis, 0, 2);
     return {o.f[j], o.r_imu(j, j)};
   }
-  const int slot = window_.slotOf(h.sv_id);
+  const int slot = window_.slotOf(h.sv_id, h.receiver);
   if (slot < 0) return {};
   const int j = h.fault == GlrFault::kRangeStep   ? kRangeStep
                 : h.fault == GlrFault::kRangeRamp ? kRangeRamp

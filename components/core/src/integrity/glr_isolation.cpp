@@ -42,8 +42,8 @@ void isolateOnset(const GlrWindow& window, const GlrConfig& config, int onset_ag
   r.source = imu ? GlrSourceClass::kImu
                  : (best_slot >= 0 ? GlrSourceClass::kSatellite : GlrSourceClass::kNone);
   // Which direction (eqs. 14-15 with T a unit vector): f* = f_j, R* = R_jj.
-  std::array<GlrCandidate, kMaxSatellites + kImuDirections> all{};
-  std::array<int, kMaxSatellites + kImuDirections> column{};
+  std::array<GlrCandidate, kMaxSlots + kImuDirections> all{};
+  std::array<int, kMaxSlots + kImuDirections> column{};
   int count = 0;
   auto scalar = [](double f, double rjj, GlrCandidate& c) {
     c.statistic = rjj > 0.0 ? 0.5 * f * f / rjj : 0.0;
@@ -58,24 +58,29 @@ void isolateOnset(const GlrWindow& window, const GlrConfig& config, int onset_ag
       column[static_cast<std::size_t>(count++)] = j;
     }
   } else {
-    // One candidate per satellite: its most likely fault kind.
+    // One candidate per satellite: its most likely fault kind, in every receiver's rows of it
+    // or (per-receiver hypotheses) in one receiver's.
+    std::array<int, 33> candidate_of_sv{};  // PRN -> index in `all` + 1
     for (int s = 0; s < window.slotsUsed(); ++s) {
       const GlrWindow::Slot& slot = window.slot(s);
       if (slot.quarantined) continue;
       GlrCandidate best;
       for (int j = 0; j < kSatDirections; ++j) {
         GlrCandidate c;
-        c.hypothesis = {j == kRangeStep   ? GlrFault::kRangeStep
-                        : j == kRangeRamp ? GlrFault::kRangeRamp
-                                          : GlrFault::kRateStep,
-                        0, slot.sv_id};
+        c.hypothesis = window.hypothesis(s, j);
         scalar(o.f[satColumn(s, j)], o.rSat(s)(j, j), c);
         if (c.statistic > best.statistic || j == 0) best = c;
       }
-      all[static_cast<std::size_t>(count++)] = best;
+      int& index = candidate_of_sv[static_cast<std::size_t>(slot.sv_id)];
+      if (index == 0) {
+        all[static_cast<std::size_t>(count)] = best;
+        index = ++count;
+      } else if (best.statistic > all[static_cast<std::size_t>(index - 1)].statistic) {
+        all[static_cast<std::size_t>(index - 1)] = best;
+      }
     }
   }
-  std::array<int, kMaxSatellites + kImuDirections> order{};
+  std::array<int, kMaxSlots + kImuDirections> order{};
   for (int i = 0; i < count; ++i) order[static_cast<std::size_t>(i)] = i;
   std::sort(order.begin(), order.begin() + count, [&](int a, int b) {
     return all[static_cast<std::size_t>(a)].statistic > all[static_cast<std::size_t>(b)].statistic;

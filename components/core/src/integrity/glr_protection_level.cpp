@@ -40,6 +40,9 @@ void toGlrEpoch(std::int64_t time_ns, const EpochDiagnostics& d, GlrEpoch& out) 
   for (Eigen::Index r = 0; r < m; ++r) {
     out.sv_id[static_cast<std::size_t>(r)] = d.sv_ids[static_cast<std::size_t>(r)];
     out.is_rate[static_cast<std::size_t>(r)] = d.is_rate[static_cast<std::size_t>(r)];
+    out.receiver[static_cast<std::size_t>(r)] = static_cast<std::size_t>(r) < d.receivers.size()
+                                                    ? d.receivers[static_cast<std::size_t>(r)]
+                                                    : 0;
   }
   out.innovation = d.innovation.head(m);
   out.innovation_cov = d.innovation_cov.topLeftCorner(m, m);
@@ -75,7 +78,8 @@ void GlrProtectionLevel::configure(const IntegrityConfig& config) {
 }
 
 void GlrProtectionLevel::reserveSignatures() {
-  const auto n = static_cast<std::size_t>(glr::kMaxDirections * monitor_->config().window);
+  const GlrConfig& c = monitor_->config();
+  const auto n = static_cast<std::size_t>(glr::directions(glrSlotCapacity(c)) * c.window);
   if (signatures_->capacity() < n) signatures_->reserve(n);
 }
 

@@ -30,19 +30,19 @@ constexpr int imuState(int j) {
 void GlrWindow::configure(const GlrConfig& config) {
   config_ = config;
   config_.window = std::clamp(config.window, 1, kMaxWindow);
+  slot_capacity_ = glrSlotCapacity(config_);
   onsets_.assign(static_cast<std::size_t>(config_.window), Onset{});
-  f_.resize(kMaxDirections, config_.window);
+  f_.resize(directions(slot_capacity_), config_.window);
   r_imu_.resize(kImuDirections * kImuDirections, config_.window);
-  r_sat_.resize(kSatDirections * kSatDirections * kMaxSatellites, config_.window);
-  const int columns = kMaxPropagated * config_.window;
-  mu_.resize(kStates, columns);
+  r_sat_.resize(kSatDirections * kSatDirections * slot_capacity_, config_.window);
+  mu_.resize(kStates, propagated(slot_capacity_) * config_.window);
   sizeWorkingBuffers();
   spacing_s_.resize(config_.window);
   reset();
 }
 
 void GlrWindow::sizeWorkingBuffers() {
-  const int columns = kMaxPropagated * config_.window;
+  const int columns = propagated(slot_capacity_) * config_.window;
   if (mu_next_->cols() != columns) mu_next_->resize(kStates, columns);
   if (z_->cols() != columns) z_->resize(kSupport, columns);
 }
@@ -53,10 +53,8 @@ void GlrWindow::reset() {
   have_previous_ = false;
   // Quarantine is a decision of the fault manager: it survives a reset of the statistics.
   std::array<int, 33> quarantined{};
-  for (int s = 0; s < slots_used_; ++s) {
-    const Slot& slot = slots_[static_cast<std::size_t>(s)];
-    if (slot.quarantined) quarantined[static_cast<std::size_t>(slot.sv_id)] = 1;
-  }
+  for (int sv = 1; sv <= 32; ++sv)
+    quarantined[static_cast<std::size_t>(sv)] = this->quarantined(sv);
   slots_ = {};
   slots_used_ = 0;
   slot_of_sv_ = {};
@@ -70,11 +68,20 @@ void GlrWindow::reset() {
   }
 }
 
-void GlrWindow::claimSlot(int slot, int sv_id) {
-  slots_[static_cast<std::size_t>(slot)] = Slot{};
-  slots_[static_cast<std::size_t>(slot)].sv_id = sv_id;
-  slots_[static_cast<std::size_t>(slot)].last_seen = epochs_;
-  slot_of_sv_[static_cast<std::size_t>(sv_id)] = slot + 1;
+void GlrWindow::claimSlot(int slot, int sv_id, std::int64_t receiver) {
+  Slot& claimed = slots_[static_cast<std::size_t>(slot)];
+  const Slot old = claimed;
+  if (old.sv_id > 0 && old.receiver == GlrHypothesis::kEveryReceiver)
+    slot_of_sv_[static_cast<std::size_t>(old.sv_id)] = 0;
+  // A receiver's slot of a quarantined satellite is quarantined with it.
+  const bool quarantined = this->quarantined(sv_id);
+  claimed = Slot{};
+  claimed.sv_id = sv_id;
+  claimed.receiver = receiver;
+  claimed.last_seen = epochs_;
+  claimed.quarantined = quarantined;
+  if (receiver == GlrHypothesis::kEveryReceiver)
+    slot_of_sv_[static_cast<std::size_t>(sv_id)] = slot + 1;
   // A new satellite has no signature yet at any onset (its two propagated columns are
   // adjacent, so their blocks are too).
   mu_.middleCols(firstColumn(muColumn(slot, 0)), 2 * config_.window).setZero();
@@ -85,13 +92,15 @@ void GlrWindow::claimSlot(int slot, int sv_id) {
 
 void GlrWindow::setQuarantined(int sv_id, bool quarantined) {
   if (sv_id < 1 || sv_id > 32) return;
-  int slot = slot_of_sv_[static_cast<std::size_t>(sv_id)] - 1;
-  if (slot < 0) {
-    if (!quarantined || slots_used_ >= kMaxSatellites) return;
-    slot = slots_used_++;
-    claimSlot(slot, sv_id);
+  if (slot_of_sv_[static_cast<std::size_t>(sv_id)] == 0) {
+    if (!quarantined || slots_used_ >= slot_capacity_) return;
+    claimSlot(slots_used_++, sv_id, GlrHypothesis::kEveryReceiver);
   }
-  slots_[static_cast<std::size_t>(slot)].quarantined = quarantined;
+  // The satellite's own slot and its receivers' slots.
+  for (int s = 0; s < slots_used_; ++s) {
+    Slot& slot = slots_[static_cast<std::size_t>(s)];
+    if (slot.sv_id == sv_id) slot.quarantined = quarantined;
+  }
 }
 
 bool GlrWindow::quarantined(int sv_id) const {
@@ -144,9 +153,51 @@ bool GlrWindow::update(const GlrEpoch& e) {
   return true;
 }
 
-int GlrWindow::slotOf(int sv_id) const {
+int GlrWindow::slotOf(int sv_id, std::int64_t receiver) const {
   if (sv_id < 1 || sv_id > 32) return -1;
-  return slot_of_sv_[static_cast<std::size_t>(sv_id)] - 1;
+  if (receiver == GlrHypothesis::kEveryReceiver)
+    return slot_of_sv_[static_cast<std::size_t>(sv_id)] - 1;
+  for (int s = 0; s < slots_used_; ++s) {
+    const Slot& slot = slots_[static_cast<std::size_t>(s)];
+    if (slot.sv_id == sv_id && slot.receiver == receiver) return s;
+  }
+  return -1;
+}
+
+GlrHypothesis GlrWindow::hypothesis(int slot, int direction) const {
+  const Slot& s = slots_[static_cast<std::size_t>(slot)];
+  const GlrFault fault = direction == kRangeStep   ? GlrFault::kRangeStep
+                         : direction == kRangeRamp ? GlrFault::kRangeRamp
+                                                   : GlrFault::kRateStep;
+  return {fault, 0, s.sv_id, s.receiver};
+}
+
+bool GlrWindow::perReceiverSlots(const GlrEpoch& e) const {
+  if (!config_.per_receiver_satellites) return false;
+  for (int r = 1; r < e.rows; ++r) {
+    if (e.receiver[static_cast<std::size_t>(r)] != e.receiver[0]) return true;
+  }
+  return false;
+}
+
+int GlrWindow::slotFor(int sv_id, std::int64_t receiver) {
+  int slot = slotOf(sv_id, receiver);
+  if (slot >= 0) return slot;
+  // A slot whose satellite has not been seen for a whole window carries no signature any more
+  // (every onset that saw it has left the window): reuse it.
+  for (int s = 0; s < slots_used_ && slot < 0; ++s) {
+    const Slot& old = slots_[static_cast<std::size_t>(s)];
+    if (!old.quarantined && epochs_ - old.last_seen > static_cast<std::uint64_t>(config_.window))
+      slot = s;
+  }
+  if (slot < 0) {
+    // Cannot happen with <= kMaxSatellites satellites (and as many receiver-satellite
+    // observations) per epoch.
+    if (slots_used_ >= slot_capacity_) return -1;
+    slot = slots_used_++;
+  }
+  claimSlot(slot, sv_id, receiver);
+  return slot;
 }
 
 void GlrWindow::assignSlots(const GlrEpoch& e) {
@@ -156,30 +207,18 @@ void GlrWindow::assignSlots(const GlrEpoch& e) {
     slot.prev_rate = slot.rate;
     slot.range = slot.rate = Rows{};
   }
-  for (int r = 0; r < e.rows; ++r) {
-    const int sv = e.sv_id[static_cast<std::size_t>(r)];
-    int slot = slot_of_sv_[static_cast<std::size_t>(sv)] - 1;
-    if (slot < 0) {
-      // A slot whose satellite has not been seen for a whole window carries no signature
-      // any more (every onset that saw it has left the window): reuse it.
-      for (int s = 0; s < slots_used_ && slot < 0; ++s) {
-        const Slot& old = slots_[static_cast<std::size_t>(s)];
-        if (!old.quarantined &&
-            epochs_ - old.last_seen > static_cast<std::uint64_t>(config_.window))
-          slot = s;
-      }
-      if (slot < 0) {
-        if (slots_used_ >= kMaxSatellites) continue;  // cannot happen with <= 24 per epoch
-        slot = slots_used_++;
-      } else {
-        slot_of_sv_[static_cast<std::size_t>(slots_[static_cast<std::size_t>(slot)].sv_id)] = 0;
-      }
-      claimSlot(slot, sv);
-    }
+  const bool per_receiver = perReceiverSlots(e);
+  auto assign = [&](int slot, int r) {
+    if (slot < 0) return;
     Slot& s = slots_[static_cast<std::size_t>(slot)];
     s.last_seen = epochs_;
     Rows& rows = e.is_rate[static_cast<std::size_t>(r)] ? s.rate : s.range;
     rows.row[static_cast<std::size_t>(rows.count++)] = r;  // accepts() bounds the count
+  };
+  for (int r = 0; r < e.rows; ++r) {
+    const int sv = e.sv_id[static_cast<std::size_t>(r)];
+    assign(slotFor(sv, GlrHypothesis::kEveryReceiver), r);
+    if (per_receiver) assign(slotFor(sv, e.receiver[static_cast<std::size_t>(r)]), r);
   }
 }
 
@@ -473,7 +512,7 @@ int GlrWindow::onsetIndex(int age) const {
 GlrWindow::OnsetView GlrWindow::onset(int age) const {
   const int ring = onsetIndex(age);
   return {onsets_[static_cast<std::size_t>(ring)].ramp_start_ns,
-          Eigen::Map<const Eigen::Matrix<double, kMaxDirections, 1>>(f_.col(ring).data()),
+          Eigen::Map<const Eigen::VectorXd>(f_.col(ring).data(), f_.rows()),
           Eigen::Map<const Eigen::Matrix<double, kImuDirections, kImuDirections>>(
               r_imu_.col(ring).data()),
           r_sat_.col(ring).data()};
@@ -521,16 +560,12 @@ void GlrWindow::positionSignatures(std::vector<PositionSignature>& out) const {
       const Eigen::Vector3d step = after(step_first + ring, kStepInput, slot.range);
       ramp += spacing_s_[ring] * step;
       if (config_.range_steps)
-        out.push_back(
-            {{GlrFault::kRangeStep, 0, slot.sv_id}, age, step, r(kRangeStep, kRangeStep)});
+        out.push_back({hypothesis(s, kRangeStep), age, step, r(kRangeStep, kRangeStep)});
       if (config_.range_ramps)
-        out.push_back(
-            {{GlrFault::kRangeRamp, 0, slot.sv_id}, age, ramp, r(kRangeRamp, kRangeRamp)});
+        out.push_back({hypothesis(s, kRangeRamp), age, ramp, r(kRangeRamp, kRangeRamp)});
       if (config_.rate_steps)
-        out.push_back({{GlrFault::kRateStep, 0, slot.sv_id},
-                       age,
-                       after(rate_first + ring, kStepInput, slot.rate),
-                       r(kRateStep, kRateStep)});
+        out.push_back({hypothesis(s, kRateStep), age,
+                       after(rate_first + ring, kStepInput, slot.rate), r(kRateStep, kRateStep)});
     }
   }
 }

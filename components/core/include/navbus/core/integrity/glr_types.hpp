@@ -20,12 +20,23 @@ namespace glr {
 inline constexpr int kStates = layout::kSize;
 inline constexpr int kMaxSatellites = kMaxEpochSatellites;
 inline constexpr int kMaxRows = 2 * kMaxSatellites;
+/// Satellite slots: one per satellite (its own fault, in every fused receiver's rows) and, with
+/// several fused receivers and GlrConfig::per_receiver_satellites, one per satellite a receiver
+/// tracks (a fault in that receiver's rows only: multipath, a spoofed channel). A stacked epoch
+/// holds at most kMaxSatellites receiver-satellite observations.
+inline constexpr int kMaxSlots = 2 * kMaxSatellites;
 inline constexpr int kImuDirections = 6;  ///< accelerometer x y z, gyro x y z
 inline constexpr int kSatDirections = 3;  ///< pseudorange step, pseudorange ramp, rate step
-inline constexpr int kMaxDirections = kImuDirections + kSatDirections * kMaxSatellites;
-/// Signature columns propagated: the IMU steps and each satellite's pseudorange and rate steps
-/// (ramps are sums of steps, see glr.cpp).
-inline constexpr int kMaxPropagated = kImuDirections + 2 * kMaxSatellites;
+/// Directions and propagated signature columns with `slots` satellite slots: the IMU steps and
+/// each slot's three directions; propagated, each slot's pseudorange and rate steps (ramps are
+/// sums of steps, see glr_window.cpp).
+constexpr int directions(int slots) {
+  return kImuDirections + kSatDirections * slots;
+}
+constexpr int propagated(int slots) {
+  return kImuDirections + 2 * slots;
+}
+inline constexpr int kMaxDirections = directions(kMaxSlots);
 inline constexpr int kMaxWindow = 100;  ///< largest configurable window M [epochs]
 /// The states pseudorange and rate rows measure: position, velocity and attitude (the first
 /// nine; attitude through the antenna's lever arm, gnss_measurement.hpp), the clock bias and
@@ -64,9 +75,14 @@ enum class GlrFault { kAccelStep, kGyroStep, kRangeStep, kRangeRamp, kRateStep }
 
 /// One direction T: what is faulty and how.
 struct GlrHypothesis {
+  /// receiver: the fault is in every fused receiver's measurements of the satellite.
+  static constexpr std::int64_t kEveryReceiver = -1;
   GlrFault fault{GlrFault::kAccelStep};
   int axis{0};   ///< body axis 0..2 for IMU faults
   int sv_id{0};  ///< satellite for measurement faults
+  /// For measurement faults: the one receiver (GlrEpoch::receiver) whose measurements of sv_id
+  /// are faulty, or kEveryReceiver (the satellite's own fault).
+  std::int64_t receiver{kEveryReceiver};
   bool isImu() const { return fault == GlrFault::kAccelStep || fault == GlrFault::kGyroStep; }
 };
 
@@ -89,7 +105,17 @@ struct GlrConfig {
   bool range_steps{true};
   bool range_ramps{true};
   bool rate_steps{true};
+  /// With several fused receivers: beside each satellite's own fault, a fault in one receiver's
+  /// measurements of it (each direction above per receiver-satellite pair). Without it a
+  /// one-receiver error is fitted by the satellite's every-receiver directions or an IMU one.
+  /// Doubles the satellite slots the window is sized for (memory and cost of a fused filter).
+  bool per_receiver_satellites{false};
 };
+
+/// Satellite slots a window of this configuration holds.
+constexpr int glrSlotCapacity(const GlrConfig& config) {
+  return config.per_receiver_satellites ? glr::kMaxSlots : glr::kMaxSatellites;
+}
 
 /// One measurement epoch of the monitored filter, SI units, rows in the filter's order.
 struct GlrEpoch {
@@ -97,10 +123,13 @@ struct GlrEpoch {
   int rows{0};
   std::array<int, glr::kMaxRows> sv_id{};
   std::array<bool, glr::kMaxRows> is_rate{};  ///< false: pseudorange row
-  glr::RowVector innovation;                  ///< eps = predicted - measured [m, m/s]
-  glr::RowMatrix innovation_cov;              ///< V = H P- H^T + R
-  glr::HMatrix h;                             ///< rows x n
-  glr::KMatrix k;  ///< n x rows: the gain applied (0 columns for unused rows)
+  /// The receiver of each row (any key: the filter's receiver index, a receiver id); rows of
+  /// one satellite with different keys are different receivers' measurements of it.
+  std::array<std::int64_t, glr::kMaxRows> receiver{};
+  glr::RowVector innovation;      ///< eps = predicted - measured [m, m/s]
+  glr::RowMatrix innovation_cov;  ///< V = H P- H^T + R
+  glr::HMatrix h;                 ///< rows x n
+  glr::KMatrix k;                 ///< n x rows: the gain applied (0 columns for unused rows)
   StateMatrix phi{StateMatrix::Identity()};  ///< transition from the previous epoch to this one
 };
 

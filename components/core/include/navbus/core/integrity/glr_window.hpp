@@ -25,8 +25,8 @@ class GlrWindow {
  public:
   /// f (eq. 9) and R (eq. 10) of one onset, read from the per-onset columns.
   struct OnsetView {
-    std::int64_t ramp_start_ns;  ///< epoch theta - 1: the fault began after it
-    Eigen::Map<const Eigen::Matrix<double, glr::kMaxDirections, 1>> f;
+    std::int64_t ramp_start_ns;           ///< epoch theta - 1: the fault began after it
+    Eigen::Map<const Eigen::VectorXd> f;  ///< glr::directions(slot capacity) entries
     Eigen::Map<const Eigen::Matrix<double, glr::kImuDirections, glr::kImuDirections>> r_imu;
     const double* r_sat;
     Eigen::Map<const Eigen::Matrix3d> rSat(int slot) const {
@@ -43,9 +43,11 @@ class GlrWindow {
     const int* begin() const { return row.data(); }
     const int* end() const { return row.data() + count; }
   };
-  /// A satellite's place in f, R and the signatures.
+  /// A satellite's place in f, R and the signatures: its own fault (every receiver's rows of
+  /// it) or, with per-receiver hypotheses, one receiver's rows of it.
   struct Slot {
     int sv_id{0};
+    std::int64_t receiver{GlrHypothesis::kEveryReceiver};  ///< whose rows (GlrEpoch::receiver)
     std::uint64_t last_seen{0};
     Rows range, rate;            ///< rows this epoch (none if absent)
     Rows prev_range, prev_rate;  ///< rows at the previous epoch
@@ -83,15 +85,18 @@ class GlrWindow {
   OnsetView onset(int age) const;
   int slotsUsed() const { return slots_used_; }
   const Slot& slot(int s) const { return slots_[static_cast<std::size_t>(s)]; }
-  /// The slot of a satellite, -1 if it has none.
-  int slotOf(int sv_id) const;
+  /// The slot of a satellite's own fault or (receiver) of one receiver's rows of it, -1 if
+  /// there is none.
+  int slotOf(int sv_id, std::int64_t receiver = GlrHypothesis::kEveryReceiver) const;
+  /// The hypothesis of a slot's direction (kRangeStep, kRangeRamp or kRateStep).
+  GlrHypothesis hypothesis(int slot, int direction) const;
 
   /// A quarantined satellite keeps its slot (its sums go on) across resets.
   void setQuarantined(int sv_id, bool quarantined);
   bool quarantined(int sv_id) const;
 
   /// Every enabled direction at every onset, after update(); `out` is cleared and refilled
-  /// (no allocation once its capacity suffices: kMaxDirections * window). Quarantined
+  /// (no allocation once its capacity suffices: glr::kMaxDirections * window). Quarantined
   /// satellites are left out (they cannot raise a detection).
   void positionSignatures(std::vector<PositionSignature>& out) const;
 
@@ -106,10 +111,16 @@ class GlrWindow {
   /// A block of mu_ / z_: one signature column c for every ring position.
   int firstColumn(int c) const { return c * config_.window; }
   int onsetIndex(int age) const;
-  int propagatedColumns() const { return glr::kImuDirections + 2 * slots_used_; }
+  int propagatedColumns() const { return glr::propagated(slots_used_); }
 
   void assignSlots(const GlrEpoch& e);
-  void claimSlot(int slot, int sv_id);
+  /// The slot of (sv, receiver), claimed if it has none: a free one or one whose satellite has
+  /// not been seen for a whole window; -1 when every slot is taken.
+  int slotFor(int sv_id, std::int64_t receiver);
+  void claimSlot(int slot, int sv_id, std::int64_t receiver);
+  /// Whether this epoch's rows come from more than one receiver and the configuration asks
+  /// for per-receiver hypotheses.
+  bool perReceiverSlots(const GlrEpoch& e) const;
   void prepareEpoch(const GlrEpoch& e);
   /// Adds to the live rows every state this epoch's recursion can make nonzero (see live_).
   void growLive(const GlrEpoch& e);
@@ -135,9 +146,10 @@ class GlrWindow {
   std::vector<Onset> onsets_;  ///< ring buffer, capacity window
   int onset_head_{0};          ///< index of the oldest onset
   int onset_count_{0};
-  std::array<Slot, glr::kMaxSatellites> slots_{};
+  std::array<Slot, glr::kMaxSlots> slots_{};
   int slots_used_{0};
-  std::array<int, 33> slot_of_sv_{};  ///< PRN 1..32 -> slot + 1 (0: none)
+  int slot_capacity_{glr::kMaxSatellites};  ///< kMaxSlots with per-receiver hypotheses
+  std::array<int, 33> slot_of_sv_{};        ///< PRN 1..32 -> slot of its own fault + 1 (0: none)
 
   // Signatures of every onset in one matrix, so that one product propagates them all: column
   // c (an IMU step or a satellite's range or rate step, see muColumn) of the onset at ring
@@ -161,11 +173,11 @@ class GlrWindow {
   OnsetArray spacing_s_;  ///< t_theta - t_{theta-1} of each ring position [s]
   // Sums of eqs. 9-10, one column per ring position: f per direction, the IMU group's R (6 x 6,
   // column-major) and each satellite slot's R (3 x 3, column-major, slot after slot).
-  Eigen::Matrix<double, glr::kMaxDirections, Eigen::Dynamic> f_;
+  // Sized for the slot capacity in configure() (a one-receiver filter's window stays small:
+  // it is copied into every snapshot of the filter's recovery history).
+  Eigen::MatrixXd f_;
   Eigen::Matrix<double, glr::kImuDirections * glr::kImuDirections, Eigen::Dynamic> r_imu_;
-  Eigen::Matrix<double, glr::kSatDirections * glr::kSatDirections * glr::kMaxSatellites,
-                Eigen::Dynamic>
-      r_sat_;
+  Eigen::MatrixXd r_sat_;
 
   // Per-epoch quantities (current epoch k) and what the recursion keeps of epoch k-1.
   bool have_previous_{false};
