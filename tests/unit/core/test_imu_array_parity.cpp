@@ -105,6 +105,32 @@ TEST(ImuArrayParity, WithoutTheLeverArmsTheRotationAlarmsTheAccelerometers) {
   EXPECT_GE(firstDetection(array, body, 4000, ImuInstrument::kAccelerometer), 1000);
 }
 
+TEST(ImuArrayParity, TheLeverArmTermCarriesTheGyrosNoiseIntoTheAccelerometersSigmas) {
+  // Given MEMS units (0.228 deg/sqrt(h), 70 ug/sqrt(Hz)) 0.5 m apart on the turning body, the
+  // lever-arm term's first difference of the noisy rate adds about 4 times the accelerometers'
+  // own noise to the units off the origin; when the array runs 20000 fault-free samples after
+  // learning, then the accelerometers do not alarm (their sigmas include that noise), and an
+  // off-origin unit's minimum detectable bias is larger than with the units together.
+  auto units = triplexUnits();
+  for (int u = 0; u < 3; ++u) {
+    units[static_cast<std::size_t>(u)].gyro_sigma_rad =
+        0.228 * nu::kDeg / 60.0 * std::sqrt(kArrayDt);
+    units[static_cast<std::size_t>(u)].accel_sigma_mps = 70.0 * nu::kMicroG * std::sqrt(kArrayDt);
+    units[static_cast<std::size_t>(u)].lever_arm_b_m =
+        Eigen::Vector3d(0.5 * (u == 1) - 0.5 * (u == 2), 0, 0);
+  }
+  ImuArrayParity array = makeArray(units);
+  RotatingBody body(units);
+  for (int i = 0; i < 1000; ++i) array.update(body.next());
+  EXPECT_EQ(firstDetection(array, body, 20000, ImuInstrument::kAccelerometer), -1);
+  auto together = units;
+  for (auto& u : together) u.lever_arm_b_m.setZero();
+  const double apart = array.minimumDetectableBias(ImuInstrument::kAccelerometer, 1, 1);
+  const double close =
+      makeArray(together).minimumDetectableBias(ImuInstrument::kAccelerometer, 1, 1);
+  EXPECT_GT(apart, 1.3 * close) << "0.5 m apart " << apart << ", together " << close;
+}
+
 TEST(ImuArrayParity, RefusesArraysItCannotMonitorNamingTheField) {
   std::string error;
   auto units = triplexUnits();

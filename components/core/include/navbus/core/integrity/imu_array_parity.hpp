@@ -112,6 +112,8 @@ class ImuArrayParity {
   /// (Re)builds the channel's space from its rows; false (with `error`) when it has no parity
   /// or the GLR configuration is out of range.
   bool build(ImuInstrument kind, std::string& error);
+  /// An accelerometer's noise per sample with what the lever-arm term adds (see the .cpp).
+  double accelerometerSigma(const ImuArrayUnit& unit, const Eigen::Vector3d& axis_b) const;
   void fillGyro(const std::array<ImuIncrement, kMaxUnits>& increments);
   void fillAccelerometer(const std::array<ImuIncrement, kMaxUnits>& increments);
   /// Learns or tracks the reference and runs the test of one kind.

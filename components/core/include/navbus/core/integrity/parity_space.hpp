@@ -68,6 +68,10 @@ class ParitySpace {
   /// x^ = (H^T W^2 H)^-1 H^T W^2 m: every instrument, weighted by 1 / sigma^2 (with one common
   /// unknown: x[0], the rest 0).
   Eigen::Vector3d estimate(const parity::Measurements& m) const { return estimator_ * m; }
+  /// The covariance of estimate() from the instruments' noise, (H^T W^2 H)^-1.
+  Eigen::Matrix3d estimateCovariance() const {
+    return estimator_ * sigmas_.cwiseAbs2().asDiagonal() * estimator_.transpose();
+  }
 
  private:
   ParitySpace() = default;
