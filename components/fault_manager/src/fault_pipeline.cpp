@@ -226,12 +226,12 @@ void FaultPipeline::reportProgress(const navbus::FilterDiagnostics& judged) {
   sinks_.progress(p);
 }
 
+void FaultPipeline::satelliteKeptOut(int sv_id) {
+  // The GLR's epochs lose it too: a filter fusing both receivers still monitors its rows.
+  glr_.keepOut(sv_id);
+}
+
 std::uint32_t FaultPipeline::decide(navbus::FaultDecision& d) {
-  // A satellite the cross-receiver test excludes (from both receivers: which one saw it wrong
-  // is unknown) leaves the GLR too: a filter fusing both receivers still monitors its rows.
-  if (d.detector() == ReceiverDetector::kDetectorName && d.source() == navbus::SOURCE_SATELLITE &&
-      d.event() == navbus::EVENT_FAULT_DETECTED)
-    glr_.keepOut(d.sv_id());
   d.decision_id(next_decision_id_++);
   d.run_id(run_id_);
   if (sinks_.decision) sinks_.decision(d);

@@ -265,6 +265,7 @@ void ReceiverDetector::reportSatellite(std::int64_t time_ns, std::size_t r,
   c.sv_id(static_cast<std::uint16_t>(p.sv_id));
   c.scope(navbus::SCOPE_ALL);
   out.command(c);
+  out.satelliteKeptOut(p.sv_id);
   spdlog::warn(
       "decision {}: sv {} differs between receivers {} and {} by {:.4g} m (+- {:.2g}){}, l {:.4g} "
       ">= h {:.4g}",

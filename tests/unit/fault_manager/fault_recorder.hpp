@@ -17,8 +17,10 @@ class Recorder : public FaultOutput {
     return d.decision_id();
   }
   void command(navbus::FilterCommand& c) override { commands.push_back(c); }
+  void satelliteKeptOut(int sv_id) override { kept_out.push_back(sv_id); }
   std::vector<navbus::FaultDecision> decisions;
   std::vector<navbus::FilterCommand> commands;
+  std::vector<int> kept_out;
 };
 
 }  // namespace navbus::fault_manager::test

@@ -30,9 +30,10 @@ receivers:
 
 using Recorder = fm::test::Recorder;
 
-/// Receiver `id`'s epoch at second t: five satellites, 3 m noise, its clock (+ `jump_m`).
+/// Receiver `id`'s epoch at second t: five satellites, 3 m noise, its clock (+ `jump_m`), and
+/// satellite `long_sv` `long_m` long.
 navbus::GnssObservationEpoch epoch(std::uint32_t id, int t, std::mt19937_64& rng,
-                                   double jump_m = 0.0) {
+                                   double jump_m = 0.0, int long_sv = 0, double long_m = 0.0) {
   const nc::earth::Geodetic p{0.637, 2.225, 1000.0};
   const Eigen::Vector3d rx = nc::earth::geodeticToEcef(p);
   const Eigen::Matrix3d C_n_e = nc::earth::C_n_e(p.latitude_rad, p.longitude_rad);
@@ -51,7 +52,7 @@ navbus::GnssObservationEpoch epoch(std::uint32_t id, int t, std::mt19937_64& rng
                  2.02e7;
     navbus::GnssSatelliteMeasurement m;
     m.sv_id(static_cast<std::uint16_t>(k + 1));
-    m.pseudorange_m((sat - rx).norm() + clock + noise(rng));
+    m.pseudorange_m((sat - rx).norm() + clock + noise(rng) + (k + 1 == long_sv ? long_m : 0.0));
     m.pseudorange_rate_mps(0.0);
     for (int i = 0; i < 3; ++i) m.sat_pos_ecef_m()[static_cast<std::size_t>(i)] = sat[i];
     m.pseudorange_sigma_m(3.0);
@@ -128,6 +129,33 @@ TEST(ReceiverDetector, AlignsABacklogOfOneReceiverBeforeTheOtherAndNamesAClockJu
   EXPECT_GT(cmd.bias_sigma(), 0.5);
   EXPECT_LT(cmd.bias_sigma(), 30.0);
   EXPECT_EQ(detector.testedUpToNs(), 1400000299000000000);
+  EXPECT_TRUE(out.kept_out.empty()) << "a clock jump keeps no satellite out";
+}
+
+TEST(ReceiverDetector, ASatelliteOneReceiverMeasuresWrongIsExcludedFromBothAndKeptOutOfTheGlr) {
+  // Given two receivers, when receiver 2's satellite 3 reads 100 m long from second 100, then
+  // the one decision names satellite 3 (ambiguous between the receivers: two cannot say whose
+  // measurement is wrong), its command excludes it from every receiver, and the detector tells
+  // the pipeline to keep it out of the other tests (the GLR of a filter fusing both receivers).
+  const fm::FaultManagerConfig config = fm::parseFaultManagerConfig(YAML::Load(kTwoReceivers));
+  fm::ReceiverDetector detector(config.receivers);
+  Recorder out;
+  std::mt19937_64 rng(7);
+  for (int t = 0; t < 200; ++t) {
+    detector.onEpoch(epoch(1, t, rng), out);
+    detector.onEpoch(epoch(2, t, rng, 0.0, 3, t >= 100 ? 100.0 : 0.0), out);
+  }
+  ASSERT_EQ(out.decisions.size(), 1u) << detector.summary();
+  const navbus::FaultDecision& d = out.decisions[0];
+  EXPECT_EQ(d.source(), navbus::SOURCE_SATELLITE);
+  EXPECT_EQ(d.sv_id(), 3u);
+  EXPECT_TRUE(d.ambiguous());
+  EXPECT_GE(d.time_gps_ns(), 1400000100000000000ull);
+  EXPECT_LT(d.time_gps_ns(), 1400000110000000000ull);
+  ASSERT_EQ(out.commands.size(), 1u);
+  EXPECT_EQ(out.commands[0].kind(), navbus::CMD_EXCLUDE_SATELLITE);
+  EXPECT_EQ(out.commands[0].scope(), navbus::SCOPE_ALL);
+  EXPECT_EQ(out.kept_out, std::vector<int>{3});
 }
 
 TEST(ReceiverDetector, AReceiverGoneIsNotWaitedForBeyondItsLastEpochAndIsAgainWhenItReturns) {

@@ -15,6 +15,9 @@ class FaultOutput {
   virtual std::uint32_t decide(navbus::FaultDecision& d) = 0;
   /// Stamps command id, vehicle and issuer and publishes the command.
   virtual void command(navbus::FilterCommand& c) = 0;
+  /// A detector excluded satellite sv_id for good, from every receiver (the cross-receiver
+  /// test cannot say whose measurement was wrong): the other tests stop seeing it too.
+  virtual void satelliteKeptOut(int sv_id) = 0;
 };
 
 /// CMD_FAIL_SENSOR_AXIS for the sensor, unit and axis a published decision names (its id, time

@@ -105,6 +105,7 @@ class FaultPipeline : private FaultOutput {
  private:
   std::uint32_t decide(navbus::FaultDecision& d) override;
   void command(navbus::FilterCommand& c) override;
+  void satelliteKeptOut(int sv_id) override;
   void onWatchdogEvent(const WatchdogEvent& e);
   void reportProgress(const navbus::FilterDiagnostics& judged);
   /// A progress report when the cross-receiver test has judged further.
