@@ -80,7 +80,8 @@ class GlrMonitor {
   /// does to the position after the latest epoch's update (GlrWindow::PositionSignature).
   using PositionSignature = GlrWindow::PositionSignature;
   /// Every enabled direction at every onset, after update(); `out` is cleared and refilled
-  /// (no allocation once its capacity suffices: kMaxDirections * window). Quarantined
+  /// (no allocation once its capacity suffices: glr::directions(glrSlotCapacity(config())) x
+  /// window). Quarantined
   /// satellites are left out (they cannot raise a detection).
   void positionSignatures(std::vector<PositionSignature>& out) const {
     window_.positionSignatures(out);

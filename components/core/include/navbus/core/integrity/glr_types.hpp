@@ -36,7 +36,6 @@ constexpr int directions(int slots) {
 constexpr int propagated(int slots) {
   return kImuDirections + 2 * slots;
 }
-inline constexpr int kMaxDirections = directions(kMaxSlots);
 inline constexpr int kMaxWindow = 100;  ///< largest configurable window M [epochs]
 /// The states pseudorange and rate rows measure: position, velocity and attitude (the first
 /// nine; attitude through the antenna's lever arm, gnss_measurement.hpp), the clock bias and
@@ -60,7 +59,6 @@ using RowVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRows, 1>;
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, kMaxRows>;
 using HMatrix = Eigen::Matrix<double, Eigen::Dynamic, kStates, Eigen::RowMajor, kMaxRows, kStates>;
 using KMatrix = Eigen::Matrix<double, kStates, Eigen::Dynamic, 0, kStates, kMaxRows>;
-using DirectionVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDirections, 1>;
 /// A satellite's directions, in this order among its three entries of f and in its 3 x 3 R.
 inline constexpr int kRangeStep = 0;
 inline constexpr int kRangeRamp = 1;

@@ -96,7 +96,8 @@ class GlrWindow {
   bool quarantined(int sv_id) const;
 
   /// Every enabled direction at every onset, after update(); `out` is cleared and refilled
-  /// (no allocation once its capacity suffices: glr::kMaxDirections * window). Quarantined
+  /// (no allocation once its capacity suffices: glr::directions(glrSlotCapacity(config)) x
+  /// window). Quarantined
   /// satellites are left out (they cannot raise a detection).
   void positionSignatures(std::vector<PositionSignature>& out) const;
 
