@@ -415,6 +415,8 @@ void parseEkf(const YAML::Node& node, core::EngineConfig& e) {
       .number("initial_clock_bias_sigma_m", t.clock_bias_sigma_m, kAnyNonNegative)
       .number("initial_clock_drift_sigma_mps", t.clock_drift_sigma_mps, kAnyNonNegative)
       .number("gate_sigma", t.gate_sigma, kAnyNonNegative)
+      // The covariance propagated over up to this interval at once (0: every increment).
+      .number("covariance_period_s", t.covariance_period_s, {0.0, 1.0})
       // The IMU's scale-factor errors, states when their sigma is positive.
       .number("accel_scale_factor_sigma_ppm", t.accel_scale_sigma, {0.0, 1e5}, kPartsPerMillion)
       .number("gyro_scale_factor_sigma_ppm", t.gyro_scale_sigma, {0.0, 1e5}, kPartsPerMillion)

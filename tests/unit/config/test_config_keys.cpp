@@ -257,6 +257,22 @@ TEST_F(ConfigKeys, ScaleFactorSigmasAreInPartsPerMillionAndBounded) {
   EXPECT_NE(negative.find("-5"), std::string::npos) << negative;
 }
 
+TEST_F(ConfigKeys, TheCovariancePeriodIsInSecondsAndBounded) {
+  const auto with = [&](const std::string& name, const std::string& block) {
+    return write(name,
+                 "mode: loosely_coupled\ninputs: {imu: {id: 1, period_s: 0.005}, gnss_fix: "
+                 "{id: 1, period_s: 0.1}}\nekf: " +
+                     block + "\n");
+  };
+  const auto c = navbus::bus::parseFile(with("ok.yaml", "{covariance_period_s: 0.1}"), filter);
+  EXPECT_DOUBLE_EQ(c.engine.tuning.covariance_period_s, 0.1);
+  const auto off = navbus::bus::parseFile(with("off.yaml", "{}"), filter);
+  EXPECT_EQ(off.engine.tuning.covariance_period_s, 0.0);  // every increment, as before
+  const std::string long_period = errorOf(with("long.yaml", "{covariance_period_s: 2.5}"), filter);
+  EXPECT_NE(long_period.find("ekf.covariance_period_s"), std::string::npos) << long_period;
+  EXPECT_NE(long_period.find("2.5"), std::string::npos) << long_period;
+}
+
 TEST_F(ConfigKeys, ProtectionLevelsOnFixesNeedTheCentralizedFilter) {
   const auto with = [&](const std::string& name, const std::string& mode,
                         const std::string& fusion) {

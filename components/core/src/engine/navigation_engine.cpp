@@ -245,6 +245,7 @@ bool NavigationEngine::addImu(const ImuIncrement& raw) {
   }
   if (filter_->state().time_ns >= next_output_ns_) {
     next_output_ns_ = (filter_->state().time_ns / period + 1) * period;
+    filter_->settleCovariance();  // the solution's sigmas are of this time
     return true;
   }
   return false;
@@ -578,6 +579,7 @@ bool NavigationEngine::addGnssEpoch(std::int64_t time_ns,
     if (aligner_->aligned()) startFromAlignment();
     return false;
   }
+  filter_->settleCovariance();  // P_Q and the GLR's Phi are read around the update
   startReceiverClocks();
   const bool any = std::any_of(used_->begin(), used_->end(), [](const SatelliteObservation& o) {
     return o.use_range || o.use_rate;
@@ -742,6 +744,7 @@ void NavigationEngine::addGnssFix(const GnssFixMeasurement& fix) {
     return;
   }
   if (!filter_->initialized() || mode_ == EngineMode::kInertialLost) return;
+  filter_->settleCovariance();  // the fix's prior and the GLR's Phi are read before its update
   if ((status_ & kStatusReinitialising) != 0 && config_.aiding != AidingMode::kTightlyCoupled &&
       config_.aiding != AidingMode::kInertialOnly) {
     reinitialiseFromFix(fix);

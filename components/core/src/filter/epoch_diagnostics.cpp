@@ -1,8 +1,29 @@
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 
+#include <array>
+
 namespace navbus::core {
 
-void AppliedGain::compute(EpochDiagnostics& d, const StateMatrix& prior_P) {
+void AppliedGain::prepare(EpochDiagnostics& d, const StateMatrix& prior_P) {
+  const Eigen::Index m = d.h.rows();
+  std::array<Eigen::Index, layout::kSize> support{};
+  std::size_t n = 0;
+  for (Eigen::Index k = 0; k < layout::kSize; ++k) {
+    if (!d.h.col(k).isZero(0.0)) support[n++] = k;
+  }
+  hp_.setZero(m, layout::kSize);
+  for (std::size_t a = 0; a < n; ++a) {
+    const Eigen::Index k = support[a];
+    hp_.noalias() += d.h.col(k) * prior_P.row(k);
+  }
+  d.innovation_cov.setZero(m, m);
+  for (std::size_t a = 0; a < n; ++a) {
+    const Eigen::Index k = support[a];
+    d.innovation_cov.noalias() += hp_.col(k) * d.h.col(k).transpose();
+  }
+}
+
+void AppliedGain::compute(EpochDiagnostics& d) {
   const Eigen::Index m = d.h.rows();
   cov_ = d.innovation_cov;
   for (Eigen::Index i = 0; i < m; ++i) {
@@ -12,7 +33,7 @@ void AppliedGain::compute(EpochDiagnostics& d, const StateMatrix& prior_P) {
     cov_(i, i) = 1.0;
   }
   llt_.compute(cov_);
-  d.k = llt_.solve(d.h * prior_P).transpose();
+  d.k = llt_.solve(hp_).transpose();
   for (Eigen::Index i = 0; i < m; ++i) {
     if (!d.used[static_cast<std::size_t>(i)]) d.k.col(i).setZero();
   }
@@ -40,9 +61,10 @@ void fixEpochDiagnostics(const FixEpochInput& in, AppliedGain& gain, EpochDiagno
   for (int j = 0; j < layout::kSize; ++j) {
     if (!in.active[static_cast<std::size_t>(j)]) d.h.col(j).setZero();
   }
-  d.innovation_cov = d.h * *in.prior_P * d.h.transpose() + r;
+  gain.prepare(d, *in.prior_P);
+  d.innovation_cov += r;
   d.phi = *in.phi;
-  gain.compute(d, *in.prior_P);
+  gain.compute(d);
   for (int j = 0; j < layout::kSize; ++j) {
     if (!in.estimated[static_cast<std::size_t>(j)]) d.k.row(j).setZero();
   }

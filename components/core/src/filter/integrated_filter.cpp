@@ -64,6 +64,7 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
                                   double clock_drift_mps, const FilterTuning& tuning,
                                   const StateMask& active, FusionStructure structure,
                                   const StateMatrix& initial_covariance) {
+  pending_.clear();  // what was gathered belongs to the previous run
   tuning_ = tuning;
   ins_ = StrapdownNed(tuning.gravity);
   ins_.initialize(state);
@@ -93,6 +94,7 @@ void IntegratedFilter::initialize(const NavState& state, double clock_bias_m,
 }
 
 void IntegratedFilter::setStructure(FusionStructure s) {
+  settleCovariance();
   if (s == FusionStructure::kFederated && structure_ != FusionStructure::kFederated) {
     // The locals start from the current estimate with 1/share of its information each; their
     // fusion gives back the current covariance.
@@ -113,19 +115,28 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
   const double dt = inc.interval_s;
   // F at the state at the start of the interval (first-order hold of the error dynamics).
   const earth::LocalEarth at_state = ins_.earthAtState();
-  StateMatrix Phi = transitionMatrix(
-      errorDynamics(ins_.state(), inc.delta_vel_b_mps / dt, inc.delta_angle_b_rad / dt, at_state),
-      dt);
+  const ErrorDynamicsBlocks F = errorDynamicsBlocks(ins_.state(), inc.delta_vel_b_mps / dt,
+                                                    inc.delta_angle_b_rad / dt, at_state);
   ins_.propagate(inc, at_state);
   for (std::size_t r = 0; r < clock_bias_m_.size(); ++r)
     clock_bias_m_[r] += clock_drift_mps_[r] * dt;
   if (suspend_filter) {
+    settleCovariance();            // the increments before this one
     smoothing_.continues = false;  // the covariance stood still: nothing to smooth across
     return;
   }
+  decayGaussMarkovEstimates(dt);
+  pending_.add(F, dt, processNoise(dt));
+  // Per increment with a smoothing log: the smoother's model is the increments' own.
+  if (smoothing_log_ != nullptr || pending_.duration_s() + 0.5 * dt >= tuning_.covariance_period_s)
+    settleCovariance();
+}
+
+StateVector IntegratedFilter::processNoise(double dt) const {
   // Discrete process noise: white specific force / rate noise into velocity / attitude
   // (isotropic, so the body-to-NED rotation drops out), clock random walks (seed 000 eq. 3),
-  // bias random walks (a failed axis's own walk replaces its bias's).
+  // bias random walks (a failed axis's own walk replaces its bias's). The Gauss-Markov states'
+  // (star-tracker bias, pseudorange and fix errors) come with their decay (settleCovariance).
   // The inertial part (white noises, bias walks) carries the adaptive process-noise scale.
   const double q_scale = process_noise_scale_;
   StateVector q = StateVector::Zero();
@@ -139,49 +150,11 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
     // Random constants with a random walk (layout::kMountingMisalignment).
     q.segment<3>(kMountingMisalignment.index)
         .setConstant(std::pow(tuning_.mounting_misalignment_rw_rad_per_sqrts, 2) * dt);
-  } else if (central_.active()[static_cast<std::size_t>(kStarTrackerBias.index)]) {
-    // First-order Gauss-Markov: decay exp(-dt / tau), driving noise that keeps the variance
-    // at sigma^2 (exact discretization). The estimate is the process's expected value and
-    // decays with it; held constant, its error would gain the unmodelled (1 - decay) b_est.
-    const double decay = std::exp(-dt / tuning_.star_tracker_bias_correlation_time_s);
-    const double sigma = tuning_.star_tracker_bias_sigma_rad;
-    star_tracker_bias_ *= decay;
-    for (int i = kStarTrackerBias.index; i < kStarTrackerBias.end(); ++i) {
-      Phi(i, i) = decay;
-      q[i] = sigma * sigma * (1.0 - decay * decay);
-    }
-  }
-  if (modelsPseudorangeErrors()) {
-    // Each satellite's pseudorange error: first-order Gauss-Markov, exactly discretized as the
-    // star-tracker bias above. A free state stays at the prior (variance sigma^2, estimate 0).
-    const double decay = std::exp(-dt / tuning_.pseudorange_error_correlation_time_s);
-    const double sigma = tuning_.pseudorange_error_sigma_m;
-    pseudorange_errors_.decay(decay);
-    const int end = kPseudorangeError.index + pseudorange_errors_.slotsInUse();
-    for (int i = kPseudorangeError.index; i < end; ++i) {
-      Phi(i, i) = decay;
-      q[i] = sigma * sigma * (1.0 - decay * decay);
-    }
-  }
-  if (modelsFixPositionError()) {
-    // The fix's position error per NED axis: first-order Gauss-Markov, exactly discretized as
-    // the star-tracker bias above.
-    const double decay = std::exp(-dt / tuning_.fix_position_error_correlation_time_s);
-    fix_position_error_ned_m_ *= decay;
-    const Eigen::Vector3d sigma(tuning_.fix_position_error_sigma_h_m,
-                                tuning_.fix_position_error_sigma_h_m,
-                                tuning_.fix_position_error_sigma_v_m);
-    for (int i = 0; i < 3; ++i) {
-      Phi(kFixPositionError.index + i, kFixPositionError.index + i) = decay;
-      q[kFixPositionError.index + i] = sigma[i] * sigma[i] * (1.0 - decay * decay);
-    }
   }
   if (second_clock_) {
     // The second receiver's oscillator: the first's random walks (seed 000 eq. 3).
     q[kSecondClockBias.index] = q[kClockBias.index];
     q[kSecondClockDrift.index] = q[kClockDrift.index];
-  } else {
-    Phi(kSecondClockBias.index, kSecondClockDrift.index) = 0.0;  // pseudorange-error states
   }
   for (int a = 0; a < 3; ++a) {
     q[kAccelBias.index + a] = std::pow(axis_failed_[static_cast<std::size_t>(a)]
@@ -195,6 +168,64 @@ void IntegratedFilter::propagate(const ImuIncrement& raw, bool suspend_filter) {
                                       2) *
                              dt * q_scale;
   }
+  return q;
+}
+
+bool IntegratedFilter::modelsStarTrackerBias() const {
+  return !modelsMountingMisalignment() &&
+         central_.active()[static_cast<std::size_t>(kStarTrackerBias.index)];
+}
+
+void IntegratedFilter::decayGaussMarkovEstimates(double dt) {
+  // Each estimate is its process's expected value and decays with it; held constant, its
+  // error would gain the unmodelled (1 - decay) b_est.
+  if (modelsStarTrackerBias())
+    star_tracker_bias_ *= std::exp(-dt / tuning_.star_tracker_bias_correlation_time_s);
+  if (modelsPseudorangeErrors())
+    pseudorange_errors_.decay(std::exp(-dt / tuning_.pseudorange_error_correlation_time_s));
+  if (modelsFixPositionError())
+    fix_position_error_ned_m_ *= std::exp(-dt / tuning_.fix_position_error_correlation_time_s);
+}
+
+void IntegratedFilter::settleCovariance() {
+  if (pending_.empty()) return;
+  StateMatrix Phi = pending_.transition();
+  StateVector q = pending_.processNoise();
+  // First-order Gauss-Markov states: decay exp(-T / tau), driving noise that keeps the variance
+  // at sigma^2 (exact discretization over the interval T).
+  const double T = pending_.duration_s();
+  const auto gaussMarkov = [&](int first, int end, double tau_s, const double* sigma) {
+    const double decay = std::exp(-T / tau_s);
+    for (int i = first; i < end; ++i) {
+      Phi(i, i) = decay;
+      q[i] = sigma[i - first] * sigma[i - first] * (1.0 - decay * decay);
+    }
+  };
+  if (modelsStarTrackerBias()) {
+    const double sigma[3] = {tuning_.star_tracker_bias_sigma_rad,
+                             tuning_.star_tracker_bias_sigma_rad,
+                             tuning_.star_tracker_bias_sigma_rad};
+    gaussMarkov(kStarTrackerBias.index, kStarTrackerBias.end(),
+                tuning_.star_tracker_bias_correlation_time_s, sigma);
+  }
+  if (modelsPseudorangeErrors()) {
+    // Each satellite's pseudorange error; a free state stays at the prior (variance sigma^2).
+    const int end = kPseudorangeError.index + pseudorange_errors_.slotsInUse();
+    for (int i = kPseudorangeError.index; i < end; ++i)
+      gaussMarkov(i, i + 1, tuning_.pseudorange_error_correlation_time_s,
+                  &tuning_.pseudorange_error_sigma_m);
+  }
+  if (modelsFixPositionError()) {
+    // The fix's position error per NED axis.
+    const double sigma[3] = {tuning_.fix_position_error_sigma_h_m,
+                             tuning_.fix_position_error_sigma_h_m,
+                             tuning_.fix_position_error_sigma_v_m};
+    gaussMarkov(kFixPositionError.index, kFixPositionError.end(),
+                tuning_.fix_position_error_correlation_time_s, sigma);
+  }
+  if (!second_clock_)
+    Phi(kSecondClockBias.index, kSecondClockDrift.index) = 0.0;  // pseudorange-error states
+  pending_.clear();
   if (structure_ == FusionStructure::kFederated) {
     for (ErrorState& l : local_) l.predict(Phi, q * tuning_.federated_share);
   }
@@ -225,6 +256,7 @@ void IntegratedFilter::recordForSmoothing() {
 }
 
 void IntegratedFilter::closeSmoothingRecord() {
+  settleCovariance();
   if (smoothing_log_ != nullptr && initialized() &&
       (smoothing_.updated || ins_.state().time_ns > smoothing_.last_record_ns))
     emitSmoothingRecord();
@@ -251,10 +283,12 @@ void IntegratedFilter::emitSmoothingRecord() {
 }
 
 void IntegratedFilter::trackProcessNoise(bool on) {
+  settleCovariance();
   central_.trackProcessNoise(on ? maskOf({kVel, kAtt, kAccelBias, kGyroBias}) : StateMask());
 }
 
 void IntegratedFilter::beginCovarianceJump() {
+  settleCovariance();
   // The updates already taken at this epoch stay before the jump: their record first.
   if (smoothing_log_ != nullptr && smoothing_.updated) emitSmoothingRecord();
 }
@@ -301,6 +335,7 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
 
 const std::vector<MeasurementReport>& IntegratedFilter::update(
     const std::vector<SatelliteObservation>& sats, const AntennaArms& antennas) {
+  settleCovariance();
   ErrorState& es = structure_ == FusionStructure::kFederated ? local_[kGnssLocal] : central_;
   const auto m = static_cast<Eigen::Index>(2 * sats.size());
   EpochDiagnostics& d = *last_epoch_;
@@ -339,10 +374,9 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
   }
   // Batch view from the prior covariance, published for the GLR; the update itself is
   // sequential (exact for the diagonal R) so that each row can be gated on its own.
-  d.innovation_cov = d.h * es.P() * d.h.transpose();
+  applied_gain_->prepare(d, es.P());
   d.innovation_cov.diagonal() += r;
   d.phi = phi_since_update_t_.transpose();
-  prior_P_ = es.P();
   std::vector<MeasurementReport>& reports = *reports_;
   reports.clear();
   for (Eigen::Index row = 0; row < m; ++row) {
@@ -367,7 +401,7 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
     reports.push_back({d.sv_ids[static_cast<std::size_t>(row)],
                        d.is_rate[static_cast<std::size_t>(row)], fuse, res});
   }
-  applied_gain_->compute(d, prior_P_);
+  applied_gain_->compute(d);
   closeUpdate();
   return reports;
 }
@@ -472,22 +506,26 @@ void IntegratedFilter::feedback(const StateVector& dx) {
 }
 
 void IntegratedFilter::setActive(const StateMask& active) {
+  settleCovariance();
   central_.setActive(active);
   for (ErrorState& l : local_) l.setActive(active);
 }
 
 void IntegratedFilter::setEstimated(const StateMask& estimated) {
+  settleCovariance();
   central_.setEstimated(estimated);
   for (ErrorState& l : local_) l.setEstimated(estimated);
 }
 
 void IntegratedFilter::zeroOffDiagonal() {
+  settleCovariance();
   breakSmoothing();  // no process noise gives it
   central_.zeroOffDiagonal();
   for (ErrorState& l : local_) l.zeroOffDiagonal();
 }
 
 void IntegratedFilter::setAxisFailed(bool accelerometer, int axis, bool failed) {
+  settleCovariance();
   bool& flag = axis_failed_[static_cast<std::size_t>((accelerometer ? 0 : 3) + axis)];
   if (failed && !flag) {
     const double sigma =
@@ -498,6 +536,7 @@ void IntegratedFilter::setAxisFailed(bool accelerometer, int axis, bool failed) 
 }
 
 void IntegratedFilter::addVariance(int state, double variance) {
+  settleCovariance();
   beginCovarianceJump();  // process noise of the smoother's model
   central_.P()(state, state) += variance;
   for (ErrorState& l : local_) l.P()(state, state) += variance * tuning_.federated_share;
@@ -506,6 +545,7 @@ void IntegratedFilter::addVariance(int state, double variance) {
 
 bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, double course_rad,
                                                 double speed_mps) {
+  settleCovariance();
   if (structure_ == FusionStructure::kFederated || speed_mps <= 0.0) return false;
   constexpr int kHeading = kAtt.index + 2;
   // z observes the cross-track velocity error; the heading follows through its correlation
@@ -539,6 +579,7 @@ bool IntegratedFilter::correctHeadingFromCourse(double z_rad, double sigma_rad, 
 }
 
 void IntegratedFilter::floorEarthRateRemainderVariance() {
+  settleCovariance();
   // The federated master is rebuilt from its locals at every update (and takes no course check).
   if (structure_ == FusionStructure::kFederated) return;
   StateMatrix& P = central_.P();
@@ -554,6 +595,7 @@ void IntegratedFilter::floorEarthRateRemainderVariance() {
 }
 
 void IntegratedFilter::floorGyrocompassHeadingVariance(double heading_sigma_rad) {
+  settleCovariance();
   if (structure_ == FusionStructure::kFederated) return;
   // At rest the heading and the east gyro bias are one observable (static_alignment.cpp step
   // 8: phi_D = -e_g^n_E / (W cos L) with the bias error e = -b), which gyrocompassing has read.
@@ -575,6 +617,7 @@ void IntegratedFilter::floorGyrocompassHeadingVariance(double heading_sigma_rad)
 }
 
 void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
+  settleCovariance();
   for (int i = block.index; i < block.end(); ++i) {
     const double v = central_.P()(i, i);
     if (v < sigma * sigma) addVariance(i, sigma * sigma - v);
@@ -582,6 +625,7 @@ void IntegratedFilter::inflateVariances(const StateBlock& block, double sigma) {
 }
 
 void IntegratedFilter::resetNavigation(const GnssFixMeasurement& fix) {
+  settleCovariance();
   breakSmoothing();  // what the filter knew of position and velocity is dropped
   NavState s = ins_.state();
   s.position = fix.position;
@@ -595,6 +639,7 @@ void IntegratedFilter::resetNavigation(const GnssFixMeasurement& fix) {
 
 void IntegratedFilter::resetClock(double bias_m, double drift_mps, double bias_sigma_m,
                                   double drift_sigma_mps, int receiver) {
+  settleCovariance();
   clock_bias_m_[slot(receiver)] = bias_m;
   clock_drift_mps_[slot(receiver)] = drift_mps;
   resetState(layout::clockBiasOf(receiver).index, bias_sigma_m);
@@ -602,16 +647,19 @@ void IntegratedFilter::resetClock(double bias_m, double drift_mps, double bias_s
 }
 
 void IntegratedFilter::modelSecondReceiverClock(bool on) {
+  settleCovariance();
   second_clock_ = on;
   pseudorange_errors_.leaveStatesToSecondClock(on);
 }
 
 void IntegratedFilter::shiftClock(double jump_m, double sigma_m, int receiver) {
+  settleCovariance();
   clock_bias_m_[slot(receiver)] += jump_m;
   if (sigma_m > 0.0) addVariance(layout::clockBiasOf(receiver).index, sigma_m * sigma_m);
 }
 
 void IntegratedFilter::resetState(int i, double sigma) {
+  settleCovariance();
   beginCovarianceJump();  // a fresh state: a zero row of Phi and the prior as process noise
   central_.resetState(i, sigma);
   for (ErrorState& l : local_) {  // a local filter that does not carry the state keeps 0
@@ -621,6 +669,7 @@ void IntegratedFilter::resetState(int i, double sigma) {
 }
 
 void IntegratedFilter::resetVariances(const StateBlock& block, double sigma) {
+  settleCovariance();
   breakSmoothing();  // variances set, correlations kept: no process noise gives it
   central_.setVariances(block, sigma);
   for (ErrorState& l : local_) l.setVariances(block, sigma * std::sqrt(tuning_.federated_share));

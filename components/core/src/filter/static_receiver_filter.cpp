@@ -63,10 +63,9 @@ const EpochDiagnostics& StaticReceiverFilter::update(
     r[i] = sat.pseudorange_sigma_m * sat.pseudorange_sigma_m;
     d.sv_ids.push_back(sat.sv_id);
   }
-  d.innovation_cov = d.h * error_.P() * d.h.transpose();
+  applied_gain_.prepare(d, error_.P());
   d.innovation_cov.diagonal() += r;
   d.phi = phi_;
-  prior_P_ = error_.P();
   for (Eigen::Index i = 0; i < m; ++i) {
     ScalarUpdateResult res;
     if (sats[static_cast<std::size_t>(i)].use_range) {
@@ -83,7 +82,7 @@ const EpochDiagnostics& StaticReceiverFilter::update(
     d.test_ratio.push_back(res.test_ratio);
     d.used.push_back(res.accepted);
   }
-  applied_gain_.compute(d, prior_P_);
+  applied_gain_.compute(d);
   feedback();
   phi_.setIdentity();
   return d;

@@ -14,7 +14,12 @@ StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
 
 StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
                           const Eigen::Vector3d& w_ib_b, const earth::LocalEarth& at_state) {
-  using namespace layout;
+  return errorDynamics(errorDynamicsBlocks(s, f_b, w_ib_b, at_state));
+}
+
+ErrorDynamicsBlocks errorDynamicsBlocks(const NavState& s, const Eigen::Vector3d& f_b,
+                                        const Eigen::Vector3d& w_ib_b,
+                                        const earth::LocalEarth& at_state) {
   const Eigen::Matrix3d C_b_n = s.q_b_to_n.toRotationMatrix();
   const Eigen::Vector3d f_n = C_b_n * f_b;
   const Eigen::Vector3d& w_ie = at_state.w_ie_ned;
@@ -50,32 +55,74 @@ StateMatrix errorDynamics(const NavState& s, const Eigen::Vector3d& f_b,
   dwen_dv(1, 0) = -1.0 / rm;
   dwen_dv(2, 1) = -tan_lat / rn;
 
-  StateMatrix F = StateMatrix::Zero();
+  ErrorDynamicsBlocks F;
   // Position (the curvilinear rates lat' = vN / rm, lon' = vE / (rn cos lat), h' = -vD, in the
   // metres above): dN' = dvN + (vN dD - vD dN) / rm,
   // dE' = dvE + vE tan(lat) dN / rm - (vD + vN tan(lat)) dE / rn + vE dD / rn, dD' = dvD.
-  F(kPos.index, kPos.index) = -v.z() / rm;
-  F(kPos.index, kPos.index + 2) = v.x() / rm;
-  F(kPos.index + 1, kPos.index) = v.y() * tan_lat / rm;
-  F(kPos.index + 1, kPos.index + 1) = -(v.z() + v.x() * tan_lat) / rn;
-  F(kPos.index + 1, kPos.index + 2) = v.y() / rn;
-  F.block<3, 3>(kPos.index, kVel.index) = Eigen::Matrix3d::Identity();
+  F.pos_pos.setZero();
+  F.pos_pos(0, 0) = -v.z() / rm;
+  F.pos_pos(0, 2) = v.x() / rm;
+  F.pos_pos(1, 0) = v.y() * tan_lat / rm;
+  F.pos_pos(1, 1) = -(v.z() + v.x() * tan_lat) / rn;
+  F.pos_pos(1, 2) = v.y() / rn;
   // Velocity, v' = C f - (2 w_ie + w_en) x v + g: the perturbation of the Coriolis and transport
   // term is -(2 w_ie + w_en) x dv + v x (2 dw_ie + dw_en).
-  F.block<3, 3>(kVel.index, kPos.index) = skew(v) * (2.0 * dwie_dr + dwen_dr);
-  F(kVel.index + 2, kPos.index + 2) += 2.0 * g / radius;  // gravity grows downwards
-  F.block<3, 3>(kVel.index, kVel.index) = -skew(2.0 * w_ie + w_en) + skew(v) * dwen_dv;
-  F.block<3, 3>(kVel.index, kAtt.index) = skew(f_n);
-  F.block<3, 3>(kVel.index, kAccelBias.index) = -C_b_n;
-  F.block<3, 3>(kVel.index, kAccelScale.index) = -C_b_n * f_b.asDiagonal();
+  F.vel_pos = skew(v) * (2.0 * dwie_dr + dwen_dr);
+  F.vel_pos(2, 2) += 2.0 * g / radius;  // gravity grows downwards
+  F.vel_vel = -skew(2.0 * w_ie + w_en) + skew(v) * dwen_dv;
+  F.vel_att = skew(f_n);
+  F.vel_accel_bias = -C_b_n;
+  F.vel_accel_scale = -C_b_n * f_b.asDiagonal();
   // Attitude, phi' = -w_in x phi + dw_in + C_b_n e_g.
-  F.block<3, 3>(kAtt.index, kPos.index) = dwie_dr + dwen_dr;
-  F.block<3, 3>(kAtt.index, kVel.index) = dwen_dv;
-  F.block<3, 3>(kAtt.index, kAtt.index) = -skew(w_ie + w_en);
-  F.block<3, 3>(kAtt.index, kGyroBias.index) = C_b_n;
-  F.block<3, 3>(kAtt.index, kGyroScale.index) = C_b_n * w_ib_b.asDiagonal();
-  F(kClockBias.index, kClockDrift.index) = 1.0;
-  F(kSecondClockBias.index, kSecondClockDrift.index) = 1.0;
+  F.att_pos = dwie_dr + dwen_dr;
+  F.att_vel = dwen_dv;
+  F.att_att = -skew(w_ie + w_en);
+  F.att_gyro_bias = C_b_n;
+  F.att_gyro_scale = C_b_n * w_ib_b.asDiagonal();
+  return F;
+}
+
+ErrorDynamicsBlocks& ErrorDynamicsBlocks::operator*=(double s) {
+  for (Eigen::Matrix3d* m :
+       {&pos_pos, &vel_pos, &vel_vel, &vel_att, &vel_accel_bias, &vel_accel_scale, &att_pos,
+        &att_vel, &att_att, &att_gyro_bias, &att_gyro_scale})
+    *m *= s;
+  constant *= s;
+  return *this;
+}
+
+void ErrorDynamicsBlocks::addScaled(const ErrorDynamicsBlocks& b, double s) {
+  pos_pos += s * b.pos_pos;
+  vel_pos += s * b.vel_pos;
+  vel_vel += s * b.vel_vel;
+  vel_att += s * b.vel_att;
+  vel_accel_bias += s * b.vel_accel_bias;
+  vel_accel_scale += s * b.vel_accel_scale;
+  att_pos += s * b.att_pos;
+  att_vel += s * b.att_vel;
+  att_att += s * b.att_att;
+  att_gyro_bias += s * b.att_gyro_bias;
+  att_gyro_scale += s * b.att_gyro_scale;
+  constant += s * b.constant;
+}
+
+StateMatrix errorDynamics(const ErrorDynamicsBlocks& b) {
+  using namespace layout;
+  StateMatrix F = StateMatrix::Zero();
+  F.block<3, 3>(kPos.index, kPos.index) = b.pos_pos;
+  F.block<3, 3>(kPos.index, kVel.index) = b.constant * Eigen::Matrix3d::Identity();
+  F.block<3, 3>(kVel.index, kPos.index) = b.vel_pos;
+  F.block<3, 3>(kVel.index, kVel.index) = b.vel_vel;
+  F.block<3, 3>(kVel.index, kAtt.index) = b.vel_att;
+  F.block<3, 3>(kVel.index, kAccelBias.index) = b.vel_accel_bias;
+  F.block<3, 3>(kVel.index, kAccelScale.index) = b.vel_accel_scale;
+  F.block<3, 3>(kAtt.index, kPos.index) = b.att_pos;
+  F.block<3, 3>(kAtt.index, kVel.index) = b.att_vel;
+  F.block<3, 3>(kAtt.index, kAtt.index) = b.att_att;
+  F.block<3, 3>(kAtt.index, kGyroBias.index) = b.att_gyro_bias;
+  F.block<3, 3>(kAtt.index, kGyroScale.index) = b.att_gyro_scale;
+  F(kClockBias.index, kClockDrift.index) = b.constant;
+  F(kSecondClockBias.index, kSecondClockDrift.index) = b.constant;
   return F;
 }
 

@@ -34,9 +34,15 @@ struct EpochDiagnostics {
 /// rows in V (identity block) gives it in one solve. Keeps its storage between epochs.
 class AppliedGain {
  public:
-  void compute(EpochDiagnostics& d, const StateMatrix& prior_P);
+  /// Before the epoch's updates: H P- (kept for compute()) and d.innovation_cov = H P- H^T
+  /// (R still to add), H = d.h. Both over H's support, the columns with a nonzero element (8
+  /// to 11 of the layout's 38 states for pseudoranges, more with their error states).
+  void prepare(EpochDiagnostics& d, const StateMatrix& prior_P);
+  /// After them: d.k from the prepared H P- and the rows the updates accepted (d.used).
+  void compute(EpochDiagnostics& d);
 
  private:
+  Eigen::MatrixXd hp_;  ///< H P-, m x n
   Eigen::MatrixXd cov_;
   /// Factorized once at construction (of nothing), so that every member is set: a default
   /// LLT leaves its status unset, which GCC reports when a filter is assigned.

@@ -35,6 +35,11 @@ struct FilterTuning {
   double accel_scale_sigma{0.0};  ///< 1 sigma [1] (1e-3: 1000 ppm)
   double gyro_scale_sigma{0.0};   ///< 1 sigma [1]
   double gate_sigma{5.0};         ///< innovation gate in standard deviations; <= 0: no gate
+  /// The longest interval one covariance propagation covers [s]: 0 propagates it with every
+  /// increment; a longer one gathers the increments' error dynamics and process noise until an
+  /// update, a solution epoch or the period's end needs it (propagation_interval.hpp). The
+  /// mechanization runs every increment either way.
+  double covariance_period_s{0.0};
   // Star-tracker bias (seed 001): a first-order Gauss-Markov rotation about each star-tracker
   // axis, modelled as the layout's kStarTrackerBias states when its sigma is positive (0: not
   // modelled, the states stay inactive).

@@ -23,6 +23,7 @@
 #include "navbus/core/filter/error_state.hpp"
 #include "navbus/core/filter/filter_tuning.hpp"
 #include "navbus/core/filter/innovation_window.hpp"
+#include "navbus/core/filter/propagation_interval.hpp"
 #include "navbus/core/filter/pseudorange_error_slots.hpp"
 #include "navbus/core/filter/rts_smoother.hpp"
 #include "navbus/core/gnss/gnss_measurement.hpp"
@@ -68,6 +69,14 @@ class IntegratedFilter {
   /// clock and, unless `suspend_filter` (the filter is not run: seed 004's case I during an
   /// outage), the covariance(s).
   void propagate(const ImuIncrement& raw, bool suspend_filter = false);
+  /// Applies the covariance propagation the increments since the last one gathered
+  /// (FilterTuning::covariance_period_s; nothing when none is pending). Every method that
+  /// reads or changes the covariance in here does it first; a caller that reads covariance(),
+  /// local(), transitionSinceUpdate() or processNoisePart() between increments calls it
+  /// before (the engine does at each solution epoch and measurement).
+  void settleCovariance();
+  /// Whether increments wait for their covariance propagation.
+  bool covariancePending() const { return !pending_.empty(); }
   /// Processes one epoch of pseudoranges and rates; returns one report per row (a buffer
   /// reused from epoch to epoch, valid until the next call). Rows a satellite's use_range /
   /// use_rate exclude are monitored only: their innovations are in the diagnostics (for the
@@ -180,7 +189,10 @@ class IntegratedFilter {
   /// Whether the transition since the last update is kept for the pseudorange epochs'
   /// diagnostics (the GLR's Phi): on for tightly coupled aiding, off otherwise (it costs a third
   /// of the covariance propagation).
-  void keepTransitionSinceUpdate(bool on) { keep_transition_ = on; }
+  void keepTransitionSinceUpdate(bool on) {
+    settleCovariance();
+    keep_transition_ = on;
+  }
   /// Adaptive process noise (adaptive_process_noise.hpp): the scale on the inertial process
   /// noise (velocity and attitude white noise, IMU bias random walks) from the next increment on.
   void setProcessNoiseScale(double scale) { process_noise_scale_ = scale; }
@@ -189,9 +201,15 @@ class IntegratedFilter {
   void trackProcessNoise(bool on);
   /// That part (zero unless tracked; ErrorState::processNoisePart), and its restart.
   StateMatrix processNoisePart() const { return central_.processNoisePart(); }
-  void forgetProcessNoise() { central_.forgetProcessNoise(); }
+  void forgetProcessNoise() {
+    settleCovariance();
+    central_.forgetProcessNoise();
+  }
   const EpochDiagnostics& lastEpoch() const { return *last_epoch_; }
-  void restartAt(std::int64_t time_ns) { ins_.restartAt(time_ns); }
+  void restartAt(std::int64_t time_ns) {
+    settleCovariance();
+    ins_.restartAt(time_ns);
+  }
   /// Records what a fixed-interval smoother needs into `log` (nullptr: nothing recorded, the
   /// default), from the next increment on (rts_smoother.hpp). Not owned.
   void setSmoothingLog(SmoothingLog* log) { smoothing_log_ = log; }
@@ -212,6 +230,12 @@ class IntegratedFilter {
   void turnAttitudeCovariance(double dpsi_rad);
   /// Whether the satellites' pseudorange errors are states (layout::kPseudorangeError active).
   bool modelsPseudorangeErrors() const;
+  /// Whether the star tracker's bias is a Gauss-Markov state (not a mounting misalignment).
+  bool modelsStarTrackerBias() const;
+  /// One increment's discrete process noise, the Gauss-Markov states' left out.
+  StateVector processNoise(double dt) const;
+  /// The Gauss-Markov states' estimates over one increment (their expected value decays).
+  void decayGaussMarkovEstimates(double dt);
   /// Gives this epoch's satellites their pseudorange-error states (a new one starts from the
   /// prior); returns each satellite's state index, -1 where none is modelled.
   const std::vector<int>& pseudorangeErrorStates(const std::vector<SatelliteObservation>& sats);
@@ -240,13 +264,13 @@ class IntegratedFilter {
   /// SparseRows::timesTransposedBlockTriangular).
   StateMatrix phi_since_update_t_{StateMatrix::Identity()};
   bool keep_transition_{true};
+  PropagationInterval pending_;      ///< increments whose covariance propagation waits
   double process_noise_scale_{1.0};  ///< on the inertial process noise (setProcessNoiseScale)
   // The latest epoch's outputs and the update's working buffers: each update rewrites them
   // before it reads them, so the recovery history's copies of the filter leave them out
   // (Scratch: an engine snapshot copies no epoch's diagnostics, a restore keeps the buffers).
   Scratch<EpochDiagnostics> last_epoch_;
-  StateMatrix prior_P_{StateMatrix::Zero()};  ///< P- of the latest GNSS epoch
-  Scratch<AppliedGain> applied_gain_;         ///< the diagnostics' K from the sequential updates
+  Scratch<AppliedGain> applied_gain_;  ///< the diagnostics' K from the sequential updates
   Scratch<std::vector<MeasurementReport>> reports_;
   Scratch<Eigen::VectorXd> range_variances_;   ///< R's diagonal of the epoch being processed
   Scratch<std::vector<int>> epoch_sv_ids_;     ///< the satellites of the epoch being processed
@@ -283,6 +307,7 @@ class IntegratedFilter {
 template <int M>
 std::array<ScalarUpdateResult, M> IntegratedFilter::update(const AidingMeasurement<M>& m,
                                                            AidingKind kind) {
+  settleCovariance();
   AidingMeasurement<M> used = m;
   ErrorState& es = target(kind);
   if constexpr (M == 3) {

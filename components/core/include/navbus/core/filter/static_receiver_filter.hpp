@@ -60,7 +60,6 @@ class StaticReceiverFilter {
   double clock_drift_mps_{0.0};
   ErrorState error_;
   StateMatrix phi_{StateMatrix::Identity()};
-  StateMatrix prior_P_{StateMatrix::Zero()};
   EpochDiagnostics last_epoch_;
   AppliedGain applied_gain_;
 };

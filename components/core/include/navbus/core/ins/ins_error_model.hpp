@@ -33,6 +33,27 @@ StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
 StateMatrix errorDynamics(const NavState& state, const Eigen::Vector3d& f_b,
                           const Eigen::Vector3d& w_ib_b, const earth::LocalEarth& at_state);
 
+/// The 3 x 3 blocks of F that vary with the state and the IMU's readings, and the weight of its
+/// constant couplings (dr/dv = I, the clock bias's drift = 1). F is linear in them, so the
+/// blocks of several increments summed with their intervals as weights (addScaled) are the
+/// blocks of the integral of F over those increments, constant couplings times the time.
+struct ErrorDynamicsBlocks {
+  Eigen::Matrix3d pos_pos, vel_pos, vel_vel, vel_att, vel_accel_bias, vel_accel_scale;
+  Eigen::Matrix3d att_pos, att_vel, att_att, att_gyro_bias, att_gyro_scale;
+  double constant{1.0};  ///< 1 in F; the time in an integral of F
+
+  ErrorDynamicsBlocks& operator*=(double s);
+  /// += s b.
+  void addScaled(const ErrorDynamicsBlocks& b, double s);
+};
+
+/// F's blocks at `state` (the arguments of errorDynamics()).
+ErrorDynamicsBlocks errorDynamicsBlocks(const NavState& state, const Eigen::Vector3d& f_b,
+                                        const Eigen::Vector3d& w_ib_b,
+                                        const earth::LocalEarth& at_state);
+/// The matrix of the blocks (F, or its integral when they are one).
+StateMatrix errorDynamics(const ErrorDynamicsBlocks& blocks);
+
 /// Transition matrix over dt: I + F dt + (F dt)^2 / 2.
 StateMatrix transitionMatrix(const StateMatrix& F, double dt);
 

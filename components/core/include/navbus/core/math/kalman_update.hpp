@@ -3,6 +3,7 @@
 // is data); a measurement with ratio > 1 is rejected and leaves the state untouched.
 #pragma once
 
+#include <array>
 #include <bitset>
 #include <cmath>
 
@@ -31,15 +32,34 @@ ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<do
                                 double gate_sigma, const std::bitset<N>* estimated = nullptr,
                                 Eigen::Matrix<double, N, 1>* gain = nullptr) {
   ScalarUpdateResult out;
-  const Eigen::Matrix<double, N, 1> Ph = P * h.transpose();
-  out.innovation = z - (h * x)(0, 0);
-  out.innovation_var = (h * Ph)(0, 0) + r;
+  // An aiding row reaches a few states (3 to 11 of the layout's 38): P h^T and h x over h's
+  // nonzero elements only.
+  std::array<int, N> support{};
+  int n_support = 0;
+  for (int k = 0; k < N; ++k) {
+    if (h[k] != 0.0) support[static_cast<std::size_t>(n_support++)] = k;
+  }
+  Eigen::Matrix<double, N, 1> Ph = Eigen::Matrix<double, N, 1>::Zero();
+  double hx = 0.0;
+  for (int n = 0; n < n_support; ++n) {
+    const int k = support[static_cast<std::size_t>(n)];
+    Ph.noalias() += P.col(k) * h[k];
+    hx += h[k] * x[k];
+  }
+  double hPh = 0.0;
+  for (int n = 0; n < n_support; ++n) {
+    const int k = support[static_cast<std::size_t>(n)];
+    hPh += h[k] * Ph[k];
+  }
+  out.innovation = z - hx;
+  out.innovation_var = hPh + r;
   // Without a gate (gate_sigma <= 0) the ratio is the normalized innovation squared eps^2 / V.
   const double gate2 = gate_sigma > 0.0 ? gate_sigma * gate_sigma : 1.0;
   out.test_ratio = out.innovation * out.innovation / (gate2 * out.innovation_var);
   if (!(out.innovation_var > 0.0) || !std::isfinite(out.test_ratio)) return out;
   if (gate_sigma > 0.0 && !(out.test_ratio <= 1.0)) return out;
-  Eigen::Matrix<double, N, 1> K = Ph / out.innovation_var;
+  const double V = out.innovation_var;
+  Eigen::Matrix<double, N, 1> K = Ph / V;
   if (estimated != nullptr) {
     for (int i = 0; i < N; ++i) {
       if (!(*estimated)[static_cast<std::size_t>(i)]) K[i] = 0.0;
@@ -49,11 +69,25 @@ ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<do
   // Joseph form expanded for one row, O(N^2) instead of two N^3 products: with Ph = P h^T and
   // h P h^T + r = V, (I - K h) P (I - K h)^T + K r K^T = P - K Ph^T - Ph K^T + V K K^T, an
   // identity for any gain K (so it keeps the Joseph form's tolerance of gain errors; Bierman,
-  // Factorization Methods for Discrete Sequential Estimation, 1977, ch. V).
-  P.noalias() -= K * Ph.transpose();
-  P.noalias() -= Ph * K.transpose();
-  P.noalias() += (out.innovation_var * K) * K.transpose();
-  P = 0.5 * (P + P.transpose());
+  // Factorization Methods for Discrete Sequential Estimation, 1977, ch. V). The change is zero
+  // in every row and column where Ph is (K is Ph / V or 0 there): states the row does not
+  // reach through P, such as inactive ones. It is symmetric: computed once per pair and written
+  // to both halves.
+  std::array<int, N> reached{};
+  int n_reached = 0;
+  for (int i = 0; i < N; ++i) {
+    if (Ph[i] != 0.0) reached[static_cast<std::size_t>(n_reached++)] = i;
+  }
+  for (int b = 0; b < n_reached; ++b) {
+    const int j = reached[static_cast<std::size_t>(b)];
+    const double kj = K[j], phj = Ph[j], vkj = V * kj;
+    for (int a = 0; a <= b; ++a) {
+      const int i = reached[static_cast<std::size_t>(a)];
+      const double p = P(i, j) - K[i] * phj - Ph[i] * kj + K[i] * vkj;
+      P(i, j) = p;
+      P(j, i) = p;
+    }
+  }
   if (gain != nullptr) *gain = K;
   out.accepted = true;
   return out;
