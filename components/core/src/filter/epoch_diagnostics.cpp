@@ -1,30 +1,44 @@
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 
 #include <array>
+#include <cassert>
 
 namespace navbus::core {
 
 void AppliedGain::prepare(EpochDiagnostics& d, const StateMatrix& prior_P) {
   const Eigen::Index m = d.h.rows();
-  std::array<Eigen::Index, layout::kSize> support{};
-  std::size_t n = 0;
-  for (Eigen::Index k = 0; k < layout::kSize; ++k) {
-    if (!d.h.col(k).isZero(0.0)) support[n++] = k;
+  std::array<int, layout::kSize> support{};
+  int n_support = 0;
+  for (int k = 0; k < layout::kSize; ++k) {
+    if (!d.h.col(k).isZero(0.0)) support[static_cast<std::size_t>(n_support++)] = k;
+  }
+  n_reached_ = 0;
+  for (int j = 0; j < layout::kSize; ++j) {
+    for (int a = 0; a < n_support; ++a) {
+      if (prior_P(support[static_cast<std::size_t>(a)], j) != 0.0) {
+        reached_[static_cast<std::size_t>(n_reached_++)] = j;
+        break;
+      }
+    }
   }
   hp_.setZero(m, layout::kSize);
-  for (std::size_t a = 0; a < n; ++a) {
-    const Eigen::Index k = support[a];
-    hp_.noalias() += d.h.col(k) * prior_P.row(k);
+  for (int b = 0; b < n_reached_; ++b) {
+    const int j = reached_[static_cast<std::size_t>(b)];
+    for (int a = 0; a < n_support; ++a) {
+      const int k = support[static_cast<std::size_t>(a)];
+      hp_.col(j) += d.h.col(k) * prior_P(k, j);
+    }
   }
   d.innovation_cov.setZero(m, m);
-  for (std::size_t a = 0; a < n; ++a) {
-    const Eigen::Index k = support[a];
+  for (int a = 0; a < n_support; ++a) {
+    const int k = support[static_cast<std::size_t>(a)];
     d.innovation_cov.noalias() += hp_.col(k) * d.h.col(k).transpose();
   }
 }
 
 void AppliedGain::compute(EpochDiagnostics& d) {
   const Eigen::Index m = d.h.rows();
+  assert(m <= kMaxRows);
   cov_ = d.innovation_cov;
   for (Eigen::Index i = 0; i < m; ++i) {
     if (d.used[static_cast<std::size_t>(i)]) continue;
@@ -33,7 +47,13 @@ void AppliedGain::compute(EpochDiagnostics& d) {
     cov_(i, i) = 1.0;
   }
   llt_.compute(cov_);
-  d.k = llt_.solve(hp_).transpose();
+  // K^T = V^-1 H P- on the reached columns; the gain's other rows are zero.
+  rhs_.resize(m, n_reached_);
+  for (int b = 0; b < n_reached_; ++b) rhs_.col(b) = hp_.col(reached_[static_cast<std::size_t>(b)]);
+  llt_.solveInPlace(rhs_);
+  d.k.setZero(layout::kSize, m);
+  for (int b = 0; b < n_reached_; ++b)
+    d.k.row(reached_[static_cast<std::size_t>(b)]) = rhs_.col(b).transpose();
   for (Eigen::Index i = 0; i < m; ++i) {
     if (!d.used[static_cast<std::size_t>(i)]) d.k.col(i).setZero();
   }

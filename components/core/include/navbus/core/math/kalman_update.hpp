@@ -59,7 +59,7 @@ ScalarUpdateResult scalarUpdate(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<do
   if (!(out.innovation_var > 0.0) || !std::isfinite(out.test_ratio)) return out;
   if (gate_sigma > 0.0 && !(out.test_ratio <= 1.0)) return out;
   const double V = out.innovation_var;
-  Eigen::Matrix<double, N, 1> K = Ph / V;
+  Eigen::Matrix<double, N, 1> K = Ph * (1.0 / V);  // one division, not N
   if (estimated != nullptr) {
     for (int i = 0; i < N; ++i) {
       if (!(*estimated)[static_cast<std::size_t>(i)]) K[i] = 0.0;
