@@ -187,13 +187,9 @@ void IntegratedFilter::decayGaussMarkovEstimates(double dt) {
     fix_position_error_ned_m_ *= std::exp(-dt / tuning_.fix_position_error_correlation_time_s);
 }
 
-void IntegratedFilter::settleCovariance() {
-  if (pending_.empty()) return;
-  StateMatrix Phi = pending_.transition();
-  StateVector q = pending_.processNoise();
+void IntegratedFilter::gaussMarkovTransition(double T, StateMatrix& Phi, StateVector& q) const {
   // First-order Gauss-Markov states: decay exp(-T / tau), driving noise that keeps the variance
   // at sigma^2 (exact discretization over the interval T).
-  const double T = pending_.duration_s();
   const auto gaussMarkov = [&](int first, int end, double tau_s, const double* sigma) {
     const double decay = std::exp(-T / tau_s);
     for (int i = first; i < end; ++i) {
@@ -223,6 +219,13 @@ void IntegratedFilter::settleCovariance() {
     gaussMarkov(kFixPositionError.index, kFixPositionError.end(),
                 tuning_.fix_position_error_correlation_time_s, sigma);
   }
+}
+
+void IntegratedFilter::settleCovariance() {
+  if (pending_.empty()) return;
+  StateMatrix Phi = pending_.transition();
+  StateVector q = pending_.processNoise();
+  gaussMarkovTransition(pending_.duration_s(), Phi, q);
   if (!second_clock_)
     Phi(kSecondClockBias.index, kSecondClockDrift.index) = 0.0;  // pseudorange-error states
   pending_.clear();

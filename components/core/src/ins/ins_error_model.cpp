@@ -1,5 +1,6 @@
 #include "navbus/core/ins/ins_error_model.hpp"
 
+#include <array>
 #include <cmath>
 
 #include "navbus/core/math/rotation.hpp"
@@ -82,27 +83,25 @@ ErrorDynamicsBlocks errorDynamicsBlocks(const NavState& s, const Eigen::Vector3d
   return F;
 }
 
+namespace {
+/// The blocks of ErrorDynamicsBlocks, for the operations that treat them alike.
+constexpr std::array<Eigen::Matrix3d ErrorDynamicsBlocks::*, 11> kBlocks{
+    &ErrorDynamicsBlocks::pos_pos,        &ErrorDynamicsBlocks::vel_pos,
+    &ErrorDynamicsBlocks::vel_vel,        &ErrorDynamicsBlocks::vel_att,
+    &ErrorDynamicsBlocks::vel_accel_bias, &ErrorDynamicsBlocks::vel_accel_scale,
+    &ErrorDynamicsBlocks::att_pos,        &ErrorDynamicsBlocks::att_vel,
+    &ErrorDynamicsBlocks::att_att,        &ErrorDynamicsBlocks::att_gyro_bias,
+    &ErrorDynamicsBlocks::att_gyro_scale};
+}  // namespace
+
 ErrorDynamicsBlocks& ErrorDynamicsBlocks::operator*=(double s) {
-  for (Eigen::Matrix3d* m :
-       {&pos_pos, &vel_pos, &vel_vel, &vel_att, &vel_accel_bias, &vel_accel_scale, &att_pos,
-        &att_vel, &att_att, &att_gyro_bias, &att_gyro_scale})
-    *m *= s;
+  for (const auto block : kBlocks) this->*block *= s;
   constant *= s;
   return *this;
 }
 
 void ErrorDynamicsBlocks::addScaled(const ErrorDynamicsBlocks& b, double s) {
-  pos_pos += s * b.pos_pos;
-  vel_pos += s * b.vel_pos;
-  vel_vel += s * b.vel_vel;
-  vel_att += s * b.vel_att;
-  vel_accel_bias += s * b.vel_accel_bias;
-  vel_accel_scale += s * b.vel_accel_scale;
-  att_pos += s * b.att_pos;
-  att_vel += s * b.att_vel;
-  att_att += s * b.att_att;
-  att_gyro_bias += s * b.att_gyro_bias;
-  att_gyro_scale += s * b.att_gyro_scale;
+  for (const auto block : kBlocks) this->*block += s * (b.*block);
   constant += s * b.constant;
 }
 

@@ -236,6 +236,8 @@ class IntegratedFilter {
   StateVector processNoise(double dt) const;
   /// The Gauss-Markov states' estimates over one increment (their expected value decays).
   void decayGaussMarkovEstimates(double dt);
+  /// The Gauss-Markov states' transition (exp(-T / tau)) and driving noise over T.
+  void gaussMarkovTransition(double T, StateMatrix& Phi, StateVector& q) const;
   /// Gives this epoch's satellites their pseudorange-error states (a new one starts from the
   /// prior); returns each satellite's state index, -1 where none is modelled.
   const std::vector<int>& pseudorangeErrorStates(const std::vector<SatelliteObservation>& sats);
