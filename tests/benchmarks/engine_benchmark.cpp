@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "allocation_counter.hpp"
+#include "benchmark_args.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
@@ -130,9 +131,19 @@ void integrityAndAlignment(const std::string& dir, int n) {
 
 }  // namespace
 
+namespace {
+int benchmark(const std::string& dir, int count);
+}  // namespace
+
 int main(int argc, char** argv) {
-  const std::string dir = argc > 1 ? argv[1] : "sim/scenarios";
-  const int n = argc > 2 ? std::atoi(argv[2]) : 40000;
+  int exit_code = 0;
+  const auto args = navbus::bench::parseDirAndCount(argc, argv, 40000, "IMU_CYCLES", exit_code);
+  if (!args) return exit_code;
+  return navbus::bench::runOrReport(argv[0], [&] { return benchmark(args->dir, args->count); });
+}
+
+namespace {
+int benchmark(const std::string& dir, int n) {
   const auto leo = scenarioFile(dir + "/seed001_leo.yaml");
   const auto inputs = makeInputs(leo, n);
   core::EngineConfig cfg = configFor(leo, 0.005);
@@ -178,3 +189,4 @@ int main(int argc, char** argv) {
   integrityAndAlignment(dir, n);
   return 0;
 }
+}  // namespace

@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include "allocation_counter.hpp"
+#include "benchmark_args.hpp"
 #include "navbus/bus/config.hpp"
 #include "navbus/core/engine/navigation_engine.hpp"
 #include "navbus/core/integrity/glr.hpp"
@@ -188,9 +189,19 @@ void parityCost(const navbus::sim::ScenarioConfig& scenario, int samples) {
 
 }  // namespace
 
+namespace {
+int benchmark(const std::string& dir, int count);
+}  // namespace
+
 int main(int argc, char** argv) {
-  const std::string dir = argc > 1 ? argv[1] : "sim/scenarios";
-  const int seconds = argc > 2 ? std::atoi(argv[2]) : 300;
+  int exit_code = 0;
+  const auto args = navbus::bench::parseDirAndCount(argc, argv, 300, "SECONDS", exit_code);
+  if (!args) return exit_code;
+  return navbus::bench::runOrReport(argv[0], [&] { return benchmark(args->dir, args->count); });
+}
+
+namespace {
+int benchmark(const std::string& dir, int seconds) {
   auto load = [&](const char* file) {
     return navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(dir + "/" + file)).scenario;
   };
@@ -230,3 +241,4 @@ int main(int argc, char** argv) {
       "the TC update\n");
   return 0;
 }
+}  // namespace
