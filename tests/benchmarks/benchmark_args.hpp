@@ -1,7 +1,7 @@
 // The benchmarks' two positional arguments, a scenario directory and a count: --help prints the
 // usage, a count that is not a positive integer is an error naming it (exit 2, as the tools'
-// usage errors), and main's body runs inside runOrReport, which turns an unreadable scenario
-// file into a message and exit 2 instead of an uncaught exception.
+// usage errors), and benchmarkMain turns an unreadable scenario file into a message and exit 2
+// instead of an uncaught exception.
 #pragma once
 
 #include <cstdio>
@@ -42,13 +42,17 @@ inline std::optional<DirAndCount> parseDirAndCount(int argc, char** argv, int de
   return a;
 }
 
-/// Runs `body`; a failure (e.g. a scenario file that cannot be read) is printed, exit 2.
-template <typename Body>
-int runOrReport(const char* program, Body&& body) {
+/// A benchmark's main: its arguments (parseDirAndCount), then body(dir, count); a failure
+/// (e.g. a scenario file that cannot be read) is printed, exit 2.
+inline int benchmarkMain(int argc, char** argv, int default_count, const char* count_name,
+                         int (*body)(const std::string& dir, int count)) {
+  int exit_code = 0;
+  const auto args = parseDirAndCount(argc, argv, default_count, count_name, exit_code);
+  if (!args) return exit_code;
   try {
-    return body();
+    return body(args->dir, args->count);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: %s\n", program, e.what());
+    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
     return 2;
   }
 }

@@ -129,20 +129,7 @@ void integrityAndAlignment(const std::string& dir, int n) {
   printRow("aligned start + protection levels", run(integrity, inputs, true), base);
 }
 
-}  // namespace
-
-namespace {
-int benchmark(const std::string& dir, int count);
-}  // namespace
-
-int main(int argc, char** argv) {
-  int exit_code = 0;
-  const auto args = navbus::bench::parseDirAndCount(argc, argv, 40000, "IMU_CYCLES", exit_code);
-  if (!args) return exit_code;
-  return navbus::bench::runOrReport(argv[0], [&] { return benchmark(args->dir, args->count); });
-}
-
-namespace {
+/// The benchmark: the scenarios in `dir`, `count` IMU cycles or seconds of data.
 int benchmark(const std::string& dir, int n) {
   const auto leo = scenarioFile(dir + "/seed001_leo.yaml");
   const auto inputs = makeInputs(leo, n);
@@ -189,4 +176,9 @@ int benchmark(const std::string& dir, int n) {
   integrityAndAlignment(dir, n);
   return 0;
 }
+
 }  // namespace
+
+int main(int argc, char** argv) {
+  return navbus::bench::benchmarkMain(argc, argv, 40000, "IMU_CYCLES", benchmark);
+}

@@ -187,20 +187,7 @@ void parityCost(const navbus::sim::ScenarioConfig& scenario, int samples) {
       median(times), samples, 2.0 * median(times), static_cast<double>(allocs) / samples);
 }
 
-}  // namespace
-
-namespace {
-int benchmark(const std::string& dir, int count);
-}  // namespace
-
-int main(int argc, char** argv) {
-  int exit_code = 0;
-  const auto args = navbus::bench::parseDirAndCount(argc, argv, 300, "SECONDS", exit_code);
-  if (!args) return exit_code;
-  return navbus::bench::runOrReport(argv[0], [&] { return benchmark(args->dir, args->count); });
-}
-
-namespace {
+/// The benchmark: the scenarios in `dir`, `count` IMU cycles or seconds of data.
 int benchmark(const std::string& dir, int seconds) {
   auto load = [&](const char* file) {
     return navbus::sensor_sim::parseSimConfig(navbus::bus::loadYamlFile(dir + "/" + file)).scenario;
@@ -241,4 +228,9 @@ int benchmark(const std::string& dir, int seconds) {
       "the TC update\n");
   return 0;
 }
+
 }  // namespace
+
+int main(int argc, char** argv) {
+  return navbus::bench::benchmarkMain(argc, argv, 300, "SECONDS", benchmark);
+}

@@ -1,7 +1,6 @@
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 
 #include <array>
-#include <cassert>
 
 namespace navbus::core {
 
@@ -38,7 +37,6 @@ void AppliedGain::prepare(EpochDiagnostics& d, const StateMatrix& prior_P) {
 
 void AppliedGain::compute(EpochDiagnostics& d) {
   const Eigen::Index m = d.h.rows();
-  assert(m <= kMaxRows);
   cov_ = d.innovation_cov;
   for (Eigen::Index i = 0; i < m; ++i) {
     if (d.used[static_cast<std::size_t>(i)]) continue;
@@ -48,12 +46,13 @@ void AppliedGain::compute(EpochDiagnostics& d) {
   }
   llt_.compute(cov_);
   // K^T = V^-1 H P- on the reached columns; the gain's other rows are zero.
-  rhs_.resize(m, n_reached_);
-  for (int b = 0; b < n_reached_; ++b) rhs_.col(b) = hp_.col(reached_[static_cast<std::size_t>(b)]);
-  llt_.solveInPlace(rhs_);
+  rhs_.resize(m, layout::kSize);
+  auto rhs = rhs_.leftCols(n_reached_);
+  for (int b = 0; b < n_reached_; ++b) rhs.col(b) = hp_.col(reached_[static_cast<std::size_t>(b)]);
+  llt_.solveInPlace(rhs);
   d.k.setZero(layout::kSize, m);
   for (int b = 0; b < n_reached_; ++b)
-    d.k.row(reached_[static_cast<std::size_t>(b)]) = rhs_.col(b).transpose();
+    d.k.row(reached_[static_cast<std::size_t>(b)]) = rhs.col(b).transpose();
   for (Eigen::Index i = 0; i < m; ++i) {
     if (!d.used[static_cast<std::size_t>(i)]) d.k.col(i).setZero();
   }

@@ -539,7 +539,6 @@ void IntegratedFilter::setAxisFailed(bool accelerometer, int axis, bool failed) 
 }
 
 void IntegratedFilter::addVariance(int state, double variance) {
-  settleCovariance();
   beginCovarianceJump();  // process noise of the smoother's model
   central_.P()(state, state) += variance;
   for (ErrorState& l : local_) l.P()(state, state) += variance * tuning_.federated_share;
@@ -662,7 +661,6 @@ void IntegratedFilter::shiftClock(double jump_m, double sigma_m, int receiver) {
 }
 
 void IntegratedFilter::resetState(int i, double sigma) {
-  settleCovariance();
   beginCovarianceJump();  // a fresh state: a zero row of Phi and the prior as process noise
   central_.resetState(i, sigma);
   for (ErrorState& l : local_) {  // a local filter that does not carry the state keeps 0

@@ -11,7 +11,6 @@
 #include <Eigen/Core>
 
 #include "navbus/core/filter/aiding_measurements.hpp"
-#include "navbus/core/gnss/gnss_measurement.hpp"
 #include "navbus/core/ins/ins_error_model.hpp"
 
 namespace navbus::core {
@@ -43,15 +42,14 @@ class AppliedGain {
   void compute(EpochDiagnostics& d);
 
  private:
-  static constexpr int kMaxRows = 2 * kMaxEpochSatellites;
   Eigen::MatrixXd hp_;  ///< H P-, m x n; zero outside the reached columns
   /// The states H reaches through P- (a column of H P- with a nonzero element), ascending: the
   /// gain's other rows are zero.
   std::array<int, layout::kSize> reached_{};
   int n_reached_{0};
-  /// The solve's right-hand sides: H P-'s reached columns (fixed capacity: no allocation).
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxRows, layout::kSize>
-      rhs_;
+  /// The solve's right-hand sides, H P-'s reached columns in the leading ones (m x n, sized
+  /// as hp_: storage reused while the epoch's row count stays).
+  Eigen::MatrixXd rhs_;
   Eigen::MatrixXd cov_;
   /// Factorized once at construction (of nothing), so that every member is set: a default
   /// LLT leaves its status unset, which GCC reports when a filter is assigned.
