@@ -11,6 +11,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
+#include <boost/math/special_functions/gamma.hpp>
 
 #include "navbus/core/filter/epoch_diagnostics.hpp"
 #include "navbus/core/filter/error_state.hpp"
@@ -251,6 +252,31 @@ TEST(ChiSquare, TailProbabilitiesMatchTables) {
   EXPECT_NEAR(nc::chiSquareSignificance(3.841459, 1), -std::log10(0.05), 1e-5);
   EXPECT_GT(nc::chiSquareSignificance(3000.0, 6), 600.0);
   EXPECT_GT(nc::chiSquareSignificance(3000.0, 3), nc::chiSquareSignificance(3000.0, 6));
+}
+
+// Against Boost.Math's regularized upper incomplete gamma function, Q(dof/2, x/2), over the
+// degrees of freedom the monitors use (a 12-satellite epoch has 24 rows) and far into the tail;
+// and the significance continuous where the survival underflows and its log form takes over.
+TEST(ChiSquare, SurvivalEqualsTheIncompleteGammaFunctionAndTheTailIsContinuous) {
+  double worst = 0.0;
+  for (int dof = 1; dof <= 80; ++dof) {
+    for (double x = 1e-2; x < 1400.0; x *= 1.05) {
+      const double q = boost::math::gamma_q(0.5 * dof, 0.5 * x);
+      if (q < 1e-290) continue;
+      worst = std::max(worst, std::abs(nc::chiSquareSurvival(x, dof) / q - 1.0));
+    }
+  }
+  EXPECT_LT(worst, 1e-11);
+  for (const int dof : {24, 25}) {
+    double previous = nc::chiSquareSignificance(1299.5, dof);
+    for (double x = 1300.0; x < 1600.0; x += 0.5) {
+      const double s = nc::chiSquareSignificance(x, dof);
+      EXPECT_GT(s, previous) << "dof " << dof << ", x " << x;
+      EXPECT_LT(s - previous, 0.5 * std::log10(std::exp(1.0)) + 1e-9)
+          << "dof " << dof << ", x " << x;
+      previous = s;
+    }
+  }
 }
 
 TEST(Glr, SignatureSumsEqualTheExplicitRegression) {
