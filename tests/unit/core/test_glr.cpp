@@ -18,6 +18,7 @@
 #include "navbus/core/integrity/glr.hpp"
 #include "navbus/core/integrity/glr_protection_level.hpp"
 #include "navbus/core/math/chi_square.hpp"
+#include "navbus/core/math/kalman_update.hpp"
 
 namespace nc = navbus::core;
 using nc::GlrFault;
@@ -277,6 +278,56 @@ TEST(ChiSquare, SurvivalEqualsTheIncompleteGammaFunctionAndTheTailIsContinuous) 
       previous = s;
     }
   }
+}
+
+// The gain the GLR is given, from the covariance after the sequential scalar updates
+// (K = P+ H^T R^-1), equals the batch solve P- H^T V^-1 on the accepted rows and is zero on the
+// others; with a consider state among those H reaches it is refused (compute() gives it).
+TEST(AppliedGain, FromThePosteriorCovarianceEqualsTheBatchSolve) {
+  constexpr int n = nc::layout::kSize;
+  constexpr int active = 17;  // the rest inactive: zero rows and columns in P
+  constexpr int m = 8;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g;
+  Eigen::Matrix<double, active, active> a;
+  for (int i = 0; i < active; ++i)
+    for (int j = 0; j < active; ++j) a(i, j) = g(rng);
+  nc::StateMatrix prior = nc::StateMatrix::Zero();
+  prior.topLeftCorner<active, active>() =
+      a * a.transpose() + active * Eigen::Matrix<double, active, active>::Identity();
+  nc::EpochDiagnostics d;
+  d.h = Eigen::MatrixXd::Zero(m, n);
+  Eigen::VectorXd r(m);
+  for (int i = 0; i < m; ++i) {
+    for (const int k : {i % 3, 3 + i % 3, 15, 16}) d.h(i, k) = g(rng);
+    r[i] = 0.5 + std::abs(g(rng));
+  }
+  d.used.assign(m, true);
+  d.used[5] = false;  // gated out
+  nc::AppliedGain gain;
+  gain.prepare(d, prior);
+  d.innovation_cov.diagonal() += r;
+  nc::StateVector x = nc::StateVector::Zero();
+  nc::StateMatrix posterior = prior;
+  for (int i = 0; i < m; ++i) {
+    const Eigen::Matrix<double, 1, n> h = d.h.row(i);
+    if (d.used[static_cast<std::size_t>(i)]) {
+      ASSERT_TRUE(nc::scalarUpdate<n>(x, posterior, h, 1.0, r[i], 0.0).accepted);
+    }
+  }
+  nc::EpochDiagnostics batch = d;
+  gain.compute(batch);
+  ASSERT_TRUE(gain.computeFromPosterior(d, posterior, r, nc::StateMask().set()));
+  ASSERT_EQ(d.k.rows(), n);
+  ASSERT_EQ(d.k.cols(), m);
+  EXPECT_LT((d.k - batch.k).cwiseAbs().maxCoeff(), 1e-12 * batch.k.cwiseAbs().maxCoeff());
+  EXPECT_TRUE(d.k.col(5).isZero(0.0));
+  EXPECT_TRUE(d.k.bottomRows(n - active).isZero(0.0));
+  nc::StateMask consider = nc::StateMask().set();
+  consider.reset(16);
+  const Eigen::MatrixXd before = d.k;
+  EXPECT_FALSE(gain.computeFromPosterior(d, posterior, r, consider));
+  EXPECT_EQ(d.k, before);
 }
 
 TEST(Glr, SignatureSumsEqualTheExplicitRegression) {

@@ -20,18 +20,43 @@ void AppliedGain::prepare(EpochDiagnostics& d, const StateMatrix& prior_P) {
       }
     }
   }
+  // Each row's own support (a pseudorange row: position and its receiver's clock, 4 to 8 of
+  // H's 8 to 11 columns): H P- and V over it.
+  row_support_.resize(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    RowSupport& rs = row_support_[static_cast<std::size_t>(i)];
+    rs.count = 0;
+    for (int a = 0; a < n_support; ++a) {
+      const int k = support[static_cast<std::size_t>(a)];
+      if (d.h(i, k) != 0.0) rs.column[static_cast<std::size_t>(rs.count++)] = k;
+    }
+  }
   hp_.setZero(m, layout::kSize);
   for (int b = 0; b < n_reached_; ++b) {
     const int j = reached_[static_cast<std::size_t>(b)];
-    for (int a = 0; a < n_support; ++a) {
-      const int k = support[static_cast<std::size_t>(a)];
-      hp_.col(j) += d.h.col(k) * prior_P(k, j);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const RowSupport& rs = row_support_[static_cast<std::size_t>(i)];
+      double sum = 0.0;
+      for (int a = 0; a < rs.count; ++a) {
+        const int k = rs.column[static_cast<std::size_t>(a)];
+        sum += d.h(i, k) * prior_P(k, j);
+      }
+      hp_(i, j) = sum;
     }
   }
-  d.innovation_cov.setZero(m, m);
-  for (int a = 0; a < n_support; ++a) {
-    const int k = support[static_cast<std::size_t>(a)];
-    d.innovation_cov.noalias() += hp_.col(k) * d.h.col(k).transpose();
+  // V = (H P-) H^T, symmetric: the lower triangle, mirrored.
+  d.innovation_cov.resize(m, m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const RowSupport& rs = row_support_[static_cast<std::size_t>(i)];
+    for (Eigen::Index j = i; j < m; ++j) {
+      double v = 0.0;
+      for (int a = 0; a < rs.count; ++a) {
+        const int k = rs.column[static_cast<std::size_t>(a)];
+        v += hp_(j, k) * d.h(i, k);
+      }
+      d.innovation_cov(j, i) = v;
+      d.innovation_cov(i, j) = v;
+    }
   }
 }
 
@@ -56,6 +81,36 @@ void AppliedGain::compute(EpochDiagnostics& d) {
   for (Eigen::Index i = 0; i < m; ++i) {
     if (!d.used[static_cast<std::size_t>(i)]) d.k.col(i).setZero();
   }
+}
+
+bool AppliedGain::computeFromPosterior(EpochDiagnostics& d, const StateMatrix& posterior_P,
+                                       const Eigen::VectorXd& r, const StateMask& estimated) const {
+  const Eigen::Index m = d.h.rows();
+  for (int b = 0; b < n_reached_; ++b) {
+    if (!estimated[static_cast<std::size_t>(reached_[static_cast<std::size_t>(b)])]) return false;
+  }
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (d.used[static_cast<std::size_t>(i)] && !(r[i] > 0.0)) return false;
+  }
+  // Column i of K is P+ h_i^T / r_i over h_i's nonzero elements (prepare()'s row supports), on
+  // the reached states: P+ is zero (as P-) between them and the others, whose gain rows stay 0.
+  d.k.setZero(layout::kSize, m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (!d.used[static_cast<std::size_t>(i)]) continue;
+    const RowSupport& rs = row_support_[static_cast<std::size_t>(i)];
+    std::array<double, layout::kSize> h_over_r{};
+    for (int a = 0; a < rs.count; ++a)
+      h_over_r[static_cast<std::size_t>(a)] = d.h(i, rs.column[static_cast<std::size_t>(a)]) / r[i];
+    for (int b = 0; b < n_reached_; ++b) {
+      const int j = reached_[static_cast<std::size_t>(b)];
+      double sum = 0.0;
+      for (int a = 0; a < rs.count; ++a)
+        sum += posterior_P(j, rs.column[static_cast<std::size_t>(a)]) *
+               h_over_r[static_cast<std::size_t>(a)];
+      d.k(j, i) = sum;
+    }
+  }
+  return true;
 }
 
 void fixEpochDiagnostics(const FixEpochInput& in, AppliedGain& gain, EpochDiagnostics& d) {

@@ -404,7 +404,7 @@ const std::vector<MeasurementReport>& IntegratedFilter::update(
     reports.push_back({d.sv_ids[static_cast<std::size_t>(row)],
                        d.is_rate[static_cast<std::size_t>(row)], fuse, res});
   }
-  applied_gain_->compute(d);
+  if (!applied_gain_->computeFromPosterior(d, es.P(), r, es.estimated())) applied_gain_->compute(d);
   closeUpdate();
   return reports;
 }

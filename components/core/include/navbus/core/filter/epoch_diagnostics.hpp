@@ -40,9 +40,24 @@ class AppliedGain {
   void prepare(EpochDiagnostics& d, const StateMatrix& prior_P);
   /// After them: d.k from the prepared H P- and the rows the updates accepted (d.used).
   void compute(EpochDiagnostics& d);
+  /// The same gain without a solve, from the covariance after the updates:
+  /// K_a = P+ H_a^T R_a^-1 for the accepted rows a, with R diagonal (r: each row's variance)
+  /// (the information form of the optimal gain; Simon, Optimal State Estimation, 2006,
+  /// eq. 3.42), equal to P- H_a^T V_aa^-1 when the updates applied the optimal gain to every
+  /// state H reaches. Returns false, with d.k unchanged, when some of those states are not
+  /// estimated (a consider state's gain row is 0, and P+ is then not the optimal one) or a
+  /// variance is not positive: then compute() gives it.
+  bool computeFromPosterior(EpochDiagnostics& d, const StateMatrix& posterior_P,
+                            const Eigen::VectorXd& r, const StateMask& estimated) const;
 
  private:
-  Eigen::MatrixXd hp_;  ///< H P-, m x n; zero outside the reached columns
+  /// A row's nonzero columns of H, ascending.
+  struct RowSupport {
+    std::array<int, layout::kSize> column{};
+    int count{0};
+  };
+  std::vector<RowSupport> row_support_;  ///< per row of the epoch (capacity kept)
+  Eigen::MatrixXd hp_;                   ///< H P-, m x n; zero outside the reached columns
   /// The states H reaches through P- (a column of H P- with a nonzero element), ascending: the
   /// gain's other rows are zero.
   std::array<int, layout::kSize> reached_{};
