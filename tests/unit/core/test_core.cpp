@@ -58,6 +58,18 @@ TEST(Rotation, QuaternionFromRotationVectorMatchesAngleAxis) {
   }
 }
 
+// Below 1e-3 rad the rotation vector's quaternion comes from its Taylor series (no sine and
+// cosine): the same as the closed form to rounding, up to the series' edge and just past it.
+TEST(Rotation, TheSmallAngleSeriesEqualsTheClosedFormToRounding) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.48, -0.6, 0.64).normalized();
+  for (double angle = 1e-7; angle < 2e-3; angle *= 1.3) {
+    const Eigen::Quaterniond q = quaternionFromRotationVector(angle * axis);
+    const Eigen::Quaterniond expected(Eigen::AngleAxisd(angle, axis));
+    EXPECT_NEAR(q.w(), expected.w(), 2.3e-16) << angle;
+    EXPECT_LT((q.vec() - expected.vec()).norm(), 4e-16 * angle) << angle;
+  }
+}
+
 TEST(Rotation, EulerRoundTripAcrossAttitudes) {
   for (double r = -3.0; r <= 3.0; r += 1.5) {
     for (double p = -1.5; p <= 1.5; p += 0.5) {

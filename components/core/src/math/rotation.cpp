@@ -16,8 +16,11 @@ Eigen::Quaterniond quaternionFromRotationVector(const Eigen::Vector3d& phi) {
   const double angle_sq = phi.squaredNorm();
   double c;  // cos(angle / 2)
   double k;  // sin(angle / 2) / angle
-  if (angle_sq < 1e-12) {
-    // Taylor series to fourth order: exact in double precision below 1e-6 rad.
+  if (angle_sq < 1e-6) {
+    // Taylor series to fourth order: the first term left out (angle^6 / 46080 in the cosine)
+    // is under 3e-23 below 1e-3 rad, so the series is exact in double precision there (a
+    // 200 Hz increment at up to 0.2 rad/s, the NED frame's rotation over one) and costs no
+    // sine and cosine.
     c = 1.0 - angle_sq / 8.0 + angle_sq * angle_sq / 384.0;
     k = 0.5 - angle_sq / 48.0 + angle_sq * angle_sq / 3840.0;
   } else {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <bitset>
+#include <cmath>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -107,9 +108,18 @@ template <int M>
 std::array<ScalarUpdateResult, M> ErrorState::update(const AidingMeasurement<M>& m,
                                                      double gate_sigma) {
   using RowMatrix = Eigen::Matrix<double, M, layout::kSize>;
-  const Eigen::Matrix<double, M, M> L = m.r.llt().matrixL();
-  const Eigen::Matrix<double, M, 1> z = L.template triangularView<Eigen::Lower>().solve(m.z);
-  RowMatrix H = L.template triangularView<Eigen::Lower>().solve(m.h);
+  // Whitened rows: L^-1 z and L^-1 H with R = L L^T (one row: divided by sqrt(r)).
+  Eigen::Matrix<double, M, 1> z;
+  RowMatrix H;
+  if constexpr (M == 1) {
+    const double l = std::sqrt(m.r(0, 0));
+    z[0] = m.z[0] / l;
+    H = m.h * (1.0 / l);  // as Eigen's triangular solve of a row: bit for bit
+  } else {
+    const Eigen::Matrix<double, M, M> L = m.r.llt().matrixL();
+    z = L.template triangularView<Eigen::Lower>().solve(m.z);
+    H = L.template triangularView<Eigen::Lower>().solve(m.h);
+  }
   for (int j = 0; j < layout::kSize; ++j) {
     if (!active_[static_cast<std::size_t>(j)]) H.col(j).setZero();
   }
