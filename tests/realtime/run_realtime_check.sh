@@ -2,8 +2,8 @@
 # The real-time option (a `realtime:` block in any participant's configuration; domain 118):
 #   1. navbus-filter with {policy: fifo, priority: 10, cpus: [the last core], lock_memory: true}:
 #      every thread of the process (the Fast DDS threads it created included) runs SCHED_FIFO on
-#      that core, the DDS threads at priority 10 and the main (processing) thread at 11, with
-#      locked memory (VmLck > 0), as the kernel reports in /proc;
+#      that core at priority 10, the main (processing) thread at the DDS threads' priority (not
+#      above them: docs/bus.md), with locked memory (VmLck > 0), as the kernel reports in /proc;
 #   2. the fault manager and the simulator take the same block and report the same grant;
 #   3. refusals are configuration errors (exit 2) naming the key and the system's reason:
 #      without CAP_SYS_NICE, with a locked-memory limit of 0 and no CAP_IPC_LOCK, a core this
@@ -57,7 +57,6 @@ for task in /proc/$filter/task/*; do
   cpus=$(awk '/^Cpus_allowed_list/ {print $2}' "$task/status")
   name=$(cat "$task/comm")
   want=10
-  [ "$tid" != "$filter" ] || want=11
   echo "thread $tid ($name): policy $policy priority $priority cpus $cpus"
   [ "$policy" = 1 ] || fail "thread $tid ($name) has policy $policy, not SCHED_FIFO (1)"
   [ "$priority" = "$want" ] || fail "thread $tid ($name) at priority $priority, not $want"

@@ -25,12 +25,7 @@ Participant::Participant(const Options& options, ShutdownSignal& shutdown)
           "realtime.lock_memory: mlockall succeeded but nothing is locked (VmLck 0 kB): a build "
           "with AddressSanitizer ignores mlockall");
     }
-    const int processing = raiseProcessingThread(options.realtime);
-    spdlog::info("real-time: granted {}{}", realtime_.text(),
-                 processing > 0 ? fmt::format("; this processing thread at priority {}, the DDS "
-                                              "threads at {}",
-                                              processing, realtime_.priority)
-                                : "");
+    spdlog::info("real-time: granted {}", realtime_.text());
   }
   waitset_.attach_condition(shutdown_.condition());
   if (publish_health_) {

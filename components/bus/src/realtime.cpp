@@ -201,14 +201,6 @@ RealtimeGrant applyRealtime(const RealtimeOptions& o) {
   return g;
 }
 
-int raiseProcessingThread(const RealtimeOptions& o) {
-  if (o.policy == SchedulingPolicy::kOther) return 0;
-  const int priority =
-      std::min(o.priority + kProcessingPriorityStep, sched_get_priority_max(linuxPolicy(o.policy)));
-  setScheduling(o.policy, priority, "realtime.policy");
-  return priority;
-}
-
 std::string RealtimeGrant::text() const {
   return std::string("policy ") + policyName(policy) + " priority " + std::to_string(priority) +
          ", cpus " + listText(cpus) + ", memory " + (memory_locked ? "locked" : "not locked");

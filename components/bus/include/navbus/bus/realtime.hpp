@@ -5,8 +5,12 @@
 //
 // applied to the process's main thread before the DDS participant is created, so that the
 // threads Fast DDS creates (Fast DDS 2.9 has no per-thread settings) inherit the scheduling
-// class, priority and CPU affinity (the threads that exist already are given them too); the main
-// thread, which takes the samples and runs the pipeline, is then raised one priority above them.
+// class, priority and CPU affinity (the threads that exist already are given them too). The main
+// thread, which takes the samples and runs the pipeline, keeps the same priority as the DDS
+// threads: under fifo and rr a thread is not preempted by one of equal priority, so a burst of
+// receptions cannot interrupt the processing, and a woken processing thread does not preempt a
+// receive thread that is still handing its sample over (one priority above them cost 20-40 us
+// at the median of each hop, docs/results.md "Latency tail").
 // Memory is locked as it is touched (mlockall with MCL_ONFAULT: locking every thread's whole stack
 // would cost megabytes), and the main thread's stack is touched ahead. What the kernel granted is
 // read back and reported; a refusal is a ConfigError naming the key, the value and the system's
@@ -34,8 +38,6 @@ struct RealtimeOptions {
 
 /// The top-level key of the block.
 inline constexpr const char* kRealtimeKey = "realtime";
-/// The main (processing) thread's priority above the DDS threads' under fifo and rr.
-inline constexpr int kProcessingPriorityStep = 1;
 /// The main thread's stack touched ahead under lock_memory [bytes].
 inline constexpr std::size_t kPrefaultedStackBytes = 256 * 1024;
 
@@ -56,10 +58,6 @@ struct RealtimeGrant {
 /// the kernel refuses (no CAP_SYS_NICE, a container without it, RLIMIT_MEMLOCK, a core this
 /// process may not use). Nothing requested: nothing changed, the current state read back.
 RealtimeGrant applyRealtime(const RealtimeOptions& options);
-
-/// Raises the calling thread kProcessingPriorityStep above the others under fifo and rr (within
-/// the policy's maximum); returns its priority.
-int raiseProcessingThread(const RealtimeOptions& options);
 
 /// "other", "fifo", "rr".
 const char* policyName(SchedulingPolicy policy);
