@@ -278,6 +278,17 @@ TEST(ChiSquare, SurvivalEqualsTheIncompleteGammaFunctionAndTheTailIsContinuous) 
       previous = s;
     }
   }
+  // Gross statistics (a pseudorange wrong by light-seconds): the survival is 0 and the
+  // significance -log10 Q = (x/2 - log S) / ln 10, with log S negligible next to x/2, for every
+  // finite x (the tail's terms would overflow a double from x ~ 4e28 on).
+  for (int dof = 1; dof <= 80; ++dof) {
+    for (const double x : {1e20, 4e28, 1e32, 1e100, 1e300, 1.7e308}) {
+      EXPECT_EQ(nc::chiSquareSurvival(x, dof), 0.0) << "dof " << dof << ", x " << x;
+      const double expected = 0.5 * x / std::log(10.0);
+      EXPECT_NEAR(nc::chiSquareSignificance(x, dof) / expected, 1.0, 1e-12)
+          << "dof " << dof << ", x " << x;
+    }
+  }
 }
 
 // The gain the GLR is given, from the covariance after the sequential scalar updates
