@@ -19,7 +19,9 @@ install_node_readers
 cp "$src/tests/foxglove/check_browser.mjs" "$src/tests/foxglove/browser_page.html" "$node_dir/"
 
 domain=114
-printf 'extends: %s\ndomain_id: %s\n' "$src/config/filter_demo.yaml" $domain > "$work/filter.yaml"
+# No fault manager here: the filter does not wait for one (filter_demo.yaml's judged_from_start).
+printf 'extends: %s\ndomain_id: %s\nfault_monitor: {judged_from_start: false}\n' \
+  "$src/config/filter_demo.yaml" $domain > "$work/filter.yaml"
 "$bin/navbus-filter" -c "$work/filter.yaml" > "$work/filter.log" 2>&1 &
 pids+=($!)
 "$bin/navbus" -d $domain foxglove --port 0 > "$work/bridge.log" 2>&1 &

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <thread>
 
 #include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/HealthPubSubTypes.h>
@@ -67,16 +68,6 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
           std::max(kNotProducingMinNs, kNotProducingPeriods * config.engine.solution_period_ns)),
       sensors_(p, sensorEvents()) {
   using namespace bus;
-  sensors_.subscribe<navbus::ImuIncrement>(profile::kSensorReader,
-                                           [this](const auto& m) { pipeline_.onImu(m); });
-  sensors_.subscribe<navbus::ImuIncrementBlock>(profile::kSensorReader,
-                                                [this](const auto& m) { pipeline_.onImuBlock(m); });
-  sensors_.subscribe<navbus::GnssObservationEpoch>(
-      profile::kMeasurementReader, [this](const auto& m) { pipeline_.onGnssObservations(m); });
-  sensors_.subscribe<navbus::GnssFix>(profile::kMeasurementReader,
-                                      [this](const auto& m) { pipeline_.onGnssFix(m); });
-  sensors_.subscribe<navbus::StarTrackerAttitude>(
-      profile::kMeasurementReader, [this](const auto& m) { pipeline_.onStarTracker(m); });
   p.subscribe<navbus::FaultDecisionPubSubType>(topic::kFaultDecision, profile::kDecisionReader,
                                                [this](const auto& d, const auto&) {
                                                  pipeline_.onDecision(d);
@@ -86,7 +77,7 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
       topic::kFilterCommand, profile::kDecisionReader, [this](const auto& c, const auto& info) {
         pipeline_.onCommand(c, participant_.dds().writerIdentity(info));
       });
-  p.subscribe<navbus::FaultMonitorProgressPubSubType>(
+  auto* progress_reader = p.subscribe<navbus::FaultMonitorProgressPubSubType>(
       topic::kFaultProgress, profile::kProgressReader,
       [this](const auto& report, const auto& info) {
         pipeline_.onFaultMonitorProgress(report);
@@ -98,6 +89,10 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
           if (!writer || *writer == *monitor_identity_) monitor_->onReport(steadyNowNs());
         }
       });
+  if (config.fault_monitor && config.fault_monitor->judged_from_start)
+    awaitFaultMonitor(config.fault_monitor->judgement_wait_ns, *progress_reader,
+                      publishesDiagnostics(config));
+  subscribeInputs();
   // Bounded-wait release of inputs held for a silent stream, and the held solution while
   // inertial data is lost (the solution topic's deadline promises at least 1 Hz).
   p.setAfterDispatch([this] { pump(); });
@@ -110,6 +105,49 @@ FilterNode::FilterNode(bus::Participant& p, const FilterConfig& config)
   p.addTimer(std::chrono::nanoseconds(config.engine.solution_period_ns),
              [this] { pipeline_.publishHeldSolution(); });
   updateState();
+}
+
+void FilterNode::subscribeInputs() {
+  using namespace bus;
+  sensors_.subscribe<navbus::ImuIncrement>(profile::kSensorReader,
+                                           [this](const auto& m) { pipeline_.onImu(m); });
+  sensors_.subscribe<navbus::ImuIncrementBlock>(profile::kSensorReader,
+                                                [this](const auto& m) { pipeline_.onImuBlock(m); });
+  sensors_.subscribe<navbus::GnssObservationEpoch>(
+      profile::kMeasurementReader, [this](const auto& m) { pipeline_.onGnssObservations(m); });
+  sensors_.subscribe<navbus::GnssFix>(profile::kMeasurementReader,
+                                      [this](const auto& m) { pipeline_.onGnssFix(m); });
+  sensors_.subscribe<navbus::StarTrackerAttitude>(
+      profile::kMeasurementReader, [this](const auto& m) { pipeline_.onStarTracker(m); });
+}
+
+bool FilterNode::faultMonitorConnected(eprosima::fastdds::dds::DataReader& progress_reader,
+                                       bool diagnostics) const {
+  eprosima::fastdds::dds::SubscriptionMatchedStatus progress;
+  progress_reader.get_subscription_matched_status(progress);
+  return progress.current_count > 0 && (!diagnostics || diagnostics_writer_.matchedReaders() > 0);
+}
+
+void FilterNode::awaitFaultMonitor(std::int64_t wait_ns,
+                                   eprosima::fastdds::dds::DataReader& progress_reader,
+                                   bool diagnostics) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto until = start + std::chrono::nanoseconds(wait_ns);
+  while (!participant_.stopping() && !faultMonitorConnected(progress_reader, diagnostics) &&
+         std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(kMonitorPollPeriod);
+  }
+  const double waited_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (faultMonitorConnected(progress_reader, diagnostics)) {
+    spdlog::info("fault monitor connected after {:.2f} s: taking the inputs (judged_from_start)",
+                 waited_s);
+  } else if (!participant_.stopping()) {
+    spdlog::warn(
+        "no fault monitor connected after {:.2f} s (fault_monitor.judgement_wait_s): taking the "
+        "inputs without it; epochs published before it connects are not judged",
+        waited_s);
+  }
 }
 
 bus::SensorReaders::Events FilterNode::sensorEvents() {

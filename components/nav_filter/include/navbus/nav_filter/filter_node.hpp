@@ -3,6 +3,7 @@
 // and republish the held solution while inertial data is lost.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -37,6 +38,20 @@ class FilterNode {
   void updateState();
   /// Follows the configured fault monitor's health reports (FilterConfig::fault_monitor).
   void watchFaultMonitor(const FaultMonitorWatch& watch);
+  /// With fault_monitor.judged_from_start: the monitor starts with the filter, and the output
+  /// waits for its judgement of the first epoch. So the inputs are taken only once it is
+  /// connected (its progress reports reach this filter and, tightly coupled, a reader has
+  /// matched the diagnostics), at most `wait_ns`: the diagnostics are volatile, and an epoch
+  /// published before the monitor's reader matched would never be judged (measured: under DDS
+  /// Security the filter and the fault manager matched 1-3 s after the simulator's fast replay
+  /// had started, and the GLR missed the demo's ramp).
+  void awaitFaultMonitor(std::int64_t wait_ns, eprosima::fastdds::dds::DataReader& progress_reader,
+                         bool diagnostics);
+  bool faultMonitorConnected(eprosima::fastdds::dds::DataReader& progress_reader,
+                             bool diagnostics) const;
+  /// The sensor streams' readers (the simulator's fast pacing waits for them).
+  void subscribeInputs();
+  static constexpr std::chrono::milliseconds kMonitorPollPeriod{10};
   /// What the sensor readers tell the pipeline besides the samples: announced ends, liveliness.
   bus::SensorReaders::Events sensorEvents();
   static constexpr int kNotProducingPeriods = 3;
