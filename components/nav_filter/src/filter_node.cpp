@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <thread>
 
 #include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/HealthPubSubTypes.h>
@@ -133,9 +132,11 @@ void FilterNode::awaitFaultMonitor(std::int64_t wait_ns,
                                    bool diagnostics) {
   const auto start = std::chrono::steady_clock::now();
   const auto until = start + std::chrono::nanoseconds(wait_ns);
+  // Meanwhile the loop runs (health says STARTING, commands are taken), without inputs.
+  participant_.setState(navbus::STATE_STARTING);
   while (!participant_.stopping() && !faultMonitorConnected(progress_reader, diagnostics) &&
          std::chrono::steady_clock::now() < until) {
-    std::this_thread::sleep_for(kMonitorPollPeriod);
+    participant_.spinOnce(kMonitorPollPeriod);
   }
   const double waited_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
