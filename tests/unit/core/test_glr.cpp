@@ -18,6 +18,7 @@
 #include "navbus/core/integrity/glr.hpp"
 #include "navbus/core/integrity/glr_protection_level.hpp"
 #include "navbus/core/math/chi_square.hpp"
+#include "navbus/core/math/column_product.hpp"
 #include "navbus/core/math/kalman_update.hpp"
 
 namespace nc = navbus::core;
@@ -793,4 +794,30 @@ TEST(GlrProtection, AFixEpochCarriesTheGainItsTwoUpdatesApplied) {
   in.used[4] = false;
   nc::fixEpochDiagnostics(in, gain, d);
   EXPECT_EQ(d.k.col(4).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// The GLR's signature products (columnProduct): the AVX2 + FMA kernel where the CPU has it,
+// Eigen's product elsewhere; either equals the product to rounding for every size up to the
+// limit, with padding rows of the operands' storage and leading dimensions as the window uses
+// them, and writes nothing below row n.
+TEST(ColumnProduct, EqualsTheMatrixProductForEverySizeAndLeavesTheRowsBelowAlone) {
+  std::mt19937 rng(20261201);
+  std::normal_distribution<double> normal;
+  constexpr int kLd = nc::kMaxColumnProductSize + 3;
+  std::printf("columnProduct on this CPU: %s\n",
+              nc::columnProductUsesFma() ? "AVX2 + FMA kernel" : "Eigen's product");
+  for (int n = 1; n <= nc::kMaxColumnProductSize; ++n) {
+    for (int cols : {1, 2, 5, 13, 61}) {
+      Eigen::MatrixXd a(n + 2, n), b(kLd, cols), c = Eigen::MatrixXd::Constant(kLd, cols, 7.0);
+      for (Eigen::Index i = 0; i < a.size(); ++i) a.data()[i] = normal(rng);
+      for (Eigen::Index i = 0; i < b.size(); ++i) b.data()[i] = normal(rng);
+      nc::columnProduct(n, cols, a.data(), n + 2, b.data(), kLd, c.data(), kLd);
+      const Eigen::MatrixXd expected = a.topRows(n) * b.topRows(n);
+      const double scale = expected.cwiseAbs().maxCoeff();
+      ASSERT_LE((c.topRows(n) - expected).cwiseAbs().maxCoeff(), 1e-14 * n * scale)
+          << "n " << n << ", " << cols << " columns";
+      ASSERT_TRUE((c.bottomRows(kLd - n).array() == 7.0).all())
+          << "n " << n << ", " << cols << " columns: a row below n was written";
+    }
+  }
 }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "navbus/core/math/column_product.hpp"
+
 namespace navbus::core {
 
 using namespace glr;
@@ -308,7 +310,9 @@ void GlrWindow::propagate() {
       b_live_(r, c) = b_(live_[static_cast<std::size_t>(r)], live_[static_cast<std::size_t>(c)]);
   }
   const int columns = propagatedColumns() * config_.window;
-  mu_next_->topLeftCorner(n, columns).noalias() = b_live_ * mu_.topLeftCorner(n, columns);
+  columnProduct(n, columns, b_live_.data(), static_cast<int>(b_live_.outerStride()), mu_.data(),
+                static_cast<int>(mu_.outerStride()), mu_next_->data(),
+                static_cast<int>(mu_next_->outerStride()));
   mu_.swap(*mu_next_);
   const bool range = config_.range_steps || config_.range_ramps;
   for (int s = 0; s < slots_used_; ++s) {
@@ -389,7 +393,9 @@ void GlrWindow::accumulate() {
   // accumulateSatellite.
   const int columns = propagatedColumns() * config_.window;
   const int n = support_count_;
-  z_->topLeftCorner(n, columns).noalias() = s_ * mu_.topLeftCorner(n, columns);
+  columnProduct(n, columns, s_.data(), static_cast<int>(s_.outerStride()), mu_.data(),
+                static_cast<int>(mu_.outerStride()), z_->data(),
+                static_cast<int>(z_->outerStride()));
   if (config_.imu_steps) accumulateImu();
   // The satellites' sums are support-wide dot products, many per onset: with the support's size
   // known at compile time for the usual cases (position, velocity and clock; with a lever arm,
