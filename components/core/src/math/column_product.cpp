@@ -56,7 +56,20 @@ __attribute__((target("avx2,fma"))) void fmaKernel(int n, int cols, const double
 }
 
 constexpr int kMaxBlocks = kMaxColumnProductSize / 4;
-static_assert(kMaxBlocks == 10, "fmaProduct dispatches 1..10 blocks");
+
+/// The kernel of `blocks` blocks (NB..kMaxBlocks).
+template <int NB>
+__attribute__((target("avx2,fma"))) void fmaBlocks(int blocks, int n, int cols,
+                                                   const double* a_padded, const double* b, int ldb,
+                                                   double* c, int ldc, __m256i last_mask) {
+  if constexpr (NB < kMaxBlocks) {
+    if (blocks > NB) {
+      fmaBlocks<NB + 1>(blocks, n, cols, a_padded, b, ldb, c, ldc, last_mask);
+      return;
+    }
+  }
+  fmaKernel<NB>(n, cols, a_padded, b, ldb, c, ldc, last_mask);
+}
 
 __attribute__((target("avx2,fma"))) void fmaProduct(int n, int cols, const double* a, int lda,
                                                     const double* b, int ldb, double* c, int ldc) {
@@ -70,39 +83,7 @@ __attribute__((target("avx2,fma"))) void fmaProduct(int n, int cols, const doubl
   const int last = n - 4 * (blocks - 1);  // rows of the last block, 1..4
   const __m256i mask =
       _mm256_setr_epi64x(-1, last > 1 ? -1 : 0, last > 2 ? -1 : 0, last > 3 ? -1 : 0);
-  const double* ap = padded.data();
-  switch (blocks) {
-    case 1:
-      fmaKernel<1>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    case 2:
-      fmaKernel<2>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    case 3:
-      fmaKernel<3>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    case 4:
-      fmaKernel<4>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    case 5:
-      fmaKernel<5>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    case 6:
-      fmaKernel<6>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    case 7:
-      fmaKernel<7>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    case 8:
-      fmaKernel<8>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    case 9:
-      fmaKernel<9>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-    default:
-      fmaKernel<kMaxBlocks>(n, cols, ap, b, ldb, c, ldc, mask);
-      break;
-  }
+  fmaBlocks<1>(blocks, n, cols, padded.data(), b, ldb, c, ldc, mask);
 }
 
 bool cpuHasFma() {
