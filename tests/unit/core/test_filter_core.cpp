@@ -5,6 +5,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+
 #include <Eigen/Eigenvalues>
 
 #include "navbus/core/filter/error_state.hpp"
@@ -358,6 +359,71 @@ TEST(SparseRows, ProductsEqualTheDenseOnesForTransitionMatrices) {
     EXPECT_TRUE(navbus::core::transitionPattern().isBlockUpperTriangular(layout::kCoupledSize));
     EXPECT_FALSE(
         navbus::core::transitionPattern().isBlockUpperTriangular(layout::kCoupledSize - 1));
+  }
+}
+
+namespace {
+/// Column i of B A^T as SparseRows' documentation defines it, one scalar product and sum at a
+/// time in the pattern's (ascending) order: out(r) = sum_k A(i, k) B(r, k - offset).
+template <class Matrix>
+Eigen::VectorXd scalarColumnSum(const StateMat& A, int i, const Matrix& B, int offset = 0) {
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(B.rows());
+  for (int k = 0; k < layout::kSize; ++k) {
+    if (A(i, k) == 0.0) continue;
+    for (Eigen::Index r = 0; r < B.rows(); ++r) c(r) += A(i, k) * B(r, k - offset);
+  }
+  return c;
+}
+}  // namespace
+
+TEST(SparseRows, ProductsAreTheScalarSumsInThePatternsOrderBitForBit) {
+  // Given a transition matrix and a covariance,
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  navbus::core::NavState s = ins();
+  s.vel_ned_mps = 150.0 * Eigen::Vector3d(u(rng), u(rng), u(rng));
+  const StateMat Phi = navbus::core::transitionMatrix(
+      navbus::core::errorDynamics(s, Eigen::Vector3d(u(rng), u(rng), -9.8),
+                                  0.1 * Eigen::Vector3d(u(rng), u(rng), u(rng)),
+                                  earth::GravityModel::kWgs84Normal),
+      0.01);
+  const StateMat A = StateMat::Random();
+  const StateMat P = A * A.transpose();
+  const navbus::core::SparseRows<layout::kSize> sparse(Phi);
+  constexpr int kLead = layout::kCoupledSize;
+  constexpr int kTrail = layout::kSize - kLead;
+  // then B Phi^T is the scalar sums exactly (not to rounding: the same operations in the same
+  // order),
+  StateMat times_t;
+  for (int i = 0; i < layout::kSize; ++i) times_t.col(i) = scalarColumnSum(Phi, i, P);
+  EXPECT_EQ(sparse.timesTransposed(P), times_t);
+  // and so are Phi P Phi^T's steps (W^T = P Phi(0:Lead, :)^T, then W Phi^T's leading rows, the
+  // trailing block from P22) and the block triangular running product.
+  Eigen::Matrix<double, layout::kSize, kLead> wt;
+  for (int i = 0; i < kLead; ++i) wt.col(i) = scalarColumnSum(Phi, i, P);
+  const Eigen::Matrix<double, kLead, layout::kSize> w = wt.transpose();
+  Eigen::Matrix<double, kTrail, kTrail> tt;
+  const Eigen::Matrix<double, kTrail, kTrail> p22 = P.bottomRightCorner<kTrail, kTrail>();
+  for (int i = kLead; i < layout::kSize; ++i)
+    tt.col(i - kLead) = scalarColumnSum(Phi, i, p22, kLead);
+  const Eigen::Matrix<double, kTrail, kTrail> t = tt.transpose();
+  // (the upper triangle is computed, the lower one mirrored from it).
+  const StateMat sandwich = sparse.sandwichBlockTriangular<kLead>(P);
+  EXPECT_EQ(sandwich, sandwich.transpose());
+  for (int j = 0; j < layout::kSize; ++j) {
+    const Eigen::VectorXd lead = scalarColumnSum(Phi, j, w);
+    const Eigen::VectorXd trail =
+        j >= kLead ? scalarColumnSum(Phi, j, t, kLead) : Eigen::VectorXd();
+    for (int i = 0; i <= j; ++i) {
+      const double expected = i < kLead ? lead(i) : trail(i - kLead);
+      EXPECT_EQ(sandwich(i, j), expected) << "(" << i << ", " << j << ")";
+    }
+  }
+  const StateMat ct = (Phi * Phi).transpose();
+  const StateMat running = sparse.timesTransposedBlockTriangular<kLead>(ct);
+  for (int i = kLead; i < layout::kSize; ++i) {
+    const Eigen::Matrix<double, kTrail, layout::kSize> ct2 = ct.bottomRows<kTrail>();
+    EXPECT_EQ(Eigen::VectorXd(running.col(i).tail<kTrail>()), scalarColumnSum(Phi, i, ct2)) << i;
   }
 }
 

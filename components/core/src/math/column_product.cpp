@@ -1,11 +1,18 @@
 #include "navbus/core/math/column_product.hpp"
 
-#include <immintrin.h>
-
 #include <array>
+
+// The kernel is x86-64 code (AVX2 and FMA, chosen at run time); elsewhere Eigen's product.
+#if defined(__x86_64__)
+#define NAVBUS_X86_KERNELS 1
+#include <immintrin.h>
+#else
+#define NAVBUS_X86_KERNELS 0
+#endif
 
 namespace navbus::core {
 
+#if NAVBUS_X86_KERNELS
 namespace {
 
 // A kernel of NB blocks of four rows and NC columns at a time: NB x NC accumulators (at most
@@ -86,25 +93,32 @@ __attribute__((target("avx2,fma"))) void fmaProduct(int n, int cols, const doubl
   fmaBlocks<1>(blocks, n, cols, padded.data(), b, ldb, c, ldc, mask);
 }
 
-bool cpuHasFma() {
+bool cpuHasAvx2Fma() {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return __builtin_cpu_supports("avx2") != 0 && __builtin_cpu_supports("fma") != 0;
 }
 
 }  // namespace
+#endif
 
 bool columnProductUsesFma() {
-  static const bool has = cpuHasFma();
+#if NAVBUS_X86_KERNELS
+  static const bool has = cpuHasAvx2Fma();
   return has;
+#else
+  return false;
+#endif
 }
 
 void columnProduct(int n, int cols, const double* a, int lda, const double* b, int ldb, double* c,
                    int ldc) {
   if (n <= 0 || cols <= 0) return;
+#if NAVBUS_X86_KERNELS
   if (columnProductUsesFma() && n <= kMaxColumnProductSize) {
     fmaProduct(n, cols, a, lda, b, ldb, c, ldc);
     return;
   }
+#endif
   using Stride = Eigen::OuterStride<>;
   const Eigen::Map<const Eigen::MatrixXd, 0, Stride> am(a, n, n, Stride(lda));
   const Eigen::Map<const Eigen::MatrixXd, 0, Stride> bm(b, n, cols, Stride(ldb));
