@@ -40,8 +40,9 @@ class FilterNode {
   void watchFaultMonitor(const FaultMonitorWatch& watch);
   /// With fault_monitor.judged_from_start: the monitor starts with the filter, and the output
   /// waits for its judgement of the first epoch. So the inputs are taken only once it is
-  /// connected (its progress reports reach this filter and, tightly coupled, a reader has
-  /// matched the diagnostics), at most `wait_ns`: the diagnostics are volatile, and an epoch
+  /// connected (a progress writer has matched this filter's reader and, tightly coupled, a
+  /// reader has matched the diagnostics; whose they are is not checked here, a recorder of the
+  /// diagnostics counts too), at most `wait_ns`: the diagnostics are volatile, and an epoch
   /// published before the monitor's reader matched would never be judged (measured: under DDS
   /// Security the filter and the fault manager matched 1-3 s after the simulator's fast replay
   /// had started, and the GLR missed the demo's ramp).
