@@ -39,7 +39,7 @@ std::optional<int> recordSimulatorRun(int domain, const std::filesystem::path& d
   test::ChildProcess recorder(
       navbus::test_paths::toolExe(),
       {"-d", std::to_string(domain), "record", "navbus/imu/increment_block", "navbus/imu/raw",
-       "navbus/gnss/observations", "navbus/gnss/fix", "-o", (dir / "rec").string()},
+       "navbus/gnss/observations_block", "navbus/gnss/fix_block", "-o", (dir / "rec").string()},
       (dir / "record.log").string());
   test::ChildProcess sim(navbus::test_paths::sensorSimExe(), {"-c", sim_cfg, "--seed", seed},
                          (dir / "sim.log").string());
@@ -95,16 +95,16 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
   ASSERT_EQ(recordSimulatorRun(kDomain, dir, sim_cfg, "5"), 0)
       << test::readFile(dir / "sim.log") << test::readFile(dir / "record.log");
   // 60 s of 50 Hz increments in blocks of 0.1 s (a CSV row per increment); the scenario's
-  // GNSS fixes as the simulator reports them.
+  // GNSS fixes (in blocks too, a row per fix) as the simulator reports them.
   const std::string record_log = test::readFile(dir / "record.log");
   EXPECT_NE(record_log.find("recorded 600 samples of navbus/imu/increment_block"),
             std::string::npos)
       << record_log;
   EXPECT_EQ(dataRows(dir / "rec" / "navbus_imu_increment_block.csv"), 3000u);
-  EXPECT_NE(
-      test::readFile(dir / "sim.log")
-          .find(std::to_string(dataRows(dir / "rec" / "navbus_gnss_fix.csv")) + " GNSS fixes"),
-      std::string::npos);
+  EXPECT_NE(test::readFile(dir / "sim.log")
+                .find(std::to_string(dataRows(dir / "rec" / "navbus_gnss_fix_block.csv")) +
+                      " GNSS fixes"),
+            std::string::npos);
 
   // 2. The recording replayed into a new filter and fault manager.
   bus::ShutdownSignal shutdown;
@@ -120,9 +120,10 @@ TEST(Replay, RecordedRunReplaysIntoANewFilterBitIdentical) {
                             (dir / "filter.log").string());
   test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
                         (dir / "fm.log").string());
-  const auto replay = startReplay(
-      kDomain, dir,
-      {{"navbus/imu/increment_block", 2}, {"navbus/gnss/observations", 2}, {"navbus/gnss/fix", 2}});
+  const auto replay = startReplay(kDomain, dir,
+                                  {{"navbus/imu/increment_block", 2},
+                                   {"navbus/gnss/observations_block", 2},
+                                   {"navbus/gnss/fix_block", 2}});
   while (replay->running()) me.spinOnce(50ms);
   const std::string replay_log = test::readFile(dir / "replay.log");
   EXPECT_EQ(replay->wait(1s), 0) << replay_log;
@@ -465,9 +466,10 @@ TEST(Replay, ATriplexRecordingReplaysEveryLaneBitIdentical) {
   test::ChildProcess fm(navbus::test_paths::faultManagerExe(), {"-c", fm_cfg},
                         (dir / "fm.log").string());
   // The increments' readers: the filter's, the fault manager's watchdog and its parity test's.
-  const auto replay = startReplay(
-      kDomain, dir,
-      {{"navbus/imu/increment_block", 3}, {"navbus/gnss/observations", 2}, {"navbus/gnss/fix", 1}});
+  const auto replay = startReplay(kDomain, dir,
+                                  {{"navbus/imu/increment_block", 3},
+                                   {"navbus/gnss/observations_block", 2},
+                                   {"navbus/gnss/fix_block", 1}});
   while (replay->running()) me.spinOnce(50ms);
   const std::string replay_log = test::readFile(dir / "replay.log");
   EXPECT_EQ(replay->wait(1s), 0) << replay_log;

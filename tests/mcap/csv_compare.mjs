@@ -1,7 +1,9 @@
 // Decoded navbus messages compared with navbus's CSV recording of the same run, field by field
 // (shared by check_mcap.mjs and the Foxglove bridge's check_bridge.mjs).
 // CSV columns (records/formatters.hpp): "name", "name[i]" for arrays, "seq.field" (a row per
-// element) for the sequence of structs, "a;b;c" for a sequence of numbers, enums by name,
+// element) for the sequence of structs, "seq.inner.field" (a row per element of each element's
+// own sequence of structs, the element's cells repeated: a block of GNSS epochs, a row per
+// satellite), "a;b;c" for a sequence of numbers, enums by name,
 // booleans as 0/1, a nested struct's fields as "<struct>_<field>". Fields the CSV summarizes as
 // text (diagnostics, decision candidates) are not compared.
 
@@ -23,17 +25,26 @@ export function compareRows(topic, value, rows, enums, fail, counts) {
   const columns = Object.keys(rows[0]).filter(
     (c) => c !== "source_timestamp_ns" && c !== "reception_timestamp_ns",
   );
+  const at = rowElements(value, columns);
   rows.forEach((row, r) => {
     for (const column of columns) {
-      const m = /^([a-z_0-9]+)(?:\[(\d+)\])?(?:\.([a-z_0-9]+)(?:\[(\d+)\])?)?$/.exec(column);
+      const m =
+        /^([a-z_0-9]+)(?:\[(\d+)\])?(?:\.([a-z_0-9]+)(?:\[(\d+)\])?)?(?:\.([a-z_0-9]+)(?:\[(\d+)\])?)?$/.exec(
+          column,
+        );
       if (!m) {
         fail(`${topic}: column '${column}' is not a field path`);
         continue;
       }
       let v = field(value, m[1]);
-      if (m[3] !== undefined) {
+      const [element, inner] = at ? (at[r] ?? [r, -1]) : [r, -1];
+      if (m[5] !== undefined) {
+        if (row[column] === "" && inner < 0) continue; // an element without inner elements
+        v = v?.[element]?.[m[3]]?.[inner]?.[m[5]];
+        if (m[6] !== undefined) v = v?.[Number(m[6])];
+      } else if (m[3] !== undefined) {
         if (row[column] === "" && (v?.length ?? 0) === 0) continue; // no element: empty cells
-        v = v?.[r]?.[m[3]];
+        v = v?.[element]?.[m[3]];
         if (m[4] !== undefined) v = v?.[Number(m[4])];
       } else if (m[2] !== undefined) {
         v = v?.[Number(m[2])];
@@ -59,6 +70,21 @@ export function compareRows(topic, value, rows, enums, fail, counts) {
     }
   });
   return cells;
+}
+
+// With a sequence inside the sequence's elements (columns "seq.inner.field"): for each CSV row,
+// [element, inner element] (inner -1 for an element whose own sequence is empty: one row).
+// Otherwise null: row r is element r.
+function rowElements(value, columns) {
+  const nested = columns.map((c) => /^([a-z_0-9]+)\.([a-z_0-9]+)\.[a-z_0-9]+/.exec(c)).find((m) => m);
+  if (!nested) return null;
+  const at = [];
+  (field(value, nested[1]) ?? []).forEach((e, i) => {
+    const n = e?.[nested[2]]?.length ?? 0;
+    if (n === 0) at.push([i, -1]);
+    for (let k = 0; k < n; k += 1) at.push([i, k]);
+  });
+  return at;
 }
 
 // A message's field by its CSV name; a nested struct's fields are named "<struct>_<field>"

@@ -107,8 +107,9 @@ du -sb "$work/csv" | awk '{print "CSV recording: " $1 " bytes"}'
 # --- 3. replay from MCAP = replay from CSV = the recording -----------------------------------
 replay_into() {  # RECORDING OUT_DIR
   local rec_pid
-  "$bin/navbus" -d 107 record navbus/imu/increment_block navbus/imu/raw navbus/gnss/observations \
-    navbus/gnss/fix -o "$2" --idle 3 > "$work/replay_record.log" 2>&1 &
+  "$bin/navbus" -d 107 record navbus/imu/increment_block navbus/imu/raw \
+    navbus/gnss/observations_block navbus/gnss/fix_block -o "$2" --idle 3 \
+    > "$work/replay_record.log" 2>&1 &
   rec_pid=$!
   pids=($rec_pid)
   "$bin/navbus" -d 107 replay "$1" --speed 0 > "$work/replay.log" 2>&1 ||
@@ -118,7 +119,8 @@ replay_into() {  # RECORDING OUT_DIR
 }
 replay_into "$work/run.mcap" "$work/from_mcap"
 replay_into "$work/csv" "$work/from_csv"
-for topic in navbus_imu_increment_block navbus_imu_raw navbus_gnss_observations navbus_gnss_fix; do
+for topic in navbus_imu_increment_block navbus_imu_raw navbus_gnss_observations_block \
+  navbus_gnss_fix_block; do
   original=$(content "$work/csv/$topic.csv" | md5sum)
   [ "$(content "$work/from_mcap/$topic.csv" | md5sum)" = "$original" ] ||
     fail "$topic replayed from MCAP differs from the recording"

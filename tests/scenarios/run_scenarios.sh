@@ -25,14 +25,15 @@ for scenario in seed000_aircraft:100:1:0 seed001_leo:200:10:5 seed003_laser_ins:
   check "gnss_fix.csv rows" $((gnss_hz * seconds)) "$(rows "$work/$name/gnss_fix.csv")"
   check "star_tracker.csv rows" $((st_hz * seconds)) "$(rows "$work/$name/star_tracker.csv")"
   # Over the bus, fast pacing, recorded by a separate participant (the only reader here).
-  # Fast pacing sends the increments in blocks (navbus/imu/increment_block): a CSV row each.
+  # Fast pacing sends every stream in blocks (navbus/imu/increment_block, navbus/gnss/fix_block,
+  # ...): a CSV row per element.
   cat > "$work/$name.bus.yaml" <<YAML
 extends: $file
 timing: {min_readers: {imu: 1, raw_imu: 1, gnss: 1, star_tracker: 1}}
 YAML
   topics=(navbus/imu/increment_block navbus/imu/raw)
-  [ "$gnss_hz" -gt 0 ] && topics+=(navbus/gnss/observations navbus/gnss/fix)
-  [ "$st_hz" -gt 0 ] && topics+=(navbus/startracker/attitude)
+  [ "$gnss_hz" -gt 0 ] && topics+=(navbus/gnss/observations_block navbus/gnss/fix_block)
+  [ "$st_hz" -gt 0 ] && topics+=(navbus/startracker/attitude_block)
   # The recorder stops itself once nothing has come for 3 s (--idle): killing it as soon as the
   # simulator exits lost what was still queued for it (seed 003's 2400 Hz raw stream under the
   # sanitizers: 10 increments of 300 recorded); 60 s at most.
@@ -42,8 +43,8 @@ YAML
     || { cat "$work/$name.bus.log"; exit 1; }
   wait $rec || true
   check "bus imu increments" $((imu_hz * seconds)) "$(rows "$work/$name.bus/navbus_imu_increment_block.csv")"
-  if [ "$gnss_hz" -gt 0 ]; then check "bus gnss fixes" $((gnss_hz * seconds)) "$(rows "$work/$name.bus/navbus_gnss_fix.csv")"; fi
-  if [ "$st_hz" -gt 0 ]; then check "bus star-tracker attitudes" $((st_hz * seconds)) "$(rows "$work/$name.bus/navbus_startracker_attitude.csv")"; fi
+  if [ "$gnss_hz" -gt 0 ]; then check "bus gnss fixes" $((gnss_hz * seconds)) "$(rows "$work/$name.bus/navbus_gnss_fix_block.csv")"; fi
+  if [ "$st_hz" -gt 0 ]; then check "bus star-tracker attitudes" $((st_hz * seconds)) "$(rows "$work/$name.bus/navbus_startracker_attitude_block.csv")"; fi
   domain=$((domain + 1))
 done
 exit $status

@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "navbus/bus/health.hpp"
+#include "navbus/bus/streams.hpp"
 
 namespace navbus::bus {
 
@@ -106,6 +107,39 @@ std::optional<Rejection> validate(const navbus::ImuIncrementBlock& s, const Vali
     }
   }
   return std::nullopt;
+}
+
+namespace {
+template <class Block>
+std::optional<Rejection> validateBlock(const Block& s) {
+  using Traits = SensorBlock<Block>;
+  const auto& elements = Traits::elements(s);
+  const std::string_view name = Traits::kElements;
+  if (elements.empty()) {
+    return Rejection{navbus::REJECT_OUT_OF_RANGE, std::string(name) + ".size", 0.0};
+  }
+  const std::uint32_t id = SensorMessage<Block>::sensorId(s);
+  for (std::size_t i = 0; i < elements.size(); ++i) {
+    const std::uint32_t element_id = SensorMessage<typename Traits::Element>::sensorId(elements[i]);
+    if (element_id != id) {
+      return Rejection{navbus::REJECT_INCONSISTENT, indexed(name, i) + "." + Traits::kIdField,
+                       static_cast<double>(element_id)};
+    }
+  }
+  return std::nullopt;
+}
+}  // namespace
+
+std::optional<Rejection> validate(const navbus::GnssObservationEpochBlock& s,
+                                  const ValidationLimits&) {
+  return validateBlock(s);
+}
+std::optional<Rejection> validate(const navbus::GnssFixBlock& s, const ValidationLimits&) {
+  return validateBlock(s);
+}
+std::optional<Rejection> validate(const navbus::StarTrackerAttitudeBlock& s,
+                                  const ValidationLimits&) {
+  return validateBlock(s);
 }
 
 std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const ValidationLimits& l) {

@@ -81,11 +81,17 @@ class RecordedSamples {
   }
 
  private:
+  /// A fast-pacing block of measurements goes in as its elements, each one sample of its own
+  /// topic (the filter takes them so), in the block's order.
   template <class T>
   static void add(const T& m, int rank, std::vector<Event>& out) {
-    using Traits = bus::SensorMessage<T>;
-    out.push_back({static_cast<std::int64_t>(Traits::timeGpsNs(m)), rank, Traits::sensorId(m),
-                   out.size(), m});
+    if constexpr (bus::kIsSensorBlock<T>) {
+      for (const auto& element : bus::SensorBlock<T>::elements(m)) add(element, rank, out);
+    } else {
+      using Traits = bus::SensorMessage<T>;
+      out.push_back({static_cast<std::int64_t>(Traits::timeGpsNs(m)), rank, Traits::sensorId(m),
+                     out.size(), m});
+    }
   }
 
   std::filesystem::path path_;
@@ -117,8 +123,13 @@ std::vector<Event> loadEvents(const RecordingSetup& setup, RecordingResult& resu
   if (setup.fault_manager && setup.fault_manager->dither.enabled)
     recorded.load<navbus::ImuRawBlockPubSubType>(bus::topic::kImuRaw, 0, events);
   recorded.load<navbus::GnssObservationEpochPubSubType>(bus::topic::kGnssObservations, 1, events);
+  recorded.load<navbus::GnssObservationEpochBlockPubSubType>(bus::topic::kGnssObservationsBlock, 1,
+                                                             events);
   recorded.load<navbus::GnssFixPubSubType>(bus::topic::kGnssFix, 2, events);
+  recorded.load<navbus::GnssFixBlockPubSubType>(bus::topic::kGnssFixBlock, 2, events);
   recorded.load<navbus::StarTrackerAttitudePubSubType>(bus::topic::kStarTracker, 3, events);
+  recorded.load<navbus::StarTrackerAttitudeBlockPubSubType>(bus::topic::kStarTrackerBlock, 3,
+                                                            events);
   if (events.empty())
     throw bus::ConfigError(
         "no recording of a sensor topic in '" + setup.dir.string() +

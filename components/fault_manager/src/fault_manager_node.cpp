@@ -41,6 +41,10 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   watch<navbus::GnssObservationEpoch>(profile::kMeasurementWatchdogReader);
   watch<navbus::GnssFix>(profile::kMeasurementWatchdogReader);
   watch<navbus::StarTrackerAttitude>(profile::kMeasurementWatchdogReader);
+  // And of epochs, fixes and attitudes.
+  watch<navbus::GnssObservationEpochBlock>(profile::kMeasurementWatchdogReader);
+  watch<navbus::GnssFixBlock>(profile::kMeasurementWatchdogReader);
+  watch<navbus::StarTrackerAttitudeBlock>(profile::kMeasurementWatchdogReader);
   // Confirms suspect streams (a DDS deadline event before the own silence reached it) within
   // this period of their silence reaching the deadline.
   p.addTimer(std::chrono::milliseconds(10), [this] { pipeline_.onWatchdogTick(running()); });
@@ -66,6 +70,10 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
     receiver_sensors_.subscribe<navbus::GnssObservationEpoch>(
         profile::kMeasurementReader,
         [this](const navbus::GnssObservationEpoch& m) { pipeline_.onGnssEpoch(m); });
+    receiver_sensors_.subscribe<navbus::GnssObservationEpochBlock>(
+        profile::kMeasurementReader, [this](const navbus::GnssObservationEpochBlock& m) {
+          for (const navbus::GnssObservationEpoch& epoch : m.epochs()) pipeline_.onGnssEpoch(epoch);
+        });
   }
   if (config.glr.enabled) {
     p.subscribe<navbus::FilterDiagnosticsPubSubType>(
@@ -151,6 +159,18 @@ void FaultManagerNode::watch(const char* profile) {
       for (const navbus::ImuIncrement& increment : m.increments()) {
         ++increments.received;
         pipeline_.onStreamSample(kind, m.sensor_id(), increment.seq(), increment.time_gps_ns(),
+                                 now);
+      }
+    } else if constexpr (bus::kIsSensorBlock<Message>) {
+      // The same for a block of epochs, fixes or attitudes, under the element's topic.
+      using Element = typename bus::SensorBlock<Message>::Element;
+      participant_.health().stream(Traits::kTopic.topic).countAccepted(Traits::sensorId(m));
+      bus::StreamCounters& elements =
+          participant_.health().stream(bus::SensorMessage<Element>::kTopic.topic);
+      const std::int64_t now = steadyNowNs();
+      for (const Element& element : bus::SensorBlock<Message>::elements(m)) {
+        ++elements.received;
+        pipeline_.onStreamSample(kind, Traits::sensorId(m), element.seq(), element.time_gps_ns(),
                                  now);
       }
     } else {

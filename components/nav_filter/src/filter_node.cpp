@@ -118,6 +118,13 @@ void FilterNode::subscribeInputs() {
                                       [this](const auto& m) { pipeline_.onGnssFix(m); });
   sensors_.subscribe<navbus::StarTrackerAttitude>(
       profile::kMeasurementReader, [this](const auto& m) { pipeline_.onStarTracker(m); });
+  // Fast pacing's blocks: each element is taken as one sample of its own topic.
+  sensors_.subscribe<navbus::GnssObservationEpochBlock>(
+      profile::kMeasurementReader, [this](const auto& m) { pipeline_.onGnssObservationsBlock(m); });
+  sensors_.subscribe<navbus::GnssFixBlock>(profile::kMeasurementReader,
+                                           [this](const auto& m) { pipeline_.onGnssFixBlock(m); });
+  sensors_.subscribe<navbus::StarTrackerAttitudeBlock>(
+      profile::kMeasurementReader, [this](const auto& m) { pipeline_.onStarTrackerBlock(m); });
 }
 
 bool FilterNode::faultMonitorConnected(eprosima::fastdds::dds::DataReader& progress_reader,

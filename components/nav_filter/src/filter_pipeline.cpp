@@ -9,6 +9,8 @@
 #include <spdlog/spdlog.h>
 
 #include "navbus/bus/conversions.hpp"
+#include "navbus/bus/health.hpp"
+#include "navbus/bus/streams.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/nav_filter/pipeline_summary.hpp"
 #include "navbus/nav_filter/solution_messages.hpp"
@@ -86,6 +88,10 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
                      &time_reference_),
       star_gate_(bus::topic::kStarTracker, health.stream(bus::topic::kStarTracker),
                  config.time_jump, &time_reference_),
+      gnss_obs_block_gate_(bus::topic::kGnssObservationsBlock,
+                           health.stream(bus::topic::kGnssObservationsBlock)),
+      gnss_fix_block_gate_(bus::topic::kGnssFixBlock, health.stream(bus::topic::kGnssFixBlock)),
+      star_block_gate_(bus::topic::kStarTrackerBlock, health.stream(bus::topic::kStarTrackerBlock)),
       commands_(config, health.stream(bus::topic::kFilterCommand), sinks_.command_outcome) {
   receivers_judged_ = config.fault_monitor && config.fault_monitor->receivers_judged;
   spare_satellite_lists_.reserve(kSpareSatelliteLists);
@@ -240,6 +246,33 @@ void FilterPipeline::onStarTracker(const navbus::StarTrackerAttitude& m) {
   if (admitOrHold(star_gate_, star_held_, m, {kRankStarTracker, m.tracker_id()},
                   config_.star_tracker, use))
     useStarTracker(m);
+}
+
+template <class Block, class Take>
+void FilterPipeline::takeBlock(const Block& msg, bus::StreamGate& block_gate,
+                               bus::StreamGate& element_gate, Take take) {
+  const auto& elements = bus::SensorBlock<Block>::elements(msg);
+  const std::uint64_t first_ns = elements.empty() ? 0 : elements.front().time_gps_ns();
+  if (!block_gate.admit(msg, bus::SensorMessage<Block>::sensorId(msg), msg.seq(), first_ns)) return;
+  for (const auto& element : elements) {
+    ++element_gate.counters().received;
+    take(element);
+  }
+}
+
+void FilterPipeline::onGnssObservationsBlock(const navbus::GnssObservationEpochBlock& msg) {
+  takeBlock(msg, gnss_obs_block_gate_, gnss_obs_gate_,
+            [this](const navbus::GnssObservationEpoch& m) { onGnssObservations(m); });
+}
+
+void FilterPipeline::onGnssFixBlock(const navbus::GnssFixBlock& msg) {
+  takeBlock(msg, gnss_fix_block_gate_, gnss_fix_gate_,
+            [this](const navbus::GnssFix& m) { onGnssFix(m); });
+}
+
+void FilterPipeline::onStarTrackerBlock(const navbus::StarTrackerAttitudeBlock& msg) {
+  takeBlock(msg, star_block_gate_, star_gate_,
+            [this](const navbus::StarTrackerAttitude& m) { onStarTracker(m); });
 }
 
 void FilterPipeline::useStarTracker(const navbus::StarTrackerAttitude& m) {

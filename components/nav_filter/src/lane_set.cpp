@@ -261,6 +261,18 @@ void LaneSet::onStarTracker(const navbus::StarTrackerAttitude& msg) {
   forEach([&](FilterPipeline& l) { l.onStarTracker(msg); });
 }
 
+void LaneSet::onGnssObservationsBlock(const navbus::GnssObservationEpochBlock& msg) {
+  forEach([&](FilterPipeline& l) { l.onGnssObservationsBlock(msg); });
+}
+
+void LaneSet::onGnssFixBlock(const navbus::GnssFixBlock& msg) {
+  forEach([&](FilterPipeline& l) { l.onGnssFixBlock(msg); });
+}
+
+void LaneSet::onStarTrackerBlock(const navbus::StarTrackerAttitudeBlock& msg) {
+  forEach([&](FilterPipeline& l) { l.onStarTrackerBlock(msg); });
+}
+
 void LaneSet::onStreamEnded(bus::StreamKind kind, std::uint32_t id) {
   if (kind != bus::StreamKind::kImu || lanes_.size() == 1) {
     forEach([&](FilterPipeline& l) { l.onStreamEnded(kind, id); });

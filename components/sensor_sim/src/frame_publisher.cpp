@@ -96,11 +96,23 @@ FramePublisher::FramePublisher(bus::Participant& participant, const SimConfig& c
     imu_ = createWriter<navbus::ImuIncrement>();
   }
   if (config.publish_raw) raw_ = createWriter<navbus::ImuRawBlock>();
+  gnss_.written = &written_.gnss_epochs;
+  fix_.written = &written_.gnss_fixes;
+  star_.written = &written_.star_tracker;
+  // With blocks, epochs, fixes and attitudes go in blocks of the frames an increment block covers.
+  auto create = [this](auto& stream) {
+    using Stream = std::decay_t<decltype(stream)>;
+    if (batcher_) {
+      stream.blocks = createWriter<typename Stream::BlockType>();
+    } else {
+      stream.single = createWriter<typename Stream::Element>();
+    }
+  };
   if (config.publish_gnss) {
-    gnss_ = createWriter<navbus::GnssObservationEpoch>();
-    fix_ = createWriter<navbus::GnssFix>();
+    create(gnss_);
+    create(fix_);
   }
-  if (config.publish_star_tracker) star_ = createWriter<navbus::StarTrackerAttitude>();
+  if (config.publish_star_tracker) create(star_);
 }
 
 template <class Message>
@@ -161,13 +173,57 @@ bool FramePublisher::writeIncrementBlock(ImuBlockBatcher& batcher) {
   return true;
 }
 
+template <class Block>
+FramePublisher::BlockStream<Block>& FramePublisher::streamOf() {
+  if constexpr (std::is_same_v<Block, navbus::GnssObservationEpochBlock>) return gnss_;
+  if constexpr (std::is_same_v<Block, navbus::GnssFixBlock>) return fix_;
+  if constexpr (std::is_same_v<Block, navbus::StarTrackerAttitudeBlock>) return star_;
+}
+
+template <class Block>
+bool FramePublisher::writeMeasurementBlock(MeasurementBlockBatcher<Block>& batcher) {
+  if (batcher.empty()) return true;
+  BlockStream<Block>& stream = streamOf<Block>();
+  const Block block = batcher.take();
+  if (!writeReliably(stream.blocks, block)) return false;
+  *stream.written += bus::SensorBlock<Block>::elements(block).size();
+  ++written_.measurement_samples;
+  return true;
+}
+
+template <class Block>
+bool FramePublisher::writeMeasurement(const typename bus::SensorBlock<Block>::Element& sample) {
+  BlockStream<Block>& stream = streamOf<Block>();
+  if (!batcher_) {
+    if (!writeReliably(stream.single, sample)) return false;
+    ++*stream.written;
+    ++written_.measurement_samples;
+    return true;
+  }
+  MeasurementBlockBatcher<Block>& batcher =
+      stream.batchers[bus::SensorMessage<typename BlockStream<Block>::Element>::sensorId(sample)];
+  if (batcher.add(sample)) return true;
+  // The block holds its bound (a stream faster than the blocks): it goes first.
+  return writeMeasurementBlock(batcher) && batcher.add(sample);
+}
+
+template <class Block>
+bool FramePublisher::writePendingBlocks(BlockStream<Block>& stream) {
+  for (auto& [id, batcher] : stream.batchers) {
+    if (!writeMeasurementBlock(batcher)) return false;
+  }
+  return true;
+}
+
 bool FramePublisher::writeBlocks() {
-  // The units' blocks cover the same frames as the scenario IMU's (filled in lockstep).
+  // The units' blocks cover the same frames as the scenario IMU's (filled in lockstep), and so
+  // do the measurements' blocks: the merge downstream waits for neither.
   if (!writeIncrementBlock(*batcher_)) return false;
   for (ImuBlockBatcher& b : unit_batchers_) {
     if (!writeIncrementBlock(b)) return false;
   }
-  return !batcher_->hasRaw() || writeRaw(batcher_->takeRaw());
+  if (batcher_->hasRaw() && !writeRaw(batcher_->takeRaw())) return false;
+  return writePendingBlocks(gnss_) && writePendingBlocks(fix_) && writePendingBlocks(star_);
 }
 
 bool FramePublisher::publish(const sim::SensorFrame& f) {
@@ -176,25 +232,21 @@ bool FramePublisher::publish(const sim::SensorFrame& f) {
     if constexpr (std::is_same_v<T, navbus::ImuIncrement>) return writeIncrement(sample);
     if constexpr (std::is_same_v<T, navbus::ImuRawBlock>)
       return batcher_ ? batchRaw(sample) : writeRaw(sample);
-    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>) {
-      if (!writeReliably(gnss_, sample)) return false;
-      ++written_.gnss_epochs;
-      return true;
-    }
-    if constexpr (std::is_same_v<T, navbus::GnssFix>) {
-      if (!writeReliably(fix_, sample)) return false;
-      ++written_.gnss_fixes;
-      return true;
-    }
-    if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>) {
-      if (!writeReliably(star_, sample)) return false;
-      ++written_.star_tracker;
-      return true;
-    }
+    if constexpr (std::is_same_v<T, navbus::GnssObservationEpoch>)
+      return writeMeasurement<navbus::GnssObservationEpochBlock>(sample);
+    if constexpr (std::is_same_v<T, navbus::GnssFix>)
+      return writeMeasurement<navbus::GnssFixBlock>(sample);
+    if constexpr (std::is_same_v<T, navbus::StarTrackerAttitude>)
+      return writeMeasurement<navbus::StarTrackerAttitudeBlock>(sample);
   });
   if (!written) return false;
-  // A full block of increments goes out with the raw samples of the same frames.
+  // A full block of increments goes out with the raw samples and measurements of its frames.
   return !(batcher_ && batcher_->full()) || writeBlocks();
+}
+
+template <class Block>
+std::size_t FramePublisher::matchedReaders(const BlockStream<Block>& stream) const {
+  return batcher_ ? stream.blocks.matchedReaders() : stream.single.matchedReaders();
 }
 
 std::size_t FramePublisher::imuReaders() const {
@@ -208,14 +260,17 @@ bool FramePublisher::readersMatched() const {
   };
   return imuReaders() >= static_cast<std::size_t>(m.imu) &&
          (!config_.publish_raw || enough(raw_, m.raw_imu)) &&
-         (!config_.publish_gnss || (enough(gnss_, m.gnss) && enough(fix_, m.gnss_fix))) &&
-         (!config_.publish_star_tracker || enough(star_, m.star_tracker));
+         (!config_.publish_gnss ||
+          (matchedReaders(gnss_) >= static_cast<std::size_t>(m.gnss) &&
+           matchedReaders(fix_) >= static_cast<std::size_t>(m.gnss_fix))) &&
+         (!config_.publish_star_tracker ||
+          matchedReaders(star_) >= static_cast<std::size_t>(m.star_tracker));
 }
 
 void FramePublisher::flush() {
   constexpr auto kWait = bus::Participant::kFinishAcknowledgmentWait;
-  for (auto* w :
-       {imu_.raw(), imu_blocks_.raw(), raw_.raw(), gnss_.raw(), fix_.raw(), star_.raw()}) {
+  for (auto* w : {imu_.raw(), imu_blocks_.raw(), raw_.raw(), gnss_.single.raw(), gnss_.blocks.raw(),
+                  fix_.single.raw(), fix_.blocks.raw(), star_.single.raw(), star_.blocks.raw()}) {
     if (w != nullptr &&
         w->wait_for_acknowledgments(bus::toDdsDuration(kWait)) != ReturnCode_t::RETCODE_OK) {
       spdlog::warn("{}: not every reliable reader acknowledged the data within {} s",
@@ -231,6 +286,20 @@ void disposeIfPublished(bus::Writer<Sample>& writer, std::uint64_t published, co
   if (published > 0) writer.dispose(key);
 }
 }  // namespace
+
+template <class Block>
+void FramePublisher::disposeStream(BlockStream<Block>& stream,
+                                   const std::vector<std::uint32_t>& ids) {
+  using Traits = bus::SensorBlock<Block>;
+  for (const std::uint32_t id : ids) {
+    typename Traits::Element single;
+    Block block;
+    Traits::setSensorId(block, id);
+    Traits::setElementSensorId(single, id);
+    disposeIfPublished(stream.single, batcher_ ? 0 : *stream.written, single);
+    disposeIfPublished(stream.blocks, batcher_ ? *stream.written : 0, block);
+  }
+}
 
 void FramePublisher::endStreams() {
   if (batcher_ && !writeBlocks()) return;  // stopped meanwhile
@@ -252,17 +321,9 @@ void FramePublisher::endStreams() {
   std::vector<std::uint32_t> receiver_ids{config_.gnss_receiver_id};
   receiver_ids.insert(receiver_ids.end(), config_.extra_gnss_receiver_ids.begin(),
                       config_.extra_gnss_receiver_ids.end());
-  for (const std::uint32_t id : receiver_ids) {
-    navbus::GnssObservationEpoch gnss;
-    gnss.receiver_id(id);
-    disposeIfPublished(gnss_, written_.gnss_epochs, gnss);
-  }
-  navbus::GnssFix fix;
-  fix.receiver_id(config_.gnss_receiver_id);
-  disposeIfPublished(fix_, written_.gnss_fixes, fix);
-  navbus::StarTrackerAttitude star;
-  star.tracker_id(config_.star_tracker_id);
-  disposeIfPublished(star_, written_.star_tracker, star);
+  disposeStream(gnss_, receiver_ids);
+  disposeStream(fix_, {config_.gnss_receiver_id});
+  disposeStream(star_, {config_.star_tracker_id});
 }
 
 }  // namespace navbus::sensor_sim

@@ -154,9 +154,10 @@ int main(int argc, char** argv) {
         static_cast<double>(n.increments) / units * static_cast<double>(period_ns) * 1e-9;
     spdlog::info(
         "summary: published {} IMU increments in {} samples, {} raw samples in {} blocks, {} GNSS "
-        "epochs, {} GNSS fixes, {} star-tracker attitudes ({:.3f} s of data), {} write retries",
+        "epochs, {} GNSS fixes, {} star-tracker attitudes in {} samples ({:.3f} s of data), {} "
+        "write retries",
         n.increments, n.increment_samples, n.raw_samples, n.raw_blocks, n.gnss_epochs, n.gnss_fixes,
-        n.star_tracker, data_s, publisher.writeRetries());
+        n.star_tracker, n.measurement_samples, data_s, publisher.writeRetries());
     spdlog::info(
         "throughput: {:.3f} s of data in {:.3f} s from the first write to the last "
         "acknowledgment ({:.1f}x real time): {:.0f} samples/s, {:.0f} measurements/s",

@@ -38,6 +38,15 @@ std::int64_t dataTimeNs(const ImuRawBlock& m) {
   return static_cast<std::int64_t>(m.first_sample_time_gps_ns()) +
          std::max<std::int64_t>(n - 1, 0) * static_cast<std::int64_t>(m.sample_period_ns());
 }
+std::int64_t dataTimeNs(const GnssObservationEpochBlock& m) {
+  return static_cast<std::int64_t>(bus::newestElementTimeGpsNs(m));
+}
+std::int64_t dataTimeNs(const GnssFixBlock& m) {
+  return static_cast<std::int64_t>(bus::newestElementTimeGpsNs(m));
+}
+std::int64_t dataTimeNs(const StarTrackerAttitudeBlock& m) {
+  return static_cast<std::int64_t>(bus::newestElementTimeGpsNs(m));
+}
 template <class T>
 std::int64_t dataTimeNs(const T& m) {
   return static_cast<std::int64_t>(m.time_gps_ns());

@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
+#include <type_traits>
+#include <vector>
 
 #include <navbus_idl/FaultPubSubTypes.h>
 #include <navbus_idl/GnssPubSubTypes.h>
@@ -46,7 +48,7 @@ constexpr const StreamKindInfo& streamInfo(StreamKind kind) {
   return kStreamKinds[static_cast<std::size_t>(kind)];
 }
 
-/// A topic that carries a sensor stream (fast pacing carries the IMU stream in blocks too).
+/// A topic that carries a sensor stream (fast pacing carries every merged stream in blocks too).
 struct SensorTopic {
   const char* topic;
   StreamKind kind;
@@ -57,7 +59,7 @@ struct SensorTopic {
   const char* fast_writer_profile;  ///< the simulator in fast pacing
 };
 
-inline constexpr std::array<SensorTopic, 6> kSensorTopics{{
+inline constexpr std::array<SensorTopic, 9> kSensorTopics{{
     {topic::kImuIncrement, StreamKind::kImu, "navbus::ImuIncrement", profile::kSensorReader,
      profile::kSensorWatchdogReader, profile::kSensorWriter, profile::kSensorWriterFastPacing},
     {topic::kImuIncrementBlock, StreamKind::kImu, "navbus::ImuIncrementBlock",
@@ -72,6 +74,16 @@ inline constexpr std::array<SensorTopic, 6> kSensorTopics{{
      profile::kMeasurementWatchdogReader, profile::kMeasurementWriter,
      profile::kMeasurementWriterFastPacing},
     {topic::kStarTracker, StreamKind::kStarTracker, "navbus::StarTrackerAttitude",
+     profile::kMeasurementReader, profile::kMeasurementWatchdogReader, profile::kMeasurementWriter,
+     profile::kMeasurementWriterFastPacing},
+    {topic::kGnssObservationsBlock, StreamKind::kGnssObservations,
+     "navbus::GnssObservationEpochBlock", profile::kMeasurementReader,
+     profile::kMeasurementWatchdogReader, profile::kMeasurementWriter,
+     profile::kMeasurementWriterFastPacing},
+    {topic::kGnssFixBlock, StreamKind::kGnssFix, "navbus::GnssFixBlock",
+     profile::kMeasurementReader, profile::kMeasurementWatchdogReader, profile::kMeasurementWriter,
+     profile::kMeasurementWriterFastPacing},
+    {topic::kStarTrackerBlock, StreamKind::kStarTracker, "navbus::StarTrackerAttitudeBlock",
      profile::kMeasurementReader, profile::kMeasurementWatchdogReader, profile::kMeasurementWriter,
      profile::kMeasurementWriterFastPacing},
 }};
@@ -138,6 +150,106 @@ struct SensorMessage<navbus::StarTrackerAttitude> {
   static std::uint64_t timeGpsNs(const navbus::StarTrackerAttitude& m) { return m.time_gps_ns(); }
 };
 
+/// Fast pacing's blocks of the measurement streams: consecutive elements of one sensor's stream
+/// in one sample, each element read as one sample of the element's topic.
+template <class Block>
+struct SensorBlock;
+
+template <>
+struct SensorBlock<navbus::GnssObservationEpochBlock> {
+  using Element = navbus::GnssObservationEpoch;
+  static constexpr const char* kElements = "epochs";      ///< the sequence's field name
+  static constexpr const char* kIdField = "receiver_id";  ///< the elements' sensor id field
+  static constexpr std::size_t kMaxElements = 8;          ///< the sequence's IDL bound
+  static const std::vector<Element>& elements(const navbus::GnssObservationEpochBlock& b) {
+    return b.epochs();
+  }
+  static std::vector<Element>& elements(navbus::GnssObservationEpochBlock& b) { return b.epochs(); }
+  static void setSensorId(navbus::GnssObservationEpochBlock& b, std::uint32_t id) {
+    b.receiver_id(id);
+  }
+  static void setElementSensorId(Element& e, std::uint32_t id) { e.receiver_id(id); }
+};
+
+template <>
+struct SensorBlock<navbus::GnssFixBlock> {
+  using Element = navbus::GnssFix;
+  static constexpr const char* kElements = "fixes";
+  static constexpr const char* kIdField = "receiver_id";
+  static constexpr std::size_t kMaxElements = 16;
+  static const std::vector<Element>& elements(const navbus::GnssFixBlock& b) { return b.fixes(); }
+  static std::vector<Element>& elements(navbus::GnssFixBlock& b) { return b.fixes(); }
+  static void setSensorId(navbus::GnssFixBlock& b, std::uint32_t id) { b.receiver_id(id); }
+  static void setElementSensorId(Element& e, std::uint32_t id) { e.receiver_id(id); }
+};
+
+template <>
+struct SensorBlock<navbus::StarTrackerAttitudeBlock> {
+  using Element = navbus::StarTrackerAttitude;
+  static constexpr const char* kElements = "attitudes";
+  static constexpr const char* kIdField = "tracker_id";
+  static constexpr std::size_t kMaxElements = 16;
+  static const std::vector<Element>& elements(const navbus::StarTrackerAttitudeBlock& b) {
+    return b.attitudes();
+  }
+  static std::vector<Element>& elements(navbus::StarTrackerAttitudeBlock& b) {
+    return b.attitudes();
+  }
+  static void setSensorId(navbus::StarTrackerAttitudeBlock& b, std::uint32_t id) {
+    b.tracker_id(id);
+  }
+  static void setElementSensorId(Element& e, std::uint32_t id) { e.tracker_id(id); }
+};
+
+/// Whether T is a measurement block (has a SensorBlock).
+template <class T, class = void>
+struct IsSensorBlock : std::false_type {};
+template <class T>
+struct IsSensorBlock<T, std::void_t<typename SensorBlock<T>::Element>> : std::true_type {};
+template <class T>
+inline constexpr bool kIsSensorBlock = IsSensorBlock<T>::value;
+
+/// The newest element's data time of a measurement block (0 for an empty block).
+template <class Block>
+std::uint64_t newestElementTimeGpsNs(const Block& m) {
+  const auto& e = SensorBlock<Block>::elements(m);
+  return e.empty() ? std::uint64_t{0} : e.back().time_gps_ns();
+}
+
+template <>
+struct SensorMessage<navbus::GnssObservationEpochBlock> {
+  using PubSubType = navbus::GnssObservationEpochBlockPubSubType;
+  static constexpr const SensorTopic& kTopic = kSensorTopics[6];
+  static std::uint32_t sensorId(const navbus::GnssObservationEpochBlock& m) {
+    return m.receiver_id();
+  }
+  static std::uint64_t timeGpsNs(const navbus::GnssObservationEpochBlock& m) {
+    return newestElementTimeGpsNs(m);
+  }
+};
+
+template <>
+struct SensorMessage<navbus::GnssFixBlock> {
+  using PubSubType = navbus::GnssFixBlockPubSubType;
+  static constexpr const SensorTopic& kTopic = kSensorTopics[7];
+  static std::uint32_t sensorId(const navbus::GnssFixBlock& m) { return m.receiver_id(); }
+  static std::uint64_t timeGpsNs(const navbus::GnssFixBlock& m) {
+    return newestElementTimeGpsNs(m);
+  }
+};
+
+template <>
+struct SensorMessage<navbus::StarTrackerAttitudeBlock> {
+  using PubSubType = navbus::StarTrackerAttitudeBlockPubSubType;
+  static constexpr const SensorTopic& kTopic = kSensorTopics[8];
+  static std::uint32_t sensorId(const navbus::StarTrackerAttitudeBlock& m) {
+    return m.tracker_id();
+  }
+  static std::uint64_t timeGpsNs(const navbus::StarTrackerAttitudeBlock& m) {
+    return newestElementTimeGpsNs(m);
+  }
+};
+
 /// Calls `fn(MessageTag<Message>{})` for each sensor message type, in kSensorTopics order (for
 /// code that instantiates something per type: readers, writers, CSV loaders).
 template <class Message>
@@ -152,6 +264,9 @@ void forEachSensorMessage(Fn&& fn) {
   fn(MessageTag<navbus::GnssObservationEpoch>{});
   fn(MessageTag<navbus::GnssFix>{});
   fn(MessageTag<navbus::StarTrackerAttitude>{});
+  fn(MessageTag<navbus::GnssObservationEpochBlock>{});
+  fn(MessageTag<navbus::GnssFixBlock>{});
+  fn(MessageTag<navbus::StarTrackerAttitudeBlock>{});
 }
 
 }  // namespace navbus::bus

@@ -12,6 +12,11 @@ inline constexpr const char* kImuRaw = "navbus/imu/raw";
 inline constexpr const char* kGnssObservations = "navbus/gnss/observations";
 inline constexpr const char* kGnssFix = "navbus/gnss/fix";
 inline constexpr const char* kStarTracker = "navbus/startracker/attitude";
+/// Blocks of epochs, fixes and attitudes (GnssObservationEpochBlock, GnssFixBlock,
+/// StarTrackerAttitudeBlock): the simulator's fast pacing.
+inline constexpr const char* kGnssObservationsBlock = "navbus/gnss/observations_block";
+inline constexpr const char* kGnssFixBlock = "navbus/gnss/fix_block";
+inline constexpr const char* kStarTrackerBlock = "navbus/startracker/attitude_block";
 inline constexpr const char* kNavSolution = "navbus/nav/solution";
 inline constexpr const char* kNavSolutionLowLatency = "navbus/nav/solution_low_latency";
 /// Every filter lane's solution (redundant IMUs, filter `lanes:`), one instance per lane.

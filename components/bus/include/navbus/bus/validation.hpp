@@ -50,6 +50,14 @@ std::optional<Rejection> validate(const navbus::ImuIncrement& s, const Validatio
 /// increment is then validated (and counted) as an ImuIncrement sample.
 std::optional<Rejection> validate(const navbus::ImuIncrementBlock& s, const ValidationLimits& l);
 std::optional<Rejection> validate(const navbus::ImuRawBlock& s, const ValidationLimits& l);
+/// A measurement block's structure only (bus/streams.hpp SensorBlock): at least one element,
+/// each of the block's sensor. Each element is then validated (and counted) as a sample of its
+/// own topic.
+std::optional<Rejection> validate(const navbus::GnssObservationEpochBlock& s,
+                                  const ValidationLimits& l);
+std::optional<Rejection> validate(const navbus::GnssFixBlock& s, const ValidationLimits& l);
+std::optional<Rejection> validate(const navbus::StarTrackerAttitudeBlock& s,
+                                  const ValidationLimits& l);
 /// Epoch-level checks only (none today beyond the IDL bounds): a bad satellite costs that
 /// satellite, not the epoch; see screenSatellites.
 std::optional<Rejection> validate(const navbus::GnssObservationEpoch& s, const ValidationLimits& l);
@@ -221,6 +229,8 @@ class StreamGate {
   /// Undoes the accepted count of a sample of `sensor_id` rejected after admission.
   void unaccept(std::uint32_t sensor_id);
   const std::string& topic() const { return topic_; }
+  /// The topic's counters (a block's elements are received under their own topic's).
+  StreamCounters& counters() { return counters_; }
   const ValidationLimits& limits() const { return limits_; }
   SequenceTracker& tracker() { return tracker_; }
 

@@ -112,6 +112,11 @@ class FilterPipeline {
   void onGnssObservations(const navbus::GnssObservationEpoch& msg);
   void onGnssFix(const navbus::GnssFix& msg);
   void onStarTracker(const navbus::StarTrackerAttitude& msg);
+  /// Blocks of epochs, fixes and attitudes (fast pacing): as onImuBlock, each element through
+  /// onGnssObservations, onGnssFix or onStarTracker as one sample of its own topic.
+  void onGnssObservationsBlock(const navbus::GnssObservationEpochBlock& msg);
+  void onGnssFixBlock(const navbus::GnssFixBlock& msg);
+  void onStarTrackerBlock(const navbus::StarTrackerAttitudeBlock& msg);
   /// The writer of a stream announced the end of its data (disposed the instance): the stream
   /// no longer holds the ordered merge back, so what it preceded is released at once rather
   /// than after the bounded wait. Offline, flush() is the same end. Logged (streams in use).
@@ -206,6 +211,11 @@ class FilterPipeline {
   template <class Sample, class Use>
   bool admitOrHold(bus::StreamGate& gate, HeldSamples<Sample>& held, const Sample& msg, StreamId id,
                    const std::optional<InputConfig>& expected, Use use);
+  /// A measurement block's structure and block sequence under `block_gate`; then each element,
+  /// received under `element_gate`'s topic, to `take`.
+  template <class Block, class Take>
+  void takeBlock(const Block& msg, bus::StreamGate& block_gate, bus::StreamGate& element_gate,
+                 Take take);
   /// After admission: convert to the core types, correct the configured time offset, queue.
   void useImu(const navbus::ImuIncrement& msg);
   void useGnssObservations(const navbus::GnssObservationEpoch& m);
@@ -284,6 +294,9 @@ class FilterPipeline {
   bus::StreamGate gnss_obs_gate_;
   bus::StreamGate gnss_fix_gate_;
   bus::StreamGate star_gate_;
+  bus::StreamGate gnss_obs_block_gate_;  ///< the block topics: structure and block sequence
+  bus::StreamGate gnss_fix_block_gate_;
+  bus::StreamGate star_block_gate_;
   HeldSamples<navbus::ImuIncrement> imu_held_;
   HeldSamples<navbus::GnssObservationEpoch> gnss_obs_held_;
   HeldSamples<navbus::GnssFix> gnss_fix_held_;

@@ -50,6 +50,9 @@ class LaneSet {
   void onGnssObservations(const navbus::GnssObservationEpoch& msg);
   void onGnssFix(const navbus::GnssFix& msg);
   void onStarTracker(const navbus::StarTrackerAttitude& msg);
+  void onGnssObservationsBlock(const navbus::GnssObservationEpochBlock& msg);
+  void onGnssFixBlock(const navbus::GnssFixBlock& msg);
+  void onStarTrackerBlock(const navbus::StarTrackerAttitudeBlock& msg);
   void onStreamEnded(bus::StreamKind kind, std::uint32_t id);
   void onDecision(const navbus::FaultDecision& d) { lanes_.front()->onDecision(d); }
   /// An IMU-axis or IMU-stream command naming a unit goes to that unit's lane (failing an axis

@@ -74,17 +74,30 @@ class CellParser {
                            " is recorded as a summary, not field by field: this topic cannot be "
                            "replayed");
   }
-  /// One element per row; a single row whose cells of the sequence are empty is no element.
+  /// One element per row; a single row whose cells of the sequence are empty is no element. An
+  /// element with a sequence of structs of its own spans the consecutive rows whose cells of
+  /// its other fields are equal (CellCollector::rows).
   template <class S>
   void rows(const std::string& name, std::vector<S>& seq) {
     seq.clear();
     const std::string element_prefix = prefix_ + name + ".";
-    for (std::size_t r = first_; r < first_ + count_; ++r) {
+    NestedRowsName nested;
+    const S probe{};
+    visitFields(probe, nested);
+    const std::string nested_prefix =
+        nested.name.empty() ? std::string() : element_prefix + nested.name + ".";
+    for (std::size_t r = first_; r < first_ + count_;) {
       if (count_ == 1 && rowIsEmpty(r, element_prefix)) break;
-      CellParser element_parser(table_, r, 1, element_prefix);
+      std::size_t n = 1;
+      while (!nested_prefix.empty() && r + n < first_ + count_ &&
+             sameElement(r, r + n, element_prefix, nested_prefix)) {
+        ++n;
+      }
+      CellParser element_parser(table_, r, n, element_prefix);
       S element;
       visitFields(element, element_parser);
       seq.push_back(element);
+      r += n;
     }
   }
 
@@ -94,6 +107,29 @@ class CellParser {
   }
   std::string where(const std::string& name) const {
     return table_.file + " line " + std::to_string(first_ + 2) + " column '" + prefix_ + name + "'";
+  }
+  /// The name of the sequence of structs a struct holds, if any.
+  struct NestedRowsName {
+    std::string name;
+    template <class T>
+    void operator()(const std::string&, const T&) {}
+    void text(const std::string&, const std::string&) {}
+    template <class S>
+    void rows(const std::string& sequence, const std::vector<S>&) {
+      name = sequence;
+    }
+  };
+  /// Rows a and b hold the same element: equal cells in its columns outside its own sequence's.
+  bool sameElement(std::size_t a, std::size_t b, const std::string& element_prefix,
+                   const std::string& nested_prefix) const {
+    for (std::size_t c = 0; c < table_.header.size(); ++c) {
+      const std::string& column = table_.header[c];
+      if (column.rfind(element_prefix, 0) == 0 && column.rfind(nested_prefix, 0) != 0 &&
+          table_.rows[a][c] != table_.rows[b][c]) {
+        return false;
+      }
+    }
+    return true;
   }
   bool rowIsEmpty(std::size_t row, const std::string& element_prefix) const {
     for (std::size_t c = 0; c < table_.header.size(); ++c) {

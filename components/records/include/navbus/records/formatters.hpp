@@ -56,17 +56,19 @@ class CellCollector {
   }
   void text(const std::string& name, const std::string& s) { add(name, csvQuote(s)); }
 
+  /// An element that has a sequence of structs itself (a block of GNSS epochs) gives a row
+  /// per element of that one, its own cells repeated on each.
   template <class S>
   void rows(const std::string& name, const std::vector<S>& seq) {
     rows_at_ = cells_.size();
     CellCollector names(prefix_ + name + ".");
     const S empty{};
     visitFields(empty, names);
-    row_names_ = names.names_;
+    row_names_ = names.header();
     for (const auto& element : seq) {
       CellCollector sub;
       visitFields(element, sub);
-      row_cells_.push_back(sub.cells_);
+      for (auto& row : sub.rowsOut()) row_cells_.push_back(std::move(row));
     }
   }
 

@@ -1,7 +1,8 @@
 // Field lists of every navbus message, written once and used for text (echo) and CSV (record).
 // visitFields(msg, v) calls, in declaration order:
 //   v(name, value)       for scalars, enums, strings, fixed arrays and sequences of numbers;
-//   v.rows(name, seq)    for the one sequence of structs a message may have (CSV: a row each);
+//   v.rows(name, seq)    for the one sequence of structs a message may have (CSV: a row each;
+//                        an element may have one of its own: a row per element of that);
 //   v.text(name, str)    for nested structures summarized as text.
 #pragma once
 
@@ -93,6 +94,12 @@ IfMessage<M, navbus::GnssObservationEpoch> visitFields(M& m, V& v) {
   v.rows("satellites", m.satellites());
 }
 template <class M, class V>
+IfMessage<M, navbus::GnssObservationEpochBlock> visitFields(M& m, V& v) {
+  v("receiver_id", m.receiver_id());
+  v("seq", m.seq());
+  v.rows("epochs", m.epochs());  // a row per satellite of each epoch
+}
+template <class M, class V>
 IfMessage<M, navbus::GnssFix> visitFields(M& m, V& v) {
   v("receiver_id", m.receiver_id());
   v("seq", m.seq());
@@ -115,6 +122,18 @@ IfMessage<M, navbus::StarTrackerAttitude> visitFields(M& m, V& v) {
   v("q_b_to_i", m.q_b_to_i());
   v("sigma_b_rad", m.sigma_b_rad());
   v("valid", m.valid());
+}
+template <class M, class V>
+IfMessage<M, navbus::GnssFixBlock> visitFields(M& m, V& v) {
+  v("receiver_id", m.receiver_id());
+  v("seq", m.seq());
+  v.rows("fixes", m.fixes());
+}
+template <class M, class V>
+IfMessage<M, navbus::StarTrackerAttitudeBlock> visitFields(M& m, V& v) {
+  v("tracker_id", m.tracker_id());
+  v("seq", m.seq());
+  v.rows("attitudes", m.attitudes());
 }
 /// A filter lane's solution: the lane, its selection, its fit, and the solution's navigation
 /// fields (the rest of the solution is in navbus/nav/solution when the lane is selected).

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "navbus/bus/conversions.hpp"
 #include "navbus/bus/participant.hpp"
 #include "navbus/sensor_sim/imu_block_batcher.hpp"
+#include "navbus/sensor_sim/measurement_block_batcher.hpp"
 #include "navbus/sensor_sim/scenario_config.hpp"
 #include "navbus/sim/samples.hpp"
 
@@ -39,16 +41,16 @@ struct FrameSequence {
 };
 
 /// What a FramePublisher wrote to the bus: measurements per stream and the DDS samples that
-/// carried them (fewer than the measurements where increments and raw samples go in blocks).
+/// carried them (fewer than the measurements where they go in blocks).
 struct WrittenCounts {
   std::uint64_t increments{0}, increment_samples{0};  ///< increments; samples carrying them
   std::uint64_t raw_samples{0}, raw_blocks{0};
   std::uint64_t gnss_epochs{0}, gnss_fixes{0}, star_tracker{0};
+  /// Samples carrying the epochs, fixes and attitudes (one each, or blocks of them).
+  std::uint64_t measurement_samples{0};
 
   /// DDS samples written, all streams.
-  std::uint64_t samples() const {
-    return increment_samples + raw_blocks + gnss_epochs + gnss_fixes + star_tracker;
-  }
+  std::uint64_t samples() const { return increment_samples + raw_blocks + measurement_samples; }
   /// Measurements carried: each increment, raw sample, GNSS epoch and fix, attitude.
   std::uint64_t measurements() const {
     return increments + raw_samples + gnss_epochs + gnss_fixes + star_tracker;
@@ -107,8 +109,8 @@ class FramePublisher {
  public:
   FramePublisher(bus::Participant& participant, const SimConfig& config);
 
-  /// Writes every sample of the frame (in fast pacing with blocks, increments and raw samples
-  /// once a block is full); returns false if the run was stopped meanwhile.
+  /// Writes every sample of the frame (in fast pacing with blocks, every stream's block once
+  /// the increment block is full); returns false if the run was stopped meanwhile.
   bool publish(const sim::SensorFrame& frame);
   /// Readers matched on the topic that carries the increments.
   std::size_t imuReaders() const;
@@ -141,6 +143,31 @@ class FramePublisher {
   bool batchRaw(const navbus::ImuRawBlock& raw);
   /// Writes the pending blocks (fast pacing with blocks).
   bool writeBlocks();
+  /// An epoch, fix or attitude: written, or (with blocks) added to its sensor's block.
+  template <class Block>
+  bool writeMeasurement(const typename bus::SensorBlock<Block>::Element& sample);
+  template <class Block>
+  bool writeMeasurementBlock(MeasurementBlockBatcher<Block>& batcher);
+  /// One stream's measurement blocks: its writer and a batcher per sensor id (written in id
+  /// order), the measurements written, and their writer one at a time without blocks.
+  template <class Block>
+  struct BlockStream {
+    using BlockType = Block;
+    using Element = typename bus::SensorBlock<Block>::Element;
+    bus::Writer<Element> single;
+    bus::Writer<Block> blocks;
+    std::map<std::uint32_t, MeasurementBlockBatcher<Block>> batchers;
+    std::uint64_t* written{nullptr};  ///< the count in WrittenCounts
+  };
+  template <class Block>
+  BlockStream<Block>& streamOf();
+  template <class Block>
+  bool writePendingBlocks(BlockStream<Block>& stream);
+  template <class Block>
+  void disposeStream(BlockStream<Block>& stream, const std::vector<std::uint32_t>& ids);
+  /// The writer that carries a measurement stream now (the block writer with blocks).
+  template <class Block>
+  std::size_t matchedReaders(const BlockStream<Block>& stream) const;
 
   bus::Participant& participant_;
   SimConfig config_;
@@ -148,14 +175,14 @@ class FramePublisher {
   bus::Writer<navbus::ImuIncrement> imu_;              ///< one increment per sample
   bus::Writer<navbus::ImuIncrementBlock> imu_blocks_;  ///< or blocks of them
   bus::Writer<navbus::ImuRawBlock> raw_;
-  bus::Writer<navbus::GnssObservationEpoch> gnss_;
-  bus::Writer<navbus::GnssFix> fix_;
-  bus::Writer<navbus::StarTrackerAttitude> star_;
+  WrittenCounts written_;
+  BlockStream<navbus::GnssObservationEpochBlock> gnss_;
+  BlockStream<navbus::GnssFixBlock> fix_;
+  BlockStream<navbus::StarTrackerAttitudeBlock> star_;
   std::optional<ImuBlockBatcher> batcher_;  ///< with blocks
   /// With blocks: the further IMU units' increments, one batcher per unit (in unit order)
   std::vector<ImuBlockBatcher> unit_batchers_;
   FrameSequence sequence_;  ///< the frames' sequence numbers (emitFrame)
-  WrittenCounts written_;
   std::uint64_t write_retries_{0};
 };
 
