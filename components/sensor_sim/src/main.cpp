@@ -38,8 +38,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"realtime", "fast"}));
   double block_override = -1.0;
   app.add_option("--fast-pacing-block", block_override,
-                 "seconds of IMU data per DDS sample in fast pacing (overrides "
-                 "timing.fast_pacing_block_s; 0: one increment per sample)")
+                 "seconds of each stream's data per DDS sample in fast pacing (overrides "
+                 "timing.fast_pacing_block_s; 0: one measurement per sample)")
       ->check(CLI::Range(0.0, 10.0));
   app.footer("Exit codes: 0 done, 1 runtime error, 2 configuration error, 3 DDS error.");
 

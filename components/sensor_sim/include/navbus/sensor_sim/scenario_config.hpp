@@ -21,9 +21,10 @@ struct SimConfig {
   bool start_now{true};    ///< start at the current GPS time (real time), else the configured time
   double duration_s{0.0};  ///< 0: until stopped (bus) or the end of the segments (files)
   Pacing pacing{Pacing::kRealTime};
-  /// [s] of IMU data per DDS sample in fast pacing: increments go out as ImuIncrementBlocks and
-  /// raw samples in blocks as long (bus throughput); 0: one ImuIncrement per sample, as in
-  /// real time, which always publishes each increment as it is due.
+  /// [s] of data per DDS sample in fast pacing: increments go out as ImuIncrementBlocks, raw
+  /// samples in blocks as long, and the epochs, fixes and attitudes of the same frames in
+  /// their blocks (bus throughput); 0: one measurement per sample, as in real time, which
+  /// always publishes each measurement as it is due.
   double fast_pacing_block_s{0.1};
   double wait_for_readers_s{10.0};  ///< wait this long for readers before publishing
   /// Readers to wait for before publishing, per topic.
