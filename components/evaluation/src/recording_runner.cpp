@@ -81,8 +81,9 @@ class RecordedSamples {
   }
 
  private:
-  /// A fast-pacing block of measurements goes in as its elements, each one sample of its own
-  /// topic (the filter takes them so), in the block's order.
+  /// A fast-pacing block of epochs, fixes or attitudes goes in as its elements, each one
+  /// sample of its own topic at its own time (the filter takes them so); a block of increments
+  /// as one sample at its newest increment's time.
   template <class T>
   static void add(const T& m, int rank, std::vector<Event>& out) {
     if constexpr (bus::kIsSensorBlock<T>) {

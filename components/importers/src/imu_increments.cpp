@@ -2,11 +2,14 @@
 
 #include <cmath>
 
+#include "navbus/bus/streams.hpp"
+
 namespace navbus::importers {
 
 namespace {
-/// The topic's bound: sequence<ImuIncrement, 64> (idl/Imu.idl).
+/// Increments per imported block: 0.64 s of a 100 Hz IMU, within the topic's bound.
 constexpr std::size_t kMaxBlockElements = 64;
+static_assert(kMaxBlockElements <= bus::kMaxIncrementsPerBlock);
 }  // namespace
 
 std::vector<navbus::ImuIncrement> incrementsFromSamples(const std::vector<ImuSample>& samples,

@@ -125,15 +125,15 @@ TEST(ImuBlockBatcher, RawSamplesThatDoNotContinueTheBlockAreRefused) {
   b.first_sample_time_gps_ns(1'020'000'000 + 416'667);  // one sample missing
   EXPECT_FALSE(batcher.addRaw(b));
   EXPECT_THROW(sensor_sim::ImuBlockBatcher(0), std::invalid_argument);
-  EXPECT_THROW(sensor_sim::ImuBlockBatcher(65), std::invalid_argument);
+  EXPECT_THROW(sensor_sim::ImuBlockBatcher(bus::kMaxIncrementsPerBlock + 1), std::invalid_argument);
 }
 
 TEST(ImuBlockBatcher, BlockLengthFromTheScenario) {
   auto config = [](const std::string& timing) {
     return sensor_sim::parseSimConfig(YAML::Load("timing: {imu_rate_hz: 200, " + timing + "}"));
   };
-  EXPECT_EQ(sensor_sim::incrementsPerBlock(config("pacing: fast")), 20u);  // 0.1 s by default
-  EXPECT_EQ(sensor_sim::incrementsPerBlock(config("pacing: fast, fast_pacing_block_s: 0.3")), 60u);
+  EXPECT_EQ(sensor_sim::incrementsPerBlock(config("pacing: fast")), 60u);  // 0.3 s by default
+  EXPECT_EQ(sensor_sim::incrementsPerBlock(config("pacing: fast, fast_pacing_block_s: 0.1")), 20u);
   EXPECT_EQ(sensor_sim::incrementsPerBlock(config("pacing: fast, fast_pacing_block_s: 0")), 0u);
   EXPECT_EQ(sensor_sim::incrementsPerBlock(config("pacing: realtime")), 0u);
   try {

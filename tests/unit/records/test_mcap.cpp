@@ -309,9 +309,10 @@ TEST(McapSchemas, EveryTopicTypeHasSelfContainedSchemas) {
   for (const char* type :
        {"navbus::ImuIncrement", "navbus::ImuIncrementBlock", "navbus::ImuRawBlock",
         "navbus::GnssObservationEpoch", "navbus::GnssFix", "navbus::StarTrackerAttitude",
-        "navbus::NavigationSolution", "navbus::FilterDiagnostics", "navbus::FaultDecision",
-        "navbus::FilterCommand", "navbus::FilterCommandOutcome", "navbus::FaultMonitorProgress",
-        "navbus::Health"}) {
+        "navbus::GnssObservationEpochBlock", "navbus::GnssFixBlock",
+        "navbus::StarTrackerAttitudeBlock", "navbus::NavigationSolution",
+        "navbus::FilterDiagnostics", "navbus::FaultDecision", "navbus::FilterCommand",
+        "navbus::FilterCommandOutcome", "navbus::FaultMonitorProgress", "navbus::Health"}) {
     const auto* s = idl_schemas::find(type);
     ASSERT_NE(s, nullptr) << type;
     const std::string idl(s->omgidl);
@@ -323,7 +324,7 @@ TEST(McapSchemas, EveryTopicTypeHasSelfContainedSchemas) {
     EXPECT_EQ(s->ros2_name, "navbus/msg/" + bare);
   }
   const std::string block(idl_schemas::find("navbus::ImuIncrementBlock")->ros2msg);
-  EXPECT_EQ(block.rfind("uint32 sensor_id\nuint64 seq\nnavbus/ImuIncrement[<=64] increments\n", 0),
+  EXPECT_EQ(block.rfind("uint32 sensor_id\nuint64 seq\nnavbus/ImuIncrement[<=128] increments\n", 0),
             0u)
       << block;
   EXPECT_NE(block.find("\n" + std::string(80, '=') + "\nMSG: navbus/ImuIncrement\n"),

@@ -2,7 +2,7 @@
 // the filter's least-squares lane). Each unit's increments come in time order (one reliable
 // reader instance per unit); the units' instances come in any order between them: a reader hands
 // out one unit's whole backlog before the next's (up to its history per instance: 5000 blocks of
-// up to 64 increments, qos/navbus_qos.xml). A time is released when every unit has delivered it,
+// up to 128 increments, qos/navbus_qos.xml). A time is released when every unit has delivered it,
 // or when a unit missing there has delivered a later time (it never will), or has ended, or one
 // unit holds more than `depth` increments waiting (the missing one is silent): then incomplete,
 // with the units present. Each unit's increments wait in a queue of their own (64 bytes each).
@@ -15,6 +15,7 @@
 #include <limits>
 #include <optional>
 
+#include "navbus/bus/streams.hpp"
 #include "navbus/core/ins/strapdown.hpp"
 
 namespace navbus::bus {
@@ -23,8 +24,8 @@ class ImuUnitAligner {
  public:
   static constexpr int kMaxUnits = 6;
   /// Increments a reader may hand out of one unit before another's: its history per instance
-  /// (5000 samples) of the largest blocks (64 increments).
-  static constexpr std::size_t kReaderBacklog = 5000 * 64;
+  /// (5000 samples) of the largest blocks (kMaxIncrementsPerBlock).
+  static constexpr std::size_t kReaderBacklog = 5000 * kMaxIncrementsPerBlock;
   using Increments = std::array<core::ImuIncrement, kMaxUnits>;
 
   struct Sample {

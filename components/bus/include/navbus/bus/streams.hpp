@@ -150,6 +150,9 @@ struct SensorMessage<navbus::StarTrackerAttitude> {
   static std::uint64_t timeGpsNs(const navbus::StarTrackerAttitude& m) { return m.time_gps_ns(); }
 };
 
+/// The bound of ImuIncrementBlock.increments (idl/Imu.idl).
+inline constexpr std::size_t kMaxIncrementsPerBlock = 128;
+
 /// Fast pacing's blocks of the measurement streams: consecutive elements of one sensor's stream
 /// in one sample, each element read as one sample of the element's topic.
 template <class Block>

@@ -9,12 +9,14 @@
 
 #include <navbus_idl/Imu.h>
 
+#include "navbus/bus/streams.hpp"
+
 namespace navbus::sensor_sim {
 
 class ImuBlockBatcher {
  public:
   /// The IDL bounds of ImuIncrementBlock.increments and ImuRawBlock.samples.
-  static constexpr std::size_t kMaxIncrements = 64;
+  static constexpr std::size_t kMaxIncrements = bus::kMaxIncrementsPerBlock;
   static constexpr std::size_t kMaxRawSamples = 256;
 
   /// `increments_per_block` in 1..kMaxIncrements.

@@ -25,7 +25,7 @@ struct SimConfig {
   /// samples in blocks as long, and the epochs, fixes and attitudes of the same frames in
   /// their blocks (bus throughput); 0: one measurement per sample, as in real time, which
   /// always publishes each measurement as it is due.
-  double fast_pacing_block_s{0.1};
+  double fast_pacing_block_s{0.3};
   double wait_for_readers_s{10.0};  ///< wait this long for readers before publishing
   /// Readers to wait for before publishing, per topic.
   struct MinReaders {
