@@ -220,7 +220,7 @@ TEST(LoadedFaultLoop, PseudorangeRampWithTheFaultManagerStoppedEqualsOffline) {
 // selector leaves lane 1; the filter is stopped twice and the fault manager once, two busy loops
 // beside them. The published solutions, every lane's own and the decision equal offline's.
 TEST(LoadedLanes, TriplexLanesThroughASwitchWithStopsAndCpuHogsEqualOffline) {
-  run({85,
+  run({190,
        "seed000_triplex_gyro_ramp",
        240,
        2,
