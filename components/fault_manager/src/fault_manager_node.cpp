@@ -145,34 +145,33 @@ bus::SensorReaders::Events FaultManagerNode::streamEvents() {
   return events;
 }
 
+template <class Block, class Elements>
+void FaultManagerNode::watchElements(const Block& m, const char* element_topic,
+                                     const Elements& elements) {
+  // The block is counted under its topic; each element is received (and watched) as one
+  // sample of its own topic, as the filter counts them.
+  using Traits = bus::SensorMessage<Block>;
+  participant_.health().stream(Traits::kTopic.topic).countAccepted(Traits::sensorId(m));
+  bus::StreamCounters& counters = participant_.health().stream(element_topic);
+  const std::int64_t now = steadyNowNs();
+  for (const auto& element : elements) {
+    ++counters.received;
+    pipeline_.onStreamSample(Traits::kTopic.kind, Traits::sensorId(m), element.seq(),
+                             element.time_gps_ns(), now);
+  }
+}
+
 template <class Message>
 void FaultManagerNode::watch(const char* profile) {
   using Traits = bus::SensorMessage<Message>;
   static constexpr StreamKind kind = Traits::kTopic.kind;  // no capture needed
   auto* reader = sensors_.subscribe<Message>(profile, [this](const Message& m) {
     if constexpr (std::is_same_v<Message, navbus::ImuIncrementBlock>) {
-      // The block is counted under its topic; each element is received (and watched) as
-      // one increment, under the increment topic, as the filter counts them.
-      participant_.health().stream(Traits::kTopic.topic).countAccepted(m.sensor_id());
-      bus::StreamCounters& increments = participant_.health().stream(bus::topic::kImuIncrement);
-      const std::int64_t now = steadyNowNs();
-      for (const navbus::ImuIncrement& increment : m.increments()) {
-        ++increments.received;
-        pipeline_.onStreamSample(kind, m.sensor_id(), increment.seq(), increment.time_gps_ns(),
-                                 now);
-      }
+      watchElements(m, bus::topic::kImuIncrement, m.increments());
     } else if constexpr (bus::kIsSensorBlock<Message>) {
-      // The same for a block of epochs, fixes or attitudes, under the element's topic.
       using Element = typename bus::SensorBlock<Message>::Element;
-      participant_.health().stream(Traits::kTopic.topic).countAccepted(Traits::sensorId(m));
-      bus::StreamCounters& elements =
-          participant_.health().stream(bus::SensorMessage<Element>::kTopic.topic);
-      const std::int64_t now = steadyNowNs();
-      for (const Element& element : bus::SensorBlock<Message>::elements(m)) {
-        ++elements.received;
-        pipeline_.onStreamSample(kind, Traits::sensorId(m), element.seq(), element.time_gps_ns(),
-                                 now);
-      }
+      watchElements(m, bus::SensorMessage<Element>::kTopic.topic,
+                    bus::SensorBlock<Message>::elements(m));
     } else {
       pipeline_.onStreamSample(kind, Traits::sensorId(m), m.seq(), Traits::timeGpsNs(m),
                                steadyNowNs());

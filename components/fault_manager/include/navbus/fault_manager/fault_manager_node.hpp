@@ -27,6 +27,10 @@ class FaultManagerNode {
   /// Watches the sensor topic of `Message` with the reader `profile` (its deadline).
   template <class Message>
   void watch(const char* profile);
+  /// A block read by a watchdog reader: counted under its topic, each element received and
+  /// watched as one sample of `element_topic`.
+  template <class Block, class Elements>
+  void watchElements(const Block& m, const char* element_topic, const Elements& elements);
   bus::SensorReaders::Events streamEvents();
   /// Reliable readers of every IMU's increments for the parity detector.
   void subscribeIncrements();

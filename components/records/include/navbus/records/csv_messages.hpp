@@ -29,6 +29,14 @@ E enumFromName(const std::string& name, const std::string& where) {
   throw bus::ConfigError(where + ": '" + name + "' is not one of " + known);
 }
 
+/// Rows [first, first + count) of a table in groups of consecutive rows whose cells in the
+/// columns `prefix` + a field name (no further '.') are equal: the rows of one struct, its own
+/// fields repeated on each row of its sequence of structs (a message, or a block's epoch).
+/// (first row, rows) per group.
+std::vector<std::pair<std::size_t, std::size_t>> rowGroups(const CsvTable& table, std::size_t first,
+                                                           std::size_t count,
+                                                           const std::string& prefix);
+
 /// Fills the fields of one message from the rows [first, first + count) of a table.
 class CellParser {
  public:
@@ -81,23 +89,16 @@ class CellParser {
   void rows(const std::string& name, std::vector<S>& seq) {
     seq.clear();
     const std::string element_prefix = prefix_ + name + ".";
-    NestedRowsName nested;
+    HasRows nested;
     const S probe{};
     visitFields(probe, nested);
-    const std::string nested_prefix =
-        nested.name.empty() ? std::string() : element_prefix + nested.name + ".";
-    for (std::size_t r = first_; r < first_ + count_;) {
+    for (const auto& [r, n] :
+         nested.found ? rowGroups(table_, first_, count_, element_prefix) : singleRows()) {
       if (count_ == 1 && rowIsEmpty(r, element_prefix)) break;
-      std::size_t n = 1;
-      while (!nested_prefix.empty() && r + n < first_ + count_ &&
-             sameElement(r, r + n, element_prefix, nested_prefix)) {
-        ++n;
-      }
       CellParser element_parser(table_, r, n, element_prefix);
       S element;
       visitFields(element, element_parser);
       seq.push_back(element);
-      r += n;
     }
   }
 
@@ -108,28 +109,22 @@ class CellParser {
   std::string where(const std::string& name) const {
     return table_.file + " line " + std::to_string(first_ + 2) + " column '" + prefix_ + name + "'";
   }
-  /// The name of the sequence of structs a struct holds, if any.
-  struct NestedRowsName {
-    std::string name;
+  /// Whether a struct holds a sequence of structs.
+  struct HasRows {
+    bool found{false};
     template <class T>
     void operator()(const std::string&, const T&) {}
     void text(const std::string&, const std::string&) {}
     template <class S>
-    void rows(const std::string& sequence, const std::vector<S>&) {
-      name = sequence;
+    void rows(const std::string&, const std::vector<S>&) {
+      found = true;
     }
   };
-  /// Rows a and b hold the same element: equal cells in its columns outside its own sequence's.
-  bool sameElement(std::size_t a, std::size_t b, const std::string& element_prefix,
-                   const std::string& nested_prefix) const {
-    for (std::size_t c = 0; c < table_.header.size(); ++c) {
-      const std::string& column = table_.header[c];
-      if (column.rfind(element_prefix, 0) == 0 && column.rfind(nested_prefix, 0) != 0 &&
-          table_.rows[a][c] != table_.rows[b][c]) {
-        return false;
-      }
-    }
-    return true;
+  /// Each of this parser's rows on its own: (row, 1).
+  std::vector<std::pair<std::size_t, std::size_t>> singleRows() const {
+    std::vector<std::pair<std::size_t, std::size_t>> rows;
+    for (std::size_t r = first_; r < first_ + count_; ++r) rows.emplace_back(r, 1);
+    return rows;
   }
   bool rowIsEmpty(std::size_t row, const std::string& element_prefix) const {
     for (std::size_t c = 0; c < table_.header.size(); ++c) {
