@@ -396,11 +396,14 @@ namespace navbus::bus {
 
 void StreamGate::reject(const Rejection& r, std::uint32_t sensor_id) {
   const std::uint64_t n = ++counters_.rejected[r.reason];
+  bool first_of_sensor = false;
   if (SensorCounters* s = counters_.sensor(sensor_id))
-    ++s->rejected;
+    first_of_sensor = ++s->rejected == 1;
   else
     ++counters_.unlisted_sensor_samples;
-  if (n == 1 || n % 1000 == 0) {
+  // Each kind the first time and every 1000th, and each listed sensor's first refusal: every
+  // refused source is named once (units refused in blocks interleave in any order).
+  if (n == 1 || n % 1000 == 0 || first_of_sensor) {
     spdlog::warn("{}: rejected sample of sensor {} ({}; {} rejected for this reason so far)",
                  topic_, sensor_id, r.describe(), n);
   }

@@ -180,7 +180,8 @@ struct StreamCounters;
 
 /// The admission pipeline of one input topic: validate, check time/sequence per sensor, count
 /// (accepted, rejected by reason, sequence gaps) and log each kind of rejection the first time
-/// and every 1000th time after, with the field and value.
+/// and every 1000th time after, and each listed sensor's first rejection, with the field and
+/// value.
 class StreamGate {
  public:
   StreamGate(std::string topic, StreamCounters& counters, ValidationLimits limits = {})
