@@ -629,6 +629,46 @@ TEST(Glr, RefusesBadEpochsAndCountsThem) {
   EXPECT_EQ(glr.refused(), 4u);
 }
 
+TEST(Glr, ACopyTakenMidRunCarriesNoWorkingBuffersAndGoesOnBitForBit) {
+  // Given a monitor that has seen 15 epochs of a loop with a lever arm and a range step, when it
+  // is copied (as the filter's recovery history copies it into each snapshot) and the original
+  // and the copy then take the same remaining epochs, then both give the same statistics, sums
+  // and position signatures to the last bit: every working buffer the copy leaves behind is
+  // written before it is read. The monitor's own size stays what a snapshot should hold: its
+  // window's sums and the previous epoch's gain and H, not the per-epoch matrices (about 100 KB
+  // of them, made on the first update of each copy).
+  const std::uint64_t seed = 23;
+  const LoopShape shape{true, 18};
+  const LoopRun run = simulate(seed, 30, {{{GlrFault::kRangeStep, 0, 6}, 20, 3.0}}, true, shape);
+  nc::GlrConfig cfg;
+  cfg.window = 10;
+  nc::GlrMonitor original(cfg);
+  for (int k = 0; k < 15; ++k) ASSERT_TRUE(original.update(run.epochs[k]).valid);
+  nc::GlrMonitor copy(original);
+  std::vector<nc::GlrMonitor::PositionSignature> a, b;
+  for (std::size_t k = 15; k < run.epochs.size(); ++k) {
+    const nc::GlrResult want = original.update(run.epochs[k]);
+    const nc::GlrResult got = copy.update(run.epochs[k]);
+    ASSERT_TRUE(got.valid);
+    EXPECT_EQ(got.statistic, want.statistic) << "epoch " << k;
+    EXPECT_EQ(got.detected, want.detected) << "epoch " << k;
+    EXPECT_EQ(got.onset_epochs_ago, want.onset_epochs_ago) << "epoch " << k;
+  }
+  for (int age = 0; age < original.onsetCount(); ++age) {
+    for (const GlrHypothesis& h :
+         {GlrHypothesis{GlrFault::kGyroStep, 2, 0}, GlrHypothesis{GlrFault::kRangeStep, 0, 6},
+          GlrHypothesis{GlrFault::kRangeRamp, 0, 6}}) {
+      EXPECT_EQ(copy.directionSums(age, h).f, original.directionSums(age, h).f) << age;
+      EXPECT_EQ(copy.directionSums(age, h).r, original.directionSums(age, h).r) << age;
+    }
+  }
+  original.positionSignatures(a);
+  copy.positionSignatures(b);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].position_ned, b[i].position_ned) << i;
+  EXPECT_LT(sizeof(nc::GlrMonitor), 48u * 1024u);  // 38 KB; 127 KB with the per-epoch matrices
+}
+
 namespace {
 
 const nc::GlrMonitor::PositionSignature* findSignature(

@@ -823,9 +823,9 @@ void NavigationEngine::fixEpoch(std::int64_t time_ns, FixEpochInput& epoch,
     epoch.test_ratio[i] = p[i].test_ratio;
     epoch.test_ratio[i + 3] = v[i].test_ratio;
   }
-  fixEpochDiagnostics(epoch, fix_gain_, fix_epoch_);
-  if (config_.integrity.enabled) integrity_->onEpoch(time_ns, fix_epoch_);
-  if (config_.adaptive_process_noise.enabled) adaptProcessNoise(time_ns, fix_epoch_, process_part);
+  fixEpochDiagnostics(epoch, fix_gain_, *fix_epoch_);
+  if (config_.integrity.enabled) integrity_->onEpoch(time_ns, *fix_epoch_);
+  if (config_.adaptive_process_noise.enabled) adaptProcessNoise(time_ns, *fix_epoch_, process_part);
 }
 
 void NavigationEngine::adaptProcessNoise(std::int64_t time_ns, const EpochDiagnostics& d,

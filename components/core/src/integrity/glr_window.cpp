@@ -44,9 +44,10 @@ void GlrWindow::configure(const GlrConfig& config) {
 }
 
 void GlrWindow::sizeWorkingBuffers() {
+  Work& work = *work_;
   const int columns = propagated(slot_capacity_) * config_.window;
-  if (mu_next_->cols() != columns) mu_next_->resize(kStates, columns);
-  if (z_->cols() != columns) z_->resize(kSupport, columns);
+  if (work.mu_next.cols() != columns) work.mu_next.resize(kStates, columns);
+  if (work.z.cols() != columns) work.z.resize(kSupport, columns);
 }
 
 void GlrWindow::reset() {
@@ -132,9 +133,10 @@ bool GlrWindow::accepts(const GlrEpoch& e) const {
 }
 
 bool GlrWindow::update(const GlrEpoch& e) {
+  Work& work = *work_;
   sizeWorkingBuffers();
-  llt_.compute(e.innovation_cov);  // used again for V^-1 in prepareEpoch
-  if (llt_.info() != Eigen::Success) return false;
+  work.llt.compute(e.innovation_cov);  // used again for V^-1 in prepareEpoch
+  if (work.llt.info() != Eigen::Success) return false;
   ++epochs_;
   assignSlots(e);
   const bool had_previous = have_previous_;
@@ -225,25 +227,26 @@ void GlrWindow::assignSlots(const GlrEpoch& e) {
 }
 
 void GlrWindow::prepareEpoch(const GlrEpoch& e) {
+  Work& work = *work_;
   const int m = e.rows;
   if (have_previous_) {
     // Closed-loop transition from the previous epoch's prior to this one's (doc eq. C3).
-    g_.resize(kStates, prev_k_.cols());
-    g_.noalias() = e.phi * prev_k_;
+    work.g.resize(kStates, prev_k_.cols());
+    work.g.noalias() = e.phi * prev_k_;
     // H is zero outside the support (validate), so G H only touches the support's columns.
-    b_ = e.phi;
-    b_.middleCols<kSupportHead.dof>(kSupportHead.index).noalias() -=
-        g_ * prev_h_fixed_.leftCols<kSupportHead.dof>();
-    b_.middleCols<kSupportTail.dof>(kSupportTail.index).noalias() -=
-        g_ * prev_h_fixed_.rightCols<kSupportTail.dof>();
+    work.b = e.phi;
+    work.b.middleCols<kSupportHead.dof>(kSupportHead.index).noalias() -=
+        work.g * prev_h_fixed_.leftCols<kSupportHead.dof>();
+    work.b.middleCols<kSupportTail.dof>(kSupportTail.index).noalias() -=
+        work.g * prev_h_fixed_.rightCols<kSupportTail.dof>();
   }
   prev_time_ns_ = time_ns_;
   time_ns_ = e.time_ns;
   // V = L L^T: V^-1 eps and V^-1 H by two triangular solves; the few entries of V^-1 the
   // direct inputs need (vInv) from the columns of L^-1.
-  l_inv_.setIdentity(m, m);
-  llt_.matrixL().solveInPlace(l_inv_);
-  w_ = llt_.solve(e.innovation);
+  work.l_inv.setIdentity(m, m);
+  work.llt.matrixL().solveInPlace(work.l_inv);
+  work.w = work.llt.solve(e.innovation);
 }
 
 void GlrWindow::addLive(int state) {
@@ -254,15 +257,16 @@ void GlrWindow::addLive(int state) {
 }
 
 void GlrWindow::growLive(const GlrEpoch& e) {
+  Work& work = *work_;
   // What the recursion below can make nonzero: B's rows that read a live state, G's rows (the
   // measurement inputs, doc eq. C3) and the IMU steps' inputs Phi(:, bias) (doc eq. C4). A row
   // added now is zero, so its own column of B does not matter this epoch.
   const int live_before = live_count_;
   for (int i = 0; i < kStates; ++i) {
     if (row_of_[static_cast<std::size_t>(i)] >= 0) continue;
-    bool reached = !g_.row(i).isZero(0.0);
+    bool reached = !work.g.row(i).isZero(0.0);
     for (int r = 0; r < live_before && !reached; ++r)
-      reached = b_(i, live_[static_cast<std::size_t>(r)]) != 0.0;
+      reached = work.b(i, live_[static_cast<std::size_t>(r)]) != 0.0;
     for (int j = 0; j < kImuDirections && !reached && config_.imu_steps; ++j)
       reached = e.phi(i, imuState(j)) != 0.0;
     if (reached) addLive(i);
@@ -270,6 +274,7 @@ void GlrWindow::growLive(const GlrEpoch& e) {
 }
 
 void GlrWindow::reorderLive(const std::array<int, kStates>& first, int count) {
+  Work& work = *work_;
   // The new order: `first`, then the other live states as they were; mu's rows follow (through
   // the working buffer). Runs when the support changes, not every epoch.
   std::array<int, kStates> order = first;
@@ -282,9 +287,9 @@ void GlrWindow::reorderLive(const std::array<int, kStates>& first, int count) {
   const int columns = static_cast<int>(mu_.cols());
   for (int r = 0; r < n; ++r) {
     const int state = order[static_cast<std::size_t>(r)];
-    mu_next_->row(r) = mu_.row(row_of_[static_cast<std::size_t>(state)]).head(columns);
+    work.mu_next.row(r) = mu_.row(row_of_[static_cast<std::size_t>(state)]).head(columns);
   }
-  mu_.swap(*mu_next_);
+  mu_.swap(work.mu_next);
   for (int r = 0; r < n; ++r) {
     live_[static_cast<std::size_t>(r)] = order[static_cast<std::size_t>(r)];
     row_of_[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])] = r;
@@ -292,28 +297,31 @@ void GlrWindow::reorderLive(const std::array<int, kStates>& first, int count) {
 }
 
 double GlrWindow::vInv(int i, int j) const {
+  const Work& work = *work_;
   // (V^-1)_ij = sum_k (L^-1)_ki (L^-1)_kj, over the rows where both columns can be nonzero.
   const int first = std::max(i, j);
-  const int n = static_cast<int>(l_inv_.rows()) - first;
-  return l_inv_.col(i).tail(n).dot(l_inv_.col(j).tail(n));
+  const int n = static_cast<int>(work.l_inv.rows()) - first;
+  return work.l_inv.col(i).tail(n).dot(work.l_inv.col(j).tail(n));
 }
 
 void GlrWindow::propagate() {
+  Work& work = *work_;
   // mu_k = Phi_k (mu_{k-1} - K_{k-1} rho_{k-1}) = B mu_{k-1} - G D_{k-1}  (doc eq. C3), for
   // every onset and column in one product, on the live rows. (Splitting off B's identity on
   // the random-constant biases saves a quarter of the multiplications and costs more than that
   // in a second product and pass on this size, measured.)
   const int n = live_count_;
-  b_live_.resize(n, n);
+  work.b_live.resize(n, n);
   for (int c = 0; c < n; ++c) {
     for (int r = 0; r < n; ++r)
-      b_live_(r, c) = b_(live_[static_cast<std::size_t>(r)], live_[static_cast<std::size_t>(c)]);
+      work.b_live(r, c) =
+          work.b(live_[static_cast<std::size_t>(r)], live_[static_cast<std::size_t>(c)]);
   }
   const int columns = propagatedColumns() * config_.window;
-  columnProduct(n, columns, b_live_.data(), static_cast<int>(b_live_.outerStride()), mu_.data(),
-                static_cast<int>(mu_.outerStride()), mu_next_->data(),
-                static_cast<int>(mu_next_->outerStride()));
-  mu_.swap(*mu_next_);
+  columnProduct(n, columns, work.b_live.data(), static_cast<int>(work.b_live.outerStride()),
+                mu_.data(), static_cast<int>(mu_.outerStride()), work.mu_next.data(),
+                static_cast<int>(work.mu_next.outerStride()));
+  mu_.swap(work.mu_next);
   const bool range = config_.range_steps || config_.range_ramps;
   for (int s = 0; s < slots_used_; ++s) {
     const Slot& slot = slots_[static_cast<std::size_t>(s)];
@@ -326,11 +334,12 @@ void GlrWindow::propagate() {
 }
 
 void GlrWindow::subtractInput(int column, int row) {
+  Work& work = *work_;
   // - G D: the direct input d = kStepInput entered row `row` of the previous epoch.
   const int n = live_count_;
-  g_live_.resize(n);
-  for (int r = 0; r < n; ++r) g_live_[r] = g_(live_[static_cast<std::size_t>(r)], row);
-  mu_.block(0, firstColumn(column), n, config_.window).colwise() -= g_live_ * kStepInput;
+  work.g_live.resize(n);
+  for (int r = 0; r < n; ++r) work.g_live[r] = work.g(live_[static_cast<std::size_t>(r)], row);
+  mu_.block(0, firstColumn(column), n, config_.window).colwise() -= work.g_live * kStepInput;
 }
 
 void GlrWindow::startOnset(const GlrEpoch& e) {
@@ -360,6 +369,7 @@ void GlrWindow::startOnset(const GlrEpoch& e) {
 }
 
 void GlrWindow::prepareSupport(const GlrEpoch& e) {
+  Work& work = *work_;
   // The statistics see the state only through H: everything below lives on H's support, the
   // live states with a nonzero column in H (position, velocity, the clock, and attitude only
   // with a lever arm), which makes S mu an 8 x 8 product instead of n x n. The support is kept
@@ -378,24 +388,25 @@ void GlrWindow::prepareSupport(const GlrEpoch& e) {
   support_count_ = count;
   h_support_.resize(m, count);
   for (int c = 0; c < count; ++c) h_support_.col(c) = e.h.col(live_[static_cast<std::size_t>(c)]);
-  u_.resize(m, count);
-  u_ = llt_.solve(h_support_);
-  s_.resize(count, count);
-  s_.noalias() = h_support_.transpose() * u_;
-  a_.resize(count);
-  a_.noalias() = h_support_.transpose() * w_;
+  work.u.resize(m, count);
+  work.u = work.llt.solve(h_support_);
+  work.s.resize(count, count);
+  work.s.noalias() = h_support_.transpose() * work.u;
+  work.a.resize(count);
+  work.a.noalias() = h_support_.transpose() * work.w;
 }
 
 void GlrWindow::accumulate() {
+  Work& work = *work_;
   // rho_c = H mu_c + d_c e_{row_c}; f_c += rho_c^T V^-1 eps; R_cd += rho_c^T V^-1 rho_d
   // (eqs. 9-10), on H's support: mu's leading rows and z_ = S mu there for every onset at once
   // (one block of `window` columns per direction); the direct inputs d enter in
   // accumulateSatellite.
   const int columns = propagatedColumns() * config_.window;
   const int n = support_count_;
-  columnProduct(n, columns, s_.data(), static_cast<int>(s_.outerStride()), mu_.data(),
-                static_cast<int>(mu_.outerStride()), z_->data(),
-                static_cast<int>(z_->outerStride()));
+  columnProduct(n, columns, work.s.data(), static_cast<int>(work.s.outerStride()), mu_.data(),
+                static_cast<int>(mu_.outerStride()), work.z.data(),
+                static_cast<int>(work.z.outerStride()));
   if (config_.imu_steps) accumulateImu();
   // The satellites' sums are support-wide dot products, many per onset: with the support's size
   // known at compile time for the usual cases (position, velocity and clock; with a lever arm,
@@ -414,15 +425,17 @@ void GlrWindow::accumulate() {
 // The sums are added to every ring position, active or not: a position that is not (yet) an
 // onset is cleared when it becomes one (startOnset), and only active ones are read.
 void GlrWindow::accumulateImu() {
+  Work& work = *work_;
   const int window = config_.window;
   for (int c = 0; c < kImuDirections; ++c) {
     const auto mu_c = mu_.block(0, firstColumn(c), support_count_, window);
-    f_.row(c).noalias() += a_.transpose() * mu_c;
+    f_.row(c).noalias() += work.a.transpose() * mu_c;
     for (int d = c; d < kImuDirections; ++d) {
-      const OnsetArray r = mu_c.cwiseProduct(z_->block(0, firstColumn(d), support_count_, window))
-                               .colwise()
-                               .sum()
-                               .array();
+      const OnsetArray r =
+          mu_c.cwiseProduct(work.z.block(0, firstColumn(d), support_count_, window))
+              .colwise()
+              .sum()
+              .array();
       r_imu_.row(c + kImuDirections * d) += r.matrix();
       if (d != c) r_imu_.row(d + kImuDirections * c) += r.matrix();
     }
@@ -431,6 +444,7 @@ void GlrWindow::accumulateImu() {
 
 template <int N>
 void GlrWindow::accumulateSatellite(int s) {
+  Work& work = *work_;
   const Slot& slot = slots_[static_cast<std::size_t>(s)];
   using Vector = Eigen::Matrix<double, N, 1, 0, N == Eigen::Dynamic ? kSupport : N, 1>;
   using ConstColumn = Eigen::Map<const Vector>;
@@ -446,14 +460,14 @@ void GlrWindow::accumulateSatellite(int s) {
   Vector u_range = Vector::Zero(n), u_rate = Vector::Zero(n);
   double w_range = 0.0, w_rate = 0.0, v_rr = 0.0, v_rt = 0.0, v_tt = 0.0;
   for (const int i : range_rows) {
-    u_range += u_.row(i).transpose();
-    w_range += w_[i];
+    u_range += work.u.row(i).transpose();
+    w_range += work.w[i];
     for (const int j : range_rows) v_rr += vInv(i, j);
     for (const int j : rate_rows) v_rt += vInv(i, j);
   }
   for (const int i : rate_rows) {
-    u_rate += u_.row(i).transpose();
-    w_rate += w_[i];
+    u_rate += work.u.row(i).transpose();
+    w_rate += work.w[i];
     for (const int j : rate_rows) v_tt += vInv(i, j);
   }
   // Disabled hypotheses add nothing (their columns may still carry a ramp's steps).
@@ -470,18 +484,18 @@ void GlrWindow::accumulateSatellite(int s) {
   int ring = (onset_head_ + onset_count_ - 1) % window;
   for (int age = 0; age < onset_count_; ++age, ring = ring == 0 ? window - 1 : ring - 1) {
     const ConstColumn mu_step(mu_.col(step_first + ring).data(), n);
-    const ConstColumn z_step(z_->col(step_first + ring).data(), n);
+    const ConstColumn z_step(work.z.col(step_first + ring).data(), n);
     const ConstColumn mu_rate(mu_.col(rate_first + ring).data(), n);
-    const ConstColumn z_rate(z_->col(rate_first + ring).data(), n);
+    const ConstColumn z_rate(work.z.col(rate_first + ring).data(), n);
     const double c = spacing_s_[ring];
     ramp_mu += c * mu_step;
     ramp_z += c * z_step;
     ramp_d += c * d_step;
     // f_c = mu_c^T a + d_c w(r_c)
     double* f = f_.col(ring).data() + satColumn(s, 0);
-    f[kRangeStep] += on_step * (mu_step.dot(a_) + d_step * w_range);
-    f[kRangeRamp] += on_ramp * (ramp_mu.dot(a_) + ramp_d * w_range);
-    f[kRateStep] += on_rate * (mu_rate.dot(a_) + d_rate * w_rate);
+    f[kRangeStep] += on_step * (mu_step.dot(work.a) + d_step * w_range);
+    f[kRangeRamp] += on_ramp * (ramp_mu.dot(work.a) + ramp_d * w_range);
+    f[kRateStep] += on_rate * (mu_rate.dot(work.a) + d_rate * w_rate);
     // R_ij = mu_i^T S mu_j + d_j U(r_j,:) mu_i + d_i U(r_i,:) mu_j + d_i d_j V^-1(r_i, r_j);
     // the range step and ramp enter the range row, the rate step the rate row.
     const double ur_step = u_range.dot(mu_step), ur_ramp = u_range.dot(ramp_mu);

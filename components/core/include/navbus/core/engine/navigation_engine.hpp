@@ -364,8 +364,9 @@ class NavigationEngine {
   Indirect<StationarityDetector> stationarity_;
   Indirect<StageSelector> stages_;
   ConsistencyMonitor consistency_;
-  /// A fix as the protection levels' detector sees it (storage reused from fix to fix).
-  EpochDiagnostics fix_epoch_;
+  /// A fix as the protection levels' detector sees it (storage reused from fix to fix, rewritten
+  /// by each: not in the recovery history's copies of the engine).
+  Scratch<EpochDiagnostics> fix_epoch_;
   AppliedGain fix_gain_;
   std::array<NoiseScaleEstimator, kNoiseStreams> noise_scales_;
   ProcessNoiseScaleEstimator process_noise_;

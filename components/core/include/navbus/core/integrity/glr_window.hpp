@@ -167,10 +167,6 @@ class GlrWindow {
   int live_count_{0};
   /// This epoch's support (the live states H measures): the leading support_count_ live rows.
   int support_count_{0};
-  /// Working buffers, overwritten by every update before they are read (not in copies:
-  /// scratch.hpp): the next mu_ and S times mu_'s support rows (z_), same column order.
-  Scratch<SignatureMatrix> mu_next_;
-  Scratch<Eigen::Matrix<double, glr::kSupport, Eigen::Dynamic>> z_;
   OnsetArray spacing_s_;  ///< t_theta - t_{theta-1} of each ring position [s]
   // Sums of eqs. 9-10, one column per ring position: f per direction, the IMU group's R (6 x 6,
   // column-major) and each satellite slot's R (3 x 3, column-major, slot after slot).
@@ -180,29 +176,40 @@ class GlrWindow {
   Eigen::Matrix<double, glr::kImuDirections * glr::kImuDirections, Eigen::Dynamic> r_imu_;
   Eigen::MatrixXd r_sat_;
 
-  // Per-epoch quantities (current epoch k) and what the recursion keeps of epoch k-1.
+  // What the recursion keeps of epoch k-1, and this epoch's H on its support (positionSignatures
+  // reads it after the update).
   bool have_previous_{false};
   std::int64_t time_ns_{0}, prev_time_ns_{0};
-  Eigen::LLT<glr::RowMatrix> llt_;  ///< Cholesky factor of this epoch's V
   glr::KMatrix prev_k_;
-  glr::RowMatrix l_inv_;  ///< L^-1 of this epoch's V = L L^T (lower triangular)
-  glr::RowVector w_;      ///< V^-1 eps
   using SupportVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, glr::kSupport, 1>;
   using SupportMatrix =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kSupport, glr::kSupport>;
   using HSupport =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kMaxRows, glr::kSupport>;
-  HSupport h_support_, u_;  ///< H and V^-1 H on this epoch's support (live row order)
+  HSupport h_support_;  ///< H on this epoch's support (live row order)
   /// The previous epoch's H on the fixed support (kSupportHead, then kSupportTail)
   Eigen::Matrix<double, Eigen::Dynamic, glr::kSupport, 0, glr::kMaxRows, glr::kSupport>
       prev_h_fixed_;
-  SupportMatrix s_;  ///< H^T V^-1 H on the support
-  SupportVector a_;  ///< H^T V^-1 eps on the support
-  StateMatrix b_;    ///< Phi_k (I - K_{k-1} H_{k-1})
-  glr::KMatrix g_;   ///< Phi_k K_{k-1}
-  /// B on the live states (the propagation's matrix) and a G column on them
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kStates, glr::kStates> b_live_;
-  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, glr::kStates, 1> g_live_;
+
+  /// Working buffers of one update, each written before it is read (not in copies, such as the
+  /// recovery history's snapshots of the filter: scratch.hpp; about 100 KB).
+  struct Work {
+    Eigen::LLT<glr::RowMatrix> llt;  ///< Cholesky factor of this epoch's V
+    glr::RowMatrix l_inv;            ///< L^-1 of this epoch's V = L L^T (lower triangular)
+    glr::RowVector w;                ///< V^-1 eps
+    HSupport u;                      ///< V^-1 H on the support
+    SupportMatrix s;                 ///< H^T V^-1 H on the support
+    SupportVector a;                 ///< H^T V^-1 eps on the support
+    StateMatrix b;                   ///< Phi_k (I - K_{k-1} H_{k-1})
+    glr::KMatrix g;                  ///< Phi_k K_{k-1}
+    /// B on the live states (the propagation's matrix) and a G column on them
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, glr::kStates, glr::kStates> b_live;
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, glr::kStates, 1> g_live;
+    /// The next mu_ and S times mu_'s support rows (z), same column order.
+    SignatureMatrix mu_next;
+    Eigen::Matrix<double, glr::kSupport, Eigen::Dynamic> z;
+  };
+  Scratch<Work> work_;
 };
 
 }  // namespace navbus::core
