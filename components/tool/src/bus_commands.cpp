@@ -178,6 +178,12 @@ class LatencyCommand final : public Subcommand {
     cli_->add_option("--priority", table.priority, "table: the real-time rows' realtime.priority")
         ->check(CLI::Range(1, 98))
         ->capture_default_str();
+    cli_->add_option("--cpus", table.cpus,
+                     "table: the real-time rows' realtime.cpus, for navbus-filter and its IMU "
+                     "source alike (default: the last core)");
+    cli_->add_flag("--spread", table.spread,
+                   "table: no realtime.cpus in the real-time rows (their affinity as inherited)")
+        ->excludes("--cpus");
     cli_->add_flag("--keep", table.keep, "table: keep its work directory (CSV files, logs)");
   }
   int runTable(const bus::Participant::Options& options) {

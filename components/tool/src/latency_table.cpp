@@ -179,6 +179,29 @@ Row makeRow(const std::string& state, const std::string& path, std::vector<std::
   return r;
 }
 
+/// "[0, 1]"
+std::string cpuList(const std::vector<int>& cpus) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < cpus.size(); ++i)
+    out += (i > 0 ? ", " : "") + std::to_string(cpus[i]);
+  return out + "]";
+}
+
+/// The real-time rows' cores: as given, each one this machine has, or the last core (none with
+/// --spread).
+std::vector<int> realtimeCpus(const LatencyTableOptions& o) {
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  if (o.spread) return {};
+  if (o.cpus.empty()) return {static_cast<int>(std::max(online, 1L)) - 1};
+  for (const int cpu : o.cpus) {
+    if (cpu < 0 || cpu >= online) {
+      throw std::runtime_error("--cpus " + std::to_string(cpu) + ": this machine has cores 0.." +
+                               std::to_string(online - 1));
+    }
+  }
+  return o.cpus;
+}
+
 class TableRun {
  public:
   TableRun(const bus::Participant::Options& participant, const LatencyTableOptions& o)
@@ -245,9 +268,9 @@ class TableRun {
 
  private:
   void writeRealtimeFiles() {
-    const std::string block = "realtime: {policy: " + o_.policy +
-                              ", priority: " + std::to_string(o_.priority) +
-                              ", lock_memory: true}\n";
+    const std::string block =
+        "realtime: {policy: " + o_.policy + ", priority: " + std::to_string(o_.priority) +
+        (o_.cpus.empty() ? "" : ", cpus: " + cpuList(o_.cpus)) + ", lock_memory: true}\n";
     std::ofstream(work_ / "tool_realtime.yaml") << block;
     std::ofstream(work_ / "filter_realtime.yaml")
         << "extends: " << fs::absolute(o_.filter_config).string() << "\n"
@@ -348,7 +371,10 @@ struct Pool {
 
 }  // namespace
 
-int runLatencyTable(const bus::Participant::Options& participant, const LatencyTableOptions& o) {
+int runLatencyTable(const bus::Participant::Options& participant,
+                    const LatencyTableOptions& options) {
+  LatencyTableOptions o = options;
+  o.cpus = realtimeCpus(options);
   TableRun run(participant, o);
   // The second state is "idle again" when no CPU-bound process was asked for.
   const char* states[] = {"idle", o.cpu_hogs > 0 ? "loaded" : "idle-2"};
@@ -374,10 +400,11 @@ int runLatencyTable(const bus::Participant::Options& participant, const LatencyT
   std::printf(
       "navbus latency table: %d round(s) of %d samples per row at %.0f Hz (after %d warm-up), "
       "%.1f min in all; loaded: %d CPU-bound processes beside it; real-time option: policy %s, "
-      "priority %d, memory locked\n"
+      "priority %d, memory locked, cpus %s (navbus-filter and its IMU source)\n"
       "raw: navbus latency ping/pong round trip (two hops, default priority); navbus: IMU "
       "increment written -> low-latency output received (two hops through navbus-filter)\n\n",
-      o.rounds, o.samples, o.rate_hz, o.warmup, minutes, o.cpu_hogs, o.policy.c_str(), o.priority);
+      o.rounds, o.samples, o.rate_hz, o.warmup, minutes, o.cpu_hogs, o.policy.c_str(), o.priority,
+      o.cpus.empty() ? "as inherited" : cpuList(o.cpus).c_str());
   std::printf("%-7s %-26s %9s %9s %9s %9s %9s  samples\n", "[us]", "", "p50", "p99", "p99.9",
               "p99.99", "max");
   for (const Row& r : rows) printRow(r);

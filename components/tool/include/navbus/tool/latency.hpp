@@ -57,7 +57,12 @@ struct LatencyTableOptions {
   std::string filter_config{"config/filter_latency.yaml"};
   std::string policy{"fifo"};  ///< the real-time rows' `realtime.policy`
   int priority{20};            ///< and `realtime.priority` (lock_memory: true)
-  bool keep{false};            ///< keep the work directory (CSV files, logs)
+  /// and `realtime.cpus`, for the filter and its IMU source alike; empty: the last core, so that
+  /// neither waits for the other's core to wake (on this project's virtual machines a
+  /// cross-core wake-up cost the idle median 1.3-1.5x the raw round trip, docs/results.md)
+  std::vector<int> cpus;
+  bool spread{false};  ///< no `realtime.cpus`: the real-time rows' affinity as inherited
+  bool keep{false};    ///< keep the work directory (CSV files, logs)
 };
 
 /// Runs the table: child processes on domains from `participant.dds.domain_id` (six of them,
