@@ -44,14 +44,6 @@ std::string systemReason(int error) {
   return reason;
 }
 
-std::string listText(const std::vector<int>& cpus) {
-  std::string text = "[";
-  for (std::size_t i = 0; i < cpus.size(); ++i) {
-    text += (i ? ", " : "") + std::to_string(cpus[i]);
-  }
-  return text + "]";
-}
-
 void checkOptions(const RealtimeOptions& o) {
   const bool realtime_class = o.policy != SchedulingPolicy::kOther;
   if (realtime_class) {
@@ -80,7 +72,7 @@ void setAffinity(const std::vector<int>& cpus) {
   for (const int cpu : cpus) CPU_SET(cpu, &set);
   const int error = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
   if (error != 0) {
-    throw ConfigError("configuration realtime.cpus = " + listText(cpus) +
+    throw ConfigError("configuration realtime.cpus = " + cpuListText(cpus) +
                       " refused: " + std::strerror(error) + " (this machine has " +
                       std::to_string(sysconf(_SC_NPROCESSORS_ONLN)) +
                       " online cores, numbered from 0; a container may allow fewer)");
@@ -149,6 +141,14 @@ void lockMemory() {
 
 }  // namespace
 
+std::string cpuListText(const std::vector<int>& cpus) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < cpus.size(); ++i) {
+    text += (i ? ", " : "") + std::to_string(cpus[i]);
+  }
+  return text + "]";
+}
+
 const char* policyName(SchedulingPolicy policy) {
   switch (policy) {
     case SchedulingPolicy::kFifo:
@@ -203,7 +203,7 @@ RealtimeGrant applyRealtime(const RealtimeOptions& o) {
 
 std::string RealtimeGrant::text() const {
   return std::string("policy ") + policyName(policy) + " priority " + std::to_string(priority) +
-         ", cpus " + listText(cpus) + ", memory " + (memory_locked ? "locked" : "not locked");
+         ", cpus " + cpuListText(cpus) + ", memory " + (memory_locked ? "locked" : "not locked");
 }
 
 }  // namespace navbus::bus

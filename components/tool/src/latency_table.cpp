@@ -29,6 +29,7 @@
 
 #include "navbus/bus/app.hpp"
 #include "navbus/bus/proc_status.hpp"
+#include "navbus/bus/realtime.hpp"
 #include "navbus/tool/latency.hpp"
 
 extern char** environ;
@@ -179,14 +180,6 @@ Row makeRow(const std::string& state, const std::string& path, std::vector<std::
   return r;
 }
 
-/// "[0, 1]"
-std::string cpuList(const std::vector<int>& cpus) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < cpus.size(); ++i)
-    out += (i > 0 ? ", " : "") + std::to_string(cpus[i]);
-  return out + "]";
-}
-
 /// The real-time rows' cores: as given, each one this machine has, or the last core (none with
 /// --spread).
 std::vector<int> realtimeCpus(const LatencyTableOptions& o) {
@@ -270,7 +263,7 @@ class TableRun {
   void writeRealtimeFiles() {
     const std::string block =
         "realtime: {policy: " + o_.policy + ", priority: " + std::to_string(o_.priority) +
-        (o_.cpus.empty() ? "" : ", cpus: " + cpuList(o_.cpus)) + ", lock_memory: true}\n";
+        (o_.cpus.empty() ? "" : ", cpus: " + bus::cpuListText(o_.cpus)) + ", lock_memory: true}\n";
     std::ofstream(work_ / "tool_realtime.yaml") << block;
     std::ofstream(work_ / "filter_realtime.yaml")
         << "extends: " << fs::absolute(o_.filter_config).string() << "\n"
@@ -404,7 +397,7 @@ int runLatencyTable(const bus::Participant::Options& participant,
       "raw: navbus latency ping/pong round trip (two hops, default priority); navbus: IMU "
       "increment written -> low-latency output received (two hops through navbus-filter)\n\n",
       o.rounds, o.samples, o.rate_hz, o.warmup, minutes, o.cpu_hogs, o.policy.c_str(), o.priority,
-      o.cpus.empty() ? "as inherited" : cpuList(o.cpus).c_str());
+      o.cpus.empty() ? "as inherited" : bus::cpuListText(o.cpus).c_str());
   std::printf("%-7s %-26s %9s %9s %9s %9s %9s  samples\n", "[us]", "", "p50", "p99", "p99.9",
               "p99.99", "max");
   for (const Row& r : rows) printRow(r);

@@ -61,5 +61,7 @@ RealtimeGrant applyRealtime(const RealtimeOptions& options);
 
 /// "other", "fifo", "rr".
 const char* policyName(SchedulingPolicy policy);
+/// A list of core numbers as the `cpus` key takes it: "[0, 1]".
+std::string cpuListText(const std::vector<int>& cpus);
 
 }  // namespace navbus::bus
