@@ -81,9 +81,16 @@ cleanup() {
   rm -rf "$work" "$src/build/docker-prefix"
 }
 trap cleanup EXIT
+current_project=  # the compose project of the mode under test
 fail() {
   echo "FAIL: $*"
   tail -60 "$work/compose.log" 2> /dev/null || true
+  # Every container's state and the end of its log: which one did not finish, and why.
+  local c
+  for c in $(docker ps -aq --filter "label=com.docker.compose.project=$current_project"); do
+    echo "--- $(docker inspect -f '{{.Name}}: {{.State.Status}}, exit code {{.State.ExitCode}}' "$c")"
+    docker logs --tail 40 "$c" 2>&1 || true
+  done
   exit 1
 }
 
@@ -99,6 +106,7 @@ fi
 # --- the demo, once per mode --------------------------------------------------------------
 run_demo() {  # MODE
   local mode=$1 out=$work/out-$1 extra=()
+  current_project=$project-$mode
   mkdir -p "$out"
   chown 10001:10001 "$out"   # the images' user writes the recordings and figures
   if [ "$mode" = secure ]; then

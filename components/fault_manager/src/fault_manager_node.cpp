@@ -96,6 +96,8 @@ bus::SensorReaders::Events FaultManagerNode::detectorEvents() {
     // take samples up to it, which belong to this run (with the watchdog's own last time as the
     // end they started a new one, which went LOST 2 s later: a replay under the sanitizers).
     pipeline_.onStreamEnded(kind, id, last_time_gps_ns);
+    // --exit-when-ended: the end the watchdog's reader may not have taken.
+    if (kind == StreamKind::kImu && stop_after_end_ != nullptr) stop_after_end_->ended();
   };
   return events;
 }
@@ -128,7 +130,7 @@ bus::SensorReaders::Events FaultManagerNode::streamEvents() {
   events.ended = [this](StreamKind kind, std::uint32_t id, std::uint64_t last_time_gps_ns) {
     running();
     pipeline_.onStreamEnded(kind, id, last_time_gps_ns);
-    if (kind == StreamKind::kImu && on_imu_ended_) on_imu_ended_();
+    if (kind == StreamKind::kImu && stop_after_end_ != nullptr) stop_after_end_->ended();
   };
   events.deadline_missed = [this](StreamKind kind, std::uint32_t id) {
     pipeline_.onDeadlineMissed(kind, id, running());
@@ -141,6 +143,8 @@ bus::SensorReaders::Events FaultManagerNode::streamEvents() {
   events.writers_alive = [this](StreamKind kind, bool alive) {
     running();
     if (alive) pipeline_.onWritersAlive(kind);
+    if (kind == StreamKind::kImu && stop_after_end_ != nullptr)
+      stop_after_end_->writersAlive(alive);
   };
   return events;
 }

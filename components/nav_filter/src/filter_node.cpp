@@ -162,10 +162,12 @@ bus::SensorReaders::Events FilterNode::sensorEvents() {
   bus::SensorReaders::Events events;
   events.ended = [this](bus::StreamKind kind, std::uint32_t id, std::uint64_t) {
     pipeline_.onStreamEnded(kind, id);
-    if (kind == bus::StreamKind::kImu && on_imu_ended_) on_imu_ended_();
+    if (kind == bus::StreamKind::kImu && stop_after_end_ != nullptr) stop_after_end_->ended();
   };
   events.writers_alive = [this](bus::StreamKind kind, bool alive) {
     pipeline_.setWritersAlive(kind, alive, steadyNowNs());
+    if (kind == bus::StreamKind::kImu && stop_after_end_ != nullptr)
+      stop_after_end_->writersAlive(alive);
   };
   return events;
 }

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
     std::optional<nb::bus::StopAfterEnd> stop_after_end;
     if (exit_when_ended) {
       stop_after_end.emplace(participant, nb::bus::kStopAfterEndGrace);
-      node.setOnImuEnded([&] { stop_after_end->ended(); });
+      node.stopAfterEnd(*stop_after_end);
     }
     participant.run();
     spdlog::info("summary: {}\n{}", node.summary(), participant.health().summary());

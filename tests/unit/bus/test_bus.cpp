@@ -12,6 +12,7 @@
 #include "navbus/bus/dds_context.hpp"
 #include "navbus/bus/health.hpp"
 #include "navbus/bus/participant.hpp"
+#include "navbus/bus/stop_after_end.hpp"
 #include "navbus/bus/stream_end.hpp"
 #include "navbus/bus/topics.hpp"
 #include "navbus/bus/validation.hpp"
@@ -566,4 +567,48 @@ TEST(StreamEndCounter, CountsTheChangesMissedBeforeTheDispose) {
   ends.taken(a, 10);
   EXPECT_EQ(ends.disposed(a, 14), 3u);  // 11-13 never arrived
   EXPECT_EQ(ends.disposed(a, 15), 0u);  // a second instance's dispose right after
+}
+
+// --exit-when-ended (bus/stop_after_end.hpp): the announced end stops the participant after the
+// grace, whatever the writers' liveliness does then; writers gone stop it only if none is alive
+// again before the grace ends.
+namespace {
+/// Spins `p` for `d`; true if it was asked to stop meanwhile.
+bool stoppedWithin(navbus::bus::Participant& p, std::chrono::milliseconds d) {
+  const auto end = std::chrono::steady_clock::now() + d;
+  while (!p.stopping() && std::chrono::steady_clock::now() < end)
+    p.spinOnce(std::chrono::milliseconds(20));
+  return p.stopping();
+}
+navbus::bus::Participant::Options stopTestOptions() {
+  navbus::bus::Participant::Options o;
+  o.dds.domain_id = 204;
+  o.dds.participant_profile = navbus::bus::profile::kParticipantLoopback;
+  o.dds.name = "unit-stop-after-end";
+  return o;
+}
+constexpr std::chrono::milliseconds kGrace{500};
+}  // namespace
+
+TEST(StopAfterEnd, WritersGoneStopAfterTheGraceUnlessOneIsBack) {
+  navbus::bus::ShutdownSignal shutdown;
+  navbus::bus::Participant p(stopTestOptions(), shutdown);
+  navbus::bus::StopAfterEnd stop(p, kGrace);
+  stop.writersAlive(true);  // the writer matched: nothing to do
+  EXPECT_FALSE(stoppedWithin(p, 2 * kGrace));
+  stop.writersAlive(false);
+  stop.writersAlive(true);  // back within the grace (a stale view after a stall)
+  EXPECT_FALSE(stoppedWithin(p, 3 * kGrace));
+  stop.writersAlive(false);
+  EXPECT_TRUE(stoppedWithin(p, 6 * kGrace));
+}
+
+TEST(StopAfterEnd, TheAnnouncedEndIsNotCancelled) {
+  navbus::bus::ShutdownSignal shutdown;
+  navbus::bus::Participant p(stopTestOptions(), shutdown);
+  navbus::bus::StopAfterEnd stop(p, kGrace);
+  stop.ended();
+  stop.writersAlive(false);  // the writer left after its dispose, as it does
+  stop.writersAlive(true);   // and a new one came: the data this participant was for has ended
+  EXPECT_TRUE(stoppedWithin(p, 6 * kGrace));
 }

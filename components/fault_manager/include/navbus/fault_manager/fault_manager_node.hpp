@@ -4,7 +4,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <string>
 
 #include <navbus_idl/FaultPubSubTypes.h>
@@ -12,6 +11,7 @@
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/sensor_readers.hpp"
 #include "navbus/bus/stall_detector.hpp"
+#include "navbus/bus/stop_after_end.hpp"
 #include "navbus/fault_manager/fault_pipeline.hpp"
 
 namespace navbus::fault_manager {
@@ -21,7 +21,8 @@ class FaultManagerNode {
   FaultManagerNode(bus::Participant& participant, const FaultManagerConfig& config);
   std::string summary() const { return pipeline_.summary(); }
   /// Called once the IMU stream's writer announced the end of its data.
-  void setOnImuEnded(std::function<void()> fn) { on_imu_ended_ = std::move(fn); }
+  /// --exit-when-ended: told of the IMU stream's end and of its writers' liveliness.
+  void stopAfterEnd(bus::StopAfterEnd& stop) { stop_after_end_ = &stop; }
 
  private:
   /// Watches the sensor topic of `Message` with the reader `profile` (its deadline).
@@ -41,7 +42,7 @@ class FaultManagerNode {
   std::int64_t running();
 
   bus::Participant& participant_;
-  std::function<void()> on_imu_ended_;
+  bus::StopAfterEnd* stop_after_end_{nullptr};
   bus::Writer<navbus::FaultDecision> decision_writer_;
   bus::Writer<navbus::FilterCommand> command_writer_;
   bus::Writer<navbus::FaultMonitorProgress> progress_writer_;  ///< how far diagnostics are judged

@@ -5,7 +5,6 @@
 
 #include <chrono>
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <utility>
 
@@ -14,6 +13,7 @@
 #include "navbus/bus/participant.hpp"
 #include "navbus/bus/sensor_readers.hpp"
 #include "navbus/bus/stall_detector.hpp"
+#include "navbus/bus/stop_after_end.hpp"
 #include "navbus/nav_filter/filter_config.hpp"
 #include "navbus/nav_filter/lane_set.hpp"
 #include "navbus/nav_filter/monitor_liveness.hpp"
@@ -29,7 +29,8 @@ class FilterNode {
   std::string summary() const { return pipeline_.summary(); }
   /// Called once the IMU stream's writer announced the end of its data (after the pipeline
   /// was told).
-  void setOnImuEnded(std::function<void()> fn) { on_imu_ended_ = std::move(fn); }
+  /// --exit-when-ended: told of the IMU stream's end and of its writers' liveliness.
+  void stopAfterEnd(bus::StopAfterEnd& stop) { stop_after_end_ = &stop; }
 
  private:
   /// STARTING until the first solution; DEGRADED while a stream is lost or no solution has
@@ -59,7 +60,7 @@ class FilterNode {
   static constexpr std::int64_t kNotProducingMinNs = 1'000'000'000;
 
   bus::Participant& participant_;
-  std::function<void()> on_imu_ended_;
+  bus::StopAfterEnd* stop_after_end_{nullptr};
   bus::Writer<navbus::NavigationSolution> solution_writer_;
   bus::Writer<navbus::FilterDiagnostics> diagnostics_writer_;
   bus::Writer<navbus::NavigationSolution> low_latency_writer_;  ///< when configured

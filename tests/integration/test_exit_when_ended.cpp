@@ -1,0 +1,83 @@
+// --exit-when-ended (bus/stop_after_end.hpp), what the compose demo's filter and fault manager
+// rely on to stop by themselves: both stop, with exit code 0, once the simulator has announced
+// the end of its data, and also once it has left the bus without announcing it (killed here;
+// for the fault manager's best-effort watchdog reader, a dispose lost on the way looks the
+// same). Before, a participant that missed the announcement waited for ever.
+#include <gtest/gtest.h>
+#include <navbus_idl/NavigationPubSubTypes.h>
+
+#include "harness.hpp"
+#include "test_paths.hpp"
+
+using namespace navbus;
+using namespace std::chrono_literals;
+
+namespace {
+
+/// The filter and the fault manager under --exit-when-ended, and the simulator (its timing
+/// given); `sim` is started last.
+struct EndingLoop {
+  std::filesystem::path dir;
+  std::string sim_cfg, filter_cfg, fm_cfg;
+
+  EndingLoop(const std::string& name, int domain, const std::string& timing)
+      : dir(test::scratchDir(name)) {
+    const std::string d = "domain_id: " + std::to_string(domain) + "\n";
+    sim_cfg = test::writeFile(
+        dir / "sim.yaml", d + "seed: 3\ntiming: {start: now, wait_for_readers_s: 20, " + timing +
+                              ",\n  min_readers: {imu: 2, raw_imu: 1, gnss: 2, "
+                              "star_tracker: 2}}\n");
+    filter_cfg = test::writeFile(dir / "filter.yaml", test::filterConfig(domain));
+    fm_cfg = test::writeFile(dir / "fm.yaml", d);
+  }
+  std::string log(const std::string& name) const { return test::readFile(dir / name); }
+};
+
+}  // namespace
+
+TEST(ExitWhenEnded, BothStopOnceTheSimulatorAnnouncedTheEnd) {
+  test::cleanSharedMemory();
+  constexpr int kDomain = 193;
+  const EndingLoop loop("exit_when_ended_announced", kDomain, "duration_s: 20, pacing: fast");
+  test::ChildProcess filter(test_paths::filterExe(), {"-c", loop.filter_cfg, "--exit-when-ended"},
+                            (loop.dir / "filter.log").string());
+  test::ChildProcess fm(test_paths::faultManagerExe(), {"-c", loop.fm_cfg, "--exit-when-ended"},
+                        (loop.dir / "fm.log").string());
+  test::ChildProcess sim(test_paths::sensorSimExe(), {"-c", loop.sim_cfg},
+                         (loop.dir / "sim.log").string());
+  ASSERT_EQ(sim.wait(120s), 0) << loop.log("sim.log");
+  // The grace is 2 s: 10 s is a bound a busy machine keeps.
+  EXPECT_EQ(filter.wait(10s), 0) << loop.log("filter.log");
+  EXPECT_EQ(fm.wait(10s), 0) << loop.log("fm.log");
+  EXPECT_NE(loop.log("filter.log").find("the IMU stream ended; stopping"), std::string::npos);
+  EXPECT_NE(loop.log("fm.log").find("the IMU stream ended; stopping"), std::string::npos);
+  test::cleanSharedMemory();
+}
+
+TEST(ExitWhenEnded, BothStopOnceTheSimulatorLeftWithoutAnnouncingIt) {
+  test::cleanSharedMemory();
+  constexpr int kDomain = 194;
+  const EndingLoop loop("exit_when_ended_killed", kDomain, "duration_s: 0, pacing: realtime");
+  bus::ShutdownSignal shutdown;
+  bus::Participant me(test::testParticipant(kDomain, "exit-when-ended-test"), shutdown);
+  std::size_t solutions = 0;
+  me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution,
+                                             bus::profile::kSolutionReader,
+                                             [&](const auto&, const auto&) { ++solutions; });
+  test::ChildProcess filter(test_paths::filterExe(), {"-c", loop.filter_cfg, "--exit-when-ended"},
+                            (loop.dir / "filter.log").string());
+  test::ChildProcess fm(test_paths::faultManagerExe(), {"-c", loop.fm_cfg, "--exit-when-ended"},
+                        (loop.dir / "fm.log").string());
+  test::ChildProcess sim(test_paths::sensorSimExe(), {"-c", loop.sim_cfg},
+                         (loop.dir / "sim.log").string());
+  ASSERT_TRUE(test::spinUntil(me, 60s, [&] { return solutions >= 20; }))
+      << loop.log("filter.log") << loop.log("sim.log");
+  sim.signal(SIGKILL);  // no dispose, no goodbye: its liveliness lapses (1 s lease)
+  // Lease and grace: about 3 s; 15 s is a bound a busy machine keeps.
+  EXPECT_EQ(filter.wait(15s), 0) << loop.log("filter.log");
+  EXPECT_EQ(fm.wait(15s), 0) << loop.log("fm.log");
+  const std::string left = "every IMU writer left the bus without announcing";
+  EXPECT_NE(loop.log("filter.log").find(left), std::string::npos);
+  EXPECT_NE(loop.log("fm.log").find(left), std::string::npos);
+  test::cleanSharedMemory();
+}
