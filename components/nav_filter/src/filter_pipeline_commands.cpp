@@ -153,18 +153,7 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
   } else if (history_.enabled() && answersFaultWithOnset(c) &&
              countRecovery(history_.rollback(restorePoint(c, config_.recovery_onset_margin_ns),
                                              engine_, replay_))) {
-    // Restored to before the onset: the command applies there, and what followed is
-    // re-processed without the fault (nothing is published meanwhile: those solutions went out).
-    const std::int64_t restored_ns = engine_.state().time_ns;
-    history_.record(restored_ns,
-                    {kRestoredCommandStream, restored_ns, CommandInput{restored_ns, c}}, engine_);
-    applied = applyToEngine(c);
-    replaying_ = true;
-    for (MergedInput& item : replay_) process(item.stream, item.time_ns, std::move(item.input));
-    replaying_ = false;
-    spdlog::warn("command {}: filter restored to {:.3f} s (onset {:.3f} s), {} inputs re-processed",
-                 c.command_id(), 1e-9 * static_cast<double>(restored_ns),
-                 1e-9 * static_cast<double>(c.onset_time_gps_ns()), replay_.size());
+    applied = applyFromRestorePoint(c);
   } else {
     const std::int64_t now_ns = engine_.state().time_ns;
     history_.record(now_ns, {kCommandStream, now_ns, CommandInput{now_ns, c}}, engine_);
@@ -179,6 +168,34 @@ void FilterPipeline::executeCommand(const navbus::FilterCommand& c) {
     spdlog::warn("command {} from '{}' refused: kind {}: {}", c.command_id(), c.issuer(),
                  static_cast<int>(c.kind()), why);
   }
+}
+
+bool FilterPipeline::applyFromRestorePoint(const navbus::FilterCommand& c) {
+  // Restored to the snapshot before the restore point: what came before the point is
+  // re-processed as it was, the command applies at the point, and what followed is re-processed
+  // without the fault (nothing is published meanwhile: those solutions went out). The result
+  // is the same whatever the snapshot period (it only sets how much is re-processed).
+  const std::int64_t snapshot_ns = engine_.state().time_ns;
+  const std::int64_t point_ns = restorePoint(c, config_.recovery_onset_margin_ns);
+  replaying_ = true;
+  std::size_t next = 0;
+  for (; next < replay_.size() && replay_[next].time_ns < point_ns; ++next) {
+    MergedInput& item = replay_[next];
+    process(item.stream, item.time_ns, std::move(item.input));
+  }
+  history_.record(point_ns, {kRestoredCommandStream, point_ns, CommandInput{point_ns, c}}, engine_);
+  const bool applied = applyToEngine(c);
+  for (std::size_t k = next; k < replay_.size(); ++k) {
+    MergedInput& item = replay_[k];
+    process(item.stream, item.time_ns, std::move(item.input));
+  }
+  replaying_ = false;
+  spdlog::warn(
+      "command {}: filter restored to {:.3f} s, applied at {:.3f} s (onset {:.3f} s), {} inputs "
+      "re-processed",
+      c.command_id(), 1e-9 * static_cast<double>(snapshot_ns), 1e-9 * static_cast<double>(point_ns),
+      1e-9 * static_cast<double>(c.onset_time_gps_ns()), replay_.size());
+  return applied;
 }
 
 bool FilterPipeline::applyToEngine(const navbus::FilterCommand& c) {

@@ -336,3 +336,28 @@ TEST(FaultJudgement, AReceiversJudgeThatStopsAdvancingHoldsTheOutputForItsBudget
       << "passed over once, not at every epoch: " << bus.pipeline->summary();
   EXPECT_EQ(passedOver(reference.pipeline->summary()), 0) << reference.pipeline->summary();
 }
+
+// A command with an estimated onset restores the latest snapshot before the onset, re-processes
+// what came before the onset, applies the command there and re-processes the rest: the snapshot
+// period sets only how much is re-processed, never the result (docs/results.md, memory: a longer
+// period keeps fewer engine copies).
+TEST(FaultRecovery, TheSnapshotPeriodChangesNothingButWhatIsReprocessed) {
+  const std::vector<Frame> all = frames(kFrames);
+  std::vector<std::unique_ptr<FilterRun>> runs;
+  for (const double period_s : {1.0, 3.0, 7.0}) {
+    auto config = tightlyCoupled(40.0);
+    config.recovery_snapshot_period_ns = static_cast<std::int64_t>(period_s * 1e9);
+    runs.push_back(std::make_unique<FilterRun>(config));
+    // The twelfth epoch's command, its onset 3 s earlier: a snapshot of the running filter
+    // before it with every period.
+    answerInTime(*runs.back(), &relearnAccelYFromOnset, 12);
+    runs.back()->play(all);
+    const std::string summary = runs.back()->pipeline->summary();
+    EXPECT_NE(summary.find("recoveries from onset 1 (onset beyond history 0)"), std::string::npos)
+        << period_s << " s: " << summary;
+  }
+  for (std::size_t k = 1; k < runs.size(); ++k) {
+    expectSameEngine(runs.front()->pipeline->engine(), runs[k]->pipeline->engine());
+    expectSameSolutions(*runs.front(), *runs[k]);
+  }
+}

@@ -105,9 +105,11 @@ struct FilterConfig {
   std::optional<InputConfig> star_tracker;
   std::int64_t sequencer_max_wait_ns{500'000'000};
   /// Recovery from a fault found late (input_history.hpp): data kept to restore the filter
-  /// to before a fault's onset [ns] (0: off), and the spacing of the engine snapshots.
+  /// to before a fault's onset [ns] (0: off), and the spacing of the engine snapshots (each one
+  /// a copy of the engine, 0.6 MB in the demo; the period sets how much a restore re-processes,
+  /// not its result).
   std::int64_t recovery_history_ns{40'000'000'000};
-  std::int64_t recovery_snapshot_period_ns{1'000'000'000};
+  std::int64_t recovery_snapshot_period_ns{5'000'000'000};
   /// A satellite is excluded from this long before the estimated onset [ns].
   std::int64_t recovery_onset_margin_ns{5'000'000'000};
   /// Largest bias a CMD_COMPENSATE_BIAS may add [m/s^2, rad/s]; beyond, refused. A

@@ -241,6 +241,9 @@ class FilterPipeline {
   bool mergeLate(StreamId id, std::int64_t time_ns, FilterInput& input);
   /// Counts a restore to before a fault's onset (or one the history could not reach).
   bool countRecovery(bool restored);
+  /// After a rollback for `c`: re-processes up to its restore point, applies it there and
+  /// re-processes the rest.
+  bool applyFromRestorePoint(const navbus::FilterCommand& c);
   bool applyToEngine(const navbus::FilterCommand& c);
   /// An engine command into the merge at its data time (late: by rewinding, or at once).
   void enterCommand(const navbus::FilterCommand& c);

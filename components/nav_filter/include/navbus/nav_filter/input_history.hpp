@@ -1,11 +1,12 @@
 // Bounded history of what the filter processed, for recovery from a fault found late: engine
 // snapshots taken at most every `snapshot_period` of data time, and every input and command
 // processed since the oldest snapshot kept. A fault command with an estimated onset restores
-// the latest snapshot whose state time is not after the onset, applies the command there, and
-// re-processes everything that followed, so that the contamination accumulated since the onset
-// (e.g. a ramping satellite pulled into the position, a bias step absorbed into the estimates)
-// is gone rather than slowly forgotten. The engine is deterministic, so the result is the
-// same whenever the command arrives. Pure logic, DDS-free.
+// the latest snapshot taken before the onset; the inputs before the onset are re-processed,
+// the command applies at the onset, and everything that followed is re-processed, so that the
+// contamination accumulated since the onset (e.g. a ramping satellite pulled into the position,
+// a bias step absorbed into the estimates) is gone rather than slowly forgotten. The engine is
+// deterministic, so the result is the same whenever the command arrives, and whatever the
+// snapshot period (which only sets how much is re-processed). Pure logic, DDS-free.
 #pragma once
 
 #include <algorithm>
@@ -27,13 +28,16 @@ class InputHistory {
  public:
   using Item = Input;
 
-  /// `expected_items`: the inputs the span holds (FilterPipeline counts them from the
-  /// configured periods); the item buffer is made that large at once, so that it does not
-  /// allocate while it fills (it still grows if more come).
+  /// `snapshot_period_ns` is clamped to the span. `expected_items`: the inputs the span holds
+  /// (FilterPipeline counts them from the configured periods); the item buffer is made that large
+  /// at once, so that it does not allocate while it fills (it still grows if more come).
   InputHistory(std::int64_t span_ns, std::int64_t snapshot_period_ns,
                std::size_t expected_items = 16)
       : span_ns_(span_ns),
-        snapshot_period_ns_(snapshot_period_ns),
+        // A period longer than the span would keep older snapshots than the span says.
+        snapshot_period_ns_(span_ns > 0 ? std::min(snapshot_period_ns, span_ns)
+                                        : snapshot_period_ns),
+        snapshots_(span_ns > 0 ? maxSnapshots() : 1),
         items_(span_ns > 0 ? expected_items : 1) {}
 
   bool enabled() const { return span_ns_ > 0; }
@@ -51,9 +55,10 @@ class InputHistory {
     }
     if (snapshots_.empty() || time_ns - snapshots_.back().time_ns >= snapshot_period_ns_) {
       const std::size_t first_item = first_index_ + items_.size();
-      // The engine owns heap storage: every snapshot slot the span needs is made at the first
-      // snapshot, so that the history allocates nothing afterwards, not even while it fills.
-      if (snapshots_.empty() && snapshots_.capacity() < maxSnapshots()) {
+      // The engine owns heap storage: every snapshot slot the span needs (the ring is made that
+      // large) is made at the first snapshot, so that the history allocates nothing afterwards,
+      // not even while it fills (a no-op once made).
+      if (snapshots_.empty()) {
         snapshots_.prefill(maxSnapshots(), [&] {
           return Snapshot{time_ns, latest_ns_, first_item, engine};
         });
@@ -83,12 +88,13 @@ class InputHistory {
     return kept;
   }
 
-  /// Restores the engine to the latest snapshot whose state is not later than `onset_ns` and
-  /// returns the items processed since (to be re-processed by the caller, who records them
-  /// again). False when the history does not reach back to the onset.
+  /// Restores the engine to the latest snapshot of an initialized engine taken before any
+  /// input at or after `onset_ns` was processed, and returns the items processed since (to be
+  /// re-processed by the caller, who records them again: those before the onset first). False
+  /// when the history does not reach back to the onset.
   bool rollback(std::int64_t onset_ns, core::NavigationEngine& engine, std::deque<Item>& replay) {
     return restore(engine, replay, [onset_ns](const Snapshot& s) {
-      return s.engine.initialized() && s.engine.state().time_ns <= onset_ns;
+      return s.engine.initialized() && s.inputs_up_to_ns < onset_ns;
     });
   }
 
