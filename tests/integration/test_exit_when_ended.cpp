@@ -3,6 +3,8 @@
 // the end of its data, and also once it has left the bus without announcing it (killed here;
 // for the fault manager's best-effort watchdog reader, a dispose lost on the way looks the
 // same). Before, a participant that missed the announcement waited for ever.
+#include <memory>
+
 #include <gtest/gtest.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
@@ -31,6 +33,20 @@ struct EndingLoop {
     fm_cfg = test::writeFile(dir / "fm.yaml", d);
   }
   std::string log(const std::string& name) const { return test::readFile(dir / name); }
+
+  std::unique_ptr<test::ChildProcess> filter, fm, sim;
+  /// The filter and the fault manager with --exit-when-ended, then the simulator.
+  void start() {
+    filter = std::make_unique<test::ChildProcess>(
+        test_paths::filterExe(), std::vector<std::string>{"-c", filter_cfg, "--exit-when-ended"},
+        (dir / "filter.log").string());
+    fm = std::make_unique<test::ChildProcess>(
+        test_paths::faultManagerExe(), std::vector<std::string>{"-c", fm_cfg, "--exit-when-ended"},
+        (dir / "fm.log").string());
+    sim = std::make_unique<test::ChildProcess>(test_paths::sensorSimExe(),
+                                               std::vector<std::string>{"-c", sim_cfg},
+                                               (dir / "sim.log").string());
+  }
 };
 
 }  // namespace
@@ -38,17 +54,12 @@ struct EndingLoop {
 TEST(ExitWhenEnded, BothStopOnceTheSimulatorAnnouncedTheEnd) {
   test::cleanSharedMemory();
   constexpr int kDomain = 193;
-  const EndingLoop loop("exit_when_ended_announced", kDomain, "duration_s: 20, pacing: fast");
-  test::ChildProcess filter(test_paths::filterExe(), {"-c", loop.filter_cfg, "--exit-when-ended"},
-                            (loop.dir / "filter.log").string());
-  test::ChildProcess fm(test_paths::faultManagerExe(), {"-c", loop.fm_cfg, "--exit-when-ended"},
-                        (loop.dir / "fm.log").string());
-  test::ChildProcess sim(test_paths::sensorSimExe(), {"-c", loop.sim_cfg},
-                         (loop.dir / "sim.log").string());
-  ASSERT_EQ(sim.wait(120s), 0) << loop.log("sim.log");
+  EndingLoop loop("exit_when_ended_announced", kDomain, "duration_s: 20, pacing: fast");
+  loop.start();
+  ASSERT_EQ(loop.sim->wait(120s), 0) << loop.log("sim.log");
   // The grace is 2 s: 10 s is a bound a busy machine keeps.
-  EXPECT_EQ(filter.wait(10s), 0) << loop.log("filter.log");
-  EXPECT_EQ(fm.wait(10s), 0) << loop.log("fm.log");
+  EXPECT_EQ(loop.filter->wait(10s), 0) << loop.log("filter.log");
+  EXPECT_EQ(loop.fm->wait(10s), 0) << loop.log("fm.log");
   EXPECT_NE(loop.log("filter.log").find("the IMU stream ended; stopping"), std::string::npos);
   EXPECT_NE(loop.log("fm.log").find("the IMU stream ended; stopping"), std::string::npos);
   test::cleanSharedMemory();
@@ -57,25 +68,20 @@ TEST(ExitWhenEnded, BothStopOnceTheSimulatorAnnouncedTheEnd) {
 TEST(ExitWhenEnded, BothStopOnceTheSimulatorLeftWithoutAnnouncingIt) {
   test::cleanSharedMemory();
   constexpr int kDomain = 194;
-  const EndingLoop loop("exit_when_ended_killed", kDomain, "duration_s: 0, pacing: realtime");
+  EndingLoop loop("exit_when_ended_killed", kDomain, "duration_s: 0, pacing: realtime");
   bus::ShutdownSignal shutdown;
   bus::Participant me(test::testParticipant(kDomain, "exit-when-ended-test"), shutdown);
   std::size_t solutions = 0;
   me.subscribe<NavigationSolutionPubSubType>(bus::topic::kNavSolution,
                                              bus::profile::kSolutionReader,
                                              [&](const auto&, const auto&) { ++solutions; });
-  test::ChildProcess filter(test_paths::filterExe(), {"-c", loop.filter_cfg, "--exit-when-ended"},
-                            (loop.dir / "filter.log").string());
-  test::ChildProcess fm(test_paths::faultManagerExe(), {"-c", loop.fm_cfg, "--exit-when-ended"},
-                        (loop.dir / "fm.log").string());
-  test::ChildProcess sim(test_paths::sensorSimExe(), {"-c", loop.sim_cfg},
-                         (loop.dir / "sim.log").string());
+  loop.start();
   ASSERT_TRUE(test::spinUntil(me, 60s, [&] { return solutions >= 20; }))
       << loop.log("filter.log") << loop.log("sim.log");
-  sim.signal(SIGKILL);  // no dispose, no goodbye: its liveliness lapses (1 s lease)
+  loop.sim->signal(SIGKILL);  // no dispose, no goodbye: its liveliness lapses (1 s lease)
   // Lease and grace: about 3 s; 15 s is a bound a busy machine keeps.
-  EXPECT_EQ(filter.wait(15s), 0) << loop.log("filter.log");
-  EXPECT_EQ(fm.wait(15s), 0) << loop.log("fm.log");
+  EXPECT_EQ(loop.filter->wait(15s), 0) << loop.log("filter.log");
+  EXPECT_EQ(loop.fm->wait(15s), 0) << loop.log("fm.log");
   const std::string left = "every IMU writer left the bus without announcing";
   EXPECT_NE(loop.log("filter.log").find(left), std::string::npos);
   EXPECT_NE(loop.log("fm.log").find(left), std::string::npos);
