@@ -361,3 +361,18 @@ TEST(FaultRecovery, TheSnapshotPeriodChangesNothingButWhatIsReprocessed) {
     expectSameSolutions(*runs.front(), *runs[k]);
   }
 }
+
+// The first snapshot is taken before the first input, when the engine is not yet initialized,
+// so it cannot be restored; the next one is taken as soon as the engine is: a fault whose onset
+// is in the first snapshot period (2 s into the data, the default period 5 s) is restored to.
+TEST(FaultRecovery, AnOnsetInTheFirstSnapshotPeriodIsRestoredTo) {
+  const std::vector<Frame> all = frames(kFrames);
+  const auto config = tightlyCoupled(40.0);
+  ASSERT_GT(config.recovery_snapshot_period_ns, 3'000'000'000);
+  FilterRun run(config);
+  answerInTime(run, &relearnAccelYFromOnset);  // the sixth epoch's command, onset 3 s before it
+  run.play(all);
+  const std::string summary = run.pipeline->summary();
+  EXPECT_NE(summary.find("recoveries from onset 1 (onset beyond history 0)"), std::string::npos)
+      << summary;
+}

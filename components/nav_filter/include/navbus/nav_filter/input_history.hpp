@@ -53,7 +53,10 @@ class InputHistory {
       unkept_ = std::move(item);
       return unkept_;
     }
-    if (snapshots_.empty() || time_ns - snapshots_.back().time_ns >= snapshot_period_ns_) {
+    // Also the first input after the engine initialized: a restore needs an initialized
+    // snapshot, and the first one (before the first input) is not.
+    if (snapshots_.empty() || time_ns - snapshots_.back().time_ns >= snapshot_period_ns_ ||
+        (engine.initialized() && !snapshots_.back().engine.initialized())) {
       const std::size_t first_item = first_index_ + items_.size();
       // The engine owns heap storage: every snapshot slot the span needs (the ring is made that
       // large) is made at the first snapshot, so that the history allocates nothing afterwards,
@@ -110,12 +113,12 @@ class InputHistory {
     return latest_ns_;
   }
 
-  /// The most snapshots the span holds: one per period, the one kept beyond the span and the
-  /// one being taken (at most 4096).
+  /// The most snapshots the span holds: one per period, the one kept beyond the span, the one
+  /// being taken and the one taken when the engine initialized (at most 4096).
   std::size_t maxSnapshots() const {
     if (snapshot_period_ns_ <= 0) return 1;
     return static_cast<std::size_t>(
-        std::min<std::int64_t>(span_ns_ / snapshot_period_ns_ + 2, 4096));
+        std::min<std::int64_t>(span_ns_ / snapshot_period_ns_ + 3, 4096));
   }
 
  private:
