@@ -20,8 +20,8 @@ class FaultManagerNode {
  public:
   FaultManagerNode(bus::Participant& participant, const FaultManagerConfig& config);
   std::string summary() const { return pipeline_.summary(); }
-  /// Called once the IMU stream's writer announced the end of its data.
-  /// --exit-when-ended: told of the IMU stream's end and of its writers' liveliness.
+  /// --exit-when-ended: told of the IMU stream's end (after the pipeline) and of its writers'
+  /// liveliness.
   void stopAfterEnd(bus::StopAfterEnd& stop) { stop_after_end_ = &stop; }
 
  private:

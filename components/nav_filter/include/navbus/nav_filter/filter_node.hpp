@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdint>
 #include <string>
-#include <utility>
 
 #include <navbus_idl/NavigationPubSubTypes.h>
 
@@ -27,9 +26,8 @@ class FilterNode {
   /// Releases ready inputs (after every reader dispatch and periodically).
   void pump();
   std::string summary() const { return pipeline_.summary(); }
-  /// Called once the IMU stream's writer announced the end of its data (after the pipeline
-  /// was told).
-  /// --exit-when-ended: told of the IMU stream's end and of its writers' liveliness.
+  /// --exit-when-ended: told of the IMU stream's end (after the pipeline) and of its writers'
+  /// liveliness.
   void stopAfterEnd(bus::StopAfterEnd& stop) { stop_after_end_ = &stop; }
 
  private:

@@ -19,7 +19,6 @@ class RingBuffer {
 
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
-  std::size_t capacity() const { return slots_.size(); }
 
   /// Element i from the front.
   T& operator[](std::size_t i) { return *slots_[slot(i)]; }
@@ -54,7 +53,7 @@ class RingBuffer {
   /// once, rather than one by one as the buffer fills.
   template <class Make>
   void prefill(std::size_t n, Make&& make) {
-    while (slots_.size() < n) grow();
+    if (slots_.size() < n) reslot(n);  // exactly n: each slot costs an object
     for (std::optional<T>& s : slots_) {
       if (!s) s.emplace(make());
     }
@@ -81,8 +80,10 @@ class RingBuffer {
 
  private:
   std::size_t slot(std::size_t i) const { return (head_ + i) % slots_.size(); }
-  void grow() {
-    std::vector<std::optional<T>> bigger(2 * slots_.size());
+  void grow() { reslot(2 * slots_.size()); }
+  /// Moves the elements, oldest first, into `n` slots.
+  void reslot(std::size_t n) {
+    std::vector<std::optional<T>> bigger(n);
     for (std::size_t i = 0; i < slots_.size(); ++i) bigger[i] = std::move(slots_[slot(i)]);
     slots_ = std::move(bigger);
     head_ = 0;
