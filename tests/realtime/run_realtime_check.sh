@@ -3,7 +3,8 @@
 #   1. navbus-filter with {policy: fifo, priority: 10, cpus: [the last core], lock_memory: true}:
 #      every thread of the process (the Fast DDS threads it created included) runs SCHED_FIFO on
 #      that core at priority 10, the main (processing) thread at the DDS threads' priority (not
-#      above them: docs/bus.md), with locked memory (VmLck > 0), as the kernel reports in /proc;
+#      above them: docs/bus.md), but the housekeeping thread, back at SCHED_OTHER on that core;
+#      with locked memory (VmLck > 0), as the kernel reports in /proc;
 #   2. the fault manager and the simulator take the same block and report the same grant;
 #   3. refusals are configuration errors (exit 2) naming the key and the system's reason:
 #      without CAP_SYS_NICE, with a locked-memory limit of 0 and no CAP_IPC_LOCK, a core this
@@ -48,7 +49,7 @@ until grep -q "real-time: granted" "$work/filter.log"; do
 done
 sleep 1  # the DDS threads of the participant and its entities are all there by now
 grep -o "real-time: .*" "$work/filter.log"
-threads=0
+threads=0 housekeeping=0
 for task in /proc/$filter/task/*; do
   tid=${task##*/}
   # /proc/TID/stat: the fields after "(comm)"; rt_priority is field 40, policy field 41.
@@ -56,16 +57,22 @@ for task in /proc/$filter/task/*; do
   priority=${f[37]} policy=${f[38]}
   cpus=$(awk '/^Cpus_allowed_list/ {print $2}' "$task/status")
   name=$(cat "$task/comm")
-  want=10
   echo "thread $tid ($name): policy $policy priority $priority cpus $cpus"
-  [ "$policy" = 1 ] || fail "thread $tid ($name) has policy $policy, not SCHED_FIFO (1)"
-  [ "$priority" = "$want" ] || fail "thread $tid ($name) at priority $priority, not $want"
   [ "$cpus" = "$core" ] || fail "thread $tid ($name) on cpus $cpus, not $core"
+  if [ "$name" = navbus-housekp ]; then
+    # The shared-memory reclaim's thread goes back to the normal class: it must not preempt.
+    [ "$policy" = 0 ] || fail "housekeeping thread $tid has policy $policy, not SCHED_OTHER (0)"
+    housekeeping=$((housekeeping + 1))
+    continue
+  fi
+  [ "$policy" = 1 ] || fail "thread $tid ($name) has policy $policy, not SCHED_FIFO (1)"
+  [ "$priority" = 10 ] || fail "thread $tid ($name) at priority $priority, not 10"
   threads=$((threads + 1))
 done
 locked=$(awk '/^VmLck/ {print $2}' /proc/$filter/status)
 echo "$threads threads SCHED_FIFO on core $core; VmLck $locked kB"
 [ "$threads" -ge 5 ] || fail "only $threads threads: the DDS threads are not there"
+[ "$housekeeping" = 1 ] || fail "$housekeeping housekeeping threads, not 1"
 if [ -n "${ASAN_OPTIONS:-}" ]; then
   # AddressSanitizer ignores mlockall: the filter must say so, not claim a lock.
   grep -q "memory not locked" "$work/filter.log" && grep -q "ignores mlockall" "$work/filter.log" ||

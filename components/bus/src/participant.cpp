@@ -18,7 +18,8 @@ Participant::Participant(const Options& options, ShutdownSignal& shutdown)
       realtime_(applyRealtime(options.realtime)),
       dds_(options.dds),
       health_(options.dds.name),
-      publish_health_(options.publish_health) {
+      publish_health_(options.publish_health),
+      shm_reclaimer_(kShmReclaimPeriod, [] { reclaimSharedMemoryOfDeadParticipants(); }) {
   if (options.realtime.requested()) {
     if (options.realtime.lock_memory && !realtime_.memory_locked) {
       spdlog::warn(
@@ -33,7 +34,6 @@ Participant::Participant(const Options& options, ShutdownSignal& shutdown)
     addTimer(options.health_period, [this] { publishHealth(); });
   }
   reclaimSharedMemoryOfDeadParticipants();
-  addTimer(kShmReclaimPeriod, [] { reclaimSharedMemoryOfDeadParticipants(); });
 }
 
 namespace {

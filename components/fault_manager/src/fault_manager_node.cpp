@@ -161,7 +161,7 @@ void FaultManagerNode::watchElements(const Block& m, const char* element_topic,
   for (const auto& element : elements) {
     ++counters.received;
     pipeline_.onStreamSample(Traits::kTopic.kind, Traits::sensorId(m), element.seq(),
-                             element.time_gps_ns(), now);
+                             element.time_gps_ns(), now, /*in_block=*/true);
   }
 }
 

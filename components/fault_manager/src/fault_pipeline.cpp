@@ -79,7 +79,8 @@ void FaultPipeline::reportReceiversProgress() {
 }
 
 void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
-                                   std::uint64_t time_gps_ns, std::int64_t wall_now_ns) {
+                                   std::uint64_t time_gps_ns, std::int64_t wall_now_ns,
+                                   bool in_block) {
   // Best-effort watchdog readers may lose samples: count them from the sequence numbers. A
   // restarted writer (time going back) starts a new count.
   auto& tracker = trackers_[kind];
@@ -90,7 +91,10 @@ void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std
   }
   // Observed, not validated: a monitor.
   health_.stream(bus::streamInfo(kind).topic).countAccepted(sensor_id, o.missing);
-  if (auto e = watchdog_.onSample({kind, sensor_id}, time_gps_ns, wall_now_ns)) onWatchdogEvent(*e);
+  const auto delivery =
+      in_block ? StreamWatchdog::Delivery::kBlock : StreamWatchdog::Delivery::kSample;
+  if (auto e = watchdog_.onSample({kind, sensor_id}, time_gps_ns, wall_now_ns, delivery))
+    onWatchdogEvent(*e);
 }
 
 void FaultPipeline::onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id,

@@ -6,7 +6,7 @@ namespace navbus::fault_manager {
 
 std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
                                                       std::uint64_t time_gps_ns,
-                                                      std::int64_t wall_now_ns) {
+                                                      std::int64_t wall_now_ns, Delivery delivery) {
   const auto ended = ended_at_.find(key);
   if (ended != ended_at_.end()) {
     if (time_gps_ns <= ended->second) return std::nullopt;  // in flight before the end
@@ -27,15 +27,18 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
   s.suspect_deadline_ns = -1;
   s.last_time_gps_ns = time_gps_ns;
   s.last_arrival_wall_ns = wall_now_ns;
-  notePace(s);
+  notePace(s, delivery);
   return event;
 }
 
-void StreamWatchdog::notePace(State& s) {
-  if (s.ahead_of_real_time || s.last_time_gps_ns < s.first_time_gps_ns) return;
-  const auto data_span_ns = static_cast<std::int64_t>(s.last_time_gps_ns - s.first_time_gps_ns);
-  const std::int64_t wall_span_ns = s.last_arrival_wall_ns - s.first_arrival_wall_ns;
-  if (data_span_ns - wall_span_ns <= kAheadOfRealTimeNs) return;
+void StreamWatchdog::notePace(State& s, Delivery delivery) {
+  if (s.ahead_of_real_time) return;
+  if (delivery != Delivery::kBlock) {
+    if (s.last_time_gps_ns < s.first_time_gps_ns) return;
+    const auto data_span_ns = static_cast<std::int64_t>(s.last_time_gps_ns - s.first_time_gps_ns);
+    const std::int64_t wall_span_ns = s.last_arrival_wall_ns - s.first_arrival_wall_ns;
+    if (data_span_ns - wall_span_ns <= kAheadOfRealTimeNs) return;
+  }
   s.ahead_of_real_time = true;
   ++streams_ahead_;
 }

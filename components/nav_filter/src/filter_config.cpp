@@ -637,6 +637,7 @@ FilterConfig parseFilterConfig(const YAML::Node& root) {
   top.value("vehicle_id", c.vehicle_id)
       .rateHz("solution_rate_hz", e.solution_period_ns, {1.0, 1000.0})
       .seconds("sequencer_max_wait_s", c.sequencer_max_wait_ns, {0.001, 60.0})
+      .seconds("sequencer_reserve_s", c.sequencer_reserve_ns, {0.0, 60.0})
       .value("solution_writer_profile", c.solution_writer_profile)
       .value("diagnostics_writer_profile", c.diagnostics_writer_profile)
       .value("command_issuers", c.command_issuers)

@@ -45,11 +45,9 @@ std::vector<InputSequencer<FilterInput>::ExpectedStream> expectedStreams(const F
   return s;
 }
 
-/// The inputs the recovery history holds over its span: one per period of each configured
-/// stream (a stream without a period counted at the IMU's), and a quarter more for jitter and
-/// commands.
-std::size_t historyItems(const FilterConfig& c) {
-  if (c.recovery_history_ns <= 0) return 1;
+/// Inputs per nanosecond of data: one per period of each configured stream (a stream without
+/// a period counted at the IMU's).
+double inputsPerNs(const FilterConfig& c) {
   double per_ns = 0.0;
   const auto add = [&](const std::optional<InputConfig>& in) {
     const std::int64_t period_ns = in && in->period_ns > 0 ? in->period_ns : c.imu.period_ns;
@@ -60,7 +58,13 @@ std::size_t historyItems(const FilterConfig& c) {
   if (c.second_gnss_receiver_id) add(c.gnss_observations);
   add(c.gnss_fix);
   add(c.star_tracker);
-  return static_cast<std::size_t>(1.25 * per_ns * static_cast<double>(c.recovery_history_ns)) + 16;
+  return per_ns;
+}
+
+/// The inputs `span_ns` of data holds, and a quarter more for jitter and commands.
+std::size_t inputsOver(const FilterConfig& c, std::int64_t span_ns) {
+  if (span_ns <= 0) return 1;
+  return static_cast<std::size_t>(1.25 * inputsPerNs(c) * static_cast<double>(span_ns)) + 16;
 }
 
 }  // namespace
@@ -74,7 +78,7 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
       sinks_(std::move(sinks)),
       sequencer_(expectedStreams(config), config.sequencer_max_wait_ns),
       history_(config.recovery_history_ns, config.recovery_snapshot_period_ns,
-               historyItems(config)),
+               inputsOver(config, config.recovery_history_ns)),
       engine_(config.engine),
       predictor_(config.engine.tuning.gravity, config.low_latency_max_buffered),
       imu_gate_(bus::topic::kImuIncrement, imu_health.stream(bus::topic::kImuIncrement),
@@ -95,6 +99,7 @@ FilterPipeline::FilterPipeline(const FilterConfig& config, bus::HealthCounters& 
       commands_(config, health.stream(bus::topic::kFilterCommand), sinks_.command_outcome) {
   receivers_judged_ = config.fault_monitor && config.fault_monitor->receivers_judged;
   spare_satellite_lists_.reserve(kSpareSatelliteLists);
+  sequencer_.reserve(inputsOver(config, config.sequencer_reserve_ns));
 }
 
 std::vector<core::SatelliteObservation> FilterPipeline::spareSatelliteList() {
@@ -480,7 +485,7 @@ void FilterPipeline::publishHeldSolution() {
 std::string FilterPipeline::summary() const {
   return describePipeline({config_, engine_, commands_.counters(), flags_, predictor_.counters(),
                            counters_, solution_seq_, sequencer_.timeouts(), sequencer_.pending(),
-                           judgements_.reports(), judgements_.heldForCommand(),
+                           sequencer_.grown(), judgements_.reports(), judgements_.heldForCommand(),
                            sequencer_.judgementTimeouts()});
 }
 

@@ -38,8 +38,8 @@ void describeCounts(const PipelineView& v, std::ostringstream& out) {
       << ", issuer not the writer's identity " << k.impersonated << ", stale " << k.stale
       << ") late " << k.late << ", re-learn sigmas clamped to the compensation limit "
       << k.relearn_clamped << ", sequencer timeouts " << v.sequencer_timeouts << ", pending "
-      << v.pending << ", recoveries from onset " << p.onset_recoveries << " (onset beyond history "
-      << p.onset_beyond_history << ")"
+      << v.pending << ", merge buffer grown " << v.merge_grown << ", recoveries from onset "
+      << p.onset_recoveries << " (onset beyond history " << p.onset_beyond_history << ")"
       << ", late samples merged by rewinding " << p.late_merged << " (rewinds " << p.rewinds << ")"
       << ", solutions published not trustworthy " << p.solutions_untrusted;
 }

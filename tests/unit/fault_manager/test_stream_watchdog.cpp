@@ -122,6 +122,31 @@ TEST(StreamWatchdog, StreamPacedAheadOfRealTimeIsJudgedByItsWriterOnly) {
   EXPECT_TRUE(rt.onDeadlineMissed(imu, 10 * kS + 250 * kMs, 250 * kMs));
 }
 
+TEST(StreamWatchdog, AStreamInBlocksIsJudgedByItsWriterOnlyFromItsFirstBlock) {
+  // A replay of an imported drive starved of CPU from its start: its increments come in
+  // blocks, but their data time has not run ahead of the wall clock yet when the writer waits
+  // 0.47 s for a stopped reliable reader (CI, 2026-12-01). Blocks are written faster than real
+  // time: that silence is no loss; the writer going away is.
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1};
+  for (int i = 0; i < 64; ++i)  // one block of 64 increments at 100 Hz, handed over at 1 s
+    EXPECT_FALSE(w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs,
+                            StreamWatchdog::Delivery::kBlock));
+  EXPECT_EQ(w.streamsAheadOfRealTime(), 1u);
+  EXPECT_FALSE(w.onDeadlineMissed(imu, 1470 * kMs, 250 * kMs));
+  EXPECT_TRUE(w.onTick(3000 * kMs).empty());
+  EXPECT_FALSE(w.isLost(imu));
+  EXPECT_EQ(w.deadlinesAheadOfRealTime(), 1u);
+  EXPECT_EQ(w.onWritersGone(StreamKind::kImu, 4000 * kMs).size(), 1u);
+
+  // The same increments one by one, at that pace: a real-time stream, watched by its deadline.
+  StreamWatchdog rt;
+  for (int i = 0; i < 64; ++i)
+    EXPECT_FALSE(rt.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs));
+  EXPECT_EQ(rt.streamsAheadOfRealTime(), 0u);
+  EXPECT_TRUE(rt.onDeadlineMissed(imu, 1470 * kMs, 250 * kMs));
+}
+
 TEST(StreamWatchdog, AfterItsOwnStallTheWatchdogBelievesOnlyWhatPersists) {
   // The fault manager stopped for 2 s: DDS then reports every writer's liveliness lost and
   // every deadline missed, though only this process was silent.

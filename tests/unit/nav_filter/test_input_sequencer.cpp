@@ -79,3 +79,20 @@ TEST(InputSequencer, AStreamDeclaredLostDoesNotHoldOthers) {
   EXPECT_EQ(drain(s, 0).size(), 1u);
   EXPECT_EQ(s.timeouts(), 0u);
 }
+
+TEST(InputSequencer, ABacklogWithinTheReserveAllocatesNothingABiggerOneIsCounted) {
+  // A backlog after the filter was starved: 200 IMU samples arrive at once while the receiver
+  // holds them back (its next epoch not yet here). Within the reserve the buffer does not grow;
+  // the same backlog with a smaller reserve grows it, and that is counted.
+  const auto backlog = [](std::size_t reserve) {
+    Seq s({{kImu, 10 * kMs}, {kGnss, 1000 * kMs}}, 500 * kMs);
+    s.reserve(reserve);
+    s.push(kGnss, 0, -1);
+    for (int k = 0; k < 200; ++k) s.push(kImu, k * 10 * kMs, k);
+    const std::size_t released = drain(s, 0).size();  // up to the receiver's next promise
+    EXPECT_EQ(released + s.pending(), 201u);
+    return s.grown();
+  };
+  EXPECT_EQ(backlog(256), 0u);
+  EXPECT_GE(backlog(64), 1u);
+}

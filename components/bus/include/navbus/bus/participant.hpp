@@ -21,6 +21,7 @@
 
 #include "navbus/bus/dds_context.hpp"
 #include "navbus/bus/health.hpp"
+#include "navbus/bus/housekeeping_thread.hpp"
 #include "navbus/bus/realtime.hpp"
 #include "navbus/bus/shutdown.hpp"
 #include "navbus/bus/stream_end.hpp"
@@ -239,7 +240,7 @@ class Participant {
   void publishHealth();
 
   /// Removes what crashed or killed Fast DDS participants left in /dev/shm
-  /// (bus/shared_memory.hpp): at start and every kShmReclaimPeriod.
+  /// (bus/shared_memory.hpp): at start, then every kShmReclaimPeriod on a housekeeping thread.
   static void reclaimSharedMemoryOfDeadParticipants();
   static constexpr std::chrono::seconds kShmReclaimPeriod{5};
 
@@ -304,6 +305,8 @@ class Participant {
   std::function<void()> after_dispatch_;
   Writer<navbus::Health> health_writer_;
   eprosima::fastdds::dds::ConditionSeq active_;
+  /// The periodic shared-memory reclaim, off the processing thread. Last: stopped first.
+  HousekeepingThread shm_reclaimer_;
 };
 
 template <class Sample>

@@ -6,7 +6,10 @@
 // of this participant's clock (a simulator in fast pacing, `navbus replay` faster than real
 // time) is written as fast as its readers take it: its writer pauses whenever a reliable
 // reader falls behind (a stopped filter), so its silences say nothing about the sensor. Such a
-// stream is judged by its writer alone: an announced end, or liveliness lost.
+// stream is judged by its writer alone: an announced end, or liveliness lost. So is a stream
+// that comes in blocks (ImuIncrementBlock and the others, Imu.idl): blocks exist for writing
+// faster than real time, and it is known so from its first block, before its data time has run
+// ahead (a replay starved of CPU from its start stays near real time for a while).
 #pragma once
 
 #include <cstdint>
@@ -40,9 +43,12 @@ struct WatchdogEvent {
 
 class StreamWatchdog {
  public:
+  /// How a sample came: alone, or as an element of a block (paced by its writer).
+  enum class Delivery { kSample, kBlock };
   /// A sample arrived; returns a 'restored' event if the stream was lost.
   std::optional<WatchdogEvent> onSample(const StreamKey& key, std::uint64_t time_gps_ns,
-                                        std::int64_t wall_now_ns);
+                                        std::int64_t wall_now_ns,
+                                        Delivery delivery = Delivery::kSample);
   /// DDS reported a missed deadline for this stream's instance; returns a 'lost' event once.
   /// The silence is confirmed on this participant's own clock first: if the latest sample was
   /// handed over less than `deadline_ns` ago (DDS's timer runs from reception, ours from the
@@ -57,7 +63,7 @@ class StreamWatchdog {
   std::uint64_t unconfirmedDeadlines() const { return unconfirmed_; }
   /// Deadline events of streams paced ahead of real time (not a loss, see the file comment).
   std::uint64_t deadlinesAheadOfRealTime() const { return deadlines_ahead_; }
-  /// Stream runs recognised as paced ahead of real time.
+  /// Stream runs recognised as paced ahead of real time (by their data time, or their blocks).
   std::uint64_t streamsAheadOfRealTime() const { return streams_ahead_; }
   /// How far a stream's data time must run ahead of the wall clock, both counted from its
   /// first sample, before it counts as paced ahead of real time. A real-time stream cannot get
@@ -102,7 +108,7 @@ class StreamWatchdog {
     std::int64_t first_arrival_wall_ns{0};  ///< ... and when it arrived
     bool ahead_of_real_time{false};         ///< once seen ahead, for the rest of the run
   };
-  void notePace(State& s);
+  void notePace(State& s, Delivery delivery);
   std::vector<WatchdogEvent> markKindLost(StreamKind kind, std::int64_t wall_now_ns);
   std::optional<WatchdogEvent> markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns);
   std::map<StreamKey, State> states_;

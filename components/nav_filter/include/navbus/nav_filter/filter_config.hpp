@@ -104,6 +104,10 @@ struct FilterConfig {
   std::optional<InputConfig> gnss_fix;
   std::optional<InputConfig> star_tracker;
   std::int64_t sequencer_max_wait_ns{500'000'000};
+  /// Data time of every configured stream the ordered merge holds without allocating [ns]: a
+  /// backlog after the filter was starved of CPU or stopped arrives at once. A larger one grows
+  /// the buffer (an allocation on the processing thread, counted as "merge buffer grown").
+  std::int64_t sequencer_reserve_ns{2'000'000'000};
   /// Recovery from a fault found late (input_history.hpp): data kept to restore the filter
   /// to before a fault's onset [ns] (0: off), and the spacing of the engine snapshots (each one
   /// a copy of the engine, 0.6 MB in the demo; the period sets how much a restore re-processes,

@@ -81,7 +81,7 @@ class InputSequencer {
       it->second.active = true;
     }
     it->second.last_time_ns = std::max(it->second.last_time_ns, time_ns);
-    queue_.insert(pendingEnd(key), {key, std::move(payload)});  // after equal keys: arrival order
+    insertPending(key, std::move(payload));
     return PushResult::kQueued;
   }
 
@@ -178,8 +178,7 @@ class InputSequencer {
   template <class Items>
   void rewind(std::int64_t kept_up_to_ns, Items& items) {
     for (auto& [id, time_ns, payload] : items) {
-      const Key key{time_ns, id};
-      queue_.insert(pendingEnd(key), {key, std::move(payload)});
+      insertPending(Key{time_ns, id}, std::move(payload));
     }
     last_released_ = Key{kept_up_to_ns, StreamId{std::numeric_limits<int>::max(),
                                                  std::numeric_limits<std::uint32_t>::max()}};
@@ -194,6 +193,11 @@ class InputSequencer {
   }
 
   std::size_t pending() const { return queue_.size() - head_; }
+  /// Makes room for `n` pending samples at once, so that a backlog up to that size (a burst
+  /// after the caller was starved of CPU) allocates nothing.
+  void reserve(std::size_t n) { queue_.reserve(n); }
+  /// Times the buffer grew beyond what it had (each an allocation on the caller's thread).
+  std::uint64_t grown() const { return grown_; }
   std::uint64_t timeouts() const { return timeouts_; }
   /// Owed judgements not reported within the judging stream's budget.
   std::uint64_t judgementTimeouts() const { return judgement_timeouts_; }
@@ -259,6 +263,13 @@ class InputSequencer {
     return blocking_;
   }
 
+  /// Queues after every pending sample not ordered after `key` (equal keys: arrival order).
+  void insertPending(const Key& key, Payload&& payload) {
+    const std::size_t capacity = queue_.capacity();
+    queue_.insert(pendingEnd(key), {key, std::move(payload)});
+    if (queue_.capacity() != capacity) ++grown_;
+  }
+
   /// Where a sample with `key` goes: after every pending one not ordered after it.
   typename std::vector<std::pair<Key, Payload>>::iterator pendingEnd(const Key& key) {
     return std::upper_bound(queue_.begin() + static_cast<std::ptrdiff_t>(head_), queue_.end(), key,
@@ -288,6 +299,7 @@ class InputSequencer {
   std::int64_t head_blocked_since_ns_{-1};
   Key blocked_key_{0, {}};
   std::uint64_t timeouts_{0};
+  std::uint64_t grown_{0};
   std::uint64_t judgement_timeouts_{0};
 };
 

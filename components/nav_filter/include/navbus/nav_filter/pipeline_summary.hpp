@@ -42,6 +42,7 @@ struct PipelineView {
   std::uint64_t solutions_published;
   std::uint64_t sequencer_timeouts;
   std::size_t pending;
+  std::uint64_t merge_grown;         ///< the merge's buffer grew beyond its reserve
   std::uint64_t progress_reports;    ///< the fault manager's progress reports
   std::uint64_t progress_held;       ///< ... that came before the command they name
   std::uint64_t judgement_timeouts;  ///< owed judgements that did not come within the budget
