@@ -1,19 +1,31 @@
 #include "navbus/fault_manager/fault_manager_node.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <type_traits>
 
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "navbus/bus/topics.hpp"
+#include "navbus/bus/writer_gate.hpp"
 
 namespace navbus::fault_manager {
 
 namespace {
+namespace dds = eprosima::fastdds::dds;
+
 std::int64_t steadyNowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
+}
+
+/// The participant of the sample's DDS writer: its GUID prefix.
+StreamWatchdog::WriterParticipant writerParticipant(const dds::SampleInfo& info) {
+  const bus::WriterId writer = bus::writerId(info);
+  StreamWatchdog::WriterParticipant participant{};
+  std::copy_n(writer.begin(), participant.size(), participant.begin());
+  return participant;
 }
 }  // namespace
 
@@ -151,7 +163,8 @@ bus::SensorReaders::Events FaultManagerNode::streamEvents() {
 
 template <class Block, class Elements>
 void FaultManagerNode::watchElements(const Block& m, const char* element_topic,
-                                     const Elements& elements) {
+                                     const Elements& elements,
+                                     const StreamWatchdog::WriterParticipant& writer) {
   // The block is counted under its topic; each element is received (and watched) as one
   // sample of its own topic, as the filter counts them.
   using Traits = bus::SensorMessage<Block>;
@@ -161,7 +174,8 @@ void FaultManagerNode::watchElements(const Block& m, const char* element_topic,
   for (const auto& element : elements) {
     ++counters.received;
     pipeline_.onStreamSample(Traits::kTopic.kind, Traits::sensorId(m), element.seq(),
-                             element.time_gps_ns(), now, /*in_block=*/true);
+                             element.time_gps_ns(), now,
+                             {StreamWatchdog::Delivery::kBlock, writer});
   }
 }
 
@@ -169,19 +183,21 @@ template <class Message>
 void FaultManagerNode::watch(const char* profile) {
   using Traits = bus::SensorMessage<Message>;
   static constexpr StreamKind kind = Traits::kTopic.kind;  // no capture needed
-  auto* reader = sensors_.subscribe<Message>(profile, [this](const Message& m) {
-    if constexpr (std::is_same_v<Message, navbus::ImuIncrementBlock>) {
-      watchElements(m, bus::topic::kImuIncrement, m.increments());
-    } else if constexpr (bus::kIsSensorBlock<Message>) {
-      using Element = typename bus::SensorBlock<Message>::Element;
-      watchElements(m, bus::SensorMessage<Element>::kTopic.topic,
-                    bus::SensorBlock<Message>::elements(m));
-    } else {
-      pipeline_.onStreamSample(kind, Traits::sensorId(m), m.seq(), Traits::timeGpsNs(m),
-                               steadyNowNs());
-      if constexpr (std::is_same_v<Message, navbus::ImuRawBlock>) pipeline_.onRawBlock(m);
-    }
-  });
+  auto* reader =
+      sensors_.subscribe<Message>(profile, [this](const Message& m, const dds::SampleInfo& info) {
+        const StreamWatchdog::WriterParticipant writer = writerParticipant(info);
+        if constexpr (std::is_same_v<Message, navbus::ImuIncrementBlock>) {
+          watchElements(m, bus::topic::kImuIncrement, m.increments(), writer);
+        } else if constexpr (bus::kIsSensorBlock<Message>) {
+          using Element = typename bus::SensorBlock<Message>::Element;
+          watchElements(m, bus::SensorMessage<Element>::kTopic.topic,
+                        bus::SensorBlock<Message>::elements(m), writer);
+        } else {
+          pipeline_.onStreamSample(kind, Traits::sensorId(m), m.seq(), Traits::timeGpsNs(m),
+                                   steadyNowNs(), {StreamWatchdog::Delivery::kSample, writer});
+          if constexpr (std::is_same_v<Message, navbus::ImuRawBlock>) pipeline_.onRawBlock(m);
+        }
+      });
   // The decisions quote the reader's own requested deadline (from the QoS profile) as threshold.
   const auto period = reader->get_qos().deadline().period;
   pipeline_.setDeadline(

@@ -80,7 +80,7 @@ void FaultPipeline::reportReceiversProgress() {
 
 void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
                                    std::uint64_t time_gps_ns, std::int64_t wall_now_ns,
-                                   bool in_block) {
+                                   const StreamWatchdog::Source& source) {
   // Best-effort watchdog readers may lose samples: count them from the sequence numbers. A
   // restarted writer (time going back) starts a new count.
   auto& tracker = trackers_[kind];
@@ -91,9 +91,7 @@ void FaultPipeline::onStreamSample(StreamKind kind, std::uint32_t sensor_id, std
   }
   // Observed, not validated: a monitor.
   health_.stream(bus::streamInfo(kind).topic).countAccepted(sensor_id, o.missing);
-  const auto delivery =
-      in_block ? StreamWatchdog::Delivery::kBlock : StreamWatchdog::Delivery::kSample;
-  if (auto e = watchdog_.onSample({kind, sensor_id}, time_gps_ns, wall_now_ns, delivery))
+  if (auto e = watchdog_.onSample({kind, sensor_id}, time_gps_ns, wall_now_ns, source))
     onWatchdogEvent(*e);
 }
 

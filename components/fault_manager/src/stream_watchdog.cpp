@@ -6,7 +6,14 @@ namespace navbus::fault_manager {
 
 std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
                                                       std::uint64_t time_gps_ns,
-                                                      std::int64_t wall_now_ns, Delivery delivery) {
+                                                      std::int64_t wall_now_ns) {
+  return onSample(key, time_gps_ns, wall_now_ns, Source{});
+}
+
+std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
+                                                      std::uint64_t time_gps_ns,
+                                                      std::int64_t wall_now_ns,
+                                                      const Source& source) {
   const auto ended = ended_at_.find(key);
   if (ended != ended_at_.end()) {
     if (time_gps_ns <= ended->second) return std::nullopt;  // in flight before the end
@@ -27,19 +34,34 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
   s.suspect_deadline_ns = -1;
   s.last_time_gps_ns = time_gps_ns;
   s.last_arrival_wall_ns = wall_now_ns;
-  notePace(s, delivery);
+  notePace(s, source);
   return event;
 }
 
-void StreamWatchdog::notePace(State& s, Delivery delivery) {
-  if (s.ahead_of_real_time) return;
-  if (delivery != Delivery::kBlock) {
-    if (s.last_time_gps_ns < s.first_time_gps_ns) return;
-    const auto data_span_ns = static_cast<std::int64_t>(s.last_time_gps_ns - s.first_time_gps_ns);
-    const std::int64_t wall_span_ns = s.last_arrival_wall_ns - s.first_arrival_wall_ns;
-    if (data_span_ns - wall_span_ns <= kAheadOfRealTimeNs) return;
+void StreamWatchdog::notePace(State& s, const Source& source) {
+  s.participant = source.participant;
+  const bool known = source.participant != WriterParticipant{};
+  if (!s.ahead_of_real_time && (source.delivery == Delivery::kBlock || dataTimeAhead(s) ||
+                                (known && paced_participants_.count(source.participant) > 0)))
+    markAhead(s);
+  if (!s.ahead_of_real_time || !known || !paced_participants_.insert(source.participant).second)
+    return;
+  for (auto& [key, other] : states_) {  // its writer's other streams, seen before this one
+    if (other.participant == source.participant) markAhead(other);
   }
+}
+
+bool StreamWatchdog::dataTimeAhead(const State& s) {
+  if (s.last_time_gps_ns < s.first_time_gps_ns) return false;
+  const auto data_span_ns = static_cast<std::int64_t>(s.last_time_gps_ns - s.first_time_gps_ns);
+  const std::int64_t wall_span_ns = s.last_arrival_wall_ns - s.first_arrival_wall_ns;
+  return data_span_ns - wall_span_ns > kAheadOfRealTimeNs;
+}
+
+void StreamWatchdog::markAhead(State& s) {
+  if (s.ahead_of_real_time) return;
   s.ahead_of_real_time = true;
+  s.suspect_deadline_ns = -1;  // a silence it was suspected of says nothing now
   ++streams_ahead_;
 }
 

@@ -131,7 +131,7 @@ TEST(StreamWatchdog, AStreamInBlocksIsJudgedByItsWriterOnlyFromItsFirstBlock) {
   const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1};
   for (int i = 0; i < 64; ++i)  // one block of 64 increments at 100 Hz, handed over at 1 s
     EXPECT_FALSE(w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs,
-                            StreamWatchdog::Delivery::kBlock));
+                            StreamWatchdog::Source{StreamWatchdog::Delivery::kBlock, {}}));
   EXPECT_EQ(w.streamsAheadOfRealTime(), 1u);
   EXPECT_FALSE(w.onDeadlineMissed(imu, 1470 * kMs, 250 * kMs));
   EXPECT_TRUE(w.onTick(3000 * kMs).empty());
@@ -145,6 +145,40 @@ TEST(StreamWatchdog, AStreamInBlocksIsJudgedByItsWriterOnlyFromItsFirstBlock) {
     EXPECT_FALSE(rt.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs));
   EXPECT_EQ(rt.streamsAheadOfRealTime(), 0u);
   EXPECT_TRUE(rt.onDeadlineMissed(imu, 1470 * kMs, 250 * kMs));
+}
+
+TEST(StreamWatchdog, TheOtherStreamsOfAPacedWritersParticipantAreJudgedByTheirWriterToo) {
+  // An imported drive replayed: its increments in blocks, its GNSS fixes one by one, from one
+  // participant. The fixes, seen first, look like a real-time stream; once the increments come
+  // in blocks, they too wait with the replay, and their silence is no loss. A receiver of
+  // another participant stays watched by its deadline.
+  using Source = StreamWatchdog::Source;
+  const StreamWatchdog::WriterParticipant replay{1, 2, 3}, live{4, 5, 6};
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1}, fix{StreamKind::kGnssFix, 1},
+      other_fix{StreamKind::kGnssFix, 2};
+  EXPECT_FALSE(w.onSample(fix, 0, 1000 * kMs, Source{StreamWatchdog::Delivery::kSample, replay}));
+  EXPECT_FALSE(
+      w.onSample(other_fix, 0, 1000 * kMs, Source{StreamWatchdog::Delivery::kSample, live}));
+  EXPECT_FALSE(w.onDeadlineMissed(fix, 1100 * kMs, 2000 * kMs));  // suspect: 0.1 s of silence
+  EXPECT_FALSE(w.onDeadlineMissed(other_fix, 1100 * kMs, 2000 * kMs));
+  EXPECT_EQ(w.unconfirmedDeadlines(), 2u);
+  for (int i = 0; i < 64; ++i)
+    EXPECT_FALSE(w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs,
+                            Source{StreamWatchdog::Delivery::kBlock, replay}));
+  EXPECT_EQ(w.streamsAheadOfRealTime(), 2u);   // the increments, and the fixes with them
+  EXPECT_EQ(w.onTick(3500 * kMs).size(), 1u);  // the suspicion of the fixes is dropped...
+  EXPECT_FALSE(w.isLost(fix));
+  EXPECT_TRUE(w.isLost(other_fix));  // ... the other participant's stays and is confirmed
+  EXPECT_FALSE(w.onDeadlineMissed(fix, 4000 * kMs, 2000 * kMs));
+  EXPECT_EQ(w.deadlinesAheadOfRealTime(), 1u);
+
+  // A later stream of the paced participant is paced from its first sample.
+  const navbus::fault_manager::StreamKey star{StreamKind::kStarTracker, 1};
+  EXPECT_FALSE(w.onSample(star, 0, 5000 * kMs, Source{StreamWatchdog::Delivery::kSample, replay}));
+  EXPECT_EQ(w.streamsAheadOfRealTime(), 3u);
+  EXPECT_FALSE(w.onDeadlineMissed(star, 8000 * kMs, 2000 * kMs));
+  EXPECT_FALSE(w.isLost(star));
 }
 
 TEST(StreamWatchdog, AfterItsOwnStallTheWatchdogBelievesOnlyWhatPersists) {

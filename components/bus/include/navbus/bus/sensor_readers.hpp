@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "navbus/bus/participant.hpp"
@@ -42,8 +43,9 @@ class SensorReaders {
   SensorReaders(Participant& participant, Events events)
       : participant_(participant), events_(std::move(events)) {}
 
-  /// Subscribes the topic of `Message` (SensorMessage<Message>) with `profile`; `handler(m)`
-  /// gets each sample of the sensor's owner. Returns the reader (its QoS tells the deadline).
+  /// Subscribes the topic of `Message` (SensorMessage<Message>) with `profile`; `handler(m)`,
+  /// or `handler(m, info)`, gets each sample of the sensor's owner. Returns the reader (its QoS
+  /// tells the deadline).
   template <class Message, class Handler>
   eprosima::fastdds::dds::DataReader* subscribe(const char* profile, Handler handler) {
     using Traits = SensorMessage<Message>;
@@ -56,7 +58,12 @@ class SensorReaders {
         [this, kind = row.kind, &writers, handler](const Message& m,
                                                    const eprosima::fastdds::dds::SampleInfo& info) {
           if (!admit(kind, writers, Traits::sensorId(m), Traits::timeGpsNs(m), info)) return;
-          handler(m);
+          if constexpr (std::is_invocable_v<Handler, const Message&,
+                                            const eprosima::fastdds::dds::SampleInfo&>) {
+            handler(m, info);
+          } else {
+            handler(m);
+          }
         },
         callbacks(row.kind));
   }

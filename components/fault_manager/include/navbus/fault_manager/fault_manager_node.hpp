@@ -31,7 +31,8 @@ class FaultManagerNode {
   /// A block read by a watchdog reader: counted under its topic, each element received and
   /// watched as one sample of `element_topic`.
   template <class Block, class Elements>
-  void watchElements(const Block& m, const char* element_topic, const Elements& elements);
+  void watchElements(const Block& m, const char* element_topic, const Elements& elements,
+                     const StreamWatchdog::WriterParticipant& writer);
   bus::SensorReaders::Events streamEvents();
   /// Reliable readers of every IMU's increments for the parity detector.
   void subscribeIncrements();

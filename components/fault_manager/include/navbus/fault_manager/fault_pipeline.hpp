@@ -44,10 +44,12 @@ class FaultPipeline : private FaultOutput {
                 std::uint64_t run_id = 0);
 
   // Stream watchdogs (wall times from the participant's steady clock).
-  /// A sample of a watched stream; `seq` counts samples a best-effort reader lost. An element
-  /// of a block comes `in_block` (a stream paced by its writer: StreamWatchdog).
+  /// A sample of a watched stream; `seq` counts samples a best-effort reader lost. `source`:
+  /// alone or in a block, and its writing participant (how the watchdog tells a stream paced
+  /// by its writer).
   void onStreamSample(StreamKind kind, std::uint32_t sensor_id, std::uint64_t seq,
-                      std::uint64_t time_gps_ns, std::int64_t wall_now_ns, bool in_block = false);
+                      std::uint64_t time_gps_ns, std::int64_t wall_now_ns,
+                      const StreamWatchdog::Source& source = {});
   void onDeadlineMissed(StreamKind kind, std::uint32_t sensor_id, std::int64_t wall_now_ns);
   void onWritersGone(StreamKind kind, std::int64_t wall_now_ns);
   /// A writer of the stream kind is alive (again).

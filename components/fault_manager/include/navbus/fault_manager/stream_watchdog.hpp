@@ -9,12 +9,16 @@
 // stream is judged by its writer alone: an announced end, or liveliness lost. So is a stream
 // that comes in blocks (ImuIncrementBlock and the others, Imu.idl): blocks exist for writing
 // faster than real time, and it is known so from its first block, before its data time has run
-// ahead (a replay starved of CPU from its start stays near real time for a while).
+// ahead (a replay starved of CPU from its start stays near real time for a while). And so is
+// every stream of the same writing participant as a stream known paced so (a replay or a
+// simulator paces all its streams together: its GNSS fixes wait with its increments).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <tuple>
 #include <vector>
 
@@ -45,10 +49,18 @@ class StreamWatchdog {
  public:
   /// How a sample came: alone, or as an element of a block (paced by its writer).
   enum class Delivery { kSample, kBlock };
+  /// The participant that wrote a sample: its DDS writer's GUID prefix (all zeros: not known).
+  using WriterParticipant = std::array<std::uint8_t, 12>;
+  struct Source {
+    Delivery delivery{Delivery::kSample};
+    WriterParticipant participant{};
+  };
   /// A sample arrived; returns a 'restored' event if the stream was lost.
   std::optional<WatchdogEvent> onSample(const StreamKey& key, std::uint64_t time_gps_ns,
-                                        std::int64_t wall_now_ns,
-                                        Delivery delivery = Delivery::kSample);
+                                        std::int64_t wall_now_ns, const Source& source);
+  /// The same, from an unknown participant, alone.
+  std::optional<WatchdogEvent> onSample(const StreamKey& key, std::uint64_t time_gps_ns,
+                                        std::int64_t wall_now_ns);
   /// DDS reported a missed deadline for this stream's instance; returns a 'lost' event once.
   /// The silence is confirmed on this participant's own clock first: if the latest sample was
   /// handed over less than `deadline_ns` ago (DDS's timer runs from reception, ours from the
@@ -63,7 +75,8 @@ class StreamWatchdog {
   std::uint64_t unconfirmedDeadlines() const { return unconfirmed_; }
   /// Deadline events of streams paced ahead of real time (not a loss, see the file comment).
   std::uint64_t deadlinesAheadOfRealTime() const { return deadlines_ahead_; }
-  /// Stream runs recognised as paced ahead of real time (by their data time, or their blocks).
+  /// Stream runs recognised as paced ahead of real time (by their data time, their blocks, or
+  /// their writing participant's other streams).
   std::uint64_t streamsAheadOfRealTime() const { return streams_ahead_; }
   /// How far a stream's data time must run ahead of the wall clock, both counted from its
   /// first sample, before it counts as paced ahead of real time. A real-time stream cannot get
@@ -107,8 +120,12 @@ class StreamWatchdog {
     std::uint64_t first_time_gps_ns{0};     ///< the run's first sample: sensor time
     std::int64_t first_arrival_wall_ns{0};  ///< ... and when it arrived
     bool ahead_of_real_time{false};         ///< once seen ahead, for the rest of the run
+    WriterParticipant participant{};        ///< of the latest sample
   };
-  void notePace(State& s, Delivery delivery);
+  void notePace(State& s, const Source& source);
+  /// The stream's data time has run ahead of the wall clock (kAheadOfRealTimeNs).
+  static bool dataTimeAhead(const State& s);
+  void markAhead(State& s);
   std::vector<WatchdogEvent> markKindLost(StreamKind kind, std::int64_t wall_now_ns);
   std::optional<WatchdogEvent> markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns);
   std::map<StreamKey, State> states_;
@@ -119,6 +136,7 @@ class StreamWatchdog {
   std::map<StreamKind, bool> gone_pending_;  ///< writers gone during the grace (kind -> pending)
   std::uint64_t stale_liveliness_{0};
   std::uint64_t streams_ahead_{0};
+  std::set<WriterParticipant> paced_participants_;  ///< wrote a stream paced ahead
 };
 
 }  // namespace navbus::fault_manager
