@@ -230,8 +230,14 @@ void Participant::run() {
   finish();
 }
 
+void Participant::announceDataEnded() {
+  state_managed_ = true;
+  state_ = navbus::STATE_ENDED;
+  publishHealth();
+}
+
 void Participant::finish() {
-  state_ = navbus::STATE_STOPPING;
+  if (state_ != navbus::STATE_ENDED) state_ = navbus::STATE_STOPPING;
   publishHealth();
   if (!dds_.waitForAcknowledgments(kFinishAcknowledgmentWait)) {
     spdlog::warn(

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <type_traits>
 
+#include <navbus_idl/HealthPubSubTypes.h>
 #include <navbus_idl/NavigationPubSubTypes.h>
 
 #include "navbus/bus/topics.hpp"
@@ -57,6 +58,7 @@ FaultManagerNode::FaultManagerNode(bus::Participant& p, const FaultManagerConfig
   watch<navbus::GnssObservationEpochBlock>(profile::kMeasurementWatchdogReader);
   watch<navbus::GnssFixBlock>(profile::kMeasurementWatchdogReader);
   watch<navbus::StarTrackerAttitudeBlock>(profile::kMeasurementWatchdogReader);
+  watchAnnouncedEnds();
   // Confirms suspect streams (a DDS deadline event before the own silence reached it) within
   // this period of their silence reaching the deadline.
   p.addTimer(std::chrono::milliseconds(10), [this] { pipeline_.onWatchdogTick(running()); });
@@ -126,6 +128,22 @@ void FaultManagerNode::subscribeIncrements() {
       profile::kSensorReader, [this](const navbus::ImuIncrementBlock& m) {
         for (const navbus::ImuIncrement& increment : m.increments())
           pipeline_.onImuIncrement(increment);
+      });
+}
+
+void FaultManagerNode::watchAnnouncedEnds() {
+  // A writer's announced end, also in its health report (reliable): the watchdog's best-effort
+  // readers can lose the dispose (the compose demo under DDS Security: the end of three streams
+  // lost with blocks of increments, and the simulator's leaving judged a loss). A participant
+  // ends only the streams it wrote itself (the GUID prefix of the report's writer).
+  participant_.subscribe<navbus::HealthPubSubType>(
+      bus::topic::kHealth, bus::profile::kHealthReader,
+      [this](const navbus::Health& h, const dds::SampleInfo& info) {
+        if (h.state() != navbus::STATE_ENDED) return;
+        running();
+        for (const StreamKey& key : pipeline_.onWriterParticipantEnded(writerParticipant(info))) {
+          if (key.kind == StreamKind::kImu && stop_after_end_ != nullptr) stop_after_end_->ended();
+        }
       });
 }
 

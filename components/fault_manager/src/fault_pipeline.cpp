@@ -143,8 +143,21 @@ void FaultPipeline::onStreamEnded(StreamKind kind, std::uint32_t sensor_id,
   if (!watchdog_.onEnded({kind, sensor_id}, end_time_gps_ns)) return;
   trackers_[kind].reset(sensor_id);
   ++ended_;
-  spdlog::info("{} stream {} ended (its writer disposed it): not a loss",
-               bus::streamInfo(kind).name, sensor_id);
+  spdlog::info("{} stream {} ended as its writer announced: not a loss", bus::streamInfo(kind).name,
+               sensor_id);
+}
+
+std::vector<StreamKey> FaultPipeline::onWriterParticipantEnded(
+    const StreamWatchdog::WriterParticipant& writer) {
+  const std::vector<StreamKey> keys = watchdog_.onParticipantEnded(writer);
+  if (!keys.empty()) {
+    spdlog::info(
+        "a writer announced the end of all its data in its health report: {} of its "
+        "streams end",
+        keys.size());
+  }
+  for (const StreamKey& key : keys) onStreamEnded(key.kind, key.sensor_id, watchdog_.lastTime(key));
+  return keys;
 }
 
 void FaultPipeline::onWatchdogEvent(const WatchdogEvent& e) {

@@ -14,10 +14,15 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
                                                       std::uint64_t time_gps_ns,
                                                       std::int64_t wall_now_ns,
                                                       const Source& source) {
+  if (ended_participants_.count(source.participant) > 0) return std::nullopt;  // in flight
   const auto ended = ended_at_.find(key);
   if (ended != ended_at_.end()) {
-    if (time_gps_ns <= ended->second) return std::nullopt;  // in flight before the end
-    ended_at_.erase(ended);                                 // a new run of the stream
+    const WriterParticipant& wrote = ended->second.participant;
+    const bool other_writer = source.participant != WriterParticipant{} &&
+                              wrote != WriterParticipant{} && source.participant != wrote;
+    if (!other_writer && time_gps_ns <= ended->second.time_gps_ns)
+      return std::nullopt;   // in flight before the end
+    ended_at_.erase(ended);  // a new run of the stream
   }
   auto [it, inserted] = states_.try_emplace(key);
   State& s = it->second;
@@ -148,10 +153,22 @@ bool StreamWatchdog::onEnded(const StreamKey& key, std::uint64_t end_time_gps_ns
   const bool known = it != states_.end();
   // Kept for a stream not seen yet too: another reader of the participant told the end, and
   // this one's samples up to it are still to come.
-  std::uint64_t& ended = ended_at_[key];
-  ended = std::max({ended, end_time_gps_ns, known ? it->second.last_time_gps_ns : 0});
+  End& ended = ended_at_[key];
+  ended.time_gps_ns =
+      std::max({ended.time_gps_ns, end_time_gps_ns, known ? it->second.last_time_gps_ns : 0});
+  if (known) ended.participant = it->second.participant;
   if (known) states_.erase(it);
   return known;
+}
+
+std::vector<StreamKey> StreamWatchdog::onParticipantEnded(const WriterParticipant& writer) {
+  std::vector<StreamKey> keys;
+  if (writer == WriterParticipant{}) return keys;  // not known: names no stream
+  ended_participants_.insert(writer);
+  for (const auto& [key, s] : states_) {
+    if (s.participant == writer) keys.push_back(key);
+  }
+  return keys;
 }
 
 std::uint64_t StreamWatchdog::lastTime(const StreamKey& key) const {

@@ -191,6 +191,8 @@ const char* enumName(navbus::ParticipantState v) {
       return "DEGRADED";
     case navbus::STATE_STOPPING:
       return "STOPPING";
+    case navbus::STATE_ENDED:
+      return "ENDED";
   }
   return "UNKNOWN";
 }

@@ -140,7 +140,10 @@ int main(int argc, char** argv) {
     // The end of the data is announced (not a loss). Not on SIGTERM: a reader that stopped
     // taking (a full KEEP_ALL history) would hold the dispose's acknowledgment up.
     const bool announce_end = !participant.stopping();
-    if (announce_end) publisher.endStreams();
+    if (announce_end) {
+      publisher.endStreams();
+      participant.announceDataEnded();  // also in its health: reliable for every reader
+    }
     publisher.flush();
     // From the first write to the last acknowledgment: the bus throughput in fast pacing (not
     // the linger after it, which only keeps the writers on the bus for best-effort readers).

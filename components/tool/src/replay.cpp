@@ -363,6 +363,7 @@ int runReplayCommand(const bus::Participant::Options& participant, const ReplayO
     if (streams[e.stream]->publish(e.index, [&p] { return p.stopping(); })) ++published[e.stream];
   }
   for (auto& s : streams) s->end([&p] { return p.stopping(); });
+  if (!p.stopping()) p.announceDataEnded();  // also in its health: reliable for every reader
   const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
   if (!p.stopping()) p.spinFor(bus::kEndOfStreamLinger);  // the ends reach best-effort readers
   bool complete = true;

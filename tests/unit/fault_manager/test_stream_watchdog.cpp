@@ -181,6 +181,43 @@ TEST(StreamWatchdog, TheOtherStreamsOfAPacedWritersParticipantAreJudgedByTheirWr
   EXPECT_FALSE(w.isLost(star));
 }
 
+TEST(StreamWatchdog, AParticipantThatAnnouncedTheEndOfItsDataEndsOnlyItsOwnStreams) {
+  // The compose demo under DDS Security: the simulator's disposes of its increments (in blocks)
+  // and of its GNSS fixes never reached the best-effort watchdog readers; its health report
+  // said ENDED. Its streams end: their writers' leaving is no loss, and its blocks still in
+  // flight start no new run. Another participant's receiver is lost when its writers go.
+  using Source = StreamWatchdog::Source;
+  const StreamWatchdog::WriterParticipant sim{1, 2, 3}, other{4, 5, 6};
+  StreamWatchdog w;
+  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1}, fix{StreamKind::kGnssFix, 1},
+      other_fix{StreamKind::kGnssFix, 2};
+  for (int i = 0; i < 30; ++i)
+    EXPECT_FALSE(w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs,
+                            Source{StreamWatchdog::Delivery::kBlock, sim}));
+  EXPECT_FALSE(w.onSample(fix, 0, 1000 * kMs, Source{StreamWatchdog::Delivery::kSample, sim}));
+  EXPECT_FALSE(
+      w.onSample(other_fix, 0, 1000 * kMs, Source{StreamWatchdog::Delivery::kSample, other}));
+  EXPECT_TRUE(w.onParticipantEnded(StreamWatchdog::WriterParticipant{}).empty());  // not known
+  const auto ended = w.onParticipantEnded(sim);
+  ASSERT_EQ(ended.size(), 2u);
+  for (const auto& key : ended) {
+    EXPECT_NE(key.sensor_id, 2u);
+    EXPECT_TRUE(w.onEnded(key, w.lastTime(key)));
+  }
+  // A block taken after the report, later than the last one taken before it: no new run.
+  EXPECT_FALSE(
+      w.onSample(imu, 300 * kMs, 1100 * kMs, Source{StreamWatchdog::Delivery::kBlock, sim}));
+  EXPECT_EQ(w.lastTime(imu), 0u);
+  EXPECT_TRUE(w.onWritersGone(StreamKind::kImu, 1500 * kMs).empty());
+  const auto gone = w.onWritersGone(StreamKind::kGnssFix, 1500 * kMs);
+  ASSERT_EQ(gone.size(), 1u);
+  EXPECT_EQ(gone[0].key.sensor_id, 2u);
+  EXPECT_TRUE(gone[0].lost);
+  // The sensor's next run comes from a new participant: watched again.
+  EXPECT_FALSE(w.onSample(imu, 0, 2000 * kMs, Source{StreamWatchdog::Delivery::kBlock, other}));
+  EXPECT_EQ(w.onWritersGone(StreamKind::kImu, 2500 * kMs).size(), 1u);
+}
+
 TEST(StreamWatchdog, AfterItsOwnStallTheWatchdogBelievesOnlyWhatPersists) {
   // The fault manager stopped for 2 s: DDS then reports every writer's liveliness lost and
   // every deadline missed, though only this process was silent.

@@ -226,10 +226,15 @@ class Participant {
   void spinOnce(std::chrono::nanoseconds max_wait);
   /// Spins for `duration`, or until stopped.
   void spinFor(std::chrono::nanoseconds duration);
-  /// Publishes the final (STOPPING) health report, then waits up to kFinishAcknowledgmentWait
-  /// for the reliable readers to acknowledge everything this participant wrote, so that a
-  /// reader that is behind (a recorder on a loaded machine) still gets it; logs a warning if
-  /// they had not. run() does it by itself.
+  /// The data this participant wrote ended as announced (it disposed every stream it wrote):
+  /// publishes a health report in STATE_ENDED at once, and keeps that state until it leaves.
+  /// Health is reliable: a monitor whose best-effort reader of a stream lost the dispose learns
+  /// the end from it (the fault manager's watchdog), before the writer leaves the bus.
+  void announceDataEnded();
+  /// Publishes the final health report (STOPPING, or ENDED after announceDataEnded()), then
+  /// waits up to kFinishAcknowledgmentWait for the reliable readers to acknowledge everything
+  /// this participant wrote, so that a reader that is behind (a recorder on a loaded machine)
+  /// still gets it; logs a warning if they had not. run() does it by itself.
   void finish();
   static constexpr std::chrono::seconds kFinishAcknowledgmentWait{5};
   /// Asks the loop to end (from a handler).

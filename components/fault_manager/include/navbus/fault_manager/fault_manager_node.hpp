@@ -33,6 +33,8 @@ class FaultManagerNode {
   template <class Block, class Elements>
   void watchElements(const Block& m, const char* element_topic, const Elements& elements,
                      const StreamWatchdog::WriterParticipant& writer);
+  /// Ends the streams of a writer that announced the end of its data in its health report.
+  void watchAnnouncedEnds();
   bus::SensorReaders::Events streamEvents();
   /// Reliable readers of every IMU's increments for the parity detector.
   void subscribeIncrements();

@@ -61,6 +61,10 @@ class FaultPipeline : private FaultOutput {
   void onWatchdogTick(std::int64_t wall_now_ns);
   /// The stream's writer announced its end (disposed the instance): no loss, counted.
   void onStreamEnded(StreamKind kind, std::uint32_t sensor_id, std::uint64_t end_time_gps_ns = 0);
+  /// A participant announced the end of all its data (its health report, STATE_ENDED): every
+  /// stream it wrote ends as if its dispose had come, which a best-effort watchdog reader can
+  /// lose. Returns the streams ended.
+  std::vector<StreamKey> onWriterParticipantEnded(const StreamWatchdog::WriterParticipant& writer);
   /// A second writer publishes a stream's sensor id while its owner is alive (bus::WriterGate):
   /// a fault decision (detector "writer-identity"), once per intruding writer. No command: the
   /// filter keeps that writer's samples out by itself.

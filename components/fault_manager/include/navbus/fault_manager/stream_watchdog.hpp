@@ -104,8 +104,14 @@ class StreamWatchdog {
   /// not later than the end still in flight (another reader of the same topic may deliver
   /// them after the dispose) are ignored; a later one starts the stream again. Returns false
   /// if the stream was not known (its end is kept all the same: this participant's other
-  /// reader told it before this one's samples came).
+  /// reader told it before this one's samples came). A sample from another writing
+  /// participant than the ended run's is a new run whatever its time (a restarted source).
   bool onEnded(const StreamKey& key, std::uint64_t end_time_gps_ns = 0);
+  /// The participant `writer` announced the end of all its data (its health, STATE_ENDED: a
+  /// reliable report, where the watchdog's best-effort reader can lose a dispose). Returns the
+  /// streams whose latest sample it wrote, for the caller to end (onEnded); its samples still in
+  /// flight are ignored from now on (a new run of its sensor comes from a new participant).
+  std::vector<StreamKey> onParticipantEnded(const WriterParticipant& writer);
   /// Sensor time of the stream's latest sample (0: not known).
   std::uint64_t lastTime(const StreamKey& key) const;
 
@@ -129,7 +135,11 @@ class StreamWatchdog {
   std::vector<WatchdogEvent> markKindLost(StreamKind kind, std::int64_t wall_now_ns);
   std::optional<WatchdogEvent> markLost(const StreamKey& key, State& s, std::int64_t wall_now_ns);
   std::map<StreamKey, State> states_;
-  std::map<StreamKey, std::uint64_t> ended_at_;  ///< announced ends, data time
+  struct End {
+    std::uint64_t time_gps_ns{0};     ///< data time of the stream's last sample
+    WriterParticipant participant{};  ///< that wrote it (all zeros: not known)
+  };
+  std::map<StreamKey, End> ended_at_;  ///< announced ends
   std::uint64_t unconfirmed_{0};
   std::uint64_t deadlines_ahead_{0};
   std::int64_t grace_until_ns_{-1};          ///< after a stall: writers-gone events wait until here
@@ -137,6 +147,7 @@ class StreamWatchdog {
   std::uint64_t stale_liveliness_{0};
   std::uint64_t streams_ahead_{0};
   std::set<WriterParticipant> paced_participants_;  ///< wrote a stream paced ahead
+  std::set<WriterParticipant> ended_participants_;  ///< announced the end of all their data
 };
 
 }  // namespace navbus::fault_manager
