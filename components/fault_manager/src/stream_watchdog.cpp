@@ -14,16 +14,8 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
                                                       std::uint64_t time_gps_ns,
                                                       std::int64_t wall_now_ns,
                                                       const Source& source) {
-  if (ended_participants_.count(source.participant) > 0) return std::nullopt;  // in flight
-  const auto ended = ended_at_.find(key);
-  if (ended != ended_at_.end()) {
-    const WriterParticipant& wrote = ended->second.participant;
-    const bool other_writer = source.participant != WriterParticipant{} &&
-                              wrote != WriterParticipant{} && source.participant != wrote;
-    if (!other_writer && time_gps_ns <= ended->second.time_gps_ns)
-      return std::nullopt;   // in flight before the end
-    ended_at_.erase(ended);  // a new run of the stream
-  }
+  if (ofEndedRun(key, time_gps_ns, source)) return std::nullopt;
+  ended_at_.erase(key);  // a new run of the stream, if it had ended
   auto [it, inserted] = states_.try_emplace(key);
   State& s = it->second;
   std::optional<WatchdogEvent> event;
@@ -41,6 +33,17 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
   s.last_arrival_wall_ns = wall_now_ns;
   notePace(s, source);
   return event;
+}
+
+bool StreamWatchdog::ofEndedRun(const StreamKey& key, std::uint64_t time_gps_ns,
+                                const Source& source) const {
+  if (ended_participants_.count(source.participant) > 0) return true;
+  const auto ended = ended_at_.find(key);
+  if (ended == ended_at_.end()) return false;
+  const WriterParticipant& wrote = ended->second.participant;
+  const bool other_writer = source.participant != WriterParticipant{} &&
+                            wrote != WriterParticipant{} && source.participant != wrote;
+  return !other_writer && time_gps_ns <= ended->second.time_gps_ns;
 }
 
 void StreamWatchdog::notePace(State& s, const Source& source) {

@@ -2,6 +2,8 @@
 // events confirmed by the stream's own silence.
 #include <gtest/gtest.h>
 
+#include "navbus/bus/topics.hpp"
+#include "navbus/fault_manager/fault_pipeline.hpp"
 #include "navbus/fault_manager/stream_watchdog.hpp"
 
 using navbus::fault_manager::StreamKind;
@@ -216,6 +218,34 @@ TEST(StreamWatchdog, AParticipantThatAnnouncedTheEndOfItsDataEndsOnlyItsOwnStrea
   // The sensor's next run comes from a new participant: watched again.
   EXPECT_FALSE(w.onSample(imu, 0, 2000 * kMs, Source{StreamWatchdog::Delivery::kBlock, other}));
   EXPECT_EQ(w.onWritersGone(StreamKind::kImu, 2500 * kMs).size(), 1u);
+}
+
+TEST(FaultPipelineStreams, AWritersAnnouncedEndIsNoLossAndItsBlocksStillInFlightNoGap) {
+  // The simulator's health report (ENDED) taken before the last blocks its watchdog reader
+  // still held: they count as accepted, with no sequence gap, and its writers' leaving then
+  // is no loss (no decision, no command).
+  navbus::bus::HealthCounters health("fault-manager-test");
+  std::vector<navbus::FaultDecision> decisions;
+  int commands = 0;
+  navbus::fault_manager::FaultPipeline pipeline(
+      navbus::fault_manager::FaultManagerConfig{}, health,
+      {[&](const navbus::FaultDecision& d) { decisions.push_back(d); },
+       [&](const navbus::FilterCommand&) { ++commands; }});
+  const StreamWatchdog::WriterParticipant sim{7, 8, 9};
+  const StreamWatchdog::Source block{StreamWatchdog::Delivery::kBlock, sim};
+  for (std::uint64_t seq = 1; seq <= 30; ++seq)
+    pipeline.onStreamSample(StreamKind::kImu, 1, seq, seq * 10 * kMs, 1000 * kMs, block);
+  EXPECT_EQ(pipeline.onWriterParticipantEnded(sim).size(), 1u);
+  for (std::uint64_t seq = 31; seq <= 60; ++seq)
+    pipeline.onStreamSample(StreamKind::kImu, 1, seq, seq * 10 * kMs, 1010 * kMs, block);
+  const auto& imu = health.stream(navbus::bus::topic::kImuIncrement);
+  EXPECT_EQ(imu.sensors.at(1).accepted, 60u);
+  EXPECT_EQ(imu.sensors.at(1).sequence_gaps, 0u);
+  pipeline.onWritersGone(StreamKind::kImu, 1500 * kMs);
+  EXPECT_TRUE(decisions.empty());
+  EXPECT_EQ(commands, 0);
+  EXPECT_NE(pipeline.summary().find("streams ended as announced 1"), std::string::npos)
+      << pipeline.summary();
 }
 
 TEST(StreamWatchdog, AfterItsOwnStallTheWatchdogBelievesOnlyWhatPersists) {

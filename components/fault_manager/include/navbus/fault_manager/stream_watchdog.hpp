@@ -128,6 +128,10 @@ class StreamWatchdog {
     bool ahead_of_real_time{false};         ///< once seen ahead, for the rest of the run
     WriterParticipant participant{};        ///< of the latest sample
   };
+  /// The sample belongs to a run that ended as announced and was still in flight: not later
+  /// than the stream's end and from the same participant (or one not known), or from a
+  /// participant that announced the end of all its data.
+  bool ofEndedRun(const StreamKey& key, std::uint64_t time_gps_ns, const Source& source) const;
   void notePace(State& s, const Source& source);
   /// The stream's data time has run ahead of the wall clock (kAheadOfRealTimeNs).
   static bool dataTimeAhead(const State& s);
