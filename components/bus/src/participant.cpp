@@ -231,8 +231,7 @@ void Participant::run() {
 }
 
 void Participant::announceDataEnded() {
-  state_managed_ = true;
-  state_ = navbus::STATE_ENDED;
+  state_ = navbus::STATE_ENDED;  // not STARTING: never promoted again
   publishHealth();
 }
 

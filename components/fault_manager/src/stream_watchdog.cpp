@@ -31,6 +31,7 @@ std::optional<WatchdogEvent> StreamWatchdog::onSample(const StreamKey& key,
   s.suspect_deadline_ns = -1;
   s.last_time_gps_ns = time_gps_ns;
   s.last_arrival_wall_ns = wall_now_ns;
+  s.participant = source.participant;
   notePace(s, source);
   return event;
 }
@@ -47,7 +48,6 @@ bool StreamWatchdog::ofEndedRun(const StreamKey& key, std::uint64_t time_gps_ns,
 }
 
 void StreamWatchdog::notePace(State& s, const Source& source) {
-  s.participant = source.participant;
   const bool known = source.participant != WriterParticipant{};
   if (!s.ahead_of_real_time && (source.delivery == Delivery::kBlock || dataTimeAhead(s) ||
                                 (known && paced_participants_.count(source.participant) > 0)))
@@ -159,8 +159,10 @@ bool StreamWatchdog::onEnded(const StreamKey& key, std::uint64_t end_time_gps_ns
   End& ended = ended_at_[key];
   ended.time_gps_ns =
       std::max({ended.time_gps_ns, end_time_gps_ns, known ? it->second.last_time_gps_ns : 0});
-  if (known) ended.participant = it->second.participant;
-  if (known) states_.erase(it);
+  if (known) {
+    ended.participant = it->second.participant;
+    states_.erase(it);
+  }
   return known;
 }
 

@@ -11,6 +11,16 @@ using navbus::fault_manager::StreamWatchdog;
 
 namespace {
 constexpr std::int64_t kMs = 1'000'000;
+using Participant = StreamWatchdog::WriterParticipant;
+/// A sample alone / an element of a block, written by `p`.
+StreamWatchdog::Source single(const Participant& p) {
+  return {StreamWatchdog::Delivery::kSample, p};
+}
+StreamWatchdog::Source inBlock(const Participant& p) {
+  return {StreamWatchdog::Delivery::kBlock, p};
+}
+const navbus::fault_manager::StreamKey kImu1{StreamKind::kImu, 1}, kFix1{StreamKind::kGnssFix, 1},
+    kFix2{StreamKind::kGnssFix, 2};
 }  // namespace
 
 TEST(StreamWatchdog, OneDecisionPerTransition) {
@@ -133,7 +143,7 @@ TEST(StreamWatchdog, AStreamInBlocksIsJudgedByItsWriterOnlyFromItsFirstBlock) {
   const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1};
   for (int i = 0; i < 64; ++i)  // one block of 64 increments at 100 Hz, handed over at 1 s
     EXPECT_FALSE(w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs,
-                            StreamWatchdog::Source{StreamWatchdog::Delivery::kBlock, {}}));
+                            inBlock(Participant{})));
   EXPECT_EQ(w.streamsAheadOfRealTime(), 1u);
   EXPECT_FALSE(w.onDeadlineMissed(imu, 1470 * kMs, 250 * kMs));
   EXPECT_TRUE(w.onTick(3000 * kMs).empty());
@@ -154,20 +164,17 @@ TEST(StreamWatchdog, TheOtherStreamsOfAPacedWritersParticipantAreJudgedByTheirWr
   // participant. The fixes, seen first, look like a real-time stream; once the increments come
   // in blocks, they too wait with the replay, and their silence is no loss. A receiver of
   // another participant stays watched by its deadline.
-  using Source = StreamWatchdog::Source;
-  const StreamWatchdog::WriterParticipant replay{1, 2, 3}, live{4, 5, 6};
+  const Participant replay{1, 2, 3}, live{4, 5, 6};
   StreamWatchdog w;
-  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1}, fix{StreamKind::kGnssFix, 1},
-      other_fix{StreamKind::kGnssFix, 2};
-  EXPECT_FALSE(w.onSample(fix, 0, 1000 * kMs, Source{StreamWatchdog::Delivery::kSample, replay}));
-  EXPECT_FALSE(
-      w.onSample(other_fix, 0, 1000 * kMs, Source{StreamWatchdog::Delivery::kSample, live}));
+  const auto &imu = kImu1, &fix = kFix1, &other_fix = kFix2;
+  EXPECT_FALSE(w.onSample(fix, 0, 1000 * kMs, single(replay)));
+  EXPECT_FALSE(w.onSample(other_fix, 0, 1000 * kMs, single(live)));
   EXPECT_FALSE(w.onDeadlineMissed(fix, 1100 * kMs, 2000 * kMs));  // suspect: 0.1 s of silence
   EXPECT_FALSE(w.onDeadlineMissed(other_fix, 1100 * kMs, 2000 * kMs));
   EXPECT_EQ(w.unconfirmedDeadlines(), 2u);
   for (int i = 0; i < 64; ++i)
-    EXPECT_FALSE(w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs,
-                            Source{StreamWatchdog::Delivery::kBlock, replay}));
+    EXPECT_FALSE(
+        w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs, inBlock(replay)));
   EXPECT_EQ(w.streamsAheadOfRealTime(), 2u);   // the increments, and the fixes with them
   EXPECT_EQ(w.onTick(3500 * kMs).size(), 1u);  // the suspicion of the fixes is dropped...
   EXPECT_FALSE(w.isLost(fix));
@@ -177,7 +184,7 @@ TEST(StreamWatchdog, TheOtherStreamsOfAPacedWritersParticipantAreJudgedByTheirWr
 
   // A later stream of the paced participant is paced from its first sample.
   const navbus::fault_manager::StreamKey star{StreamKind::kStarTracker, 1};
-  EXPECT_FALSE(w.onSample(star, 0, 5000 * kMs, Source{StreamWatchdog::Delivery::kSample, replay}));
+  EXPECT_FALSE(w.onSample(star, 0, 5000 * kMs, single(replay)));
   EXPECT_EQ(w.streamsAheadOfRealTime(), 3u);
   EXPECT_FALSE(w.onDeadlineMissed(star, 8000 * kMs, 2000 * kMs));
   EXPECT_FALSE(w.isLost(star));
@@ -188,18 +195,15 @@ TEST(StreamWatchdog, AParticipantThatAnnouncedTheEndOfItsDataEndsOnlyItsOwnStrea
   // and of its GNSS fixes never reached the best-effort watchdog readers; its health report
   // said ENDED. Its streams end: their writers' leaving is no loss, and its blocks still in
   // flight start no new run. Another participant's receiver is lost when its writers go.
-  using Source = StreamWatchdog::Source;
-  const StreamWatchdog::WriterParticipant sim{1, 2, 3}, other{4, 5, 6};
+  const Participant sim{1, 2, 3}, other{4, 5, 6};
   StreamWatchdog w;
-  const navbus::fault_manager::StreamKey imu{StreamKind::kImu, 1}, fix{StreamKind::kGnssFix, 1},
-      other_fix{StreamKind::kGnssFix, 2};
+  const auto &imu = kImu1, &fix = kFix1, &other_fix = kFix2;
   for (int i = 0; i < 30; ++i)
-    EXPECT_FALSE(w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs,
-                            Source{StreamWatchdog::Delivery::kBlock, sim}));
-  EXPECT_FALSE(w.onSample(fix, 0, 1000 * kMs, Source{StreamWatchdog::Delivery::kSample, sim}));
-  EXPECT_FALSE(
-      w.onSample(other_fix, 0, 1000 * kMs, Source{StreamWatchdog::Delivery::kSample, other}));
-  EXPECT_TRUE(w.onParticipantEnded(StreamWatchdog::WriterParticipant{}).empty());  // not known
+    EXPECT_FALSE(
+        w.onSample(imu, static_cast<std::uint64_t>(i) * 10 * kMs, 1000 * kMs, inBlock(sim)));
+  EXPECT_FALSE(w.onSample(fix, 0, 1000 * kMs, single(sim)));
+  EXPECT_FALSE(w.onSample(other_fix, 0, 1000 * kMs, single(other)));
+  EXPECT_TRUE(w.onParticipantEnded(Participant{}).empty());  // not known
   const auto ended = w.onParticipantEnded(sim);
   ASSERT_EQ(ended.size(), 2u);
   for (const auto& key : ended) {
@@ -207,8 +211,7 @@ TEST(StreamWatchdog, AParticipantThatAnnouncedTheEndOfItsDataEndsOnlyItsOwnStrea
     EXPECT_TRUE(w.onEnded(key, w.lastTime(key)));
   }
   // A block taken after the report, later than the last one taken before it: no new run.
-  EXPECT_FALSE(
-      w.onSample(imu, 300 * kMs, 1100 * kMs, Source{StreamWatchdog::Delivery::kBlock, sim}));
+  EXPECT_FALSE(w.onSample(imu, 300 * kMs, 1100 * kMs, inBlock(sim)));
   EXPECT_EQ(w.lastTime(imu), 0u);
   EXPECT_TRUE(w.onWritersGone(StreamKind::kImu, 1500 * kMs).empty());
   const auto gone = w.onWritersGone(StreamKind::kGnssFix, 1500 * kMs);
@@ -216,7 +219,7 @@ TEST(StreamWatchdog, AParticipantThatAnnouncedTheEndOfItsDataEndsOnlyItsOwnStrea
   EXPECT_EQ(gone[0].key.sensor_id, 2u);
   EXPECT_TRUE(gone[0].lost);
   // The sensor's next run comes from a new participant: watched again.
-  EXPECT_FALSE(w.onSample(imu, 0, 2000 * kMs, Source{StreamWatchdog::Delivery::kBlock, other}));
+  EXPECT_FALSE(w.onSample(imu, 0, 2000 * kMs, inBlock(other)));
   EXPECT_EQ(w.onWritersGone(StreamKind::kImu, 2500 * kMs).size(), 1u);
 }
 
@@ -231,8 +234,8 @@ TEST(FaultPipelineStreams, AWritersAnnouncedEndIsNoLossAndItsBlocksStillInFlight
       navbus::fault_manager::FaultManagerConfig{}, health,
       {[&](const navbus::FaultDecision& d) { decisions.push_back(d); },
        [&](const navbus::FilterCommand&) { ++commands; }});
-  const StreamWatchdog::WriterParticipant sim{7, 8, 9};
-  const StreamWatchdog::Source block{StreamWatchdog::Delivery::kBlock, sim};
+  const Participant sim{7, 8, 9};
+  const StreamWatchdog::Source block = inBlock(sim);
   for (std::uint64_t seq = 1; seq <= 30; ++seq)
     pipeline.onStreamSample(StreamKind::kImu, 1, seq, seq * 10 * kMs, 1000 * kMs, block);
   EXPECT_EQ(pipeline.onWriterParticipantEnded(sim).size(), 1u);
